@@ -1,0 +1,1 @@
+// Reference DEM world (in progress).

@@ -1,0 +1,118 @@
+// Closed-form collect-and-collide models of a particle damper (PHYSICS.md §2-4).
+//
+// One ideal model serves both regimes: the bed moves as one block that leaves a wall
+// at maximum container velocity, travels relative to the container, and hits the
+// opposite wall fully inelastically. A bed of spheres rolling on the base (inertia
+// I = κ m r²) moves relative to the container with 1/(1+κ) of the free-flight
+// relative acceleration, so it is the free block with clearance (1+κ)h and with all
+// its relative kinetic energy (translation and spin, factor 1+κ) lost per impact:
+//   bouncing: κ = 0;   rolling solid spheres: κ = 2/5.
+// Derivations: docs/collect_and_collide.md.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pdamp::formulas {
+
+/// Standard gravity g, m/s^2 (intensity Γ = XΩ²/g).
+inline constexpr double kStandardGravity = 9.80665;
+inline constexpr double kPi = 3.14159265358979323846;
+
+enum class DamperModel { kRolling, kBouncing, kScattered, kAuto };
+std::string_view to_string(DamperModel model);
+/// "rolling", "bouncing", "scattered", "auto"; std::nullopt for anything else.
+std::optional<DamperModel> damper_model_from_string(std::string_view name);
+
+/// Which orbit the ideal model is on at a given stroke.
+enum class MotionRegime {
+  kCollectAndCollide,  ///< X >= X_opt_ideal: impact at φ* <= π, bed rides with the wall
+  kSubPeak,            ///< X_onset <= X < X_opt_ideal: symmetric orbit, impact at π + ψ
+  kScattered,          ///< X < X_onset: no synchronous orbit, empirical fit (§4)
+};
+std::string_view to_string(MotionRegime regime);
+
+/// Empirical scattered-state law (PHYSICS.md §4) in s = X/X_onset < 1:
+///   η*(s) = jump_fraction · η*_onset · s^exponent
+/// where η*_onset is the ideal orbit's value at the onset of the model in use, so
+/// jump_fraction < 1 is the height of the jump into the collect-and-collide state.
+struct ScatteredFit {
+  double jump_fraction = 0.5;  ///< η*(s→1⁻)/η*_onset, dimensionless, in [0, 1]
+  double exponent = 2.0;       ///< power of s, dimensionless, in [0, 10]
+  double s_min = 0.0;          ///< lowest s the fit was made on (validity), [0, 1)
+  /// Defaults are provisional until fitted to DEM points (effective-field issue).
+  bool provisional = true;
+  std::string source = "provisional default";
+  std::vector<std::string> validate() const;
+};
+
+/// Model constants with their defaults; all dimensionless.
+struct ModelOptions {
+  /// κ = I/(m r²) of the rolling spheres: 2/5 solid, 2/3 thin-walled hollow; (0, 1].
+  double rolling_inertia_factor = 0.4;
+  /// c in x_opt_m = c·x_opt_ideal_m for rolling: 0.8976 puts the design stroke at
+  /// 0.4 h_roll as in the source study's experiments and DEM; (0, 2].
+  double rolling_calibration = 0.8976;
+  /// c for bouncing: the ideal optimum h/π is the design value; (0, 2].
+  double bouncing_calibration = 1.0;
+  ScatteredFit scattered;
+  /// The ideal models assume no gravity along the drive; true adds a warning.
+  bool gravity_along_drive = false;
+  std::vector<std::string> validate() const;
+};
+
+/// Ideal orbit of a block of inertia factor κ (0 bouncing, 2/5 rolling) at stroke X.
+struct IdealOrbit {
+  MotionRegime regime = MotionRegime::kScattered;
+  double eta_star = 0.0;          ///< reduced loss factor, NaN when scattered
+  double impact_phase_rad = 0.0;  ///< φ* from detachment (kSubPeak: π + ψ); NaN when scattered
+};
+/// φ* in (0, π] solving φ − sin φ = r, r = h_eff/X in [0, π] (PHYSICS.md §2); robust
+/// for r → 0 (series start) and r → π; throws std::domain_error outside [0, π].
+double impact_phase(double clearance_over_stroke);
+IdealOrbit ideal_orbit(double inertia_factor, double clearance_m, double stroke_m);
+
+/// Landmarks of a model over stroke for one clearance.
+struct OptimumStroke {
+  DamperModel model = DamperModel::kRolling;
+  double clearance_m = 0.0;
+  double x_opt_m = 0.0;        ///< design stroke c·x_opt_ideal_m
+  double x_opt_ideal_m = 0.0;  ///< ideal peak (1+κ)h/π
+  double x_onset_m = 0.0;      ///< lowest stroke of the orbit (1+κ)h/√(π²+4)
+  double eta_star_peak = 0.0;  ///< 4/(π(1+κ))
+  double eta_star_onset = 0.0; ///< 4π/((π²+4)(1+κ))
+  double calibration_factor = 1.0;
+};
+/// model must be kRolling or kBouncing (std::invalid_argument otherwise);
+/// clearance_m > 0 (std::invalid_argument otherwise).
+OptimumStroke optimum_stroke(DamperModel model, double clearance_m, const ModelOptions& options = {});
+/// Inverse of optimum_stroke: h with x_opt_m(h) = stroke_m (> 0).
+double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptions& options = {});
+
+/// Closed-form reduced loss factor at one operating point.
+struct LossResult {
+  DamperModel model_requested = DamperModel::kAuto;
+  DamperModel model_used = DamperModel::kRolling;  ///< rolling or bouncing family
+  MotionRegime regime = MotionRegime::kScattered;
+  double eta_star = 0.0;          ///< reduced loss factor η*, dimensionless
+  double intensity = 0.0;         ///< Γ = XΩ²/g
+  double velocity_amplitude_m_s = 0.0;  ///< |V*| = XΩ
+  double impact_phase_rad = 0.0;  ///< NaN in the scattered state
+  double stroke_over_onset = 0.0; ///< s = X/X_onset
+  std::vector<std::string> warnings;  ///< validity-range violations (INTERFACE.md)
+};
+/// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0). kAuto: Γ < 1 rolling,
+/// else bouncing; below the onset every model gives the scattered fit (kRolling and
+/// kBouncing with a warning, since their orbit does not exist there). kScattered:
+/// the fit regardless of s (family chosen by Γ as in kAuto).
+LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
+                               double frequency_hz, const ModelOptions& options = {});
+
+/// Energy measures from η* (PHYSICS.md §1): E_diss = η*·½ m_bed |V*|², J.
+double dissipated_energy_measure(double eta_star, double bed_mass_kg, double velocity_amplitude_m_s);
+/// Energy dissipated per cycle, 2π·E_diss, J.
+double energy_per_cycle(double e_diss_j);
+
+}  // namespace pdamp::formulas

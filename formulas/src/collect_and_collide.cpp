@@ -1,0 +1,2 @@
+// collect_and_collide: implementation pending (helper in progress).
+#include "pdamp/formulas/collect_and_collide.hpp"

@@ -1,0 +1,2 @@
+// complex_power: implementation pending (helper in progress).
+#include "pdamp/formulas/complex_power.hpp"

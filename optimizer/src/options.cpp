@@ -1,0 +1,2 @@
+// Options of the optimiser module.
+#include "pdamp/optimizer/options.hpp"

@@ -1,0 +1,2 @@
+// Tests of complex_power (in progress).
+#include <catch2/catch.hpp>

@@ -1,0 +1,2 @@
+// Tests of cor_models (in progress).
+#include <catch2/catch.hpp>

@@ -1,0 +1,2 @@
+// Tests of hertz_impact (in progress).
+#include <catch2/catch.hpp>
