@@ -1,0 +1,3 @@
+// DEM benchmarks (in progress).
+#include <benchmark/benchmark.h>
+BENCHMARK_MAIN();

@@ -1,0 +1,3 @@
+// Formula benchmarks (in progress).
+#include <benchmark/benchmark.h>
+BENCHMARK_MAIN();

@@ -1,0 +1,2 @@
+// Command-line tests (in progress).
+#include <catch2/catch.hpp>
