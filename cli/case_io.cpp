@@ -1,1 +1,369 @@
-// case_io (in progress)
+// Case files: strict JSON reading (unknown keys, types, ranges) into option structs.
+#include "case_io.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "errors.hpp"
+
+namespace pdamp::cli {
+
+using nlohmann::json;
+namespace fm = formulas;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Allowed interval of a number, with its text for messages.
+struct Range {
+  double min = -kInf;
+  double max = kInf;
+  bool min_exclusive = false;
+  bool contains(double v) const { return std::isfinite(v) && (min_exclusive ? v > min : v >= min) && v <= max; }
+  std::string text() const {
+    std::ostringstream out;
+    out << "must be a finite number";
+    if (std::isfinite(min)) out << (min_exclusive ? " > " : " >= ") << min;
+    if (std::isfinite(max)) out << (std::isfinite(min) ? " and" : "") << " <= " << max;
+    return out.str();
+  }
+};
+constexpr Range kPositive{0.0, kInf, true};
+const json kEmptyObject = json::object();  // stands in for an omitted section
+
+std::string type_name(const json& value) { return value.type_name(); }
+
+/// Reads one JSON object: every read key is recorded with its resolved value, and
+/// finish() rejects the keys nobody read, naming the allowed ones.
+class ObjectReader {
+ public:
+  ObjectReader(const std::string& file, const json& object, std::string pointer, json& resolved)
+      : file_(file), object_(object), pointer_(std::move(pointer)), resolved_(resolved) {
+    if (!object_.is_object()) fail("", "must be a JSON object, got " + type_name(object_));
+    resolved_ = json::object();
+  }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(file_, pointer_ + (key.empty() ? "" : "/" + key), what);
+  }
+  bool has(const std::string& key) const { return object_.contains(key); }
+  bool is_string(const std::string& key) const { return has(key) && object_.at(key).is_string(); }
+
+  double number(const std::string& key, std::optional<double> fallback, Range range, const std::string& unit = "") {
+    known_.insert(key);
+    double value = 0.0;
+    if (!object_.contains(key)) {
+      if (!fallback) fail(key, "required (" + range.text() + unit + ")");
+      value = *fallback;
+    } else {
+      const json& item = object_.at(key);
+      if (!item.is_number()) fail(key, "must be a number" + unit + ", got " + type_name(item));
+      value = item.get<double>();
+    }
+    if (!range.contains(value)) {
+      std::ostringstream out;
+      out << "= " << value << ": " << range.text() << unit;
+      fail(key, out.str());
+    }
+    resolved_[key] = value;
+    return value;
+  }
+  std::optional<double> optional_number(const std::string& key, Range range, const std::string& unit = "") {
+    if (!object_.contains(key) || object_.at(key).is_null()) {
+      known_.insert(key);
+      return std::nullopt;
+    }
+    return number(key, std::nullopt, range, unit);
+  }
+  int integer(const std::string& key, std::optional<int> fallback, int min, int max) {
+    known_.insert(key);
+    int value = 0;
+    if (!object_.contains(key)) {
+      if (!fallback) fail(key, "required (an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "])");
+      value = *fallback;
+    } else {
+      const json& item = object_.at(key);
+      if (!item.is_number_integer()) fail(key, "must be an integer, got " + type_name(item));
+      const auto wide = item.get<long long>();
+      if (wide < min || wide > max)
+        fail(key, "= " + std::to_string(wide) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+      value = static_cast<int>(wide);
+    }
+    resolved_[key] = value;
+    return value;
+  }
+  std::string text(const std::string& key, std::optional<std::string> fallback,
+                   const std::vector<std::string>& allowed = {}) {
+    known_.insert(key);
+    std::string value;
+    if (!object_.contains(key)) {
+      if (!fallback) fail(key, "required" + allowed_text(allowed));
+      value = *fallback;
+    } else {
+      const json& item = object_.at(key);
+      if (!item.is_string()) fail(key, "must be a string, got " + type_name(item));
+      value = item.get<std::string>();
+    }
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), value) == allowed.end())
+      fail(key, "'" + value + "' is not allowed" + allowed_text(allowed));
+    resolved_[key] = value;
+    return value;
+  }
+  std::array<double, 3> vector3(const std::string& key, std::optional<std::array<double, 3>> fallback, Range range,
+                                const std::string& unit) {
+    known_.insert(key);
+    std::array<double, 3> value{};
+    if (!object_.contains(key)) {
+      if (!fallback) fail(key, "required (3 numbers" + unit + ")");
+      value = *fallback;
+    } else {
+      const json& item = object_.at(key);
+      if (!item.is_array() || item.size() != 3) fail(key, "must be an array of 3 numbers" + unit);
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (!item[i].is_number()) fail(key + "/" + std::to_string(i), "must be a number" + unit);
+        value[i] = item[i].get<double>();
+        if (!range.contains(value[i])) {
+          std::ostringstream out;
+          out << "= " << value[i] << ": " << range.text() << unit;
+          fail(key + "/" + std::to_string(i), out.str());
+        }
+      }
+    }
+    resolved_[key] = value;
+    return value;
+  }
+  /// A nested object; the callback reads it with its own reader.
+  template <typename Fn>
+  void object(const std::string& key, bool required, Fn&& read) {
+    known_.insert(key);
+    if (!object_.contains(key)) {
+      if (required) fail(key, "required (a JSON object)");
+      return;
+    }
+    ObjectReader child(file_, object_.at(key), pointer_ + "/" + key, resolved_[key]);
+    read(child);
+    child.finish();
+  }
+  void finish() const {
+    for (const auto& [key, value] : object_.items()) {
+      (void)value;
+      if (!known_.count(key)) {
+        std::string allowed;
+        for (const auto& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
+        fail(key, "unknown key (allowed here: " + allowed + ")");
+      }
+    }
+  }
+  json& resolved() { return resolved_; }
+  const std::string& file() const { return file_; }
+  const std::string& pointer() const { return pointer_; }
+
+ private:
+  static std::string allowed_text(const std::vector<std::string>& allowed) {
+    if (allowed.empty()) return "";
+    std::string out = " (one of:";
+    for (const auto& a : allowed) out += " " + a;
+    return out + ")";
+  }
+
+  const std::string& file_;
+  const json& object_;
+  std::string pointer_;
+  json& resolved_;
+  std::set<std::string> known_;
+};
+
+int axis_index(const std::string& name) { return name == "x" ? 0 : name == "y" ? 1 : 2; }
+
+fm::Material read_material(ObjectReader& r, const fm::Material& defaults) {
+  fm::Material m;
+  m.density_kg_m3 = r.number("density_kg_m3", defaults.density_kg_m3, kPositive, " kg/m^3");
+  m.youngs_modulus_pa = r.number("youngs_modulus_pa", defaults.youngs_modulus_pa, kPositive, " Pa");
+  m.poisson_ratio = r.number("poisson_ratio", defaults.poisson_ratio, {0.0, 0.4999}, "");
+  return m;
+}
+
+void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
+  const fm::ModelOptions defaults;
+  options.rolling_inertia_factor = r.number("rolling_inertia_factor", defaults.rolling_inertia_factor, {0.0, 1.0, true});
+  options.rolling_calibration = r.number("rolling_calibration", defaults.rolling_calibration, {0.0, 2.0, true});
+  options.bouncing_calibration = r.number("bouncing_calibration", defaults.bouncing_calibration, {0.0, 2.0, true});
+  r.object("scattered", false, [&](ObjectReader& s) {
+    options.scattered.jump_fraction = s.number("jump_fraction", defaults.scattered.jump_fraction, {0.0, 1.0});
+    options.scattered.exponent = s.number("exponent", defaults.scattered.exponent, {0.0, 10.0});
+    options.scattered.s_min = s.number("s_min", defaults.scattered.s_min, {0.0, 0.999});
+    options.scattered.source = s.text("source", std::string("case file"));
+    options.scattered.provisional = false;
+  });
+  if (!r.has("scattered")) {
+    auto& s = r.resolved()["scattered"];
+    s["jump_fraction"] = defaults.scattered.jump_fraction;
+    s["exponent"] = defaults.scattered.exponent;
+    s["s_min"] = defaults.scattered.s_min;
+    s["source"] = defaults.scattered.source;
+  }
+}
+
+void read_damper(ObjectReader& r, Case& c) {
+  DamperSpec& d = c.damper;
+  const std::string model = r.text("model", std::string("auto"), {"rolling", "bouncing", "auto"});
+  d.model = *fm::damper_model_from_string(model);
+  r.object("container", true, [&](ObjectReader& k) {
+    const std::string shape = k.text("shape", std::nullopt, {"box", "cylinder"});
+    if (shape == "box") {
+      d.container.shape = fm::ContainerShape::kBox;
+      d.container.box_inner_size_m = k.vector3("inner_size_m", std::nullopt, kPositive, " m");
+    } else {
+      d.container.shape = fm::ContainerShape::kCylinder;
+      d.container.cylinder_inner_radius_m = k.number("inner_radius_m", std::nullopt, kPositive, " m");
+      d.container.cylinder_inner_length_m = k.number("inner_length_m", std::nullopt, kPositive, " m");
+      d.container.cylinder_axis = axis_index(k.text("axis", std::string("x"), {"x", "y", "z"}));
+    }
+  });
+  d.drive_axis = axis_index(r.text("drive_axis", std::string("x"), {"x", "y", "z"}));
+  d.gravity_m_s2 = r.vector3("gravity_m_s2", fm::Vec3{0.0, 0.0, -fm::kStandardGravity}, {-1e3, 1e3}, " m/s^2");
+  r.object("particles", true, [&](ObjectReader& p) {
+    d.particle_count = p.integer("count", std::nullopt, 1, 10'000'000);
+    d.particle_radius_m = p.number("radius_m", std::nullopt, kPositive, " m");
+    d.particle_material = p.text("material", std::string("steel"));
+    d.packing.collect_side = p.text("collect_side", std::string("negative"), {"negative", "positive"}) == "negative" ? -1 : 1;
+    if (p.has("lattice") && !p.is_string("lattice")) {
+      const auto counts = p.vector3("lattice", std::nullopt, {1.0, 1e6}, "");
+      std::array<int, 3> n{};
+      for (int i = 0; i < 3; ++i) {
+        if (counts[i] != std::floor(counts[i])) p.fail("lattice/" + std::to_string(i), "must be a whole number >= 1");
+        n[i] = static_cast<int>(counts[i]);
+      }
+      d.packing.lattice_counts = n;
+    } else {
+      p.text("lattice", std::string("auto"), {"auto"});
+    }
+  });
+  d.packing.drive_axis = d.drive_axis;
+  // The bed rests on the wall gravity points to (the dominant component).
+  int g_axis = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(d.gravity_m_s2[i]) > std::abs(d.gravity_m_s2[g_axis])) g_axis = i;
+  const double g_norm = std::hypot(d.gravity_m_s2[0], d.gravity_m_s2[1], d.gravity_m_s2[2]);
+  if (g_norm > 0.0) d.packing.gravity_axis_sign = std::make_pair(g_axis, d.gravity_m_s2[g_axis] < 0.0 ? -1 : 1);
+  r.object("model_options", false, [&](ObjectReader& m) { read_model_options(m, d.model_options); });
+  if (!r.has("model_options")) {
+    ObjectReader defaults(r.file(), kEmptyObject, r.pointer() + "/model_options", r.resolved()["model_options"]);
+    read_model_options(defaults, d.model_options);
+  }
+  // Gravity along the drive breaks the closed forms' assumption (PHYSICS.md §2).
+  d.model_options.gravity_along_drive = g_norm > 0.0 && std::abs(d.gravity_m_s2[d.drive_axis]) > 0.01 * g_norm;
+
+  for (const auto& line : d.container.validate("damper/container")) r.fail("container", line);
+  if (!c.materials.count(d.particle_material))
+    r.fail("particles/material", "'" + d.particle_material + "' is not defined in /materials (nor built in)");
+  try {
+    d.bed = fm::collected_lattice(d.container, d.particle_count, d.particle_radius_m, d.packing);
+  } catch (const std::invalid_argument& e) {
+    r.fail("particles", e.what());
+  }
+  const auto explicit_clearance = r.optional_number("clearance_m", kPositive, " m");
+  d.clearance_m = explicit_clearance.value_or(d.bed.clearance_m);
+  const double volume = 4.0 / 3.0 * fm::kPi * std::pow(d.particle_radius_m, 3);
+  d.bed_mass_kg = d.particle_count * volume * c.materials.at(d.particle_material).density_kg_m3;
+  auto& derived = r.resolved()["derived"];
+  derived["bed_clearance_m"] = d.bed.clearance_m;
+  derived["bed_extent_m"] = d.bed.bed_extent_m;
+  derived["bed_slabs"] = d.bed.slabs;
+  derived["clearance_m"] = d.clearance_m;
+  derived["bed_mass_kg"] = d.bed_mass_kg;
+}
+
+}  // namespace
+
+std::string_view to_string(Task task) {
+  switch (task) {
+    case Task::kDamperDesign: return "damper_design";
+  }
+  return "unknown";
+}
+
+Case load_case(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", "cannot open the case file");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const auto pos = what.find("] ");
+    throw InputError(path, "", "malformed JSON: " + (pos == std::string::npos ? what : what.substr(pos + 2)));
+  }
+  Case c;
+  c.path = path;
+  ObjectReader r(path, root, "", c.resolved);
+  r.integer("format_version", 1, 1, 1);
+  c.name = r.text("name", std::nullopt);
+  c.description = r.text("description", std::string());
+  r.text("task", std::string("damper_design"), {"damper_design"});
+  c.task = Task::kDamperDesign;
+
+  c.materials["steel"] = fm::Material{};
+  r.object("materials", false, [&](ObjectReader& m) {
+    for (const auto& [name, value] : root.at("materials").items()) {
+      (void)value;
+      const fm::Material defaults = c.materials.count(name) ? c.materials.at(name) : fm::Material{};
+      m.object(name, true, [&](ObjectReader& one) { c.materials[name] = read_material(one, defaults); });
+    }
+  });
+  for (const auto& [name, material] : c.materials) {
+    auto& out = c.resolved["materials"][name];
+    out["density_kg_m3"] = material.density_kg_m3;
+    out["youngs_modulus_pa"] = material.youngs_modulus_pa;
+    out["poisson_ratio"] = material.poisson_ratio;
+  }
+
+  r.object("damper", true, [&](ObjectReader& d) { read_damper(d, c); });
+  r.object("excitation", true, [&](ObjectReader& e) {
+    c.excitation.frequency_hz = e.number("frequency_hz", std::nullopt, kPositive, " Hz");
+    c.excitation.amplitude_m = e.optional_number("amplitude_m", kPositive, " m");
+  });
+  const auto read_design = [&](ObjectReader& d) {
+    c.design.target_stroke_m = d.optional_number("target_stroke_m", kPositive, " m");
+    c.design.sweep_min_over_clearance = d.number("sweep_min_over_clearance", 0.05, kPositive);
+    c.design.sweep_max_over_clearance = d.number("sweep_max_over_clearance", 1.5, kPositive);
+    c.design.sweep_points = d.integer("sweep_points", 301, 2, 100000);
+    if (c.design.sweep_max_over_clearance <= c.design.sweep_min_over_clearance)
+      d.fail("sweep_max_over_clearance", "must be > sweep_min_over_clearance");
+  };
+  r.object("design", false, read_design);
+  if (!root.contains("design")) {
+    ObjectReader defaults(path, kEmptyObject, "/design", c.resolved["design"]);
+    read_design(defaults);
+  }
+  r.object("buffer", false, [&](ObjectReader& b) {
+    BufferSpec spec;
+    spec.layer_material = b.text("layer_material", std::nullopt);
+    if (!c.materials.count(spec.layer_material))
+      b.fail("layer_material", "'" + spec.layer_material + "' is not defined in /materials");
+    auto& in = spec.input;
+    in.frequency_hz = b.number("design_frequency_hz", std::nullopt, kPositive, " Hz");
+    const auto amplitude = b.optional_number("design_amplitude_m", kPositive, " m");
+    const auto intensity = b.optional_number("design_intensity", kPositive, "");
+    if (amplitude.has_value() == intensity.has_value())
+      b.fail("design_amplitude_m", "give exactly one of design_amplitude_m and design_intensity");
+    in.amplitude_m = amplitude.value_or(0.0);
+    in.intensity = intensity.value_or(0.0);
+    in.particles_per_contact = b.number("particles_per_contact", 1.0, {1.0, 1e9});
+    in.impact_velocity_m_s = b.optional_number("impact_velocity_m_s", kPositive, " m/s").value_or(0.0);
+    in.particle_radius_m = c.damper.particle_radius_m;
+    in.particle = c.materials.at(c.damper.particle_material);
+    in.layer = c.materials.at(spec.layer_material);
+    for (const auto& line : in.validate()) b.fail("", line);
+    c.buffer = spec;
+  });
+  r.finish();
+  return c;
+}
+
+}  // namespace pdamp::cli

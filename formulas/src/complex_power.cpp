@@ -1,2 +1,213 @@
-// complex_power: implementation pending (helper in progress).
+// Complex power P = ½F*·conj(V*) from sampled force and velocity via an FFTW r2c transform.
 #include "pdamp/formulas/complex_power.hpp"
+
+#include <fftw3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <mutex>
+#include <new>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace pdamp::formulas {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+/// Relative tolerance on T/dt being an integer (the DEM picks dt = T/n exactly, so
+/// only round-off of 1/(f·dt) is expected).
+constexpr double kWindowTolerance = 1e-9;
+/// |V*| below this fraction of max|v| counts as "no component at Ω": the velocity bin
+/// is then round-off of the other components and m_app, η* would be noise.
+constexpr double kZeroVelocityFraction = 1e-12;
+
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(12);
+  out << value;
+  return out.str();
+}
+
+[[noreturn]] void reject(const std::string& what) {
+  throw std::invalid_argument("complex_power: " + what);
+}
+
+/// FFTW plans cached per length. FFTW's planner is not thread-safe, so plan creation
+/// (and destruction) is serialised here; fftw_execute_dft_r2c on other arrays of the
+/// same alignment is thread-safe, so callers execute without the lock. Plans are made
+/// with FFTW_ESTIMATE: cheap to create, and they leave the planning arrays untouched.
+class PlanCache {
+ public:
+  PlanCache() = default;
+  PlanCache(const PlanCache&) = delete;
+  PlanCache& operator=(const PlanCache&) = delete;
+  ~PlanCache() {
+    for (auto& entry : plans_) fftw_destroy_plan(entry.second);
+  }
+
+  fftw_plan plan_for(int n) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (const auto found = plans_.find(n); found != plans_.end()) return found->second;
+    // The arrays only fix the plan's alignment and out-of-place layout: fftw_malloc
+    // gives the same SIMD alignment as the per-thread workspaces used at execution.
+    auto* in = static_cast<double*>(fftw_malloc(sizeof(double) * static_cast<std::size_t>(n)));
+    auto* out = static_cast<fftw_complex*>(
+        fftw_malloc(sizeof(fftw_complex) * (static_cast<std::size_t>(n) / 2 + 1)));
+    fftw_plan plan = (in && out) ? fftw_plan_dft_r2c_1d(n, in, out, FFTW_ESTIMATE) : nullptr;
+    fftw_free(in);
+    fftw_free(out);
+    if (!plan) throw std::runtime_error("complex_power: FFTW could not plan a transform of length " +
+                                        std::to_string(n));
+    plans_.emplace(n, plan);
+    return plan;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::unordered_map<int, fftw_plan> plans_;
+};
+
+PlanCache& plan_cache() {
+  static PlanCache cache;
+  return cache;
+}
+
+/// Per-thread input/output arrays (fftw_malloc-aligned), grown on demand and reused, so
+/// repeated calls of one length allocate nothing.
+class Workspace {
+ public:
+  Workspace() = default;
+  Workspace(const Workspace&) = delete;
+  Workspace& operator=(const Workspace&) = delete;
+  ~Workspace() {
+    fftw_free(in_);
+    fftw_free(out_);
+  }
+
+  void reserve(std::size_t n) {
+    if (n <= capacity_) return;
+    fftw_free(in_);
+    fftw_free(out_);
+    capacity_ = 0;
+    in_ = static_cast<double*>(fftw_malloc(sizeof(double) * n));
+    out_ = static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * (n / 2 + 1)));
+    if (!in_ || !out_) throw std::bad_alloc();
+    capacity_ = n;
+  }
+  double* in() { return in_; }
+  fftw_complex* out() { return out_; }
+
+ private:
+  double* in_ = nullptr;
+  fftw_complex* out_ = nullptr;
+  std::size_t capacity_ = 0;
+};
+
+struct BinAmplitude {
+  std::complex<double> amplitude;  ///< (2/N)·X[bin]
+  double max_abs = 0.0;            ///< max|sₙ|
+};
+
+/// Copies `signal` into the workspace (rejecting non-finite samples) and transforms it.
+BinAmplitude amplitude_at(std::span<const double> signal, const char* name, int bin, fftw_plan plan,
+                          Workspace& workspace) {
+  double* in = workspace.in();
+  double max_abs = 0.0;
+  for (std::size_t i = 0; i < signal.size(); ++i) {
+    const double value = signal[i];
+    if (!std::isfinite(value)) {
+      reject(std::string(name) + "[" + std::to_string(i) + "] = " + number(value) +
+             ": samples must be finite");
+    }
+    in[i] = value;
+    max_abs = std::max(max_abs, std::abs(value));
+  }
+  fftw_execute_dft_r2c(plan, in, workspace.out());
+  const fftw_complex& x = workspace.out()[bin];
+  const double scale = 2.0 / static_cast<double>(signal.size());
+  return {{scale * x[0], scale * x[1]}, max_abs};
+}
+
+}  // namespace
+
+double ComplexPower::reduced_loss_factor(double bed_mass_kg) const {
+  if (!(bed_mass_kg > 0.0) || !std::isfinite(bed_mass_kg)) {
+    throw std::invalid_argument("reduced_loss_factor: bed_mass_kg = " + number(bed_mass_kg) +
+                                ": must be > 0 and finite");
+  }
+  return e_diss_j / (0.5 * bed_mass_kg * std::norm(velocity_amplitude));
+}
+
+ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s,
+                           double dt_s, double frequency_hz) {
+  if (force_n.empty() || velocity_m_s.empty()) {
+    reject("force has " + std::to_string(force_n.size()) + " samples, velocity " +
+           std::to_string(velocity_m_s.size()) + ": both must be non-empty");
+  }
+  if (force_n.size() != velocity_m_s.size()) {
+    reject("force has " + std::to_string(force_n.size()) + " samples, velocity " +
+           std::to_string(velocity_m_s.size()) + ": lengths must be equal");
+  }
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) reject("dt_s = " + number(dt_s) + ": must be > 0 and finite");
+  if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
+    reject("frequency_hz = " + number(frequency_hz) + ": must be > 0 and finite");
+  }
+  if (force_n.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+    reject("N = " + std::to_string(force_n.size()) + " samples: at most " +
+           std::to_string(std::numeric_limits<int>::max()) + " (FFTW's int length)");
+  }
+  const int n = static_cast<int>(force_n.size());
+
+  const double period_over_dt = 1.0 / (frequency_hz * dt_s);
+  const double nearest = std::round(period_over_dt);
+  if (std::abs(period_over_dt - nearest) > kWindowTolerance * period_over_dt) {
+    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) + ": T/dt = " +
+           number(period_over_dt) + " must be an integer (within 1e-9 relative)");
+  }
+  // Below 3 samples per period Ω sits at or above Nyquist, where (2/N)·X[k] is not
+  // the amplitude.
+  if (nearest < 3.0) {
+    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) + ": T/dt = " +
+           number(nearest) + " samples per period, must be >= 3");
+  }
+  if (nearest > static_cast<double>(n) || n % static_cast<int>(nearest) != 0) {
+    reject("N = " + std::to_string(n) + " samples, T/dt = " + number(nearest) +
+           ": N must be a positive multiple of T/dt (a whole number of periods)");
+  }
+  const int samples_per_period = static_cast<int>(nearest);
+  const int periods = n / samples_per_period;
+
+  const fftw_plan plan = plan_cache().plan_for(n);
+  thread_local Workspace workspace;
+  workspace.reserve(static_cast<std::size_t>(n));
+
+  ComplexPower result;
+  result.force_amplitude = amplitude_at(force_n, "force_n", periods, plan, workspace).amplitude;
+  const BinAmplitude velocity = amplitude_at(velocity_m_s, "velocity_m_s", periods, plan, workspace);
+  result.velocity_amplitude = velocity.amplitude;
+  const double max_velocity = velocity.max_abs;
+
+  const double v_norm = std::norm(result.velocity_amplitude);
+  if (!(std::sqrt(v_norm) > kZeroVelocityFraction * max_velocity)) {
+    reject("|V*| = " + number(std::sqrt(v_norm)) + " m/s with max|v| = " + number(max_velocity) +
+           " m/s: the velocity has no component at the drive frequency " + number(frequency_hz) +
+           " Hz, so m_app and eta* are undefined");
+  }
+
+  const double omega = kTwoPi * frequency_hz;
+  const std::complex<double> f_conj_v = result.force_amplitude * std::conj(result.velocity_amplitude);
+  result.power = 0.5 * f_conj_v;
+  result.angular_frequency = omega;
+  result.e_diss_j = result.power.real() / omega;
+  result.energy_per_cycle_j = kTwoPi * result.e_diss_j;
+  result.apparent_mass_kg = f_conj_v.imag() / (omega * v_norm);
+  result.periods = periods;
+  result.samples_per_period = samples_per_period;
+  return result;
+}
+
+}  // namespace pdamp::formulas

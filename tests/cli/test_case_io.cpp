@@ -1,2 +1,180 @@
-// Command-line tests (in progress).
+// Command-line contract (INTERFACE.md): exit codes, one-line errors naming file,
+// key and range, --json keys, atomic -o output. Runs the built pdamp binary.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <functional>
+#include <iterator>
+#include <array>
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+/// Runs `pdamp <args>`, capturing stdout and stderr.
+RunResult run_pdamp(const std::string& args) {
+  const fs::path err_file = fs::temp_directory_path() / ("pdamp_test_err_" + std::to_string(::getpid()));
+  const std::string command = std::string(PDAMP_BINARY) + " " + args + " 2>" + err_file.string();
+  RunResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.out += buffer.data();
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err_file);
+  result.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  fs::remove(err_file);
+  return result;
+}
+
+std::string case_path(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/cases/" + name; }
+
+/// Writes a case built from the shipped low-intensity case with one edit applied.
+std::string edited_case(const std::string& name, const std::function<void(json&)>& edit) {
+  std::ifstream in(case_path("low_intensity_36_spheres.json"));
+  json c = json::parse(in);
+  edit(c);
+  const fs::path path = fs::temp_directory_path() / name;
+  std::ofstream(path) << c.dump(2);
+  return path.string();
+}
+
+void require_one_line_error(const RunResult& r, const std::string& must_contain) {
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.empty());
+  CHECK(r.err.rfind("pdamp: error: ", 0) == 0);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK_THAT(r.err, Catch::Contains(must_contain));
+}
+
+}  // namespace
+
+TEST_CASE("shipped cases validate and report the collected bed's clearance", "[cli]") {
+  const auto r = run_pdamp("validate " + case_path("low_intensity_36_spheres.json"));
+  REQUIRE(r.exit_code == 0);
+  const json resolved = json::parse(r.out);
+  // 160 mm inner length minus 6 slabs of 10 mm spheres (PHYSICS.md, clearance of a real bed).
+  CHECK(resolved["damper"]["derived"]["clearance_m"].get<double>() == Approx(0.100).margin(1e-12));
+  // 36 steel spheres of 5 mm radius: 36 * 4/3 pi r^3 * 7850 kg/m^3.
+  CHECK(resolved["damper"]["derived"]["bed_mass_kg"].get<double>() ==
+        Approx(36 * 4.0 / 3.0 * kPi * 1.25e-7 * 7850.0).epsilon(1e-12));
+  CHECK(resolved["damper"]["model_options"]["rolling_calibration"].get<double>() == Approx(0.8976));
+  for (const char* name : {"high_intensity_cylinder.json", "buffered_wall_60hz.json"})
+    CHECK(run_pdamp(std::string("validate ") + case_path(name)).exit_code == 0);
+}
+
+TEST_CASE("malformed JSON is a one-line error naming the file", "[cli]") {
+  const fs::path path = fs::temp_directory_path() / "pdamp_malformed.json";
+  std::ofstream(path) << "{ \"name\": \"x\", ";
+  require_one_line_error(run_pdamp("validate " + path.string()), "pdamp_malformed.json: malformed JSON");
+}
+
+TEST_CASE("unknown keys are rejected with their JSON pointer", "[cli]") {
+  const auto path = edited_case("pdamp_unknown_key.json", [](json& c) { c["damper"]["particles"]["radus_m"] = 0.005; });
+  require_one_line_error(run_pdamp("validate " + path), "/damper/particles/radus_m: unknown key");
+}
+
+TEST_CASE("a negative radius names the key and the allowed range", "[cli]") {
+  const auto path = edited_case("pdamp_negative_radius.json", [](json& c) { c["damper"]["particles"]["radius_m"] = -0.005; });
+  require_one_line_error(run_pdamp("validate " + path), "/damper/particles/radius_m: = -0.005: must be a finite number > 0");
+}
+
+TEST_CASE("particles that do not fit are rejected with the numbers", "[cli]") {
+  const auto path = edited_case("pdamp_no_fit.json", [](json& c) { c["damper"]["particles"]["count"] = 500; });
+  require_one_line_error(run_pdamp("validate " + path), "/damper/particles");
+}
+
+TEST_CASE("wrong types are rejected", "[cli]") {
+  const auto path = edited_case("pdamp_wrong_type.json", [](json& c) { c["excitation"]["frequency_hz"] = "2"; });
+  require_one_line_error(run_pdamp("validate " + path), "/excitation/frequency_hz: must be a number");
+}
+
+TEST_CASE("bad flags: negative clearance, zero amplitude, unknown model, non-numbers", "[cli]") {
+  require_one_line_error(run_pdamp("loss --model rolling --clearance -0.1 --amplitude 0.04 --frequency 2"),
+                         "--clearance: '-0.1': must be a finite number > 0");
+  require_one_line_error(run_pdamp("loss --model rolling --clearance 0.1 --amplitude 0 --frequency 2"),
+                         "--amplitude: '0': must be a finite number > 0");
+  require_one_line_error(run_pdamp("loss --model sliding --clearance 0.1 --amplitude 0.04 --frequency 2"),
+                         "--model: 'sliding' is not a model here");
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance nan"), "--clearance");
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance 0.1 --colour red"), "--colour: unknown option");
+  require_one_line_error(run_pdamp("optimum --model rolling"), "--clearance: required");
+  require_one_line_error(run_pdamp("frobnicate"), "frobnicate: unknown command");
+}
+
+TEST_CASE("--json prints exactly one object with the promised keys", "[cli]") {
+  const auto optimum = run_pdamp("optimum --model rolling --clearance 0.1 --json");
+  REQUIRE(optimum.exit_code == 0);
+  const json o = json::parse(optimum.out);
+  for (const char* key : {"model", "clearance_m", "x_opt_m", "x_opt_ideal_m", "x_onset_m"}) CHECK(o.contains(key));
+  // Calibrated design value 0.4 h_roll (PHYSICS.md §3).
+  CHECK(o["x_opt_m"].get<double>() == Approx(0.04).epsilon(1e-4));
+
+  const auto size = run_pdamp("size --model bouncing --stroke 0.01 --json");
+  REQUIRE(size.exit_code == 0);
+  const json s = json::parse(size.out);
+  for (const char* key : {"model", "stroke_m", "clearance_m"}) CHECK(s.contains(key));
+  CHECK(s["clearance_m"].get<double>() == Approx(0.01 * kPi).epsilon(1e-12));  // X_opt = h/pi
+
+  const auto loss = run_pdamp("loss --model bouncing --clearance 0.01 --amplitude 0.005 --frequency 50 --bed-mass 2 --json");
+  REQUIRE(loss.exit_code == 0);
+  const json l = json::parse(loss.out);
+  for (const char* key : {"eta_star", "e_diss_j", "energy_per_cycle_j", "regime", "warnings"}) CHECK(l.contains(key));
+  // X = h/2: eta* = (1 - cos phi*)^2/pi = 1.0685 (PHYSICS.md §2); E_diss = eta* m V^2/2.
+  const double v = 0.005 * 2 * kPi * 50;
+  CHECK(l["eta_star"].get<double>() == Approx(1.0685).epsilon(1e-3));
+  CHECK(l["e_diss_j"].get<double>() == Approx(l["eta_star"].get<double>() * 0.5 * 2.0 * v * v).epsilon(1e-12));
+
+  const auto buffer = run_pdamp("buffer --frequency 60 --intensity 20 --radius 0.0025 --layer-modulus 60e6 --json");
+  REQUIRE(buffer.exit_code == 0);
+  const json b = json::parse(buffer.out);
+  for (const char* key : {"layer_thickness_m", "impact_velocity_m_s", "max_penetration_m", "contact_time_s"})
+    CHECK(b.contains(key));
+}
+
+TEST_CASE("validity warnings go to stderr and into the JSON warnings list", "[cli]") {
+  // Rolling at Gamma = 0.16*(2 pi 5)^2/g = 16 is far outside its range (A < g).
+  const auto r = run_pdamp("loss --model rolling --clearance 0.1 --amplitude 0.16 --frequency 5 --json");
+  REQUIRE(r.exit_code == 0);
+  const json l = json::parse(r.out);
+  REQUIRE(!l["warnings"].empty());
+  CHECK_THAT(r.err, Catch::Contains("pdamp: warning: "));
+}
+
+TEST_CASE("run writes its results atomically into the output directory", "[cli]") {
+  const fs::path dir = fs::temp_directory_path() / "pdamp_run_out";
+  fs::remove_all(dir);
+  const auto r = run_pdamp("run " + case_path("low_intensity_36_spheres.json") + " -o " + dir.string() + " --json");
+  REQUIRE(r.exit_code == 0);
+  const json result = json::parse(r.out);
+  CHECK(result["task"] == "damper_design");
+  CHECK(result["outputs"].size() >= 3);
+  for (const char* name : {"design.json", "eta_curve.csv", "case_resolved.json"}) CHECK(fs::exists(dir / name));
+  for (const auto& entry : fs::directory_iterator(dir))
+    CHECK(entry.path().filename().string().rfind(".pdamp-staging", 0) != 0);
+
+  // A bad case writes nothing.
+  const fs::path bad_dir = fs::temp_directory_path() / "pdamp_run_bad";
+  fs::remove_all(bad_dir);
+  const auto path = edited_case("pdamp_bad_run.json", [](json& c) { c["excitation"]["frequency_hz"] = -1.0; });
+  CHECK(run_pdamp("run " + path + " -o " + bad_dir.string()).exit_code == 2);
+  CHECK(!fs::exists(bad_dir));
+}

@@ -1,0 +1,105 @@
+// Strict parsing of subcommand flags.
+#include "args.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "errors.hpp"
+
+namespace pdamp::cli {
+
+std::optional<double> parse_number(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+std::string help_text(const CommandSpec& spec) {
+  std::ostringstream out;
+  out << "usage: " << spec.usage << "\n\n" << spec.summary << "\n";
+  if (!spec.flags.empty()) out << "\noptions:\n";
+  for (const auto& flag : spec.flags) {
+    std::string head = "  " + flag.name + (flag.value_name.empty() ? "" : " " + flag.value_name);
+    if (head.size() < 26) head.resize(26, ' ');
+    else head += "\n" + std::string(26, ' ');
+    out << head << flag.help << "\n";
+  }
+  out << "  --help                  show this help\n";
+  return out.str();
+}
+
+ParsedArgs::ParsedArgs(const CommandSpec& spec, const std::vector<std::string>& args) : spec_(spec) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      help_ = true;
+      continue;
+    }
+    if (arg.size() > 1 && arg[0] == '-' && !parse_number(arg)) {
+      const FlagSpec* flag = nullptr;
+      for (const auto& f : spec.flags)
+        if (f.name == arg) flag = &f;
+      if (flag == nullptr)
+        throw InputError(arg, "", "unknown option for 'pdamp " + spec.name + "' (see pdamp " + spec.name + " --help)");
+      if (values_.count(arg)) throw InputError(arg, "", "given more than once");
+      if (flag->value_name.empty()) {
+        values_[arg] = "";
+      } else {
+        if (i + 1 >= args.size()) throw InputError(arg, "", "needs a value (" + flag->value_name + ")");
+        values_[arg] = args[++i];
+      }
+      continue;
+    }
+    positional_.push_back(arg);
+  }
+  if (!help_ && static_cast<int>(positional_.size()) != spec.positional) {
+    if (positional_.size() > static_cast<std::size_t>(spec.positional))
+      throw InputError(positional_[spec.positional], "", "unexpected argument (usage: " + spec.usage + ")");
+    throw InputError("pdamp " + spec.name, "", "missing the case file (usage: " + spec.usage + ")");
+  }
+}
+
+bool ParsedArgs::has(const std::string& flag) const { return values_.count(flag) > 0; }
+
+std::optional<std::string> ParsedArgs::optional_text(const std::string& flag) const {
+  const auto it = values_.find(flag);
+  if (it == values_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::string ParsedArgs::text(const std::string& flag) const {
+  auto value = optional_text(flag);
+  if (!value) throw InputError(flag, "", "required (see pdamp " + spec_.name + " --help)");
+  return *value;
+}
+
+static std::string range_text(double min, double max, bool min_exclusive) {
+  std::ostringstream out;
+  out << "must be a finite number " << (min_exclusive ? "> " : ">= ") << min;
+  if (std::isfinite(max)) out << " and <= " << max;
+  return out.str();
+}
+
+std::optional<double> ParsedArgs::optional_number(const std::string& flag, double min, double max,
+                                                  bool min_exclusive) const {
+  const auto text_value = optional_text(flag);
+  if (!text_value) return std::nullopt;
+  const auto value = parse_number(*text_value);
+  const bool in_range = value && (min_exclusive ? *value > min : *value >= min) && *value <= max;
+  if (!in_range)
+    throw InputError(flag, "", "'" + *text_value + "': " + range_text(min, max, min_exclusive));
+  return value;
+}
+
+double ParsedArgs::number(const std::string& flag, double min, double max, bool min_exclusive) const {
+  const auto value = optional_number(flag, min, max, min_exclusive);
+  if (!value) throw InputError(flag, "", "required, " + range_text(min, max, min_exclusive));
+  return *value;
+}
+
+}  // namespace pdamp::cli

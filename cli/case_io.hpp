@@ -1,0 +1,71 @@
+// The case file format (docs/cases.md): JSON -> validated option structs, and the
+// resolved case with every default filled in (`pdamp validate`).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pdamp/formulas/bed_packing.hpp"
+#include "pdamp/formulas/collect_and_collide.hpp"
+#include "pdamp/formulas/hertz_impact.hpp"
+
+namespace pdamp::cli {
+
+/// Tasks `pdamp run` knows.
+enum class Task { kDamperDesign };
+
+struct DamperSpec {
+  formulas::DamperModel model = formulas::DamperModel::kAuto;
+  formulas::Container container;
+  int drive_axis = 0;
+  formulas::Vec3 gravity_m_s2{0.0, 0.0, -formulas::kStandardGravity};
+  int particle_count = 0;
+  double particle_radius_m = 0.0;
+  std::string particle_material = "steel";
+  formulas::LatticePacking packing;
+  formulas::ModelOptions model_options;
+  // Derived on load:
+  formulas::LatticeBed bed;     ///< the collected lattice and its clearance
+  double clearance_m = 0.0;     ///< the bed's h, or the explicit `clearance_m` override
+  double bed_mass_kg = 0.0;
+};
+
+struct ExcitationSpec {
+  double frequency_hz = 0.0;
+  std::optional<double> amplitude_m;  ///< the operating stroke, if the case has one
+};
+
+struct DesignSpec {
+  std::optional<double> target_stroke_m;
+  double sweep_min_over_clearance = 0.05;
+  double sweep_max_over_clearance = 1.5;
+  int sweep_points = 301;
+};
+
+struct BufferSpec {
+  std::string layer_material;
+  formulas::BufferDesignInput input;  ///< particle data filled from the damper
+};
+
+struct Case {
+  std::string path;
+  std::string name;
+  std::string description;
+  Task task = Task::kDamperDesign;
+  std::map<std::string, formulas::Material> materials;
+  DamperSpec damper;
+  ExcitationSpec excitation;
+  DesignSpec design;
+  std::optional<BufferSpec> buffer;
+  nlohmann::json resolved;  ///< the case with every default resolved and derived values added
+};
+
+/// Reads and validates a case; InputError (exit 2) names file, JSON pointer and rule.
+Case load_case(const std::string& path);
+
+std::string_view to_string(Task task);
+
+}  // namespace pdamp::cli

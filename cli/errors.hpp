@@ -1,0 +1,28 @@
+// The CLI's error types and their exit codes (INTERFACE.md).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace pdamp::cli {
+
+/// Bad input: exit code 2, one line `pdamp: error: <where>: <key>: <what>`.
+class InputError : public std::runtime_error {
+ public:
+  /// where: a file name or a flag; key: a JSON pointer or key (may be empty).
+  InputError(const std::string& where, const std::string& key, const std::string& what)
+      : std::runtime_error(where + (key.empty() ? "" : ": " + key) + ": " + what) {}
+};
+
+/// A numerical failure detected at run time (e.g. DEM instability): exit code 3.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitOther = 1;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitNumerical = 3;
+
+}  // namespace pdamp::cli
