@@ -107,7 +107,7 @@ TEST_CASE("wrong types are rejected", "[cli]") {
   require_one_line_error(run_pdamp("validate " + path), "/excitation/frequency_hz: must be a number");
 }
 
-TEST_CASE("bad flags: negative clearance, zero amplitude, unknown model, non-numbers", "[cli]") {
+TEST_CASE("bad flags are rejected: negative clearance and zero amplitude and unknown model and non-numbers", "[cli]") {
   require_one_line_error(run_pdamp("loss --model rolling --clearance -0.1 --amplitude 0.04 --frequency 2"),
                          "--clearance: '-0.1': must be a finite number > 0");
   require_one_line_error(run_pdamp("loss --model rolling --clearance 0.1 --amplitude 0 --frequency 2"),

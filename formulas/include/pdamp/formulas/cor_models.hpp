@@ -1,4 +1,4 @@
-// Coefficient-of-restitution models, the contact level of pdamp (PHYSICS.md §6, docs/cor_models.md).
+// Coefficient-of-restitution models: the contact level of pdamp (PHYSICS.md §6).
 #pragma once
 
 #include <memory>
@@ -51,7 +51,7 @@ std::unique_ptr<RestitutionModel> make_thornton_restitution(double limiting_pres
                                                             double effective_radius_m,
                                                             double effective_mass_kg);
 /// Mean contact pressure over yield stress at first yield of a Hertz contact
-/// (Johnson, Contact Mechanics 1985, §4.2: p₀ = 1.60 Y for ν = 0.3, von Mises).
+/// (Johnson, Contact Mechanics 1985, ch. 6: p₀ = 1.60 Y for ν = 0.3, von Mises).
 inline constexpr double kLimitingPressurePerYieldStress = 1.6;
 /// Thornton's law from the yield stress Y (Pa) of the softer body: p_y = 1.6·Y.
 std::unique_ptr<RestitutionModel> make_thornton_restitution_from_yield_stress(
@@ -107,12 +107,19 @@ RestitutionFit fit_restitution(const ImpactData& data, RestitutionLaw law,
 /// pdamp's contact ends when the total force returns to zero (no tension), which
 /// happens at a positive overlap, so the realised ε is higher (0.397 for a target 0.3).
 /// realised_restitution(γ_n) integrates the dimensionless ODE to that end (adaptive
-/// Dormand–Prince, |error| < 1e-10); γ_n >= 0 finite, std::invalid_argument otherwise.
+/// Dormand–Prince from a series start, |error| < 1e-10, ~30 µs) for γ_n in
+/// [0, kMaxDampingCoefficient]; std::invalid_argument otherwise. ε falls from 1 with
+/// slope −π/√5 at γ_n = 0 and tends to ≈ 1.25/γ_n² for large γ_n.
 double realised_restitution(double damping_coefficient);
-/// γ_n >= 0 with realised_restitution(γ_n) = ε, ε in (0, 1] (ε = 1 gives 0); the
-/// realised ε matches to 1e-9 (absolute). Costs ~10 one-collision solves (~1 ms):
-/// use DampingTable in a time loop.
+/// Largest γ_n accepted (ε = 1.25e-4): beyond it the zero of the total force lies in
+/// a slow creeping return whose force (~x^{5/2}/γ_n²) drowns in the integration error.
+inline constexpr double kMaxDampingCoefficient = 100.0;
+/// γ_n >= 0 with realised_restitution(γ_n) = ε for ε in [kMinCalibratedRestitution, 1]
+/// (ε = 1 gives 0); the realised ε matches to 1e-9 (absolute). Costs ~6 one-collision
+/// solves (~0.2 ms): use DampingTable in a time loop.
 double damping_for_restitution(double restitution);
+/// Smallest ε damping_for_restitution accepts (γ_n ≈ 35).
+inline constexpr double kMinCalibratedRestitution = 1e-3;
 
 /// Precomputed inverse for the DEM's hot loop (velocity-dependent ε needs a γ_n
 /// per impact): γ_n linearly interpolated on a uniform grid of ε over
