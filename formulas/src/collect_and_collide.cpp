@@ -1,2 +1,402 @@
-// collect_and_collide: implementation pending (helper in progress).
+// Closed-form collect-and-collide models: ideal orbits, optimum strokes, η* with validity warnings.
 #include "pdamp/formulas/collect_and_collide.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pdamp::formulas {
+namespace {
+
+/// R = √(π²+4): π cos ψ + 2 sin ψ = R cos(ψ − α), so the sub-peak orbit exists for
+/// h_eff/X <= R and the onset stroke is h_eff/R.
+constexpr double kOnsetRadius = 3.724191778237173;
+/// α = atan(2/π): ψ at the onset, where the sub-peak branch ends (saddle-node).
+constexpr double kOnsetAngle = 0.5669115049410094;
+constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Above this X/h the bed hits the far wall within a small fraction of the cycle
+/// after detachment: η* is tiny and set by details the one-block model leaves out.
+constexpr double kMaxStrokeOverClearance = 10.0;
+/// Safeguarded Newton needs 1-3 steps; the cap only bounds the bisection fallback,
+/// which alone reaches full precision on [0, π] in about 55 halvings.
+constexpr int kMaxPhaseIterations = 100;
+/// impact_phase starts from the series at 0 up to this r and from the series at π above.
+constexpr double kStartSwitch = 1.3;
+/// impact_phase stops after a Newton step smaller than this fraction of φ.
+constexpr double kLastStep = 1e-8;
+/// Below this φ the series replaces φ − sin φ (which cancels: at φ = 1 the direct
+/// difference already loses about 3 bits).
+constexpr double kSeriesLimit = 1.0;
+
+/// Six significant digits; std::to_chars keeps the warning path cheap.
+std::string format(double value) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value,
+                                 std::chars_format::general, 6).ptr;
+  return std::string(buffer, end);
+}
+
+void require_positive(const char* name, double value) {
+  if (!(value > 0.0 && std::isfinite(value))) {
+    throw std::invalid_argument(std::string(name) + " = " + format(value) +
+                                ": must be > 0 and finite");
+  }
+}
+
+void require_non_negative(const char* name, double value) {
+  if (!(value >= 0.0 && std::isfinite(value))) {
+    throw std::invalid_argument(std::string(name) + " = " + format(value) +
+                                ": must be >= 0 and finite");
+  }
+}
+
+void require_valid(const ModelOptions& options) {
+  const std::vector<std::string> problems = options.validate();
+  if (problems.empty()) return;
+  std::string message = "invalid model options: ";
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    if (i > 0) message += "; ";
+    message += problems[i];
+  }
+  throw std::invalid_argument(message);
+}
+
+/// φ − sin φ for φ >= 0 with a relative error of a few ulp. Below kSeriesLimit the
+/// Taylor series Σ (−1)^k φ^{2k+3}/(2k+3)! to k = 9 (first omitted term relative to
+/// the sum: 6φ^20/23! < 3e-22); above it the direct difference, whose relative error
+/// ε·φ/(φ − sin φ) is at most ε/(1 − sin 1) ≈ 6ε.
+double phi_minus_sin(double phi) {
+  if (phi >= kSeriesLimit) return phi - std::sin(phi);
+  constexpr double kCoefficients[] = {
+      1.0 / 6.0,                      // 1/3!
+      -1.0 / 120.0,                   // 1/5!
+      1.0 / 5040.0,                   // 1/7!
+      -1.0 / 362880.0,                // 1/9!
+      1.0 / 39916800.0,               // 1/11!
+      -1.0 / 6227020800.0,            // 1/13!
+      1.0 / 1307674368000.0,          // 1/15!
+      -1.0 / 355687428096000.0,       // 1/17!
+      1.0 / 121645100408832000.0,     // 1/19!
+      -1.0 / 51090942171709440000.0,  // 1/21!
+  };
+  const double phi2 = phi * phi;
+  double sum = 0.0;
+  for (int k = 9; k >= 0; --k) sum = sum * phi2 + kCoefficients[k];
+  return sum * phi2 * phi;
+}
+
+/// 1 − cos φ without cancellation.
+double one_minus_cos(double phi) {
+  const double half_sin = std::sin(0.5 * phi);
+  return 2.0 * half_sin * half_sin;
+}
+
+double inertia_factor_of(DamperModel family, const ModelOptions& options) {
+  return family == DamperModel::kRolling ? options.rolling_inertia_factor : 0.0;
+}
+
+double calibration_of(DamperModel family, const ModelOptions& options) {
+  return family == DamperModel::kRolling ? options.rolling_calibration
+                                         : options.bouncing_calibration;
+}
+
+void require_family(DamperModel model, const char* function) {
+  if (model != DamperModel::kRolling && model != DamperModel::kBouncing) {
+    throw std::invalid_argument(std::string(function) + ": model = " +
+                                std::string(to_string(model)) + ": must be rolling or bouncing");
+  }
+}
+
+/// Onset stroke h_eff/R; computed in one place so that X = x_onset_m from
+/// optimum_stroke is classified as on the orbit (same rounding).
+double onset_stroke(double effective_clearance_m) { return effective_clearance_m / kOnsetRadius; }
+double peak_stroke(double effective_clearance_m) { return effective_clearance_m / kPi; }
+double onset_eta_star(double inertia_factor) {
+  return 4.0 * kPi / ((kPi * kPi + 4.0) * (1.0 + inertia_factor));
+}
+
+/// ideal_orbit without input checks (inputs already validated by the caller).
+IdealOrbit orbit_of(double inertia_factor, double clearance_m, double stroke_m) {
+  const double scale = 1.0 + inertia_factor;
+  const double effective_clearance_m = scale * clearance_m;
+  IdealOrbit orbit;
+  if (stroke_m >= peak_stroke(effective_clearance_m)) {
+    // Rounding can put h_eff/X a hair above π exactly at the peak stroke.
+    const double phase = impact_phase(std::min(effective_clearance_m / stroke_m, kPi));
+    const double jump = one_minus_cos(phase);
+    orbit.regime = MotionRegime::kCollectAndCollide;
+    orbit.eta_star = jump * jump / (kPi * scale);
+    orbit.impact_phase_rad = phase;
+  } else if (stroke_m >= onset_stroke(effective_clearance_m)) {
+    // π cos ψ + 2 sin ψ = R cos(ψ − α) = h_eff/X; the branch joined to the peak
+    // (ψ = 0 at h_eff/X = π) is ψ = α − acos(h_eff/(X R)), ψ in [0, α].
+    const double ratio = std::min(effective_clearance_m / (stroke_m * kOnsetRadius), 1.0);
+    const double psi = std::clamp(kOnsetAngle - std::acos(ratio), 0.0, kOnsetAngle);
+    const double cos_psi = std::cos(psi);
+    orbit.regime = MotionRegime::kSubPeak;
+    orbit.eta_star = 4.0 * cos_psi * cos_psi / (kPi * scale);
+    orbit.impact_phase_rad = kPi + psi;
+  } else {
+    orbit.regime = MotionRegime::kScattered;
+    orbit.eta_star = kNaN;
+    orbit.impact_phase_rad = kNaN;
+  }
+  return orbit;
+}
+
+void append_range_rule(std::vector<std::string>& problems, const std::string& name, double value,
+                       bool ok, const char* rule) {
+  if (!ok) problems.push_back(name + " = " + format(value) + ": must be " + rule);
+}
+
+}  // namespace
+
+std::string_view to_string(DamperModel model) {
+  switch (model) {
+    case DamperModel::kRolling: return "rolling";
+    case DamperModel::kBouncing: return "bouncing";
+    case DamperModel::kScattered: return "scattered";
+    case DamperModel::kAuto: return "auto";
+  }
+  return "unknown";
+}
+
+std::optional<DamperModel> damper_model_from_string(std::string_view name) {
+  if (name == "rolling") return DamperModel::kRolling;
+  if (name == "bouncing") return DamperModel::kBouncing;
+  if (name == "scattered") return DamperModel::kScattered;
+  if (name == "auto") return DamperModel::kAuto;
+  return std::nullopt;
+}
+
+std::string_view to_string(MotionRegime regime) {
+  switch (regime) {
+    case MotionRegime::kCollectAndCollide: return "collect_and_collide";
+    case MotionRegime::kSubPeak: return "sub_peak";
+    case MotionRegime::kScattered: return "scattered";
+  }
+  return "unknown";
+}
+
+std::vector<std::string> ScatteredFit::validate() const {
+  std::vector<std::string> problems;
+  append_range_rule(problems, "jump_fraction", jump_fraction,
+                    jump_fraction >= 0.0 && jump_fraction <= 1.0, "in [0, 1]");
+  append_range_rule(problems, "exponent", exponent, exponent >= 0.0 && exponent <= 10.0,
+                    "in [0, 10]");
+  append_range_rule(problems, "s_min", s_min, s_min >= 0.0 && s_min < 1.0, "in [0, 1)");
+  return problems;
+}
+
+std::vector<std::string> ModelOptions::validate() const {
+  std::vector<std::string> problems;
+  append_range_rule(problems, "rolling_inertia_factor", rolling_inertia_factor,
+                    rolling_inertia_factor > 0.0 && rolling_inertia_factor <= 1.0, "in (0, 1]");
+  append_range_rule(problems, "rolling_calibration", rolling_calibration,
+                    rolling_calibration > 0.0 && rolling_calibration <= 2.0, "in (0, 2]");
+  append_range_rule(problems, "bouncing_calibration", bouncing_calibration,
+                    bouncing_calibration > 0.0 && bouncing_calibration <= 2.0, "in (0, 2]");
+  for (const std::string& line : scattered.validate()) problems.push_back("scattered." + line);
+  return problems;
+}
+
+double impact_phase(double clearance_over_stroke) {
+  const double r = clearance_over_stroke;
+  if (!(r >= 0.0 && r <= kPi)) {
+    throw std::domain_error("impact_phase: clearance_over_stroke = " + format(r) +
+                            ": must be in [0, pi]");
+  }
+  if (r == 0.0) return 0.0;
+  if (r == kPi) return kPi;
+  double phi = 0.0;
+  if (r <= kStartSwitch) {
+    // Inverse series at 0 of c = (6(φ − sin φ))^{1/3} = φ·exp(−φ²/60 − φ⁴/50400 − ...):
+    // φ ≈ c(1 + c²/60 + c⁴/1400); error 3e-3 rad at r = 1, 6e-3 at r = 1.3.
+    const double c = std::cbrt(6.0 * r);
+    const double c2 = c * c;
+    phi = c * (1.0 + c2 * (1.0 / 60.0 + c2 / 1400.0));
+  } else {
+    // Inverse series at π: φ = π − δ with 2δ − δ³/6 + δ⁵/120 = π − r, so with
+    // d = (π − r)/2: δ ≈ d + d³/12 + d⁵/60; error 3e-3 rad at r = 1.3, 1e-4 at r = 2.
+    const double d = 0.5 * (kPi - r);
+    const double d2 = d * d;
+    phi = kPi - d * (1.0 + d2 * (1.0 / 12.0 + d2 / 60.0));
+  }
+  phi = std::clamp(phi, 0.0, kPi);
+  double lo = 0.0;
+  double hi = kPi;
+  // φ − sin φ is increasing and convex on [0, π]: Newton from the right of the root
+  // decreases monotonically onto it; a step from the left overshoots to the right,
+  // or out of the bracket, where bisection takes over.
+  for (int iteration = 0; iteration < kMaxPhaseIterations; ++iteration) {
+    const double residual = phi_minus_sin(phi) - r;
+    if (residual == 0.0) return phi;
+    if (residual < 0.0) {
+      lo = phi;
+    } else {
+      hi = phi;
+    }
+    const double slope = one_minus_cos(phi);
+    const double next = slope > 0.0 ? phi - residual / slope : 0.5 * (lo + hi);
+    // The Newton error after a step is (cot(φ/2)/2)·step² <= step²/φ: a relative step
+    // below 1e-8 leaves a relative error below 1e-16, so the step is the last one.
+    if (std::abs(next - phi) <= kLastStep * phi) return std::clamp(next, lo, hi);
+    phi = (next > lo && next < hi) ? next : 0.5 * (lo + hi);
+    if (hi - lo <= 2.0 * kEpsilon * hi) return phi;
+  }
+  return phi;
+}
+
+IdealOrbit ideal_orbit(double inertia_factor, double clearance_m, double stroke_m) {
+  if (!(inertia_factor >= 0.0 && inertia_factor <= 1.0)) {
+    throw std::invalid_argument("inertia_factor = " + format(inertia_factor) +
+                                ": must be in [0, 1]");
+  }
+  require_positive("clearance_m", clearance_m);
+  require_positive("stroke_m", stroke_m);
+  return orbit_of(inertia_factor, clearance_m, stroke_m);
+}
+
+double rolling_no_slip_friction(double inertia_factor, double intensity) {
+  if (!(inertia_factor > 0.0 && inertia_factor <= 1.0)) {
+    throw std::invalid_argument("inertia_factor = " + format(inertia_factor) +
+                                ": must be in (0, 1]");
+  }
+  require_non_negative("intensity", intensity);
+  return inertia_factor * intensity / (1.0 + inertia_factor);
+}
+
+OptimumStroke optimum_stroke(DamperModel model, double clearance_m, const ModelOptions& options) {
+  require_family(model, "optimum_stroke");
+  require_positive("clearance_m", clearance_m);
+  require_valid(options);
+  const double inertia_factor = inertia_factor_of(model, options);
+  const double effective_clearance_m = (1.0 + inertia_factor) * clearance_m;
+  OptimumStroke result;
+  result.model = model;
+  result.clearance_m = clearance_m;
+  result.calibration_factor = calibration_of(model, options);
+  result.x_opt_ideal_m = peak_stroke(effective_clearance_m);
+  result.x_opt_m = result.calibration_factor * result.x_opt_ideal_m;
+  result.x_onset_m = onset_stroke(effective_clearance_m);
+  result.eta_star_peak = 4.0 / (kPi * (1.0 + inertia_factor));
+  result.eta_star_onset = onset_eta_star(inertia_factor);
+  return result;
+}
+
+double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptions& options) {
+  require_family(model, "clearance_for_stroke");
+  require_positive("stroke_m", stroke_m);
+  require_valid(options);
+  // x_opt = c(1+κ)h/π, solved for h.
+  return kPi * (stroke_m / calibration_of(model, options)) /
+         (1.0 + inertia_factor_of(model, options));
+}
+
+LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
+                               double frequency_hz, const ModelOptions& options) {
+  require_positive("clearance_m", clearance_m);
+  require_positive("stroke_m", stroke_m);
+  require_positive("frequency_hz", frequency_hz);
+  require_valid(options);
+
+  const double omega = kTwoPi * frequency_hz;
+  LossResult result;
+  result.model_requested = model;
+  result.velocity_amplitude_m_s = stroke_m * omega;
+  result.intensity = result.velocity_amplitude_m_s * omega / kStandardGravity;
+  const bool low_intensity = result.intensity < 1.0;
+  const bool explicit_family = model == DamperModel::kRolling || model == DamperModel::kBouncing;
+  result.model_used = explicit_family ? model
+                      : low_intensity ? DamperModel::kRolling
+                                      : DamperModel::kBouncing;
+  const bool rolling = result.model_used == DamperModel::kRolling;
+  const double inertia_factor = inertia_factor_of(result.model_used, options);
+  const double onset_m = onset_stroke((1.0 + inertia_factor) * clearance_m);
+  const double s = stroke_m / onset_m;
+  result.stroke_over_onset = s;
+  const char* family_name = rolling ? "rolling" : "bouncing";
+
+  if (model != DamperModel::kScattered && stroke_m >= onset_m) {
+    const IdealOrbit orbit = orbit_of(inertia_factor, clearance_m, stroke_m);
+    result.regime = orbit.regime;
+    result.eta_star = orbit.eta_star;
+    result.impact_phase_rad = orbit.impact_phase_rad;
+  } else {
+    const ScatteredFit& fit = options.scattered;
+    result.regime = MotionRegime::kScattered;
+    result.impact_phase_rad = kNaN;
+    result.eta_star = fit.jump_fraction * onset_eta_star(inertia_factor) * std::pow(s, fit.exponent);
+    if (explicit_family) {
+      result.warnings.push_back(
+          std::string(family_name) + " model at stroke X = " + format(stroke_m) +
+          " m below its onset X_onset = " + format(onset_m) + " m (s = " + format(s) +
+          "): the collect-and-collide orbit does not exist there, so eta* comes from the "
+          "scattered-state fit");
+    }
+    if (s < fit.s_min || s >= 1.0) {
+      result.warnings.push_back("scattered-state fit evaluated at s = X/X_onset = " + format(s) +
+                                ", outside its range [" + format(fit.s_min) + ", 1)");
+    }
+    if (fit.provisional) {
+      result.warnings.push_back(
+          "scattered-state fit is provisional (jump_fraction = " + format(fit.jump_fraction) +
+          ", exponent = " + format(fit.exponent) + ", source: " + fit.source +
+          "): the scattered-state eta* = " + format(result.eta_star) +
+          " is a placeholder until the fit is made on DEM points");
+    }
+  }
+
+  if (model == DamperModel::kRolling && !low_intensity) {
+    result.warnings.push_back(
+        "rolling model at intensity Gamma = " + format(result.intensity) +
+        " >= 1: the container acceleration exceeds g, so spheres lift off and slide, "
+        "while the rolling model assumes A < g (rolling without slip would need a base "
+        "friction mu >= " + format(rolling_no_slip_friction(inertia_factor, result.intensity)) +
+        ")");
+  }
+  if (model == DamperModel::kBouncing && low_intensity) {
+    result.warnings.push_back(
+        "bouncing model at intensity Gamma = " + format(result.intensity) +
+        " < 1: gravity is comparable to the drive and the bed does not fly; the rolling "
+        "model describes a horizontal drive at A < g");
+  }
+  if (options.gravity_along_drive) {
+    result.warnings.push_back(
+        "gravity along the drive is not in the ideal models (PHYSICS.md section 2): it moves "
+        "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
+        " is an optimistic estimate");
+  }
+  if (stroke_m > kMaxStrokeOverClearance * clearance_m) {
+    const std::string impact =
+        std::isfinite(result.impact_phase_rad)
+            ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
+            : std::string();
+    result.warnings.push_back("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
+                              " > " + format(kMaxStrokeOverClearance) +
+                              ": the bed barely separates from the wall" + impact +
+                              ", where the one-block model is outside its range");
+  }
+  return result;
+}
+
+double dissipated_energy_measure(double eta_star, double bed_mass_kg,
+                                 double velocity_amplitude_m_s) {
+  require_non_negative("eta_star", eta_star);
+  require_positive("bed_mass_kg", bed_mass_kg);
+  require_non_negative("velocity_amplitude_m_s", velocity_amplitude_m_s);
+  return eta_star * 0.5 * bed_mass_kg * velocity_amplitude_m_s * velocity_amplitude_m_s;
+}
+
+double energy_per_cycle(double e_diss_j) {
+  require_non_negative("e_diss_j", e_diss_j);
+  return kTwoPi * e_diss_j;
+}
+
+}  // namespace pdamp::formulas

@@ -45,6 +45,7 @@ struct ScatteredFit {
   /// Defaults are provisional until fitted to DEM points (effective-field issue).
   bool provisional = true;
   std::string source = "provisional default";
+  /// One line per violated rule ("exponent = 12: must be in [0, 10]"); empty if valid.
   std::vector<std::string> validate() const;
 };
 
@@ -60,19 +61,40 @@ struct ModelOptions {
   ScatteredFit scattered;
   /// The ideal models assume no gravity along the drive; true adds a warning.
   bool gravity_along_drive = false;
+  /// One line per violated rule ("rolling_inertia_factor = 1.5: must be in (0, 1]"),
+  /// the fit's lines prefixed "scattered."; empty if valid.
   std::vector<std::string> validate() const;
 };
 
 /// Ideal orbit of a block of inertia factor κ (0 bouncing, 2/5 rolling) at stroke X.
 struct IdealOrbit {
   MotionRegime regime = MotionRegime::kScattered;
-  double eta_star = 0.0;          ///< reduced loss factor, NaN when scattered
-  double impact_phase_rad = 0.0;  ///< φ* from detachment (kSubPeak: π + ψ); NaN when scattered
+  double eta_star = 0.0;  ///< reduced loss factor η*, dimensionless; NaN when scattered
+  /// Container phase Ωt at the impact, rad, counted from the instant the container
+  /// velocity toward the wall being hit is largest (the detachment of the
+  /// collect-and-collide orbit): φ* in (0, π] on kCollectAndCollide, π + ψ with
+  /// ψ in [0, atan(2/π)] on kSubPeak; NaN when scattered.
+  double impact_phase_rad = 0.0;
 };
-/// φ* in (0, π] solving φ − sin φ = r, r = h_eff/X in [0, π] (PHYSICS.md §2); robust
-/// for r → 0 (series start) and r → π; throws std::domain_error outside [0, π].
+/// φ* in [0, π] solving φ − sin φ = r for r = h_eff/X in [0, π] (PHYSICS.md §2), to a
+/// few ulp: start from the inverse series at 0, φ ≈ (6r)^{1/3}(1 + (6r)^{2/3}/60 + ...),
+/// or at π, then 1-3 safeguarded Newton steps on the convex φ − sin φ (summed as a
+/// series below φ = 1, where the difference cancels); about 0.1 µs. Never fails on
+/// [0, π]; throws std::domain_error outside it or for NaN.
 double impact_phase(double clearance_over_stroke);
+/// Ideal orbit at stroke X for clearance h of a bed with inertia factor κ in [0, 1]
+/// (0: free block, bouncing; κ: rolling spheres, effective clearance (1+κ)h):
+///   X >= (1+κ)h/π:                 φ* − sin φ* = (1+κ)h/X,  η* = (1 − cos φ*)²/(π(1+κ));
+///   (1+κ)h/√(π²+4) <= X < (1+κ)h/π: π cos ψ + 2 sin ψ = (1+κ)h/X, η* = 4cos²ψ/(π(1+κ));
+///   below: kScattered (NaN). Throws std::invalid_argument for κ outside [0, 1] or
+///   h, X not > 0 and finite. Derivation: docs/collect_and_collide.md.
 IdealOrbit ideal_orbit(double inertia_factor, double clearance_m, double stroke_m);
+/// Smallest base friction coefficient μ at which a sphere of inertia factor κ (> 0)
+/// rolls without slip on a base accelerating with amplitude Γg: μ_min = κΓ/(1+κ)
+/// (friction needed κ m a_c/(1+κ) against μ m g). The rolling model also needs the
+/// spin-down after a wall impact to be short, i.e. μ >> μ_min (docs, "What the ideal
+/// model neglects"). Throws std::invalid_argument for κ outside (0, 1] or Γ < 0 / NaN.
+double rolling_no_slip_friction(double inertia_factor, double intensity);
 
 /// Landmarks of a model over stroke for one clearance.
 struct OptimumStroke {
@@ -85,10 +107,14 @@ struct OptimumStroke {
   double eta_star_onset = 0.0; ///< 4π/((π²+4)(1+κ))
   double calibration_factor = 1.0;
 };
-/// model must be kRolling or kBouncing (std::invalid_argument otherwise);
-/// clearance_m > 0 (std::invalid_argument otherwise).
+/// Onset, ideal peak and design stroke of the rolling (κ = options.rolling_inertia_factor)
+/// or bouncing (κ = 0) model for clearance h: x_opt_ideal = (1+κ)h/π,
+/// x_onset = (1+κ)h/√(π²+4), x_opt = c·x_opt_ideal (rolling default: 0.4 h).
+/// model must be kRolling or kBouncing, clearance_m > 0 and finite, options valid
+/// (std::invalid_argument otherwise).
 OptimumStroke optimum_stroke(DamperModel model, double clearance_m, const ModelOptions& options = {});
-/// Inverse of optimum_stroke: h with x_opt_m(h) = stroke_m (> 0).
+/// Inverse of optimum_stroke: h = π X/(c(1+κ)) with x_opt_m(h) = stroke_m (> 0, finite);
+/// same model and options rules as optimum_stroke.
 double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptions& options = {});
 
 /// Closed-form reduced loss factor at one operating point.
@@ -100,19 +126,24 @@ struct LossResult {
   double intensity = 0.0;         ///< Γ = XΩ²/g
   double velocity_amplitude_m_s = 0.0;  ///< |V*| = XΩ
   double impact_phase_rad = 0.0;  ///< NaN in the scattered state
-  double stroke_over_onset = 0.0; ///< s = X/X_onset
+  double stroke_over_onset = 0.0; ///< s = X/X_onset of the family used
   std::vector<std::string> warnings;  ///< validity-range violations (INTERFACE.md)
 };
-/// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0). kAuto: Γ < 1 rolling,
-/// else bouncing; below the onset every model gives the scattered fit (kRolling and
-/// kBouncing with a warning, since their orbit does not exist there). kScattered:
-/// the fit regardless of s (family chosen by Γ as in kAuto).
+/// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0), all finite
+/// (std::invalid_argument naming the quantity otherwise, and for invalid options).
+/// kAuto: Γ = XΩ²/g < 1 rolling, else bouncing; below the onset every model gives the
+/// scattered fit (kRolling and kBouncing with a warning, since their orbit does not
+/// exist there). kScattered: the fit regardless of s (family chosen by Γ as in kAuto).
+/// Warnings (one sentence each, with numbers): rolling at Γ >= 1, bouncing at Γ < 1,
+/// gravity along the drive, the orbit missing below its onset, the scattered fit
+/// provisional or outside [s_min, 1), X/h > 10. No allocation when there is no warning.
 LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
                                double frequency_hz, const ModelOptions& options = {});
 
-/// Energy measures from η* (PHYSICS.md §1): E_diss = η*·½ m_bed |V*|², J.
+/// Energy measures from η* (PHYSICS.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
+/// η* >= 0, m_bed > 0, |V*| >= 0, all finite (std::invalid_argument otherwise).
 double dissipated_energy_measure(double eta_star, double bed_mass_kg, double velocity_amplitude_m_s);
-/// Energy dissipated per cycle, 2π·E_diss, J.
+/// Energy dissipated per cycle, 2π·E_diss, J; e_diss_j >= 0 and finite.
 double energy_per_cycle(double e_diss_j);
 
 }  // namespace pdamp::formulas
