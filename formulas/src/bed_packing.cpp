@@ -1,2 +1,312 @@
-// bed_packing: implementation pending (helper in progress).
+// Collected simple-cubic bed in a box or cylinder: sphere centres and the clearance h.
 #include "pdamp/formulas/bed_packing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace pdamp::formulas {
+namespace {
+
+/// Relative round-off allowance in "fits" tests: L = n·2r computed in floating point
+/// may land a few ulps below n·2r and must still hold n sites.
+constexpr double kFitTolerance = 1e-9;
+
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(12);
+  out << value;
+  return out.str();
+}
+
+std::string field(const std::string& prefix, const std::string& name) {
+  return prefix.empty() ? name : prefix + "." + name;
+}
+
+bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
+
+bool is_axis(int axis) { return axis >= 0 && axis <= 2; }
+
+[[noreturn]] void reject(const std::string& what) {
+  throw std::invalid_argument("collected_lattice: " + what);
+}
+
+std::string counts_text(const std::array<int, 3>& n) {
+  return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
+}
+
+/// Whole sites of pitch 2r along an inner length L.
+int sites_along(double length_m, double radius_m) {
+  return static_cast<int>(std::floor(length_m / (2.0 * radius_m) * (1.0 + kFitTolerance)));
+}
+
+/// Where the packing puts a slab's sites: the two transverse axes (ascending) and,
+/// when gravity lies along one of them, which one and its sign.
+struct CrossSection {
+  int axis_a = 0;
+  int axis_b = 0;
+  int gravity_axis = -1;  ///< -1: no gravity, or gravity along the drive
+  int gravity_sign = 0;
+};
+
+/// Positions of n sites of pitch 2r centred on 0.
+std::vector<double> centred_positions(int n, double radius_m) {
+  std::vector<double> positions(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) positions[i] = (i - 0.5 * (n - 1)) * 2.0 * radius_m;
+  return positions;
+}
+
+/// Positions of n sites along a box axis of inner length L: centred, or resting on
+/// the wall at sign·L/2 when gravity points there (row i = 0 lowest).
+std::vector<double> box_positions(int n, double length_m, double radius_m, int gravity_sign) {
+  if (gravity_sign == 0) return centred_positions(n, radius_m);
+  std::vector<double> positions(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) positions[i] = gravity_sign * (0.5 * length_m - radius_m - 2.0 * radius_m * i);
+  return positions;
+}
+
+Vec3 site(const CrossSection& cs, double along_a, double along_b) {
+  Vec3 p{0.0, 0.0, 0.0};
+  p[cs.axis_a] = along_a;
+  p[cs.axis_b] = along_b;
+  return p;
+}
+
+std::vector<Vec3> box_sites(const Container& c, double r, const CrossSection& cs, int n_a, int n_b) {
+  const auto sign_of = [&](int axis) { return axis == cs.gravity_axis ? cs.gravity_sign : 0; };
+  const auto pa = box_positions(n_a, c.box_inner_size_m[cs.axis_a], r, sign_of(cs.axis_a));
+  const auto pb = box_positions(n_b, c.box_inner_size_m[cs.axis_b], r, sign_of(cs.axis_b));
+  std::vector<Vec3> sites;
+  sites.reserve(pa.size() * pb.size());
+  for (const double a : pa) {
+    for (const double b : pb) sites.push_back(site(cs, a, b));
+  }
+  return sites;
+}
+
+bool inside_disk(double a, double b, double radius_m, double disk_radius_m) {
+  return std::hypot(a, b) + radius_m <= disk_radius_m * (1.0 + kFitTolerance);
+}
+
+/// Every site of the square lattice (pitch 2r, registered at offsets o_a, o_b) whose
+/// sphere lies inside the disk of radius R.
+std::vector<Vec3> disk_lattice(double r, double disk_radius_m, const CrossSection& cs, double o_a,
+                               double o_b) {
+  const int reach = static_cast<int>(std::ceil(disk_radius_m / (2.0 * r))) + 1;
+  std::vector<Vec3> sites;
+  for (int i = -reach; i <= reach; ++i) {
+    for (int j = -reach; j <= reach; ++j) {
+      const double a = o_a + 2.0 * r * i;
+      const double b = o_b + 2.0 * r * j;
+      if (inside_disk(a, b, r, disk_radius_m)) sites.push_back(site(cs, a, b));
+    }
+  }
+  return sites;
+}
+
+std::vector<Vec3> cylinder_sites_auto(double r, double disk_radius_m, const CrossSection& cs) {
+  std::vector<Vec3> best;
+  for (const auto& [o_a, o_b] :
+       {std::pair{0.0, 0.0}, std::pair{r, 0.0}, std::pair{0.0, r}, std::pair{r, r}}) {
+    auto sites = disk_lattice(r, disk_radius_m, cs, o_a, o_b);
+    if (sites.size() > best.size()) best = std::move(sites);
+  }
+  return best;
+}
+
+/// An n_a × n_b block in the disk, centred, except along gravity, where its lowest
+/// row sits as deep as the wall allows: the row's outer sites touch the wall at depth
+/// √((R − r)² − w²), w = the half-width of the row's centres. Throws if a site sticks out.
+std::vector<Vec3> cylinder_sites_block(double r, double disk_radius_m, const CrossSection& cs, int n_a,
+                                       int n_b) {
+  std::vector<double> pa = centred_positions(n_a, r);
+  std::vector<double> pb = centred_positions(n_b, r);
+  if (cs.gravity_axis == cs.axis_a || cs.gravity_axis == cs.axis_b) {
+    const bool along_a = cs.gravity_axis == cs.axis_a;
+    const int n_row = along_a ? n_b : n_a;  // sites in one row across gravity
+    const int n_rows = along_a ? n_a : n_b;
+    const double half_width = (n_row - 1) * r;
+    const double reach = disk_radius_m - r;
+    const double depth = reach > half_width ? std::sqrt(reach * reach - half_width * half_width) : 0.0;
+    std::vector<double>& rows = along_a ? pa : pb;
+    for (int i = 0; i < n_rows; ++i) rows[i] = cs.gravity_sign * (depth - 2.0 * r * i);
+  }
+  std::vector<Vec3> sites;
+  for (const double a : pa) {
+    for (const double b : pb) {
+      if (!inside_disk(a, b, r, disk_radius_m)) {
+        reject("lattice_counts give " + std::to_string(n_a) + " x " + std::to_string(n_b) +
+               " sites across the cylinder for radius_m = " + number(r) +
+               ": they do not fit in inner_radius_m = " + number(disk_radius_m));
+      }
+      sites.push_back(site(cs, a, b));
+    }
+  }
+  return sites;
+}
+
+std::vector<std::string> packing_problems(const Container& container, int count, double radius_m,
+                                          const LatticePacking& packing) {
+  std::vector<std::string> problems = container.validate("container");
+  if (count < 1) problems.push_back("count = " + std::to_string(count) + ": must be >= 1");
+  if (!positive_finite(radius_m))
+    problems.push_back("radius_m = " + number(radius_m) + ": must be > 0 and finite");
+  if (!is_axis(packing.drive_axis)) {
+    problems.push_back("packing.drive_axis = " + std::to_string(packing.drive_axis) + ": must be 0, 1 or 2");
+  }
+  if (packing.collect_side != -1 && packing.collect_side != 1) {
+    problems.push_back("packing.collect_side = " + std::to_string(packing.collect_side) +
+                       ": must be -1 or +1");
+  }
+  if (packing.gravity_axis_sign) {
+    const auto [axis, sign] = *packing.gravity_axis_sign;
+    if (!is_axis(axis))
+      problems.push_back("packing.gravity axis = " + std::to_string(axis) + ": must be 0, 1 or 2");
+    if (sign != -1 && sign != 1)
+      problems.push_back("packing.gravity sign = " + std::to_string(sign) + ": must be -1 or +1");
+  }
+  if (packing.lattice_counts) {
+    for (int i = 0; i < 3; ++i) {
+      const int n = (*packing.lattice_counts)[i];
+      if (n < 1) {
+        problems.push_back("packing.lattice_counts[" + std::to_string(i) + "] = " + std::to_string(n) +
+                           ": must be >= 1");
+      }
+    }
+  }
+  return problems;
+}
+
+}  // namespace
+
+double Container::inner_length(int axis) const {
+  if (!is_axis(axis))
+    throw std::invalid_argument("Container::inner_length: axis = " + std::to_string(axis) +
+                                ": must be 0, 1 or 2");
+  if (shape == ContainerShape::kBox) return box_inner_size_m[axis];
+  return axis == cylinder_axis ? cylinder_inner_length_m : 2.0 * cylinder_inner_radius_m;
+}
+
+std::vector<std::string> Container::validate(const std::string& prefix) const {
+  std::vector<std::string> problems;
+  const auto positive = [&](double value, const std::string& name) {
+    if (!positive_finite(value))
+      problems.push_back(field(prefix, name) + " = " + number(value) + ": must be > 0 and finite");
+  };
+  switch (shape) {
+    case ContainerShape::kBox:
+      for (int i = 0; i < 3; ++i)
+        positive(box_inner_size_m[i], "box_inner_size_m[" + std::to_string(i) + "]");
+      break;
+    case ContainerShape::kCylinder:
+      positive(cylinder_inner_radius_m, "cylinder_inner_radius_m");
+      positive(cylinder_inner_length_m, "cylinder_inner_length_m");
+      if (!is_axis(cylinder_axis)) {
+        problems.push_back(field(prefix, "cylinder_axis") + " = " + std::to_string(cylinder_axis) +
+                           ": must be 0, 1 or 2");
+      }
+      break;
+    default:
+      problems.push_back(field(prefix, "shape") + " = " + std::to_string(static_cast<int>(shape)) +
+                         ": must be box or cylinder");
+  }
+  return problems;
+}
+
+LatticeBed collected_lattice(const Container& container, int count, double radius_m,
+                             const LatticePacking& packing) {
+  if (const auto problems = packing_problems(container, count, radius_m, packing); !problems.empty()) {
+    std::string text;
+    for (const auto& line : problems) text += (text.empty() ? "" : "\n") + line;
+    reject(text);
+  }
+  const double r = radius_m;
+  const int drive = packing.drive_axis;
+  const bool cylinder = container.shape == ContainerShape::kCylinder;
+  if (cylinder && drive != container.cylinder_axis) {
+    reject("a cylinder driven across its axis (drive_axis = " + std::to_string(drive) +
+           ", cylinder_axis = " + std::to_string(container.cylinder_axis) + ") is not supported yet");
+  }
+
+  CrossSection cs;
+  cs.axis_a = drive == 0 ? 1 : 0;
+  cs.axis_b = drive == 2 ? 1 : 2;
+  if (packing.gravity_axis_sign && packing.gravity_axis_sign->first != drive) {
+    cs.gravity_axis = packing.gravity_axis_sign->first;
+    cs.gravity_sign = packing.gravity_axis_sign->second;
+  }
+  const double length = container.inner_length(drive);
+
+  std::vector<Vec3> sites;
+  if (packing.lattice_counts) {
+    const auto& n = *packing.lattice_counts;
+    const long long capacity = static_cast<long long>(n[0]) * n[1] * n[2];
+    if (count > capacity) {
+      reject("count = " + std::to_string(count) + " spheres > " + std::to_string(capacity) +
+             " sites of lattice_counts " + counts_text(n));
+    }
+    const auto check_fit = [&](int axis) {
+      const double inner = container.inner_length(axis);
+      if (n[axis] * 2.0 * r > inner * (1.0 + kFitTolerance)) {
+        reject("lattice_counts " + counts_text(n) + " with radius_m = " + number(r) + ": " +
+               std::to_string(n[axis]) + " sites need " + number(n[axis] * 2.0 * r) + " m along axis " +
+               std::to_string(axis) + ", the inner length is " + number(inner) + " m");
+      }
+    };
+    check_fit(drive);
+    if (cylinder) {
+      sites = cylinder_sites_block(r, container.cylinder_inner_radius_m, cs, n[cs.axis_a], n[cs.axis_b]);
+    } else {
+      check_fit(cs.axis_a);
+      check_fit(cs.axis_b);
+      sites = box_sites(container, r, cs, n[cs.axis_a], n[cs.axis_b]);
+    }
+  } else if (cylinder) {
+    sites = cylinder_sites_auto(r, container.cylinder_inner_radius_m, cs);
+  } else {
+    sites = box_sites(container, r, cs, sites_along(container.box_inner_size_m[cs.axis_a], r),
+                      sites_along(container.box_inner_size_m[cs.axis_b], r));
+  }
+  if (sites.empty()) {
+    reject("no sphere of radius_m = " + number(r) + " fits in the cross-section normal to axis " +
+           std::to_string(drive) + " (inner lengths " + number(container.inner_length(cs.axis_a)) + " and " +
+           number(container.inner_length(cs.axis_b)) + " m)");
+  }
+
+  // Lowest first (height against gravity), then by position: a strict, deterministic
+  // order. Sites of one row share bitwise-equal heights (one expression per row index).
+  const auto height = [&](const Vec3& p) {
+    return cs.gravity_axis < 0 ? 0.0 : -cs.gravity_sign * p[cs.gravity_axis];
+  };
+  std::sort(sites.begin(), sites.end(), [&](const Vec3& p, const Vec3& q) {
+    return std::tuple(height(p), p[0], p[1], p[2]) < std::tuple(height(q), q[0], q[1], q[2]);
+  });
+
+  const int per_slab = static_cast<int>(sites.size());
+  LatticeBed bed;
+  bed.slabs = static_cast<int>((static_cast<long long>(count) + per_slab - 1) / per_slab);
+  bed.bed_extent_m = bed.slabs * 2.0 * r;
+  bed.clearance_m = length - bed.bed_extent_m;
+  if (!(bed.clearance_m > 0.0)) {
+    reject("count = " + std::to_string(count) + " spheres of radius_m = " + number(r) + " fill " +
+           std::to_string(bed.slabs) + " slabs of " + std::to_string(per_slab) + " sites, extent " +
+           number(bed.bed_extent_m) + " m along axis " + std::to_string(drive) + " of inner length " +
+           number(length) + " m: clearance_m = " + number(bed.clearance_m) + " must be > 0");
+  }
+
+  bed.centres_m.reserve(static_cast<std::size_t>(count));
+  for (int placed = 0; placed < count; ++placed) {
+    const int slab = placed / per_slab;
+    Vec3 centre = sites[static_cast<std::size_t>(placed % per_slab)];
+    centre[drive] = packing.collect_side * (0.5 * length - r - 2.0 * r * slab);
+    bed.centres_m.push_back(centre);
+  }
+  return bed;
+}
+
+}  // namespace pdamp::formulas

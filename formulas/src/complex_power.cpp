@@ -1,4 +1,4 @@
-// Complex power P = ½F*·conj(V*) from sampled force and velocity via an FFTW r2c transform.
+// Complex power P = ½F*·conj(V*) from sampled force and velocity: period folding and an FFTW r2c transform.
 #include "pdamp/formulas/complex_power.hpp"
 
 #include <fftw3.h>
@@ -14,15 +14,18 @@
 #include <string>
 #include <unordered_map>
 
+#include "pdamp/formulas/collect_and_collide.hpp"  // kPi
+
 namespace pdamp::formulas {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586476925;
+constexpr double kTwoPi = 2.0 * kPi;
 /// Relative tolerance on T/dt being an integer (the DEM picks dt = T/n exactly, so
 /// only round-off of 1/(f·dt) is expected).
 constexpr double kWindowTolerance = 1e-9;
-/// |V*| below this fraction of max|v| counts as "no component at Ω": the velocity bin
-/// is then round-off of the other components and m_app, η* would be noise.
+/// |V*| below this fraction of the period-averaged velocity's largest value counts as
+/// "no component at Ω": the bin is then round-off of the other components (DC,
+/// harmonics) and m_app, η* would be noise.
 constexpr double kZeroVelocityFraction = 1e-12;
 
 std::string number(double value) {
@@ -32,14 +35,13 @@ std::string number(double value) {
   return out.str();
 }
 
-[[noreturn]] void reject(const std::string& what) {
-  throw std::invalid_argument("complex_power: " + what);
-}
+[[noreturn]] void reject(const std::string& what) { throw std::invalid_argument("complex_power: " + what); }
 
-/// FFTW plans cached per length. FFTW's planner is not thread-safe, so plan creation
-/// (and destruction) is serialised here; fftw_execute_dft_r2c on other arrays of the
-/// same alignment is thread-safe, so callers execute without the lock. Plans are made
-/// with FFTW_ESTIMATE: cheap to create, and they leave the planning arrays untouched.
+/// FFTW plans cached per transform length. FFTW's planner is not thread-safe, so plan
+/// creation (and destruction) is serialised here; fftw_execute_dft_r2c on other arrays
+/// of the same alignment is thread-safe, so callers execute without the lock. Plans are
+/// made with FFTW_ESTIMATE: cheap to create (no timing runs, so the same algorithm and
+/// the same round-off on every run), and they leave the planning arrays untouched.
 class PlanCache {
  public:
   PlanCache() = default;
@@ -55,13 +57,14 @@ class PlanCache {
     // The arrays only fix the plan's alignment and out-of-place layout: fftw_malloc
     // gives the same SIMD alignment as the per-thread workspaces used at execution.
     auto* in = static_cast<double*>(fftw_malloc(sizeof(double) * static_cast<std::size_t>(n)));
-    auto* out = static_cast<fftw_complex*>(
-        fftw_malloc(sizeof(fftw_complex) * (static_cast<std::size_t>(n) / 2 + 1)));
+    auto* out =
+        static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * (static_cast<std::size_t>(n) / 2 + 1)));
     fftw_plan plan = (in && out) ? fftw_plan_dft_r2c_1d(n, in, out, FFTW_ESTIMATE) : nullptr;
     fftw_free(in);
     fftw_free(out);
-    if (!plan) throw std::runtime_error("complex_power: FFTW could not plan a transform of length " +
-                                        std::to_string(n));
+    if (!plan)
+      throw std::runtime_error("complex_power: FFTW could not plan a transform of length " +
+                               std::to_string(n));
     plans_.emplace(n, plan);
     return plan;
   }
@@ -77,7 +80,7 @@ PlanCache& plan_cache() {
 }
 
 /// Per-thread input/output arrays (fftw_malloc-aligned), grown on demand and reused, so
-/// repeated calls of one length allocate nothing.
+/// repeated calls allocate nothing.
 class Workspace {
  public:
   Workspace() = default;
@@ -107,29 +110,50 @@ class Workspace {
   std::size_t capacity_ = 0;
 };
 
-struct BinAmplitude {
-  std::complex<double> amplitude;  ///< (2/N)·X[bin]
-  double max_abs = 0.0;            ///< max|sₙ|
+struct FundamentalAmplitude {
+  std::complex<double> amplitude;  ///< S* = (2/N)·X_N[k]
+  double max_abs_average = 0.0;    ///< max over the period-averaged signal, |s̄ₘ|
 };
 
-/// Copies `signal` into the workspace (rejecting non-finite samples) and transforms it.
-BinAmplitude amplitude_at(std::span<const double> signal, const char* name, int bin, fftw_plan plan,
-                          Workspace& workspace) {
-  double* in = workspace.in();
-  double max_abs = 0.0;
-  for (std::size_t i = 0; i < signal.size(); ++i) {
-    const double value = signal[i];
-    if (!std::isfinite(value)) {
-      reject(std::string(name) + "[" + std::to_string(i) + "] = " + number(value) +
-             ": samples must be finite");
-    }
-    in[i] = value;
-    max_abs = std::max(max_abs, std::abs(value));
+/// S* of a signal of k whole periods of M samples (N = kM). With n = pM + m the bin-k
+/// twiddle e^{−2πi kn/N} = e^{−2πi m/M} does not depend on the period p, so
+///   X_N[k] = Σₘ (Σₚ s_{pM+m}) e^{−2πi m/M} = k·Ȳ[1],
+/// where Ȳ is the length-M DFT of the period-averaged signal s̄ₘ = (1/k)Σₚ s_{pM+m}, and
+/// S* = (2/N)·X_N[k] = (2/M)·Ȳ[1] exactly. Why: the fold costs N additions and the
+/// FFT M log M, against N log N for the length-N transform (15x faster at N = 1e5, M = 1000).
+FundamentalAmplitude fundamental(std::span<const double> signal, const char* name, int samples_per_period,
+                                 fftw_plan plan, Workspace& workspace) {
+  const std::size_t m_count = static_cast<std::size_t>(samples_per_period);
+  const std::size_t periods = signal.size() / m_count;
+  double* folded = workspace.in();
+  std::copy_n(signal.data(), m_count, folded);
+  for (std::size_t p = 1; p < periods; ++p) {
+    const double* period = signal.data() + p * m_count;
+    for (std::size_t m = 0; m < m_count; ++m) folded[m] += period[m];
   }
-  fftw_execute_dft_r2c(plan, in, workspace.out());
-  const fftw_complex& x = workspace.out()[bin];
-  const double scale = 2.0 / static_cast<double>(signal.size());
-  return {{scale * x[0], scale * x[1]}, max_abs};
+  const double inverse_periods = 1.0 / static_cast<double>(periods);
+  double max_abs_average = 0.0;
+  bool finite = true;
+  for (std::size_t m = 0; m < m_count; ++m) {
+    folded[m] *= inverse_periods;
+    finite = finite && std::isfinite(folded[m]);
+    max_abs_average = std::max(max_abs_average, std::abs(folded[m]));
+  }
+  // A non-finite sample makes its folded sum non-finite: only then search for it.
+  if (!finite) {
+    for (std::size_t i = 0; i < signal.size(); ++i) {
+      if (!std::isfinite(signal[i])) {
+        reject(std::string(name) + "[" + std::to_string(i) + "] = " + number(signal[i]) +
+               ": samples must be finite");
+      }
+    }
+    reject(std::string(name) + ": the sum over " + std::to_string(periods) +
+           " periods overflows: samples must be finite and far below 1e308");
+  }
+  fftw_execute_dft_r2c(plan, folded, workspace.out());
+  const fftw_complex& y = workspace.out()[1];
+  const double scale = 2.0 / static_cast<double>(samples_per_period);
+  return {{scale * y[0], scale * y[1]}, max_abs_average};
 }
 
 }  // namespace
@@ -142,8 +166,8 @@ double ComplexPower::reduced_loss_factor(double bed_mass_kg) const {
   return e_diss_j / (0.5 * bed_mass_kg * std::norm(velocity_amplitude));
 }
 
-ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s,
-                           double dt_s, double frequency_hz) {
+ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s, double dt_s,
+                           double frequency_hz) {
   if (force_n.empty() || velocity_m_s.empty()) {
     reject("force has " + std::to_string(force_n.size()) + " samples, velocity " +
            std::to_string(velocity_m_s.size()) + ": both must be non-empty");
@@ -158,21 +182,21 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
   }
   if (force_n.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
     reject("N = " + std::to_string(force_n.size()) + " samples: at most " +
-           std::to_string(std::numeric_limits<int>::max()) + " (FFTW's int length)");
+           std::to_string(std::numeric_limits<int>::max()));
   }
   const int n = static_cast<int>(force_n.size());
 
   const double period_over_dt = 1.0 / (frequency_hz * dt_s);
   const double nearest = std::round(period_over_dt);
   if (std::abs(period_over_dt - nearest) > kWindowTolerance * period_over_dt) {
-    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) + ": T/dt = " +
-           number(period_over_dt) + " must be an integer (within 1e-9 relative)");
+    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) +
+           ": T/dt = " + number(period_over_dt) + " must be an integer (within 1e-9 relative)");
   }
   // Below 3 samples per period Ω sits at or above Nyquist, where (2/N)·X[k] is not
-  // the amplitude.
+  // the amplitude (at M = 2 a sine of any amplitude samples to zero).
   if (nearest < 3.0) {
-    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) + ": T/dt = " +
-           number(nearest) + " samples per period, must be >= 3");
+    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) +
+           ": T/dt = " + number(nearest) + " samples per period, must be >= 3");
   }
   if (nearest > static_cast<double>(n) || n % static_cast<int>(nearest) != 0) {
     reject("N = " + std::to_string(n) + " samples, T/dt = " + number(nearest) +
@@ -181,21 +205,21 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
   const int samples_per_period = static_cast<int>(nearest);
   const int periods = n / samples_per_period;
 
-  const fftw_plan plan = plan_cache().plan_for(n);
+  const fftw_plan plan = plan_cache().plan_for(samples_per_period);
   thread_local Workspace workspace;
-  workspace.reserve(static_cast<std::size_t>(n));
+  workspace.reserve(static_cast<std::size_t>(samples_per_period));
 
   ComplexPower result;
-  result.force_amplitude = amplitude_at(force_n, "force_n", periods, plan, workspace).amplitude;
-  const BinAmplitude velocity = amplitude_at(velocity_m_s, "velocity_m_s", periods, plan, workspace);
+  result.force_amplitude = fundamental(force_n, "force_n", samples_per_period, plan, workspace).amplitude;
+  const FundamentalAmplitude velocity =
+      fundamental(velocity_m_s, "velocity_m_s", samples_per_period, plan, workspace);
   result.velocity_amplitude = velocity.amplitude;
-  const double max_velocity = velocity.max_abs;
 
   const double v_norm = std::norm(result.velocity_amplitude);
-  if (!(std::sqrt(v_norm) > kZeroVelocityFraction * max_velocity)) {
-    reject("|V*| = " + number(std::sqrt(v_norm)) + " m/s with max|v| = " + number(max_velocity) +
-           " m/s: the velocity has no component at the drive frequency " + number(frequency_hz) +
-           " Hz, so m_app and eta* are undefined");
+  if (!(std::sqrt(v_norm) > kZeroVelocityFraction * velocity.max_abs_average)) {
+    reject("|V*| = " + number(std::sqrt(v_norm)) + " m/s with max|v| = " + number(velocity.max_abs_average) +
+           " m/s over the period-averaged velocity: it has no component at the drive frequency " +
+           number(frequency_hz) + " Hz, so m_app and eta* are undefined");
   }
 
   const double omega = kTwoPi * frequency_hz;

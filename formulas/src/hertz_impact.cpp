@@ -1,2 +1,290 @@
-// hertz_impact: implementation pending (helper in progress).
+// Hertz contact of elastic spheres, impact penetration and duration, and buffered-wall sizing.
 #include "pdamp/formulas/hertz_impact.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "pdamp/formulas/collect_and_collide.hpp"  // kPi, kStandardGravity
+
+namespace pdamp::formulas {
+namespace {
+
+/// Thresholds of the buffer's validity warnings (docs/hertz_and_buffer.md).
+constexpr double kMaxContactTimeOverPeriod = 0.1;    // impact short against the period
+constexpr double kMaxContactRadiusOverRadius = 0.2;  // Hertz small-strain: a ≪ r
+constexpr double kIntensityMismatch = 1e-6;          // relative X-Γ disagreement warned about
+
+std::string number(double value, int digits = 12) {
+  std::ostringstream out;
+  out.precision(digits);
+  out << value;
+  return out.str();
+}
+
+std::string field(const std::string& prefix, const char* name) {
+  return prefix.empty() ? std::string(name) : prefix + "." + name;
+}
+
+bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
+
+bool valid(const Material& m) {
+  return positive_finite(m.density_kg_m3) && positive_finite(m.youngs_modulus_pa) && m.poisson_ratio >= 0.0 &&
+         m.poisson_ratio < 0.5;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const auto& line : lines) text += (text.empty() ? "" : "\n") + line;
+  return text;
+}
+
+void require_valid(const Material& m, const char* function, const char* name) {
+  if (!valid(m)) throw std::invalid_argument(std::string(function) + ": " + joined(m.validate(name)));
+}
+
+void require_positive(double value, const char* function, const char* name) {
+  if (!positive_finite(value)) {
+    throw std::invalid_argument(std::string(function) + ": " + name + " = " + number(value) +
+                                ": must be > 0 and finite");
+  }
+}
+
+/// (1 − ν²)/E: the compliance of one body in 1/E*.
+double compliance(const Material& m) {
+  return (1.0 - m.poisson_ratio * m.poisson_ratio) / m.youngs_modulus_pa;
+}
+
+void require_valid(const HertzContact& c, double speed, const char* function) {
+  require_positive(speed, function, "impact_speed_m_s");
+  require_positive(c.effective_modulus_pa, function, "effective_modulus_pa");
+  require_positive(c.effective_radius_m, function, "effective_radius_m");
+  require_positive(c.effective_mass_kg, function, "effective_mass_kg");
+}
+
+/// I = ∫₀¹ (1 − x^{5/2})^{-1/2} dx = (2/5)·B(2/5, 1/2) (substitute u = x^{5/2}).
+double half_contact_integral() {
+  static const double value = 0.4 * std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
+  return value;
+}
+
+}  // namespace
+
+std::vector<std::string> Material::validate(const std::string& prefix) const {
+  std::vector<std::string> problems;
+  if (!positive_finite(density_kg_m3)) {
+    problems.push_back(field(prefix, "density_kg_m3") + " = " + number(density_kg_m3) +
+                       ": must be > 0 and finite");
+  }
+  if (!positive_finite(youngs_modulus_pa)) {
+    problems.push_back(field(prefix, "youngs_modulus_pa") + " = " + number(youngs_modulus_pa) +
+                       ": must be > 0 and finite");
+  }
+  if (!(poisson_ratio >= 0.0 && poisson_ratio < 0.5)) {
+    problems.push_back(field(prefix, "poisson_ratio") + " = " + number(poisson_ratio) +
+                       ": must be in [0, 0.5)");
+  }
+  return problems;
+}
+
+double effective_modulus(const Material& a, const Material& b) {
+  require_valid(a, "effective_modulus", "a");
+  require_valid(b, "effective_modulus", "b");
+  return 1.0 / (compliance(a) + compliance(b));
+}
+
+double effective_modulus_rigid(const Material& a) {
+  require_valid(a, "effective_modulus_rigid", "a");
+  return 1.0 / compliance(a);
+}
+
+double HertzContact::force(double overlap_m) const {
+  if (!(overlap_m > 0.0)) return 0.0;
+  return 4.0 / 3.0 * effective_modulus_pa * std::sqrt(effective_radius_m) * overlap_m * std::sqrt(overlap_m);
+}
+
+HertzContact sphere_sphere_contact(double radius1_m, double mass1_kg, const Material& m1, double radius2_m,
+                                   double mass2_kg, const Material& m2) {
+  constexpr const char* kFunction = "sphere_sphere_contact";
+  require_positive(radius1_m, kFunction, "radius1_m");
+  require_positive(mass1_kg, kFunction, "mass1_kg");
+  require_positive(radius2_m, kFunction, "radius2_m");
+  require_positive(mass2_kg, kFunction, "mass2_kg");
+  require_valid(m1, kFunction, "m1");
+  require_valid(m2, kFunction, "m2");
+  HertzContact contact;
+  contact.effective_modulus_pa = 1.0 / (compliance(m1) + compliance(m2));
+  contact.effective_radius_m = radius1_m * radius2_m / (radius1_m + radius2_m);
+  contact.effective_mass_kg = mass1_kg * mass2_kg / (mass1_kg + mass2_kg);
+  return contact;
+}
+
+HertzContact sphere_wall_contact(double radius_m, double mass_kg, const Material& sphere,
+                                 const Material& wall) {
+  constexpr const char* kFunction = "sphere_wall_contact";
+  require_positive(radius_m, kFunction, "radius_m");
+  require_positive(mass_kg, kFunction, "mass_kg");
+  require_valid(sphere, kFunction, "sphere");
+  require_valid(wall, kFunction, "wall");
+  return {1.0 / (compliance(sphere) + compliance(wall)), radius_m, mass_kg};
+}
+
+HertzContact sphere_rigid_wall_contact(double radius_m, double mass_kg, const Material& sphere) {
+  constexpr const char* kFunction = "sphere_rigid_wall_contact";
+  require_positive(radius_m, kFunction, "radius_m");
+  require_positive(mass_kg, kFunction, "mass_kg");
+  require_valid(sphere, kFunction, "sphere");
+  return {1.0 / compliance(sphere), radius_m, mass_kg};
+}
+
+double max_penetration(const HertzContact& contact, double impact_speed_m_s) {
+  require_valid(contact, impact_speed_m_s, "max_penetration");
+  const double v = impact_speed_m_s;
+  return std::pow(15.0 * contact.effective_mass_kg * v * v /
+                      (16.0 * contact.effective_modulus_pa * std::sqrt(contact.effective_radius_m)),
+                  0.4);
+}
+
+double contact_time(const HertzContact& contact, double impact_speed_m_s) {
+  // Energy conservation gives δ' = v√(1 − (δ/δ_max)^{5/2}); the approach takes
+  // (δ_max/v)·I and the restitution the same.
+  return 2.0 * half_contact_integral() * max_penetration(contact, impact_speed_m_s) / impact_speed_m_s;
+}
+
+double contact_time_coefficient() { return 2.0 * std::pow(15.0 / 16.0, 0.4) * half_contact_integral(); }
+
+std::vector<std::string> BufferDesignInput::validate() const {
+  std::vector<std::string> problems;
+  const auto positive = [&](double value, const char* name) {
+    if (!positive_finite(value))
+      problems.push_back(std::string(name) + " = " + number(value) + ": must be > 0 and finite");
+  };
+  const auto non_negative = [&](double value, const char* name) {
+    if (!(value >= 0.0 && std::isfinite(value))) {
+      problems.push_back(std::string(name) + " = " + number(value) + ": must be >= 0 and finite");
+    }
+  };
+  positive(frequency_hz, "frequency_hz");
+  non_negative(amplitude_m, "amplitude_m");
+  non_negative(intensity, "intensity");
+  non_negative(impact_velocity_m_s, "impact_velocity_m_s");
+  if (amplitude_m == 0.0 && intensity == 0.0 && impact_velocity_m_s == 0.0) {
+    problems.push_back(
+        "amplitude_m = 0 and intensity = 0: give the design stroke or intensity (or impact_velocity_m_s)");
+  }
+  positive(particle_radius_m, "particle_radius_m");
+  if (!(particles_per_contact >= 1.0 && std::isfinite(particles_per_contact))) {
+    problems.push_back("particles_per_contact = " + number(particles_per_contact) +
+                       ": must be >= 1 and finite");
+  }
+  for (auto& line : particle.validate("particle")) problems.push_back(std::move(line));
+  for (auto& line : layer.validate("layer")) problems.push_back(std::move(line));
+  return problems;
+}
+
+BufferDesign size_buffer_layer(const BufferDesignInput& input) {
+  if (const auto problems = input.validate(); !problems.empty()) {
+    throw std::invalid_argument("size_buffer_layer: " + joined(problems));
+  }
+  const double f = input.frequency_hz;
+  const double omega = 2.0 * kPi * f;
+  const double r = input.particle_radius_m;
+  const double stroke =
+      input.amplitude_m > 0.0 ? input.amplitude_m : input.intensity * kStandardGravity / (omega * omega);
+  const double intensity = stroke * omega * omega / kStandardGravity;
+
+  BufferDesign design;
+  design.impact_velocity_m_s =
+      input.impact_velocity_m_s > 0.0 ? input.impact_velocity_m_s : 2.0 * stroke * omega;
+  const double particle_mass = input.particle.density_kg_m3 * 4.0 / 3.0 * kPi * r * r * r;
+  design.effective_mass_kg = input.particles_per_contact * particle_mass;
+  const HertzContact contact = sphere_wall_contact(r, design.effective_mass_kg, input.particle, input.layer);
+  const double v = design.impact_velocity_m_s;
+  design.max_penetration_m = max_penetration(contact, v);
+  design.layer_thickness_m = design.max_penetration_m;
+  design.contact_time_s = contact_time(contact, v);
+  design.contact_time_over_period = design.contact_time_s * f;
+  design.max_force_n = contact.force(design.max_penetration_m);
+  design.contact_radius_m = std::sqrt(r * design.max_penetration_m);
+  const double thickness = design.layer_thickness_m;
+  const double a = design.contact_radius_m;
+
+  auto& said = design.assumptions;
+  if (input.impact_velocity_m_s > 0.0) {
+    said.push_back("Impact speed v = " + number(v, 4) +
+                   " m/s as given (not derived from the design stroke).");
+  } else {
+    const std::string origin = input.amplitude_m > 0.0
+                                   ? "the design stroke X = " + number(stroke, 4) + " m"
+                                   : "the design stroke X = Gamma*g/Omega^2 = " + number(stroke, 4) +
+                                         " m (Gamma = " + number(input.intensity, 4) + ")";
+    said.push_back(
+        "Impact speed v = 2*X*Omega = " + number(v, 4) + " m/s from " + origin + " at f = " + number(f, 4) +
+        " Hz: at the bouncing optimum the bed leaves one wall at the peak container velocity V = X*Omega "
+        "and meets the other wall moving at -V (PHYSICS.md, section 2).");
+  }
+  if (input.particles_per_contact == 1.0) {
+    said.push_back("One sphere (r = " + number(r, 4) + " m, m = " + number(particle_mass, 4) +
+                   " kg) hits the layer alone: particles_per_contact = 1.");
+  } else {
+    said.push_back("The bed's mass is shared over its front row: each front-row sphere (r = " + number(r, 4) +
+                   " m) hits the layer carrying " + number(input.particles_per_contact, 4) +
+                   " spheres, m* = " + number(design.effective_mass_kg, 4) +
+                   " kg, as a rigid column (no wave travel or rebound inside the bed).");
+  }
+  said.push_back(
+      "The wall behind the layer is rigid and driven (no wall mass in m*); the contact is a sphere on "
+      "an elastic half-space of the layer material, E* = " +
+      number(contact.effective_modulus_pa, 4) + " Pa from both materials.");
+  said.push_back(
+      "Layer modulus E = " + number(input.layer.youngs_modulus_pa, 4) +
+      " Pa (nu = " + number(input.layer.poisson_ratio, 3) +
+      ") is taken at the design frequency and temperature: polymers are rate- and temperature-dependent "
+      "(viscoelastic), and Hertz is elastic, so the layer's own loss is not in this sizing.");
+  said.push_back(
+      "Hertz treats the layer as a half-space, valid while the contact radius a = sqrt(r*delta) is "
+      "small against the thickness; here a = " +
+      number(a, 4) + " m is " + number(a / thickness, 3) + " times the thickness " + number(thickness, 4) +
+      " m.");
+  said.push_back(
+      "The thickness equals delta_max so the design impact just compresses the layer fully (strain 1 "
+      "under the sphere's tip): a first sizing beyond linear elasticity, to be checked in the DEM.");
+
+  auto& warn = design.warnings;
+  if (design.contact_time_over_period > kMaxContactTimeOverPeriod) {
+    warn.push_back(
+        "contact time " + number(design.contact_time_s, 4) + " s is " +
+        number(design.contact_time_over_period, 3) +
+        " of the period (> 0.1): the impact is not short against the period, so it is not an impact "
+        "and the collect-and-collide timing does not hold");
+  }
+  if (a > thickness) {
+    warn.push_back(
+        "contact radius a = " + number(a, 4) + " m is " + number(a / thickness, 3) +
+        " times the layer thickness " + number(thickness, 4) +
+        " m: the layer is thin, not the half-space Hertz assumes; a thin layer on the rigid wall is "
+        "stiffer, so the design impact compresses it less than fully and bottoms out only at a higher "
+        "speed");
+  }
+  if (a > kMaxContactRadiusOverRadius * r) {
+    warn.push_back("contact radius a = " + number(a, 4) + " m is " + number(a / r, 3) +
+                   " of the particle radius " + number(r, 4) +
+                   " m (> 0.2): Hertz needs a << r (small strain)");
+  }
+  if (input.impact_velocity_m_s == 0.0 && intensity < 1.0) {
+    warn.push_back("design intensity Gamma = " + number(intensity, 3) +
+                   " < 1: the bed rolls rather than flies (PHYSICS.md, section 3), so the bouncing impact "
+                   "speed 2*X*Omega "
+                   "overestimates the impact");
+  }
+  if (input.amplitude_m > 0.0 && input.intensity > 0.0 &&
+      std::abs(input.intensity - intensity) > kIntensityMismatch * intensity) {
+    warn.push_back("intensity = " + number(input.intensity, 6) +
+                   " disagrees with amplitude_m = " + number(input.amplitude_m, 6) +
+                   " m (Gamma = " + number(intensity, 6) + "): the amplitude is used");
+  }
+  return design;
+}
+
+}  // namespace pdamp::formulas

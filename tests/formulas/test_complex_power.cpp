@@ -1,8 +1,5 @@
 // Tests of complex_power against synthetic signals whose complex power is known in closed form.
-#include "pdamp/formulas/complex_power.hpp"
-
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <complex>
 #include <functional>
@@ -12,19 +9,21 @@
 #include <thread>
 #include <vector>
 
+#include "pdamp/formulas/complex_power.hpp"
+
 namespace {
 
 using pdamp::formulas::complex_power;
 using pdamp::formulas::ComplexPower;
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kFrequency = 5.0;                   // Hz
-constexpr double kOmega = 2.0 * kPi * kFrequency;    // rad/s
+constexpr double kFrequency = 5.0;                 // Hz
+constexpr double kOmega = 2.0 * kPi * kFrequency;  // rad/s
 constexpr int kSamplesPerPeriod = 200;
 constexpr double kDt = 1.0 / (kFrequency * kSamplesPerPeriod);  // s
-constexpr double kVelocityAmplitude = 0.3;           // |V*|, m/s
-constexpr double kVelocityPhase = 0.4;               // arg V*, rad
-constexpr double kBedMass = 0.2;                     // kg
+constexpr double kVelocityAmplitude = 0.3;                      // |V*|, m/s
+constexpr double kVelocityPhase = 0.4;                          // arg V*, rad
+constexpr double kBedMass = 0.2;                                // kg
 
 using Signal = std::function<double(double)>;
 
@@ -52,12 +51,8 @@ ComplexPower analyse(const Record& record) {
 
 // Container motion with V* = 0.3·e^{0.4i}: v = Re(V* e^{iΩt}), x = ∫v, a = dv/dt.
 double velocity(double t) { return kVelocityAmplitude * std::cos(kOmega * t + kVelocityPhase); }
-double displacement(double t) {
-  return kVelocityAmplitude / kOmega * std::sin(kOmega * t + kVelocityPhase);
-}
-double acceleration(double t) {
-  return -kVelocityAmplitude * kOmega * std::sin(kOmega * t + kVelocityPhase);
-}
+double displacement(double t) { return kVelocityAmplitude / kOmega * std::sin(kOmega * t + kVelocityPhase); }
+double acceleration(double t) { return -kVelocityAmplitude * kOmega * std::sin(kOmega * t + kVelocityPhase); }
 
 // Content orthogonal to the bin at Ω over whole periods: a DC offset and harmonics 2Ω, 3Ω.
 double other_content(double t, double scale) {
@@ -113,7 +108,8 @@ TEST_CASE("a viscous damper gives eta* = c/(m_bed Omega) and no apparent mass", 
   double work = 0.0;
   for (std::size_t i = 0; i < record.force.size(); ++i) work += record.force[i] * record.velocity[i] * kDt;
   CHECK(clean.energy_per_cycle_j == Approx(work / 12.0).epsilon(1e-12));
-  CHECK(clean.e_diss_j == Approx(damper.c * kVelocityAmplitude * kVelocityAmplitude / (2.0 * kOmega)).epsilon(1e-12));
+  CHECK(clean.e_diss_j ==
+        Approx(damper.c * kVelocityAmplitude * kVelocityAmplitude / (2.0 * kOmega)).epsilon(1e-12));
 
   SECTION("a DC offset and harmonics at 2 and 3 Omega on both signals change nothing") {
     const auto force_plus = [&](double t) { return damper.force(t) + other_content(t, 1.0); };
@@ -185,7 +181,8 @@ struct NoiseCase {
   double mass_sd() const { return sigma * std::sqrt(2.0 / n()) / (kVelocityAmplitude * kOmega); }
   ComplexPower run(std::mt19937_64& rng) const {
     std::normal_distribution<double> noise(0.0, sigma);
-    Record record = sample([&](double t) { return element.force(t) + other_content(t, 1.0); }, velocity, periods);
+    Record record =
+        sample([&](double t) { return element.force(t) + other_content(t, 1.0); }, velocity, periods);
     for (double& f : record.force) f += noise(rng);
     return analyse(record);
   }
@@ -199,7 +196,8 @@ TEST_CASE("noise on the force moves eta* and m_app by the expected few sigma", "
   const ComplexPower result = noisy.run(rng);
   // sd(η*) ≈ 0.0048 and sd(m_app) ≈ 9.5e-4 kg for σ = 1 N, N = 10 000: allow 4 sd
   // (a 6e-5 chance of a false failure for an arbitrary seed; the seed is fixed).
-  CHECK(result.reduced_loss_factor(kBedMass) == Approx(noisy.element.eta_star()).margin(4.0 * noisy.eta_sd()));
+  CHECK(result.reduced_loss_factor(kBedMass) ==
+        Approx(noisy.element.eta_star()).margin(4.0 * noisy.eta_sd()));
   CHECK(result.apparent_mass_kg == Approx(noisy.element.apparent_mass()).margin(4.0 * noisy.mass_sd()));
 }
 
@@ -225,44 +223,87 @@ TEST_CASE("the scatter of eta* over noisy records matches sigma*sqrt(2/N)/(|V*| 
   CHECK(std::abs(sum_mass / kRecords) < 4.0 * noisy.mass_sd() / std::sqrt(kRecords));
 }
 
-TEST_CASE("complex_power is safe to call from several threads with different lengths", "[formulas]") {
-  const LinearElement element{2.5, 0.7, 1500.0};
-  const auto force = [&](double t) { return element.force(t); };
-  std::vector<Record> records;
-  std::vector<ComplexPower> serial;
-  for (int periods = 1; periods <= 8; ++periods) {
-    records.push_back(sample(force, velocity, periods + 20));
-    serial.push_back(analyse(records.back()));
+TEST_CASE("the amplitudes equal the DFT bin at k periods for arbitrary signals", "[formulas]") {
+  // Independent reference: the single DFT bin S* = (2/N)·Σₙ sₙ e^{−2πi kn/N} summed
+  // directly in long double, for white noise (no periodicity the code could rely on).
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  constexpr int kPeriods = 7;
+  constexpr int kN = kPeriods * kSamplesPerPeriod;
+  std::vector<double> force(kN), speed(kN);
+  for (int i = 0; i < kN; ++i) {
+    force[i] = uniform(rng);
+    speed[i] = uniform(rng) + 0.5 * std::cos(kOmega * i * kDt);
   }
-  // Each thread plans (first use of some lengths) and executes concurrently; results
-  // must equal the serial ones bit for bit (FFTW's output for one plan is deterministic).
+  const auto direct_bin = [&](const std::vector<double>& s) {
+    long double re = 0.0L, im = 0.0L;
+    const long double pi = 3.141592653589793238462643383279502884L;
+    for (int n = 0; n < kN; ++n) {
+      const long double angle =
+          -2.0L * pi * static_cast<long double>((static_cast<long long>(kPeriods) * n) % kN) / kN;
+      re += s[n] * std::cos(angle);
+      im += s[n] * std::sin(angle);
+    }
+    return std::complex<double>(static_cast<double>(2.0L * re / kN), static_cast<double>(2.0L * im / kN));
+  };
+  const ComplexPower result = complex_power(force, speed, kDt, kFrequency);
+  // The sums run over 1400 terms of size ~1: round-off ~1e-15 absolute on S* ~ 0.04.
+  CHECK(std::abs(result.force_amplitude - direct_bin(force)) < 1e-13);
+  CHECK(std::abs(result.velocity_amplitude - direct_bin(speed)) < 1e-13);
+}
+
+TEST_CASE("complex_power is safe to call from several threads with different period lengths", "[formulas]") {
+  // Eight period lengths M no other test uses, so the threads race to create their
+  // FFTW plans (the planner is not thread-safe: the cache must serialise it).
+  const LinearElement element{2.5, 0.7, 1500.0};
+  struct Job {
+    std::vector<double> force, velocity;
+    double dt = 0.0;
+  };
+  std::vector<Job> jobs;
+  for (int j = 0; j < 8; ++j) {
+    const int samples_per_period = 101 + 17 * j;
+    Job job;
+    job.dt = 1.0 / (kFrequency * samples_per_period);
+    for (int i = 0; i < 3 * samples_per_period; ++i) {
+      job.force.push_back(element.force(i * job.dt));
+      job.velocity.push_back(velocity(i * job.dt));
+    }
+    jobs.push_back(std::move(job));
+  }
+  const auto run = [&](const Job& job) { return complex_power(job.force, job.velocity, job.dt, kFrequency); };
+
   std::vector<std::vector<ComplexPower>> parallel(4);
   std::vector<std::thread> threads;
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&, t] {
       for (int repeat = 0; repeat < 5; ++repeat) {
-        for (std::size_t i = 0; i < records.size(); ++i) {
-          parallel[t].push_back(analyse(records[(i + t) % records.size()]));
-        }
+        for (std::size_t i = 0; i < jobs.size(); ++i) parallel[t].push_back(run(jobs[(i + t) % jobs.size()]));
       }
     });
   }
   for (auto& thread : threads) thread.join();
+  // Afterwards, serially: every concurrent result must equal it bit for bit (one plan
+  // per length, and FFTW's output for one plan and input is deterministic).
   for (int t = 0; t < 4; ++t) {
+    REQUIRE(parallel[t].size() == 5 * jobs.size());
     for (std::size_t j = 0; j < parallel[t].size(); ++j) {
-      const ComplexPower& expected = serial[(j % records.size() + t) % records.size()];
-      CHECK(parallel[t][j].power == expected.power);
+      const ComplexPower serial = run(jobs[(j % jobs.size() + t) % jobs.size()]);
+      CHECK(parallel[t][j].power == serial.power);
+      CHECK(parallel[t][j].apparent_mass_kg == serial.apparent_mass_kg);
     }
   }
+  CHECK(run(jobs[3]).apparent_mass_kg == Approx(element.apparent_mass()).margin(1e-12));
 }
 
 TEST_CASE("complex_power rejects records that are not whole periods", "[formulas]") {
   const Record record = sample(velocity, velocity, 4);
   SECTION("T/dt not an integer") {
     const double dt = 1.0 / (kFrequency * 200.5);
-    CHECK_THROWS_MATCHES(complex_power(record.force, record.velocity, dt, kFrequency), std::invalid_argument,
-                         Catch::Message("complex_power: dt_s = 0.000997506234414, frequency_hz = 5: T/dt = 200.5 "
-                                        "must be an integer (within 1e-9 relative)"));
+    CHECK_THROWS_MATCHES(
+        complex_power(record.force, record.velocity, dt, kFrequency), std::invalid_argument,
+        Catch::Message("complex_power: dt_s = 0.000997506234414, frequency_hz = 5: T/dt = 200.5 "
+                       "must be an integer (within 1e-9 relative)"));
   }
   SECTION("T/dt off an integer by more than 1e-9 relative") {
     const double dt = kDt * (1.0 + 1e-8);
@@ -270,13 +311,14 @@ TEST_CASE("complex_power rejects records that are not whole periods", "[formulas
   }
   SECTION("T/dt within round-off of an integer is accepted") {
     const double dt = kDt * (1.0 + 1e-12);
-    CHECK(complex_power(record.force, record.velocity, dt, kFrequency).samples_per_period == kSamplesPerPeriod);
+    CHECK(complex_power(record.force, record.velocity, dt, kFrequency).samples_per_period ==
+          kSamplesPerPeriod);
   }
   SECTION("N not a multiple of T/dt") {
     const std::span<const double> f(record.force.data(), 750);
     const std::span<const double> v(record.velocity.data(), 750);
-    CHECK_THROWS_WITH(complex_power(f, v, kDt, kFrequency),
-                      Catch::Contains("N = 750 samples, T/dt = 200") && Catch::Contains("whole number of periods"));
+    CHECK_THROWS_WITH(complex_power(f, v, kDt, kFrequency), Catch::Contains("N = 750 samples, T/dt = 200") &&
+                                                                Catch::Contains("whole number of periods"));
   }
   SECTION("shorter than one period") {
     const std::span<const double> f(record.force.data(), 150);
@@ -321,7 +363,8 @@ TEST_CASE("complex_power rejects a velocity without a component at the drive fre
   CHECK_THROWS_WITH(complex_power(harmonics_only.force, harmonics_only.velocity, kDt, kFrequency),
                     Catch::Contains("no component at the drive frequency 5 Hz"));
   const std::vector<double> zeros(600, 0.0);
-  CHECK_THROWS_WITH(complex_power(harmonics_only.force, zeros, kDt, kFrequency), Catch::Contains("|V*| = 0 m/s"));
+  CHECK_THROWS_WITH(complex_power(harmonics_only.force, zeros, kDt, kFrequency),
+                    Catch::Contains("|V*| = 0 m/s"));
 }
 
 TEST_CASE("the reduced loss factor needs a positive bed mass", "[formulas]") {

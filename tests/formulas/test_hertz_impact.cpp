@@ -1,2 +1,298 @@
-// Tests of hertz_impact (in progress).
+// Tests of the Hertz impact formulas against a numerical integration of the Hertz ODE.
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pdamp/formulas/hertz_impact.hpp"
+
+namespace {
+
+namespace fm = pdamp::formulas;
+
+constexpr double kPi = 3.14159265358979323846;
+
+double sphere_mass(double radius_m, const fm::Material& m) {
+  return m.density_kg_m3 * 4.0 / 3.0 * kPi * radius_m * radius_m * radius_m;
+}
+
+struct ImpactOde {
+  double max_penetration_m = 0.0;
+  double contact_time_s = 0.0;
+  double rebound_speed_m_s = 0.0;
+};
+
+// Independent reference: RK4 integration of m*δ'' = −(4/3)E*√R* δ^{3/2} from δ = 0,
+// δ' = v until δ returns to 0. The step is 1/20000 of the impact's time scale
+// τ = (m*²/(R*E*²v))^{1/5} (dimensional analysis, not the formula under test), so
+// t_c spans ~57 000 steps. δ_max is the largest sample: near the turning point δ is
+// flat, so sampling costs ~(h/τ)²/8 ≈ 3e-10 relative. The end of contact is found by
+// linear interpolation of δ between the last two steps, where δ'' ∝ δ^{3/2} → 0, so
+// the interpolation error is far below the step.
+ImpactOde integrate_impact(const fm::HertzContact& c, double v) {
+  const double k = 4.0 / 3.0 * c.effective_modulus_pa * std::sqrt(c.effective_radius_m);
+  const double m = c.effective_mass_kg;
+  const auto accel = [&](double delta) { return delta > 0.0 ? -k / m * delta * std::sqrt(delta) : 0.0; };
+  const double tau =
+      std::pow(m * m / (c.effective_radius_m * c.effective_modulus_pa * c.effective_modulus_pa * v), 0.2);
+  const double h = tau / 20000.0;
+  double t = 0.0, x = 0.0, u = v;
+  ImpactOde out;
+  for (;;) {
+    const double k1x = u, k1u = accel(x);
+    const double k2x = u + 0.5 * h * k1u, k2u = accel(x + 0.5 * h * k1x);
+    const double k3x = u + 0.5 * h * k2u, k3u = accel(x + 0.5 * h * k2x);
+    const double k4x = u + h * k3u, k4u = accel(x + h * k3x);
+    const double x_next = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+    const double u_next = u + h / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+    if (x_next <= 0.0 && u_next < 0.0) {
+      out.contact_time_s = t + h * x / (x - x_next);
+      out.rebound_speed_m_s = -u_next;
+      return out;
+    }
+    t += h;
+    x = x_next;
+    u = u_next;
+    out.max_penetration_m = std::max(out.max_penetration_m, x);
+    if (t > 100.0 * tau) throw std::runtime_error("integrate_impact: the impact did not end");
+  }
+}
+
+// Measured agreement with this reference: δ_max 1.9e-10 relative (the sampling of the
+// maximum, as estimated above), t_c 1e-12, rebound speed 1.5e-13. The issue asks for 1%;
+// 1e-8 keeps a 50-fold margin over the reference's own error.
+constexpr double kOdeTolerance = 1e-8;
+
+void check_against_ode(const fm::HertzContact& contact, double v) {
+  CAPTURE(contact.effective_modulus_pa, contact.effective_radius_m, contact.effective_mass_kg, v);
+  const ImpactOde ode = integrate_impact(contact, v);
+  CHECK(fm::max_penetration(contact, v) == Approx(ode.max_penetration_m).epsilon(kOdeTolerance));
+  CHECK(fm::contact_time(contact, v) == Approx(ode.contact_time_s).epsilon(kOdeTolerance));
+  // Conservation of energy in the elastic impact: the rebound speed equals v.
+  CHECK(ode.rebound_speed_m_s == Approx(v).epsilon(kOdeTolerance));
+}
+
+// A stiff polyurethane-like layer (E at the design frequency and temperature).
+fm::Material polymer() { return {1200.0, 200e6, 0.45}; }
+
+}  // namespace
+
+TEST_CASE("delta_max and contact time match an integration of the Hertz ODE", "[formulas]") {
+  const fm::Material steel;
+  const double r = 0.005;
+  SECTION("steel sphere on a rigid wall at several speeds") {
+    const auto contact = fm::sphere_rigid_wall_contact(r, sphere_mass(r, steel), steel);
+    for (const double v : {0.01, 0.5, 5.0}) check_against_ode(contact, v);
+  }
+  SECTION("steel sphere on a polymer wall") {
+    const auto contact = fm::sphere_wall_contact(r, sphere_mass(r, steel), steel, polymer());
+    check_against_ode(contact, 0.3);
+  }
+  SECTION("two unequal steel spheres") {
+    const double r2 = 0.0015;
+    const auto contact =
+        fm::sphere_sphere_contact(r, sphere_mass(r, steel), steel, r2, sphere_mass(r2, steel), steel);
+    check_against_ode(contact, 1.2);
+  }
+}
+
+TEST_CASE("the contact-time constant is 2(15/16)^(2/5) times twice the Hertz integral, about 2.87",
+          "[formulas]") {
+  // Independent reference: I = ∫₀¹ (1 − x^{5/2})^{-1/2} dx by Simpson's rule after
+  // x = 1 − u², which removes the end singularity: I = ∫₀¹ 2u (1 − (1 − u²)^{5/2})^{-1/2} du
+  // with a smooth integrand (→ 2/√(5/2) at u = 0). 2000 intervals: error ~1e-13.
+  const auto integrand = [](double u) {
+    if (u == 0.0) return 2.0 / std::sqrt(2.5);
+    return 2.0 * u / std::sqrt(1.0 - std::pow(1.0 - u * u, 2.5));
+  };
+  constexpr int kIntervals = 2000;
+  double sum = integrand(0.0) + integrand(1.0);
+  for (int i = 1; i < kIntervals; ++i)
+    sum += (i % 2 ? 4.0 : 2.0) * integrand(static_cast<double>(i) / kIntervals);
+  const double integral = sum / (3.0 * kIntervals);
+  CHECK(integral == Approx(1.4716).epsilon(1e-4));
+  CHECK(fm::contact_time_coefficient() == Approx(2.0 * std::pow(15.0 / 16.0, 0.4) * integral).epsilon(1e-10));
+  // PHYSICS.md §5 quotes 2.87, rounded: 2.8683 is within 0.06%.
+  CHECK(fm::contact_time_coefficient() == Approx(2.87).epsilon(1e-3));
+
+  const fm::Material steel;
+  const auto contact = fm::sphere_rigid_wall_contact(0.002, sphere_mass(0.002, steel), steel);
+  const double v = 0.7;
+  const double scale = std::pow(
+      contact.effective_mass_kg * contact.effective_mass_kg /
+          (contact.effective_radius_m * contact.effective_modulus_pa * contact.effective_modulus_pa * v),
+      0.2);
+  CHECK(fm::contact_time(contact, v) == Approx(2.87 * scale).epsilon(1e-3));
+}
+
+TEST_CASE("effective modulus, radius and mass follow the series rules", "[formulas]") {
+  const fm::Material steel;  // E = 210 GPa, ν = 0.3
+  const fm::Material soft{1100.0, 3e9, 0.4};
+  // Hand values: steel (1−0.09)/210e9 = 4.3333e-12, soft (1−0.16)/3e9 = 2.8e-10 per Pa.
+  CHECK(fm::effective_modulus_rigid(steel) == Approx(210e9 / 0.91).epsilon(1e-14));
+  CHECK(fm::effective_modulus(steel, soft) == Approx(1.0 / (0.91 / 210e9 + 0.84 / 3e9)).epsilon(1e-14));
+  CHECK(fm::effective_modulus(steel, steel) == Approx(210e9 / (2.0 * 0.91)).epsilon(1e-14));
+
+  const auto pair = fm::sphere_sphere_contact(0.004, 2.0, steel, 0.012, 6.0, soft);
+  CHECK(pair.effective_radius_m == Approx(0.003).epsilon(1e-14));  // 1/R* = 1/4 + 1/12 mm⁻¹
+  CHECK(pair.effective_mass_kg == Approx(1.5).epsilon(1e-14));     // 1/m* = 1/2 + 1/6 kg⁻¹
+  const auto wall = fm::sphere_wall_contact(0.004, 2.0, steel, soft);
+  CHECK(wall.effective_radius_m == 0.004);
+  CHECK(wall.effective_mass_kg == 2.0);
+  CHECK(wall.effective_modulus_pa == Approx(fm::effective_modulus(steel, soft)).epsilon(1e-15));
+
+  CHECK(wall.force(0.0) == 0.0);
+  CHECK(wall.force(-1e-6) == 0.0);
+  const double delta = 1e-5;
+  CHECK(wall.force(delta) ==
+        Approx(4.0 / 3.0 * wall.effective_modulus_pa * std::sqrt(0.004) * std::pow(delta, 1.5)));
+}
+
+TEST_CASE("materials and contacts with invalid values are rejected with the numbers", "[formulas]") {
+  const fm::Material bad{-1.0, 0.0, 0.5};
+  const auto lines = bad.validate("particle");
+  REQUIRE(lines.size() == 3);
+  CHECK(lines[0] == "particle.density_kg_m3 = -1: must be > 0 and finite");
+  CHECK(lines[1] == "particle.youngs_modulus_pa = 0: must be > 0 and finite");
+  CHECK(lines[2] == "particle.poisson_ratio = 0.5: must be in [0, 0.5)");
+  CHECK(fm::Material{}.validate("steel").empty());
+  CHECK(fm::Material{7850.0, std::nan(""), 0.3}.validate("").at(0) ==
+        "youngs_modulus_pa = nan: must be > 0 and finite");
+
+  const fm::Material steel;
+  CHECK_THROWS_WITH(fm::effective_modulus(steel, bad), Catch::Contains("b.density_kg_m3 = -1"));
+  CHECK_THROWS_WITH(fm::sphere_rigid_wall_contact(-0.005, 1.0, steel),
+                    "sphere_rigid_wall_contact: radius_m = -0.005: must be > 0 and finite");
+  CHECK_THROWS_WITH(fm::sphere_wall_contact(0.005, 0.0, steel, steel), Catch::Contains("mass_kg = 0"));
+  CHECK_THROWS_AS(fm::sphere_sphere_contact(0.005, 1.0, steel, 0.005, 1.0, bad), std::invalid_argument);
+
+  const auto contact = fm::sphere_rigid_wall_contact(0.005, 1.0, steel);
+  CHECK_THROWS_WITH(fm::max_penetration(contact, 0.0), Catch::Contains("impact_speed_m_s = 0: must be > 0"));
+  CHECK_THROWS_WITH(fm::contact_time(contact, -1.0), Catch::Contains("impact_speed_m_s = -1"));
+  CHECK_THROWS_WITH(fm::contact_time(fm::HertzContact{}, 1.0), Catch::Contains("effective_modulus_pa = 0"));
+}
+
+namespace {
+
+// 60 Hz design at Γ = 10 (PHYSICS.md §8 hybrids): steel spheres r = 5 mm on a polymer
+// layer, the front-row sphere carrying 6 spheres.
+fm::BufferDesignInput design_input() {
+  fm::BufferDesignInput in;
+  in.frequency_hz = 60.0;
+  in.intensity = 10.0;
+  in.particle_radius_m = 0.005;
+  in.layer = polymer();
+  in.particles_per_contact = 6.0;
+  return in;
+}
+
+bool any_contains(const std::vector<std::string>& lines, const std::string& text) {
+  return std::any_of(lines.begin(), lines.end(),
+                     [&](const auto& line) { return line.find(text) != std::string::npos; });
+}
+
+}  // namespace
+
+TEST_CASE("the buffer layer is as thick as the Hertz penetration of the design impact", "[formulas]") {
+  const fm::BufferDesignInput in = design_input();
+  const fm::BufferDesign design = fm::size_buffer_layer(in);
+
+  // Hand chain: Ω = 120π, X = Γg/Ω² = 0.69002 mm, v = 2XΩ = 0.52026 m/s (bouncing optimum).
+  const double omega = 2.0 * kPi * 60.0;
+  const double stroke = 10.0 * 9.80665 / (omega * omega);
+  CHECK(stroke == Approx(6.9002e-4).epsilon(1e-5));
+  CHECK(design.impact_velocity_m_s == Approx(2.0 * stroke * omega).epsilon(1e-14));
+  const double m_star = 6.0 * sphere_mass(0.005, fm::Material{});
+  CHECK(design.effective_mass_kg == Approx(m_star).epsilon(1e-14));
+
+  // Reference: the Hertz ODE for a sphere of radius r and mass m* on the layer
+  // half-space, E* from steel and polymer by hand.
+  const fm::HertzContact contact{1.0 / (0.91 / 210e9 + (1.0 - 0.45 * 0.45) / 200e6), 0.005, m_star};
+  const ImpactOde ode = integrate_impact(contact, design.impact_velocity_m_s);
+  CHECK(design.layer_thickness_m == Approx(ode.max_penetration_m).epsilon(kOdeTolerance));
+  CHECK(design.max_penetration_m == design.layer_thickness_m);
+  CHECK(design.contact_time_s == Approx(ode.contact_time_s).epsilon(kOdeTolerance));
+  CHECK(design.contact_time_over_period == Approx(ode.contact_time_s * 60.0).epsilon(kOdeTolerance));
+  CHECK(design.contact_radius_m == Approx(std::sqrt(0.005 * ode.max_penetration_m)).epsilon(kOdeTolerance));
+  // At δ_max the elastic energy (2/5)F_max δ_max equals the impact energy ½m*v².
+  CHECK(0.4 * design.max_force_n * design.max_penetration_m ==
+        Approx(0.5 * m_star * design.impact_velocity_m_s * design.impact_velocity_m_s).epsilon(1e-12));
+
+  // The assumptions are stated with their numbers.
+  CHECK(any_contains(design.assumptions, "Impact speed v = 2*X*Omega = 0.5203 m/s"));
+  CHECK(any_contains(design.assumptions, "front row"));
+  CHECK(any_contains(design.assumptions, "rate- and temperature-dependent"));
+  CHECK(any_contains(design.assumptions, "half-space"));
+  // t_c ≈ 0.94 ms is 0.056 of the 16.7 ms period: an impact. a = √(rδ) ≈ 0.91 mm is 0.18 r
+  // (Hertz's small strain holds) but 5.5 times the 0.17 mm layer: the thin-layer warning.
+  CHECK_FALSE(any_contains(design.warnings, "contact time"));
+  CHECK_FALSE(any_contains(design.warnings, "Hertz needs a << r"));
+  CHECK(any_contains(design.warnings, "the layer is thin"));
+}
+
+TEST_CASE("the buffer sizing takes the stroke or an impact speed when given", "[formulas]") {
+  fm::BufferDesignInput in = design_input();
+  const fm::BufferDesign from_intensity = fm::size_buffer_layer(in);
+  in.intensity = 0.0;
+  in.amplitude_m = 10.0 * 9.80665 / std::pow(2.0 * kPi * 60.0, 2);
+  const fm::BufferDesign from_stroke = fm::size_buffer_layer(in);
+  CHECK(from_stroke.layer_thickness_m == Approx(from_intensity.layer_thickness_m).epsilon(1e-14));
+
+  in.impact_velocity_m_s = 0.2;
+  const fm::BufferDesign given = fm::size_buffer_layer(in);
+  CHECK(given.impact_velocity_m_s == 0.2);
+  CHECK(any_contains(given.assumptions, "as given"));
+  // δ_max ∝ v^{4/5} (from ½m*v² ∝ δ^{5/2}).
+  CHECK(given.layer_thickness_m ==
+        Approx(from_stroke.layer_thickness_m * std::pow(0.2 / from_stroke.impact_velocity_m_s, 0.8))
+            .epsilon(1e-12));
+}
+
+TEST_CASE("the buffer sizing warns outside its validity range", "[formulas]") {
+  SECTION("a soft layer at high frequency: the contact lasts too long to be an impact") {
+    fm::BufferDesignInput in = design_input();
+    in.layer.youngs_modulus_pa = 1e5;
+    in.frequency_hz = 200.0;
+    const fm::BufferDesign design = fm::size_buffer_layer(in);
+    REQUIRE(design.contact_time_over_period > 0.1);
+    CHECK(any_contains(design.warnings, "the impact is not short against the period"));
+    CHECK(any_contains(design.warnings, "Hertz needs a << r"));
+  }
+  SECTION("below Gamma = 1 the bed rolls") {
+    fm::BufferDesignInput in = design_input();
+    in.intensity = 0.5;
+    CHECK(any_contains(fm::size_buffer_layer(in).warnings, "the bed rolls"));
+  }
+  SECTION("stroke and intensity that disagree") {
+    fm::BufferDesignInput in = design_input();
+    in.amplitude_m = 1e-3;
+    CHECK(any_contains(fm::size_buffer_layer(in).warnings,
+                       "intensity = 10 disagrees with amplitude_m = 0.001 m"));
+  }
+}
+
+TEST_CASE("invalid buffer inputs are reported one line per violation", "[formulas]") {
+  fm::BufferDesignInput in;
+  CHECK(in.validate() ==
+        std::vector<std::string>{"amplitude_m = 0 and intensity = 0: give the design stroke or intensity (or "
+                                 "impact_velocity_m_s)",
+                                 "particle_radius_m = 0: must be > 0 and finite"});
+  in = design_input();
+  in.frequency_hz = -60.0;
+  in.amplitude_m = -1.0;
+  in.particles_per_contact = 0.5;
+  in.layer.poisson_ratio = 0.6;
+  in.impact_velocity_m_s = std::numeric_limits<double>::infinity();
+  const auto lines = in.validate();
+  CHECK(lines == std::vector<std::string>{"frequency_hz = -60: must be > 0 and finite",
+                                          "amplitude_m = -1: must be >= 0 and finite",
+                                          "impact_velocity_m_s = inf: must be >= 0 and finite",
+                                          "particles_per_contact = 0.5: must be >= 1 and finite",
+                                          "layer.poisson_ratio = 0.6: must be in [0, 0.5)"});
+  CHECK_THROWS_WITH(fm::size_buffer_layer(in), Catch::StartsWith("size_buffer_layer: frequency_hz = -60") &&
+                                                   Catch::Contains("\nlayer.poisson_ratio = 0.6"));
+  CHECK(design_input().validate().empty());
+}

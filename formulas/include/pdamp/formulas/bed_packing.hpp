@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pdamp::formulas {
@@ -14,6 +15,7 @@ using Vec3 = std::array<double, 3>;
 enum class ContainerShape { kBox, kCylinder };
 
 /// Rigid container, centred at the origin of its own frame.
+/// Fields of the other shape are ignored.
 struct Container {
   ContainerShape shape = ContainerShape::kBox;
   Vec3 box_inner_size_m{0.0, 0.0, 0.0};  ///< box: inner lengths along x, y, z, m
@@ -21,7 +23,11 @@ struct Container {
   double cylinder_inner_length_m = 0.0;  ///< cylinder: inner length along its axis, m
   int cylinder_axis = 0;                 ///< cylinder: axis 0 = x, 1 = y, 2 = z
   /// Inner length along an axis (cylinder: its length, or 2R across it), m.
+  /// Throws std::invalid_argument unless axis is 0, 1 or 2.
   double inner_length(int axis) const;
+  /// One line per violation of the shape in use ("<prefix>.box_inner_size_m[1] = -0.06:
+  /// must be > 0 and finite"; no prefix and dot when prefix is empty): positive finite
+  /// sizes, cylinder_axis in 0..2. Empty when valid.
   std::vector<std::string> validate(const std::string& prefix) const;
 };
 
@@ -29,11 +35,13 @@ struct Container {
 struct LatticePacking {
   int drive_axis = 0;     ///< 0 = x, 1 = y, 2 = z
   int collect_side = -1;  ///< −1: collected against the wall at −L/2 of the drive axis; +1: at +L/2
-  /// Direction of gravity as an axis (0..2) and sign, or nullopt for no gravity: the
-  /// lowest sites of each slab fill first, and the bed rests on that wall.
+  /// Direction of gravity as an axis (0..2) and sign (−1 or +1: gravity points to the
+  /// wall at sign·L/2), or nullopt for no gravity: the lowest sites of each slab fill
+  /// first, and in a box the bed rests on that wall.
   std::optional<std::pair<int, int>> gravity_axis_sign;
-  /// Explicit simple-cubic lattice counts along x, y, z; nullopt = fill each slab
-  /// (the plane normal to the drive) with every site that fits, lowest first.
+  /// Explicit simple-cubic lattice counts along x, y, z (each >= 1, count <= their
+  /// product, and the lattice must fit); nullopt = fill each slab (the plane normal
+  /// to the drive) with every site that fits, lowest first.
   std::optional<std::array<int, 3>> lattice_counts;
 };
 
@@ -45,9 +53,27 @@ struct LatticeBed {
   double clearance_m = 0.0;     ///< h = inner length along the drive − bed_extent_m
 };
 
-/// Places `count` spheres of radius r against the collect wall, slab by slab.
-/// Throws std::invalid_argument with the numbers when they do not fit (or the
-/// clearance would not be positive), or for a cylinder driven across its axis.
+/// Places `count` (>= 1) spheres of radius r (> 0) on a simple cubic lattice of pitch
+/// 2r against the collect wall, slab by slab (slabs normal to the drive axis; slab j's
+/// centres at collect_side·(L/2 − r − 2r·j) along the drive).
+///
+/// Cross-section sites of a slab:
+/// - box: n = floor(L/2r) sites along each transverse axis (or the explicit counts),
+///   centred, except along gravity, where the lowest row rests on the wall gravity
+///   points to (centre r from it);
+/// - cylinder driven along its axis: the square lattice sites with |offset| + r <= R,
+///   registered on the axis or offset by r along either transverse axis, whichever
+///   holds the most sites (the first of (0,0), (r,0), (0,r), (r,r) on ties); explicit
+///   counts give an n_a × n_b block, centred, except along gravity, where it sits as
+///   low as the curved wall allows. A cylinder driven across its axis is not supported.
+/// Each slab is filled lowest first (height against gravity, then x, y, z ascending:
+/// deterministic); only the last slab may be partial. bed_extent = slabs·2r counts
+/// it whole. A relative tolerance of 1e-9 absorbs round-off in "fits" (L = 6·2r fits 6).
+///
+/// Throws std::invalid_argument with the numbers for invalid input, when the spheres
+/// do not fit (explicit lattice larger than the container, count above the lattice,
+/// no site in the cross-section, clearance not > 0), or for a cylinder driven across
+/// its axis ("not supported yet").
 LatticeBed collected_lattice(const Container& container, int count, double radius_m,
                              const LatticePacking& packing);
 

@@ -22,8 +22,8 @@ struct ComplexPower {
   /// Im(F*·conj V*)/(Ω|V*|²), kg: the in-phase-with-acceleration part of the force
   /// per unit acceleration; m for a rigid mass, −k/Ω² for a spring of stiffness k.
   double apparent_mass_kg = 0.0;
-  int periods = 0;                          ///< whole periods analysed, k >= 1
-  int samples_per_period = 0;               ///< T/dt, >= 3
+  int periods = 0;             ///< whole periods analysed, k >= 1
+  int samples_per_period = 0;  ///< T/dt, >= 3
   /// η* = E_diss/(½ m_bed |V*|²), dimensionless (PHYSICS.md §1); a viscous damper c
   /// gives c/(m_bed Ω). Throws std::invalid_argument unless bed_mass_kg > 0 and finite.
   double reduced_loss_factor(double bed_mass_kg) const;
@@ -38,12 +38,15 @@ struct ComplexPower {
 /// length N a multiple of it. Anything else throws std::invalid_argument naming the
 /// numbers, since a non-integer window leaks other frequencies into the bin at Ω.
 /// Also rejected: empty or unequal-length signals, non-finite samples, and a velocity
-/// with no component at Ω (|V*| <= 1e-12·max|v|), for which m_app and η* are undefined.
+/// with no component at Ω (|V*| <= 1e-12 × the largest value of the period-averaged
+/// velocity), for which m_app and η* are undefined.
 ///
-/// Harmonics kΩ (k ≠ 1) and a DC offset are orthogonal to the bin and do not change
-/// the result. Uses an FFTW r2c transform with one plan cached per length N (planning
-/// is serialised by a mutex, execution is not); safe to call from several threads.
-ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s,
-                           double dt_s, double frequency_hz);
+/// Harmonics jΩ (j ≠ 1) and a DC offset are orthogonal to the bin and do not change
+/// the result. The record is folded onto one period (the sum over periods) and bin 1
+/// of an FFTW r2c transform of length T/dt taken: identical to bin k of the length-N
+/// DFT, at O(N) cost. One FFTW plan is cached per T/dt (planning serialised by a mutex,
+/// execution not; per-thread workspaces): safe to call from several threads.
+ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s, double dt_s,
+                           double frequency_hz);
 
 }  // namespace pdamp::formulas

@@ -33,8 +33,8 @@ struct HertzContact {
 };
 /// The factories throw std::invalid_argument naming the value unless radii and masses
 /// are > 0 and finite and the materials valid.
-HertzContact sphere_sphere_contact(double radius1_m, double mass1_kg, const Material& m1,
-                                   double radius2_m, double mass2_kg, const Material& m2);
+HertzContact sphere_sphere_contact(double radius1_m, double mass1_kg, const Material& m1, double radius2_m,
+                                   double mass2_kg, const Material& m2);
 HertzContact sphere_wall_contact(double radius_m, double mass_kg, const Material& sphere,
                                  const Material& wall);
 HertzContact sphere_rigid_wall_contact(double radius_m, double mass_kg, const Material& sphere);
@@ -59,14 +59,14 @@ double contact_time_coefficient();
 /// elastic half-space of the layer material, carrying the momentum of
 /// particles_per_contact spheres; the wall behind the layer is rigid and driven.
 struct BufferDesignInput {
-  double frequency_hz = 60.0;   ///< design frequency f, Hz, > 0
-  double amplitude_m = 0.0;     ///< design stroke X, m, >= 0; 0 = derive from intensity
+  double frequency_hz = 60.0;  ///< design frequency f, Hz, > 0
+  double amplitude_m = 0.0;    ///< design stroke X, m, >= 0; 0 = derive from intensity
   /// Design Γ = XΩ²/g (g = 9.80665 m/s²), >= 0, used when amplitude_m = 0 (then X = Γg/Ω²);
   /// ignored (with a warning if it disagrees) when amplitude_m > 0.
   double intensity = 0.0;
   double particle_radius_m = 0.0;  ///< sphere radius r, m, > 0
-  Material particle;            ///< sphere material (density gives the particle mass)
-  Material layer;               ///< modulus at the design frequency and temperature (density unused)
+  Material particle;               ///< sphere material (density gives the particle mass)
+  Material layer;                  ///< modulus at the design frequency and temperature (density unused)
   /// Particles whose momentum drives one contact with the layer (the collected bed
   /// hits the layer with its front row: bed_particles / front_row_particles), >= 1.
   double particles_per_contact = 1.0;
@@ -78,16 +78,16 @@ struct BufferDesignInput {
   std::vector<std::string> validate() const;
 };
 struct BufferDesign {
-  double layer_thickness_m = 0.0;      ///< = max_penetration_m: the design impact just bottoms out, m
-  double impact_velocity_m_s = 0.0;    ///< design impact speed v, m/s
-  double max_penetration_m = 0.0;      ///< Hertz δ_max at v, m
-  double contact_time_s = 0.0;         ///< Hertz t_c at v, s
+  double layer_thickness_m = 0.0;         ///< = max_penetration_m: the design impact just bottoms out, m
+  double impact_velocity_m_s = 0.0;       ///< design impact speed v, m/s
+  double max_penetration_m = 0.0;         ///< Hertz δ_max at v, m
+  double contact_time_s = 0.0;            ///< Hertz t_c at v, s
   double contact_time_over_period = 0.0;  ///< t_c·f; the impact picture needs it small (warning above 0.1)
-  double effective_mass_kg = 0.0;      ///< m* = particles_per_contact·(4/3)πr³ρ, kg
-  double max_force_n = 0.0;            ///< (4/3) E* √r δ_max^{3/2}, N
-  double contact_radius_m = 0.0;       ///< a = √(r δ_max), m; half-space valid while a ≲ thickness
-  std::vector<std::string> assumptions;  ///< readable sentences with the numbers used
-  std::vector<std::string> warnings;     ///< validity-range violations (INTERFACE.md)
+  double effective_mass_kg = 0.0;         ///< m* = particles_per_contact·(4/3)πr³ρ, kg
+  double max_force_n = 0.0;               ///< (4/3) E* √r δ_max^{3/2}, N
+  double contact_radius_m = 0.0;          ///< a = √(r δ_max), m; half-space valid while a ≲ thickness
+  std::vector<std::string> assumptions;   ///< readable sentences with the numbers used
+  std::vector<std::string> warnings;      ///< validity-range violations (INTERFACE.md)
 };
 /// Sizes the layer: X from Γ if needed, v = 2XΩ unless given, m* from the bed's sharing,
 /// E* from particle and layer, thickness = δ_max(v). Throws std::invalid_argument with
