@@ -107,7 +107,7 @@ std::vector<std::string> write_eta_curve(OutputDir& out, const std::vector<Curve
      << "set datafile separator ','\n"
      << "set xlabel 'stroke X / clearance h'\nset ylabel 'reduced loss factor {/Symbol h}*'\n"
      << "set title \"" << title << " (h = " << format_number(h * 1e3, 4) << " mm, f = " << format_number(frequency_hz, 4)
-     << " Hz)\"\n"
+     << " Hz)\" noenhanced\n"
      << "set grid\nset key top right\nset yrange [0:*]\n"
      << "set arrow 1 from " << landmarks.x_onset_m / h << ", graph 0 to " << landmarks.x_onset_m / h
      << ", graph 1 nohead dt 2 lc rgb 'gray40'\n"
