@@ -1,6 +1,7 @@
 // Case files: strict JSON reading (unknown keys, types, ranges) into option structs.
 #include "case_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -53,6 +54,38 @@ class ObjectReader {
   }
   bool has(const std::string& key) const { return object_.contains(key); }
   bool is_string(const std::string& key) const { return has(key) && object_.at(key).is_string(); }
+  bool is_number(const std::string& key) const { return has(key) && object_.at(key).is_number(); }
+  std::vector<double> number_array(const std::string& key, Range range, const std::string& unit) {
+    known_.insert(key);
+    if (!has(key) || !object_.at(key).is_array()) fail(key, "required (an array of numbers" + unit + ")");
+    std::vector<double> values;
+    for (std::size_t i = 0; i < object_.at(key).size(); ++i) {
+      const json& item = object_.at(key)[i];
+      if (!item.is_number() || !range.contains(item.get<double>()))
+        fail(key + "/" + std::to_string(i), range.text() + unit);
+      values.push_back(item.get<double>());
+    }
+    resolved_[key] = values;
+    return values;
+  }
+  /// An array of objects; the callback reads each element with its own reader.
+  template <typename Fn>
+  void array(const std::string& key, Fn&& read) {
+    known_.insert(key);
+    if (!has(key)) {
+      resolved_[key] = json::array();
+      return;
+    }
+    const json& items = object_.at(key);
+    if (!items.is_array()) fail(key, "must be an array of objects, got " + type_name(items));
+    resolved_[key] = json::array();
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      resolved_[key].push_back(json::object());
+      ObjectReader child(file_, items[i], pointer_ + "/" + key + "/" + std::to_string(i), resolved_[key][i]);
+      read(child);
+      child.finish();
+    }
+  }
 
   double number(const std::string& key, std::optional<double> fallback, Range range, const std::string& unit = "") {
     known_.insert(key);
@@ -279,7 +312,127 @@ void read_damper(ObjectReader& r, Case& c) {
   derived["bed_mass_kg"] = d.bed_mass_kg;
 }
 
+int material_index(ObjectReader& r, const std::string& key, const std::string& name,
+                   const std::vector<dem_reference::MaterialOptions>& materials) {
+  for (std::size_t i = 0; i < materials.size(); ++i)
+    if (materials[i].name == name) return static_cast<int>(i);
+  r.fail(key, "'" + name + "' is not defined in /materials (nor built in)");
+}
+
+/// Contact parameters of a material pair: restitution as a number (constant) or a
+/// table {speeds_m_s, values}; friction; rolling friction.
+void read_contact_pair(ObjectReader& r, dem_reference::ContactPairOptions& pair) {
+  const dem_reference::ContactPairOptions defaults;
+  if (r.has("restitution") && !r.is_number("restitution")) {
+    r.object("restitution", true, [&](ObjectReader& t) {
+      pair.restitution.table_speeds_m_s = t.number_array("speeds_m_s", {0.0, kInf}, " m/s");
+      pair.restitution.table_values = t.number_array("values", {0.0, 1.0, true}, "");
+    });
+  } else {
+    pair.restitution.constant = r.number("restitution", defaults.restitution.constant, {0.0, 1.0, true});
+  }
+  pair.friction = r.number("friction", defaults.friction, {0.0, 10.0});
+  pair.rolling_friction = r.number("rolling_friction", defaults.rolling_friction, {0.0, 10.0});
+}
+
+void read_dem(ObjectReader& r, Case& c) {
+  namespace dr = dem_reference;
+  DemSpec& dem = c.dem;
+  dr::DamperSimulationOptions& sim = dem.simulation;
+  dr::WorldOptions& world = sim.world;
+  const dr::DamperSimulationOptions defaults;
+
+  dem.stiffness_softening = r.number("stiffness_softening", 1.0, {0.0, 1.0, true});
+  world.materials.clear();
+  for (const auto& [name, material] : c.materials) {
+    dr::MaterialOptions m{name, material};
+    m.material.youngs_modulus_pa *= dem.stiffness_softening;
+    world.materials.push_back(m);
+  }
+  const auto& d = c.damper;
+  dr::CompartmentOptions compartment;
+  compartment.container = d.container;
+  const std::string wall = r.text("wall_material", std::string("steel"));
+  compartment.wall_material = material_index(r, "wall_material", wall, world.materials);
+  dr::ParticleGroupOptions group;
+  group.count = d.particle_count;
+  group.radius_m = d.particle_radius_m;
+  group.material = material_index(r, "", d.particle_material, world.materials);
+  group.radius_spread = r.number("radius_spread", 0.0, {0.0, 0.4999});
+  compartment.particles = {group};
+  const std::string placement =
+      r.text("placement", std::string("collected_lattice"), {"collected_lattice", "centred_lattice", "random"});
+  compartment.placement = placement == "collected_lattice" ? dr::InitialPlacement::kCollectedLattice
+                          : placement == "centred_lattice" ? dr::InitialPlacement::kCentredLattice
+                                                           : dr::InitialPlacement::kRandom;
+  compartment.collect_axis = d.drive_axis;
+  compartment.collect_side = d.packing.collect_side;
+  if (d.packing.lattice_counts) compartment.lattice_counts.assign(d.packing.lattice_counts->begin(), d.packing.lattice_counts->end());
+
+  r.object("contact", false, [&](ObjectReader& p) { read_contact_pair(p, world.default_pair); });
+  if (!r.has("contact")) {
+    ObjectReader fallback(r.file(), kEmptyObject, r.pointer() + "/contact", r.resolved()["contact"]);
+    read_contact_pair(fallback, world.default_pair);
+  }
+  r.array("pairs", [&](ObjectReader& p) {
+    dr::ContactPairOptions pair = world.default_pair;
+    pair.material_a = material_index(p, "material_a", p.text("material_a", std::nullopt), world.materials);
+    pair.material_b = material_index(p, "material_b", p.text("material_b", std::nullopt), world.materials);
+    read_contact_pair(p, pair);
+    world.pairs.push_back(pair);
+  });
+  r.object("inner_structures", false, [&](ObjectReader& s) {
+    s.array("plates", [&](ObjectReader& p) {
+      dr::PlateOptions plate;
+      plate.centre_m = p.vector3("centre_m", std::nullopt, {-1e3, 1e3}, " m");
+      plate.size_m = p.vector3("size_m", std::nullopt, kPositive, " m");
+      plate.material = material_index(p, "material", p.text("material", wall), world.materials);
+      compartment.plates.push_back(plate);
+    });
+    s.array("pins", [&](ObjectReader& p) {
+      dr::PinOptions pin;
+      pin.centre_m = p.vector3("centre_m", std::nullopt, {-1e3, 1e3}, " m");
+      pin.axis = axis_index(p.text("axis", std::string("z"), {"x", "y", "z"}));
+      pin.radius_m = p.number("radius_m", std::nullopt, kPositive, " m");
+      pin.length_m = p.number("length_m", std::nullopt, kPositive, " m");
+      pin.material = material_index(p, "material", p.text("material", wall), world.materials);
+      compartment.pins.push_back(pin);
+    });
+  });
+  r.object("wall_layer", false, [&](ObjectReader& l) {
+    compartment.layer.thickness_m = l.number("thickness_m", std::nullopt, kPositive, " m");
+    compartment.layer.material = material_index(l, "material", l.text("material", std::nullopt), world.materials);
+    const std::string axis = l.text("axis", std::string("all"), {"all", "x", "y", "z"});
+    compartment.layer.axis = axis == "all" ? -1 : axis_index(axis);
+  });
+  world.compartments = {compartment};
+  world.gravity_m_s2 = d.gravity_m_s2;
+  sim.drive_axis = {0.0, 0.0, 0.0};
+  sim.drive_axis[d.drive_axis] = 1.0;
+
+  auto& integration = world.integration;
+  integration.time_step_s = r.number("time_step_s", 0.0, {0.0, 1.0}, " s (0 = automatic)");
+  integration.steps_per_contact = r.integer("steps_per_contact", integration.steps_per_contact, 40, 100000);
+  if (const auto v = r.optional_number("max_impact_speed_m_s", kPositive, " m/s")) integration.max_impact_speed_m_s = *v;
+  integration.skin_fraction = r.number("skin_fraction", integration.skin_fraction, {0.0, 2.0, true});
+  integration.max_overlap_fraction = r.number("max_overlap_fraction", integration.max_overlap_fraction, {0.0, 0.999, true});
+  sim.settling_time_s = r.number("settling_time_s", defaults.settling_time_s, {-1.0, 1e3}, " s (-1 = automatic)");
+  sim.transient_periods = r.integer("transient_periods", defaults.transient_periods, 0, 1000000);
+  sim.analysed_periods = r.integer("analysed_periods", defaults.analysed_periods, 1, 1000000);
+  sim.samples_per_period = r.integer("samples_per_period", defaults.samples_per_period, 16, 1000000);
+  sim.snapshots = r.integer("snapshots", defaults.snapshots, 0, 100000);
+  world.seed = static_cast<std::uint64_t>(r.integer("seed", 1, 0, std::numeric_limits<int>::max()));
+  world.threads = r.integer("threads", 1, 0, 1024);
+}
+
 }  // namespace
+
+dem_reference::DamperSimulationOptions dem_options(const Case& c, double amplitude_m, double frequency_hz) {
+  auto options = c.dem.simulation;
+  options.amplitude_m = amplitude_m;
+  options.frequency_hz = frequency_hz;
+  return options;
+}
 
 std::string_view to_string(Task task) {
   switch (task) {
@@ -340,6 +493,15 @@ Case load_case(const std::string& path) {
   if (!root.contains("design")) {
     ObjectReader defaults(path, kEmptyObject, "/design", c.resolved["design"]);
     read_design(defaults);
+  }
+  r.object("dem", false, [&](ObjectReader& d) { read_dem(d, c); });
+  if (!root.contains("dem")) {
+    ObjectReader defaults(path, kEmptyObject, "/dem", c.resolved["dem"]);
+    read_dem(defaults, c);
+  }
+  {
+    const auto problems = dem_options(c, c.excitation.amplitude_m.value_or(1.0), c.excitation.frequency_hz).validate("");
+    if (!problems.empty()) throw InputError(path, "/dem", problems.front());
   }
   r.object("buffer", false, [&](ObjectReader& b) {
     BufferSpec spec;

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
@@ -50,6 +51,13 @@ struct BufferSpec {
   formulas::BufferDesignInput input;  ///< particle data filled from the damper
 };
 
+/// The reference DEM of the case's damper (docs/cases.md, `dem`); amplitude and
+/// frequency are set per run from the excitation or the command line.
+struct DemSpec {
+  dem_reference::DamperSimulationOptions simulation;
+  double stiffness_softening = 1.0;  ///< factor on every Young's modulus in the DEM only
+};
+
 struct Case {
   std::string path;
   std::string name;
@@ -60,6 +68,7 @@ struct Case {
   ExcitationSpec excitation;
   DesignSpec design;
   std::optional<BufferSpec> buffer;
+  DemSpec dem;
   nlohmann::json resolved;  ///< the case with every default resolved and derived values added
 };
 
@@ -67,5 +76,8 @@ struct Case {
 Case load_case(const std::string& path);
 
 std::string_view to_string(Task task);
+
+/// The case's DEM options for one operating point (stroke X, frequency f).
+dem_reference::DamperSimulationOptions dem_options(const Case& c, double amplitude_m, double frequency_hz);
 
 }  // namespace pdamp::cli

@@ -1,7 +1,11 @@
 // Subcommands: parse flags, call the libraries, print a table or one JSON object.
 #include "commands.hpp"
 
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -12,6 +16,7 @@
 #include "errors.hpp"
 #include "output.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
+#include "pdamp/dem_reference/result_files.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
 
 namespace pdamp::cli {
@@ -321,6 +326,143 @@ int run_run(const ParsedArgs& args) {
   return kExitOther;
 }
 
+/// One progress line on stderr: rewritten in place on a terminal, else a line every 10 s.
+class ProgressLine {
+ public:
+  explicit ProgressLine(std::string label) : label_(std::move(label)), tty_(::isatty(STDERR_FILENO) == 1) {}
+  ~ProgressLine() {
+    if (tty_ && printed_) std::cerr << "\n";
+  }
+  void operator()(const dem_reference::Progress& p) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!tty_ && printed_ && now - last_ < std::chrono::seconds(10)) return;
+    last_ = now;
+    printed_ = true;
+    char line[200];
+    std::snprintf(line, sizeof line, "%s: %-9s t = %7.3f / %.3f s  %6.2f M steps/s  ETA %5.0f s", label_.c_str(),
+                  std::string(p.stage).c_str(), p.simulated_time_s, p.end_time_s, p.steps_per_s * 1e-6, p.eta_s);
+    std::cerr << (tty_ ? "\r" : "") << line << (tty_ ? "" : "\n") << std::flush;
+  }
+
+ private:
+  std::string label_;
+  bool tty_;
+  bool printed_ = false;
+  std::chrono::steady_clock::time_point last_;
+};
+
+json dem_json(const dem_reference::DamperResult& r) {
+  const auto& e = r.energy;
+  const auto& m = r.indicators;
+  return {{"eta_star", r.eta_star},
+          {"eta_star_stderr", r.eta_star_stderr},
+          {"eta_star_energy_balance", r.eta_star_energy_balance},
+          {"e_diss_j", r.e_diss_j},
+          {"energy_per_cycle_j", r.energy_per_cycle_j},
+          {"apparent_mass_kg", r.apparent_mass_kg},
+          {"apparent_mass_fraction", r.apparent_mass_kg / r.bed_mass_kg},
+          {"energy_balance_error", r.energy_balance_error},
+          {"particle_steps_per_s", r.particle_steps_per_s},
+          {"motion_mode", dem_reference::to_string(r.motion_mode)},
+          {"clearance_m", r.clearance_m},
+          {"bed_mass_kg", r.bed_mass_kg},
+          {"intensity", r.intensity},
+          {"velocity_amplitude_m_s", r.velocity_amplitude_m_s},
+          {"time_step_s", r.time_step_s},
+          {"steps_per_period", r.steps_per_period},
+          {"eta_star_per_period", r.eta_star_per_period},
+          {"energy",
+           {{"container_work_j", e.container_work_j}, {"normal_damping_j", e.normal_damping_j},
+            {"friction_j", e.friction_j}, {"rolling_j", e.rolling_j}, {"delta_kinetic_j", e.delta_kinetic_j},
+            {"delta_potential_j", e.delta_potential_j}, {"delta_elastic_j", e.delta_elastic_j}}},
+          {"motion_indicators",
+           {{"relative_stroke_over_clearance", m.relative_stroke_over_clearance},
+            {"period_correlation", m.period_correlation}, {"eta_star_variation", m.eta_star_variation},
+            {"apparent_mass_fraction", m.apparent_mass_fraction}, {"base_contact_fraction", m.base_contact_fraction},
+            {"airborne_fraction", m.airborne_fraction}, {"spread_over_packed", m.spread_over_packed}}},
+          {"run",
+           {{"outcome", dem_reference::to_string(r.summary.outcome)}, {"steps", r.summary.steps},
+            {"particles", r.summary.particles}, {"wall_time_s", r.summary.wall_time_s},
+            {"neighbour_rebuilds", r.summary.neighbour_rebuilds}}}};
+}
+
+/// force_velocity.png/.svg: the container force on the bed and the container velocity
+/// over the analysed periods (two y axes).
+std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::string& title) {
+  std::ostringstream gp;
+  gp << "# container force and velocity of a pdamp dem run; run: gnuplot force_velocity.gp\n"
+     << "set datafile separator ','\nset key autotitle columnhead\n"
+     << "set title \"" << title << "\" noenhanced\n"
+     << "set xlabel 'time t / s'\nset ylabel 'force on the bed F / N'\nset y2label 'container velocity v / (m/s)'\n"
+     << "set ytics nomirror\nset y2tics\nset grid\nset key top right\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,500 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'force_velocity.svg' : 'force_velocity.png'\n"
+     << "  plot 'time_series.csv' using 1:4 with lines lw 1.5 lc rgb 'blue' title 'force F', \\\n"
+     << "       '' using 1:3 axes x1y2 with lines lw 1.5 lc rgb 'red' title 'velocity v'\n"
+     << "}\n";
+  return out.add_plot("force_velocity.gp", gp.str(), {"force_velocity.png", "force_velocity.svg"});
+}
+
+int run_dem(const ParsedArgs& args) {
+  const std::string& path = args.positional().at(0);
+  const Case c = load_case(path);
+  const double f = args.optional_number("--frequency", 0.0, kInf).value_or(c.excitation.frequency_hz);
+  const auto amplitude = args.optional_number("--amplitude", 0.0, kInf);
+  if (!amplitude && !c.excitation.amplitude_m)
+    throw InputError(path, "/excitation/amplitude_m", "required by pdamp dem (or give --amplitude M)");
+  const double x = amplitude.value_or(c.excitation.amplitude_m.value_or(0.0));
+  auto options = dem_options(c, x, f);
+  if (const auto periods = args.optional_number("--periods", 1.0, 1e6, false)) options.analysed_periods = static_cast<int>(*periods);
+  if (const auto threads = args.optional_number("--threads", 0.0, 1024, false)) options.world.threads = static_cast<int>(*threads);
+  const auto problems = options.validate("");
+  if (!problems.empty()) throw InputError(path, "/dem", problems.front());
+
+  ProgressLine progress("pdamp dem");
+  const auto result = dem_reference::run_harmonic(options, [&](const dem_reference::Progress& p) { progress(p); });
+  if (result.summary.outcome == dem_reference::Outcome::kUnstable)
+    throw NumericalError("DEM unstable: " + result.summary.message);
+  if (result.summary.outcome != dem_reference::Outcome::kCompleted)
+    throw std::runtime_error("DEM failed: " + result.summary.message);
+
+  json out = dem_json(result);
+  out.update({{"case", c.name}, {"amplitude_m", x}, {"frequency_hz", f}});
+  // The closed form at the same point, for comparison (same model family as the case).
+  const auto closed = fm::reduced_loss_factor(c.damper.model, result.clearance_m, x, f, c.damper.model_options);
+  out["closed_form"] = {{"eta_star", closed.eta_star}, {"model_used", fm::to_string(closed.model_used)},
+                        {"regime", fm::to_string(closed.regime)}};
+  std::vector<std::string> warnings = result.warnings;
+  if (const auto dir = args.optional_text("-o")) {
+    OutputDir files(*dir);
+    dem_reference::write_time_series_csv(files.staged_path("time_series.csv").string(), result.series);
+    for (std::size_t i = 0; i < result.snapshots.size(); ++i) {
+      char name[64];
+      std::snprintf(name, sizeof name, "particles_%04zu.vtk", i);
+      dem_reference::write_vtk_snapshot(files.staged_path(name).string(), result.snapshots[i]);
+    }
+    for (auto& w : write_force_velocity_plot(files, c.name + ": X = " + format_number(x * 1e3, 4) + " mm, f = " +
+                                                        format_number(f, 4) + " Hz"))
+      warnings.push_back(w);
+    out["warnings"] = warnings;
+    files.add_json("summary.json", out);
+    out["files"] = files.commit();
+  }
+  out["warnings"] = warnings;
+  print_warnings(warnings);
+  return emit(args, out,
+              {{"case", c.name},
+               {"eta_star", format_number(result.eta_star, 4) + " +- " + format_number(result.eta_star_stderr, 2)},
+               {"eta_star (closed form)", format_number(closed.eta_star, 4) + "  (" + std::string(fm::to_string(closed.regime)) + ")"},
+               {"apparent_mass_kg", format_number(result.apparent_mass_kg, 4) + "  (" +
+                                        format_number(result.apparent_mass_kg / result.bed_mass_kg, 3) + " m_bed)"},
+               {"e_diss_j", format_number(result.e_diss_j)},
+               {"energy_balance_error", format_number(result.energy_balance_error, 3)},
+               {"motion_mode", std::string(dem_reference::to_string(result.motion_mode))},
+               {"clearance_m", format_number(result.clearance_m)},
+               {"particle_steps_per_s", format_number(result.particle_steps_per_s, 3)},
+               {"run", result.summary.brief_report()}});
+}
+
 const FlagSpec kModelOverrides[] = {
     {"--calibration", "C", "design factor c in x_opt = c*x_opt_ideal (default 0.8976 rolling, 1.0 bouncing)"},
     {"--inertia-factor", "K", "rolling spheres' I/(m r^2) (default 0.4, solid spheres)"}};
@@ -372,6 +514,17 @@ const std::vector<Command>& commands() {
          {"--impact-velocity", "M_S", "impact speed, m/s (default 2*X*Omega, the bouncing optimum)"},
          kJsonFlag}},
        run_buffer},
+      {{"dem", "pdamp dem CASE.json [--amplitude M] [--frequency HZ] [-o DIR] [--json]",
+        "reference DEM of the case's damper under harmonic motion x = X sin(2 pi f t): eta*,\n"
+        "its standard error, apparent mass, energy balance, motion mode (docs/dem.md)",
+        {{"--amplitude", "M", "stroke X, m (default: the case's excitation.amplitude_m)"},
+         {"--frequency", "HZ", "frequency f, Hz (default: the case's excitation.frequency_hz)"},
+         {"--periods", "N", "analysed periods (default: the case's dem.analysed_periods)"},
+         {"--threads", "N", "OpenMP threads, 0 = all (default: the case's dem.threads)"},
+         {"-o", "DIR", "write summary.json, time_series.csv, particles_*.vtk (ParaView) and\n"
+                       "                          force_velocity.png/.svg into DIR, atomically"},
+         kJsonFlag}, 1},
+       run_dem},
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",

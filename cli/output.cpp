@@ -49,6 +49,11 @@ fs::path OutputDir::add(const std::string& name, const std::string& content) {
   return dir_ / name;
 }
 
+fs::path OutputDir::staged_path(const std::string& name) {
+  names_.push_back(name);
+  return staging_ / name;
+}
+
 fs::path OutputDir::add_json(const std::string& name, const nlohmann::json& value) {
   return add(name, value.dump(2) + "\n");
 }

@@ -23,6 +23,9 @@ class OutputDir {
   /// Stages a text file; returns its final path.
   std::filesystem::path add(const std::string& name, const std::string& content);
   std::filesystem::path add_json(const std::string& name, const nlohmann::json& value);
+  /// Registers `name` and returns its path in the staging folder, for writers that
+  /// take a path (they must have written it before commit()).
+  std::filesystem::path staged_path(const std::string& name);
   /// Stages a gnuplot script and, when gnuplot is installed, runs it in the staging
   /// folder; the script must write `outputs` (e.g. eta.png, eta.svg). Without gnuplot
   /// the script and data stay for later use and a warning is returned.

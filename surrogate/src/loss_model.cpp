@@ -14,8 +14,7 @@ ClosedFormLossModel::ClosedFormLossModel(formulas::DamperModel model, double cle
 DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_m) const {
   const auto loss = formulas::reduced_loss_factor(model_, clearance_m_, stroke_m, frequency_hz, options_);
   // The closed forms describe dissipation only; the bed's inertia is not modelled.
-  return {loss.eta_star, std::numeric_limits<double>::quiet_NaN(),
-          std::string(formulas::to_string(loss.regime))};
+  return {loss.eta_star, std::numeric_limits<double>::quiet_NaN(), std::string(formulas::to_string(loss.regime))};
 }
 
 }  // namespace pdamp::surrogate

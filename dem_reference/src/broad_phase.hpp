@@ -1,0 +1,107 @@
+// Broad phase of the reference DEM: a uniform cell grid in the body frame and the
+// Verlet list of particle pairs closer than r_i + r_j + skin.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+namespace pdamp::dem_reference::detail {
+
+/// Uniform grid over the body-frame bounding box of the compartments; particles
+/// outside it (only after an instability) are clamped into the border cells, which
+/// keeps every pair within one cell of each other.
+class CellGrid {
+ public:
+  /// cell_m: smallest cell edge (>= 2 r_max + skin); the edge grows if the grid
+  /// would exceed max(64, 8·particles) cells.
+  void configure(const std::array<double, 3>& lo, const std::array<double, 3>& hi, double cell_m,
+                 int particles);
+  /// Counting sort of the particles into cells.
+  void bin(const double* x, const double* y, const double* z, int n);
+  /// Pairs i < j of equal `group` with |x_i − x_j| < r_i + r_j + skin, ordered by i then
+  /// j (deterministic for any thread count), written into the `i`, `j` members of
+  /// `out` (which keeps its capacity between calls). Uses the positions of bin().
+  template <class Pair>
+  void find_pairs(const double* x, const double* y, const double* z, const double* radius,
+                  const int* group, int n, double skin_m, int threads, std::vector<Pair>& out);
+  std::size_t memory_bytes() const;
+
+ private:
+  int cell_of(double x, double y, double z) const;
+  template <class Visit>
+  void for_each_candidate(int i, Visit&& visit) const;
+
+  std::array<double, 3> lo_{};
+  std::array<double, 3> inv_cell_{};
+  std::array<int, 3> dims_{1, 1, 1};
+  std::vector<int> cell_start_;  // size cells + 1
+  std::vector<int> sorted_;      // particle indices by cell
+  std::vector<int> cell_;        // cell of each particle
+  std::vector<int> counts_;      // pairs per particle (scratch)
+  std::vector<int> offsets_;     // prefix sums (scratch)
+};
+
+/// Below this many particles the list is built serially (thread start-up costs more).
+inline constexpr int kParallelListParticles = 4096;
+
+template <class Visit>
+void CellGrid::for_each_candidate(int i, Visit&& visit) const {
+  const int c = cell_[static_cast<std::size_t>(i)];
+  const int cx = c % dims_[0];
+  const int cy = (c / dims_[0]) % dims_[1];
+  const int cz = c / (dims_[0] * dims_[1]);
+  for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, dims_[2] - 1); ++z) {
+    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, dims_[1] - 1); ++y) {
+      for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, dims_[0] - 1); ++x) {
+        const auto cell = static_cast<std::size_t>((z * dims_[1] + y) * dims_[0] + x);
+        for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
+          const int j = sorted_[static_cast<std::size_t>(k)];
+          if (j > i) visit(j);
+        }
+      }
+    }
+  }
+}
+
+template <class Pair>
+void CellGrid::find_pairs(const double* x, const double* y, const double* z, const double* radius,
+                          const int* group, int n, double skin_m, int threads, std::vector<Pair>& out) {
+  const auto un = static_cast<std::size_t>(n);
+  counts_.assign(un, 0);
+  offsets_.resize(un + 1);
+  const auto near = [&](int i, int j) {
+    if (group[i] != group[j]) return false;
+    const double dx = x[i] - x[j];
+    const double dy = y[i] - y[j];
+    const double dz = z[i] - z[j];
+    const double cut = radius[i] + radius[j] + skin_m;
+    return dx * dx + dy * dy + dz * dz < cut * cut;
+  };
+  const bool parallel = threads > 1 && n > kParallelListParticles;
+#pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
+  for (int i = 0; i < n; ++i) {
+    int count = 0;
+    for_each_candidate(i, [&](int j) { count += near(i, j) ? 1 : 0; });
+    counts_[static_cast<std::size_t>(i)] = count;
+  }
+  offsets_[0] = 0;
+  for (std::size_t i = 0; i < un; ++i) offsets_[i + 1] = offsets_[i] + counts_[i];
+  out.resize(static_cast<std::size_t>(offsets_[un]));
+#pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
+  for (int i = 0; i < n; ++i) {
+    const auto begin = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(i)]);
+    auto k = begin;
+    for_each_candidate(i, [&](int j) {
+      if (near(i, j)) {
+        out[k].i = i;
+        out[k].j = j;
+        ++k;
+      }
+    });
+    std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.begin() + static_cast<std::ptrdiff_t>(k),
+              [](const Pair& a, const Pair& b) { return a.j < b.j; });
+  }
+}
+
+}  // namespace pdamp::dem_reference::detail

@@ -1,0 +1,415 @@
+// Harmonic DEM run of one damper: settling, transient, analysed periods, and the
+// measures (complex power, energy balance, motion mode).
+#include "pdamp/dem_reference/damper_simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <span>
+#include <sstream>
+#include <stdexcept>
+
+#include "pdamp/dem_reference/container_motion.hpp"
+#include "pdamp/dem_reference/world.hpp"
+#include "pdamp/formulas/complex_power.hpp"
+
+namespace pdamp::dem_reference {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const auto& line : lines) text += (text.empty() ? "" : "\n") + line;
+  return text;
+}
+
+/// Largest free-fall height: the inner extent of a compartment projected on gravity, m.
+double fall_height(const WorldOptions& w) {
+  const double g = norm(w.gravity_m_s2);
+  if (g == 0.0) return 0.0;
+  double height = 0.0;
+  for (const auto& c : w.compartments) {
+    double h = 0.0;
+    for (int a = 0; a < 3; ++a) h += std::abs(w.gravity_m_s2[static_cast<std::size_t>(a)]) / g * c.container.inner_length(a);
+    height = std::max(height, h);
+  }
+  return height;
+}
+
+/// Mean Pearson correlation of consecutive periods of a periodically sampled signal.
+double period_correlation(const std::vector<double>& signal, int samples, int periods) {
+  if (periods < 2) return 1.0;
+  double sum = 0.0;
+  for (int p = 1; p < periods; ++p) {
+    const double* a = signal.data() + static_cast<std::ptrdiff_t>((p - 1) * samples);
+    const double* b = signal.data() + static_cast<std::ptrdiff_t>(p * samples);
+    double ma = 0.0, mb = 0.0;
+    for (int k = 0; k < samples; ++k) {
+      ma += a[k];
+      mb += b[k];
+    }
+    ma /= samples;
+    mb /= samples;
+    double sab = 0.0, saa = 0.0, sbb = 0.0;
+    for (int k = 0; k < samples; ++k) {
+      sab += (a[k] - ma) * (b[k] - mb);
+      saa += (a[k] - ma) * (a[k] - ma);
+      sbb += (b[k] - mb) * (b[k] - mb);
+    }
+    // A bed at rest in the container repeats itself exactly: count it as synchronous.
+    sum += (saa > 0.0 && sbb > 0.0) ? sab / std::sqrt(saa * sbb) : 1.0;
+  }
+  return sum / (periods - 1);
+}
+
+/// The labels of PHYSICS.md from the indicators (docs/dem.md "Motion modes").
+MotionMode classify(const MotionIndicators& m, double eta_star, double intensity) {
+  if (m.relative_stroke_over_clearance < 0.1 && m.apparent_mass_fraction > 0.8) return MotionMode::kSolidLike;
+  if (std::abs(m.apparent_mass_fraction) < 0.1 && eta_star < 0.1) return MotionMode::kDecoupled;
+  if (m.relative_stroke_over_clearance > 0.5 && m.period_correlation > 0.8 && m.eta_star_variation < 0.25) {
+    return m.base_contact_fraction > 0.5 ? MotionMode::kRollingCollectAndCollide
+                                         : MotionMode::kBouncingCollectAndCollide;
+  }
+  if (m.spread_over_packed >= 2.0) return MotionMode::kGlobalFluidisation;
+  if (m.spread_over_packed >= 1.2 && intensity > 1.0) return MotionMode::kLocalFluidisation;
+  return MotionMode::kScattering;
+}
+
+/// Reports progress about twice a second (the clock is read every 4096 steps).
+class ProgressReporter {
+ public:
+  ProgressReporter(const ProgressCallback& callback, double end_time_s)
+      : callback_(callback), end_time_s_(end_time_s), start_(Clock::now()), last_(start_) {}
+  void maybe_report(std::string_view stage, std::int64_t step, std::int64_t total_steps, double time_s) {
+    if (!callback_ || (step & 4095) != 0) return;
+    const auto now = Clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < 0.5) return;
+    last_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double rate = elapsed > 0.0 ? static_cast<double>(step) / elapsed : 0.0;
+    Progress p;
+    p.stage = stage;
+    p.simulated_time_s = time_s;
+    p.end_time_s = end_time_s_;
+    p.steps_per_s = rate;
+    p.eta_s = rate > 0.0 ? static_cast<double>(total_steps - step) / rate : 0.0;
+    callback_(p);
+  }
+
+ private:
+  const ProgressCallback& callback_;
+  double end_time_s_;
+  Clock::time_point start_;
+  Clock::time_point last_;
+};
+
+ParticleSnapshot snapshot_of(const World& world, double time_s) {
+  ParticleSnapshot s;
+  s.time_s = time_s;
+  const int n = world.particle_count();
+  for (int i = 0; i < n; ++i) {
+    s.positions_m.push_back(world.position(i));
+    s.velocities_m_s.push_back(world.velocity(i));
+    s.angular_velocities_rad_s.push_back(world.angular_velocity(i));
+    s.radii_m.push_back(world.radius(i));
+    s.compartments.push_back(world.compartment(i));
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string_view to_string(MotionMode mode) {
+  switch (mode) {
+    case MotionMode::kSolidLike:
+      return "solid_like";
+    case MotionMode::kRollingCollectAndCollide:
+      return "rolling_collect_and_collide";
+    case MotionMode::kBouncingCollectAndCollide:
+      return "bouncing_collect_and_collide";
+    case MotionMode::kScattering:
+      return "scattering";
+    case MotionMode::kLocalFluidisation:
+      return "local_fluidisation";
+    case MotionMode::kGlobalFluidisation:
+      return "global_fluidisation";
+    case MotionMode::kDecoupled:
+      return "decoupled";
+  }
+  return "scattering";
+}
+
+std::vector<std::string> DamperSimulationOptions::validate(const std::string& prefix) const {
+  std::vector<std::string> errors = world.validate(prefix);
+  const auto add = [&](bool ok, const std::string& field, double value, const std::string& rule) {
+    if (ok) return;
+    std::ostringstream line;
+    line << prefix << field << " = " << value << ": " << rule;
+    errors.push_back(line.str());
+  };
+  const double axis = norm(drive_axis);
+  if (!(std::isfinite(axis) && axis > 0.0)) {
+    std::ostringstream line;
+    line << prefix << "drive_axis = [" << drive_axis[0] << ", " << drive_axis[1] << ", " << drive_axis[2]
+         << "]: must be a finite non-zero vector";
+    errors.push_back(line.str());
+  }
+  add(std::isfinite(amplitude_m) && amplitude_m > 0.0, "amplitude_m", amplitude_m, "must be > 0");
+  add(std::isfinite(frequency_hz) && frequency_hz > 0.0, "frequency_hz", frequency_hz, "must be > 0");
+  add(std::isfinite(settling_time_s) && (settling_time_s >= 0.0 || settling_time_s == -1.0), "settling_time_s",
+      settling_time_s, "must be >= 0 or -1 (automatic)");
+  add(transient_periods >= 0, "transient_periods", transient_periods, "must be >= 0");
+  add(analysed_periods >= 1, "analysed_periods", analysed_periods, "must be >= 1");
+  add(samples_per_period >= 16, "samples_per_period", samples_per_period, "must be >= 16");
+  add(snapshots >= 0, "snapshots", snapshots, "must be >= 0");
+  return errors;
+}
+
+DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress) {
+  if (const auto errors = options.validate(); !errors.empty()) throw std::invalid_argument(join_lines(errors));
+  const auto wall_start = Clock::now();
+  const HarmonicMotion motion(options.drive_axis, options.amplitude_m, options.frequency_hz);
+  const Vec3& axis = motion.axis();
+  const double v_amp = motion.velocity_amplitude_m_s();
+  const Vec3& g = options.world.gravity_m_s2;
+  const double g_norm = norm(g);
+
+  // Time step: the automatic bound at the drive's largest impact speed, reduced so that
+  // a period is a whole number of blocks of whole steps.
+  WorldOptions world_options = options.world;
+  auto& integ = world_options.integration;
+  integ.max_impact_speed_m_s =
+      std::max(integ.max_impact_speed_m_s, 2.0 * v_amp + std::sqrt(2.0 * g_norm * fall_height(world_options)));
+  const double user_step = integ.time_step_s;
+  integ.time_step_s = 0.0;
+  const TimeStepBound bound = time_step_bound(world_options);
+  if (user_step > bound.max_time_step_s) {
+    std::ostringstream msg;
+    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << bound.max_time_step_s
+        << " s (contact time " << bound.contact_time_s << " s at " << integ.max_impact_speed_m_s << " m/s over "
+        << integ.steps_per_contact << " steps, or " << integ.rayleigh_fraction << " of the Rayleigh time "
+        << bound.rayleigh_time_s << " s)";
+    throw std::invalid_argument(msg.str());
+  }
+  const double target_step = user_step > 0.0 ? user_step : bound.max_time_step_s;
+  const double period = motion.period_s();
+  const int samples = options.samples_per_period;
+  const auto steps_per_block = static_cast<std::int64_t>(std::ceil(period / (samples * target_step) - 1e-9));
+  const std::int64_t steps_per_period = steps_per_block * samples;
+  const double dt = period / static_cast<double>(steps_per_period);
+  integ.time_step_s = dt;
+
+  const ContainerState start = motion.state(0.0);
+  ContainerState rest = start;
+  rest.velocity_m_s = {0.0, 0.0, 0.0};
+  World world(world_options, rest);
+
+  DamperResult result;
+  result.bed_mass_kg = world.bed_mass_kg();
+  result.velocity_amplitude_m_s = v_amp;
+  result.intensity = motion.intensity();
+  result.time_step_s = dt;
+  result.steps_per_period = static_cast<int>(steps_per_period);
+  for (int c = 0; c < world.compartment_count(); ++c) result.compartment_clearances_m.push_back(world.clearance_m(c));
+  result.clearance_m = result.compartment_clearances_m.front();
+  const int n = world.particle_count();
+
+  // Settling: automatic = long enough for the bed to come to rest under gravity.
+  double settling = options.settling_time_s;
+  if (settling < 0.0) {
+    bool random = false;
+    for (const auto& c : world_options.compartments) random = random || c.placement == InitialPlacement::kRandom;
+    settling = g_norm == 0.0 ? 0.0
+                             : (random ? 2.0 * std::sqrt(2.0 * fall_height(world_options) / g_norm) + 0.02 : 0.01);
+  }
+  const auto settle_steps = static_cast<std::int64_t>(std::ceil(settling / dt));
+  const std::int64_t drive_steps = steps_per_period * (options.transient_periods + options.analysed_periods);
+  const std::int64_t total_steps = settle_steps + drive_steps;
+  ProgressReporter reporter(progress, drive_steps * dt);
+
+  const auto finish = [&](Outcome outcome, const std::string& message) {
+    auto& s = result.summary;
+    s.outcome = outcome;
+    s.message = message;
+    s.steps = world.step_count();
+    s.particle_steps = s.steps * n;
+    s.neighbour_rebuilds = world.neighbour_rebuilds();
+    s.particles = n;
+    s.time_step_s = dt;
+    s.simulated_time_s = world.time_s();
+    s.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    s.stage_times = world.stage_times();
+    result.particle_steps_per_s = s.wall_time_s > 0.0 ? static_cast<double>(s.particle_steps) / s.wall_time_s : 0.0;
+  };
+  const auto unstable = [&]() { return world.status().outcome != Outcome::kCompleted; };
+
+  for (std::int64_t k = 0; k < settle_steps; ++k) {
+    world.step(rest);
+    if (unstable()) {
+      finish(Outcome::kUnstable, world.status().message);
+      return result;
+    }
+    reporter.maybe_report("settling", k, total_steps, (k - settle_steps) * dt);
+  }
+
+  const std::int64_t transient_steps = steps_per_period * options.transient_periods;
+  for (std::int64_t k = 1; k <= transient_steps; ++k) {
+    world.step(motion.state(static_cast<double>(k) * dt));
+    if (unstable()) {
+      finish(Outcome::kUnstable, world.status().message);
+      return result;
+    }
+    reporter.maybe_report("transient", settle_steps + k, total_steps, static_cast<double>(k) * dt);
+  }
+
+  // Analysis: block averages of the force and the container velocity along the drive
+  // (the same boxcar filter on both leaves η* and m_app exactly unchanged), and
+  // instantaneous samples of the bed at block ends.
+  const int periods = options.analysed_periods;
+  const std::int64_t blocks = static_cast<std::int64_t>(periods) * samples;
+  TimeSeries& series = result.series;
+  std::vector<double> force_blocks, velocity_blocks;
+  force_blocks.reserve(static_cast<std::size_t>(blocks));
+  velocity_blocks.reserve(static_cast<std::size_t>(blocks));
+  for (auto* v : {&series.time_s, &series.container_position_m, &series.container_velocity_m_s, &series.force_n,
+                  &series.bed_relative_position_m, &series.bed_momentum_kg_m_s, &series.kinetic_energy_j}) {
+    v->reserve(static_cast<std::size_t>(blocks));
+  }
+  const EnergyAccount e_start = world.energy();
+  double base_sum = 0.0, airborne_sum = 0.0, spread_sum = 0.0;
+  const double packed_extent =
+      world_options.compartments.front().container.inner_length(world_options.compartments.front().collect_axis) -
+      result.clearance_m;
+  std::vector<std::int64_t> snapshot_blocks;
+  for (int s = 0; s < options.snapshots; ++s) {
+    snapshot_blocks.push_back(static_cast<std::int64_t>((s + 1.0) * static_cast<double>(blocks) / options.snapshots) - 1);
+  }
+  std::int64_t step = transient_steps;
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    double force_sum = 0.0, velocity_sum = 0.0;
+    for (std::int64_t k = 0; k < steps_per_block; ++k) {
+      ++step;
+      const ContainerState state = motion.state(static_cast<double>(step) * dt);
+      const ContainerLoad& load = world.step(state);
+      if (unstable()) {
+        finish(Outcome::kUnstable, world.status().message);
+        return result;
+      }
+      force_sum += dot(load.force_n, axis);
+      velocity_sum += dot(state.velocity_m_s, axis);
+      reporter.maybe_report("analysis", settle_steps + step, total_steps, static_cast<double>(step) * dt);
+    }
+    const double t_mid = (static_cast<double>(step - steps_per_block) + 0.5 * static_cast<double>(steps_per_block + 1)) * dt;
+    force_blocks.push_back(force_sum / static_cast<double>(steps_per_block));
+    velocity_blocks.push_back(velocity_sum / static_cast<double>(steps_per_block));
+    const ContainerState now = motion.state(static_cast<double>(step) * dt);
+    series.time_s.push_back(t_mid);
+    series.container_position_m.push_back(dot(motion.state(t_mid).position_m, axis));
+    series.container_velocity_m_s.push_back(velocity_blocks.back());
+    series.force_n.push_back(force_blocks.back());
+    const Vec3 com = world.bed_centre_of_mass();
+    series.bed_relative_position_m.push_back(dot(com, axis) - dot(now.position_m, axis));
+    series.bed_momentum_kg_m_s.push_back(dot(world.bed_momentum(), axis));
+    const EnergyAccount e = world.energy();
+    series.kinetic_energy_j.push_back(e.kinetic_j);
+    const ContactCensus census = world.contact_census(g);
+    base_sum += static_cast<double>(census.touching_base) / n;
+    airborne_sum += static_cast<double>(census.airborne) / n;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int i = 0; i < n; ++i) {
+      if (world.compartment(i) != 0) continue;
+      const double along = dot(world.position(i), axis);
+      lo = std::min(lo, along - world.radius(i));
+      hi = std::max(hi, along + world.radius(i));
+    }
+    spread_sum += packed_extent > 0.0 ? (hi - lo) / packed_extent : kNaN;
+    if (std::find(snapshot_blocks.begin(), snapshot_blocks.end(), b) != snapshot_blocks.end()) {
+      result.snapshots.push_back(snapshot_of(world, static_cast<double>(step) * dt));
+    }
+  }
+  const EnergyAccount e_end = world.energy();
+
+  // Complex power over all analysed periods and per period (PHYSICS.md §1).
+  const double block_dt = dt * static_cast<double>(steps_per_block);
+  const auto cp = formulas::complex_power(force_blocks, velocity_blocks, block_dt, options.frequency_hz);
+  const double m_bed = result.bed_mass_kg;
+  result.eta_star = cp.reduced_loss_factor(m_bed);
+  result.e_diss_j = cp.e_diss_j;
+  result.energy_per_cycle_j = cp.energy_per_cycle_j;
+  result.apparent_mass_kg = cp.apparent_mass_kg;
+  for (int p = 0; p < periods; ++p) {
+    const auto offset = static_cast<std::size_t>(p) * static_cast<std::size_t>(samples);
+    const auto one = formulas::complex_power(
+        std::span<const double>(force_blocks).subspan(offset, static_cast<std::size_t>(samples)),
+        std::span<const double>(velocity_blocks).subspan(offset, static_cast<std::size_t>(samples)), block_dt,
+        options.frequency_hz);
+    result.eta_star_per_period.push_back(one.reduced_loss_factor(m_bed));
+  }
+  const auto& per = result.eta_star_per_period;
+  const double mean = std::accumulate(per.begin(), per.end(), 0.0) / periods;
+  double var = 0.0;
+  for (const double e : per) var += (e - mean) * (e - mean);
+  var = periods > 1 ? var / (periods - 1) : 0.0;
+  result.eta_star_stderr = periods > 1 ? std::sqrt(var / periods) : kNaN;
+
+  // Energy balance over the analysed periods.
+  EnergyBalance& eb = result.energy;
+  eb.container_work_j = e_end.container_work_j - e_start.container_work_j;
+  eb.normal_damping_j = e_end.normal_damping_j - e_start.normal_damping_j;
+  eb.friction_j = e_end.friction_j - e_start.friction_j;
+  eb.rolling_j = e_end.rolling_j - e_start.rolling_j;
+  eb.delta_kinetic_j = e_end.kinetic_j - e_start.kinetic_j;
+  eb.delta_potential_j = e_end.potential_j - e_start.potential_j;
+  eb.delta_elastic_j = e_end.elastic_j - e_start.elastic_j;
+  const double dissipated = eb.normal_damping_j + eb.friction_j + eb.rolling_j;
+  const double delta_e = eb.delta_kinetic_j + eb.delta_potential_j + eb.delta_elastic_j;
+  const double scale = std::max(std::abs(eb.container_work_j), dissipated);
+  eb.relative_error = scale > 0.0 ? std::abs(eb.container_work_j - dissipated - delta_e) / scale : 0.0;
+  result.energy_balance_error = eb.relative_error;
+  result.eta_star_energy_balance = (dissipated + delta_e) / (periods * kPi * m_bed * v_amp * v_amp);
+
+  // Motion mode.
+  MotionIndicators& mi = result.indicators;
+  const auto& rel = series.bed_relative_position_m;
+  const auto [lo_it, hi_it] = std::minmax_element(rel.begin(), rel.end());
+  mi.relative_stroke_over_clearance = result.clearance_m > 0.0 ? (*hi_it - *lo_it) / result.clearance_m : kNaN;
+  mi.period_correlation = period_correlation(rel, samples, periods);
+  mi.eta_star_variation = mean != 0.0 ? std::sqrt(var) / std::abs(mean) : 0.0;
+  mi.apparent_mass_fraction = result.apparent_mass_kg / m_bed;
+  mi.base_contact_fraction = base_sum / static_cast<double>(blocks);
+  mi.airborne_fraction = airborne_sum / static_cast<double>(blocks);
+  mi.spread_over_packed = spread_sum / static_cast<double>(blocks);
+  result.motion_mode = classify(mi, result.eta_star, result.intensity);
+
+  // Validity remarks.
+  auto& warn = result.warnings;
+  if (g_norm > 0.0 && std::abs(dot(g, axis)) > 1e-6 * g_norm) {
+    warn.push_back("gravity has a component along the drive: the ideal collect-and-collide models do not apply");
+  }
+  if (result.energy_balance_error > 0.02) {
+    std::ostringstream w;
+    w << "energy balance error " << result.energy_balance_error
+      << " exceeds 0.02: lower integration.time_step_s (raise steps_per_contact)";
+    warn.push_back(w.str());
+  }
+  if (periods > 1 && result.eta_star_stderr > 0.1 * std::abs(result.eta_star)) {
+    std::ostringstream w;
+    w << "eta_star varies from period to period (standard error " << result.eta_star_stderr
+      << "): the motion is irregular; analyse more periods";
+    warn.push_back(w.str());
+  }
+  if (periods == 1) warn.push_back("one analysed period: eta_star_stderr is undefined (NaN)");
+  finish(Outcome::kCompleted, "");
+  return result;
+}
+
+}  // namespace pdamp::dem_reference

@@ -1,0 +1,92 @@
+// Sweep engine: fills an effective field point by point (DEM, formulas), in parallel,
+// saving every finished point at once so that a killed sweep resumes where it stopped.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pdamp/formulas/collect_and_collide.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/surrogate/grid.hpp"
+
+namespace pdamp::surrogate {
+
+/// The damper's response at drive frequency f (Hz) and stroke X (m). Called from up to
+/// SweepOptions::threads threads at once, so it must be thread-safe; one call may take
+/// minutes and may use threads of its own. Return status kOk with a finite η*, or
+/// kFailed (values ignored; say why in motion_mode) to record a point that cannot be
+/// computed; throwing stops the sweep (the exception reaches run_sweep's caller).
+using PointEvaluator = std::function<FieldPoint(double frequency_hz, double amplitude_m)>;
+
+/// Progress after each finished point: points done (resumed ones included), points in
+/// the grid, and the estimated seconds left (NaN until this run has finished a point).
+/// Called from worker threads, one call at a time.
+using SweepProgress = std::function<void(std::size_t points_done, std::size_t points_total, double eta_s)>;
+
+/// What a sweep writes where, and the identity that guards its results file.
+struct SweepOptions {
+  /// JSON-lines results file (header line, then one line per finished point, each
+  /// fsynced at once). If it exists, the sweep resumes from it. Empty: nothing is saved.
+  std::filesystem::path results_path;
+  FieldSource source = FieldSource::kDem;  ///< recorded in the provenance
+  std::string case_hash;                   ///< case_hash() of the case; a different hash refuses to resume
+  int model_version = 0;                   ///< physics-model version of the evaluator, >= 0; ditto
+  double clearance_m = 0.0;                ///< damper clearance h, m, > 0 (turns (Γ, X/h) nodes into drives)
+  double bed_mass_kg = 0.0;  ///< m_bed, kg, > 0 (E_diss and m_app/m_bed where the evaluator leaves them NaN)
+  int threads = 2;           ///< points evaluated at once, [1, 256]
+  SweepProgress progress;    ///< optional
+  /// One line per violated rule ("threads = 0: must be in [1, 256]"); empty if valid.
+  std::vector<std::string> validate() const;
+};
+
+struct SweepSummary {
+  std::size_t points_total = 0;     ///< nodes in the grid
+  std::size_t points_resumed = 0;   ///< read back from the results file
+  std::size_t points_computed = 0;  ///< evaluated in this run (ok or failed)
+  std::size_t points_failed = 0;    ///< status kFailed among all points
+  double wall_time_s = 0.0;         ///< this run
+  /// "18 points: 6 resumed, 12 computed (0 failed) in 12.3 s".
+  std::string brief_report() const;
+};
+
+struct SweepResult {
+  EffectiveField field;  ///< every node filled (ok or failed), provenance stamped now
+  SweepSummary summary;
+};
+
+/// Evaluates every grid node not yet in the results file, options.threads at a time, and
+/// returns the full field (the caller writes it with write_effective_field).
+///
+/// Results file: line 1 is a header {format "pdamp.field_sweep", format_version, source,
+/// case_hash, model_version, clearance_m, bed_mass_kg, axes}; every further line is one
+/// finished point {index, drive {frequency_hz, amplitude_m}, values, status, wall_time_s},
+/// written and fsynced under a mutex as soon as the point is done. Resuming re-reads the
+/// file: a header that differs from this sweep's (another case, model version, source,
+/// clearance, bed mass or grid) throws std::invalid_argument telling the user to delete
+/// or move the file, so stale points are never mixed in; a last line without its newline
+/// (a killed write) is dropped and recomputed; any other damaged line throws
+/// std::invalid_argument. A second sweep on the same file at the same time is refused
+/// (std::runtime_error; the file is locked with flock).
+///
+/// Ok points with NaN e_diss_j get η*·½ m_bed (XΩ)² (PHYSICS.md §1), and NaN
+/// apparent_mass_fraction gets apparent_mass_kg/m_bed.
+///
+/// If the evaluator or the progress callback throws, no new point is started, points in
+/// flight finish and are saved, and the first exception is rethrown: a killed or failed
+/// sweep loses at most the points in flight. An evaluator returning status ok with a
+/// non-finite η*, or status missing, counts as throwing std::runtime_error.
+/// Throws std::invalid_argument for an invalid grid or options, std::runtime_error for I/O.
+SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options);
+
+/// Evaluator of the closed forms (formulas::reduced_loss_factor) for one damper: η*,
+/// stderr 0 (exact), E_diss = η*·½ m_bed (XΩ)², apparent mass not given (NaN; the closed
+/// forms model dissipation only), motion_mode the regime name (formulas::to_string of the
+/// MotionRegime). Microseconds per point: run it with threads = 1 and no
+/// results file. Throws std::invalid_argument now for a bad clearance, bed mass or options.
+PointEvaluator formula_evaluator(formulas::DamperModel model, double clearance_m, double bed_mass_kg,
+                                 const formulas::ModelOptions& options = {});
+
+}  // namespace pdamp::surrogate

@@ -1,0 +1,353 @@
+// Parallel, resumable sweeps over a grid with a JSON-lines results file.
+#include "pdamp/surrogate/sweep.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "field_format.hpp"
+#include "file_io.hpp"
+#include "strict_json.hpp"
+#include "text_util.hpp"
+
+namespace pdamp::surrogate {
+
+using detail::number;
+using detail::positive_finite;
+using nlohmann::json;
+
+namespace {
+
+constexpr std::string_view kSweepFormat = "pdamp.field_sweep";
+constexpr int kSweepFormatVersion = 1;
+constexpr int kMaxThreads = 256;
+/// Relative agreement of a saved point's drive with the grid node it claims.
+constexpr double kDriveTolerance = 1e-9;
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+/// The header line that identifies a sweep; a results file resumes only if its header is equal.
+json sweep_header(const Grid& grid, const SweepOptions& options) {
+  return {{"format", kSweepFormat},
+          {"format_version", kSweepFormatVersion},
+          {"source", to_string(options.source)},
+          {"case_hash", options.case_hash},
+          {"model_version", options.model_version},
+          {"clearance_m", options.clearance_m},
+          {"bed_mass_kg", options.bed_mass_kg},
+          {"axes", json::array({json(detail::axis_json(grid.axis0)), json(detail::axis_json(grid.axis1))})}};
+}
+
+std::string point_line(std::size_t index, const DrivePoint& drive, const FieldPoint& p, double wall_time_s) {
+  const json line = {{"index", index},
+                     {"drive", {{"frequency_hz", drive.frequency_hz}, {"amplitude_m", drive.amplitude_m}}},
+                     {"eta_star", nullable(p.eta_star)},
+                     {"eta_star_stderr", nullable(p.eta_star_stderr)},
+                     {"e_diss_j", nullable(p.e_diss_j)},
+                     {"apparent_mass_kg", nullable(p.apparent_mass_kg)},
+                     {"apparent_mass_fraction", nullable(p.apparent_mass_fraction)},
+                     {"motion_mode", p.motion_mode},
+                     {"status", to_string(p.status)},
+                     {"wall_time_s", wall_time_s}};
+  return line.dump() + "\n";
+}
+
+/// Makes an evaluator's point storable: status ok or failed, derived columns filled in.
+FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptions& options) {
+  const std::string where =
+      "evaluator at frequency_hz = " + number(drive.frequency_hz) + ", amplitude_m = " + number(drive.amplitude_m);
+  if (p.status == PointStatus::kMissing) {
+    throw std::runtime_error(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
+  }
+  if (p.status == PointStatus::kFailed) {
+    p.eta_star = p.eta_star_stderr = p.e_diss_j = p.apparent_mass_kg = p.apparent_mass_fraction = FieldPoint::kUnknown;
+    return p;
+  }
+  if (!std::isfinite(p.eta_star))
+    throw std::runtime_error(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
+  if (std::isnan(p.e_diss_j)) {
+    const double velocity = 2.0 * formulas::kPi * drive.frequency_hz * drive.amplitude_m;  // |V*| = XΩ
+    p.e_diss_j = p.eta_star * 0.5 * options.bed_mass_kg * velocity * velocity;
+  }
+  if (std::isnan(p.apparent_mass_fraction) && std::isfinite(p.apparent_mass_kg)) {
+    p.apparent_mass_fraction = p.apparent_mass_kg / options.bed_mass_kg;
+  }
+  if (!std::isfinite(p.e_diss_j) || std::isinf(p.apparent_mass_kg) || std::isinf(p.apparent_mass_fraction) ||
+      !(std::isnan(p.eta_star_stderr) || (p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr)))) {
+    throw std::runtime_error(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
+                             ", eta_star_stderr = " + number(p.eta_star_stderr) + ")");
+  }
+  return p;
+}
+
+/// An open, exclusively locked results file.
+class ResultsFile {
+ public:
+  explicit ResultsFile(const std::filesystem::path& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+      throw std::runtime_error(path.string() + ": cannot open the sweep results file (" + std::strerror(errno) + ")");
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw std::runtime_error(path.string() +
+                               ": another sweep is writing this results file; wait for it or use "
+                               "another file");
+    }
+  }
+  ResultsFile(const ResultsFile&) = delete;
+  ResultsFile& operator=(const ResultsFile&) = delete;
+  ~ResultsFile() { ::close(fd_); }
+
+  /// Drops everything after byte `size` (a partly written last line) and appends from there.
+  void truncate_to(std::size_t size) {
+    if (::ftruncate(fd_, static_cast<off_t>(size)) != 0 || ::lseek(fd_, 0, SEEK_END) < 0) {
+      throw std::runtime_error(path_.string() + ": cannot truncate the damaged last line (" + std::strerror(errno) +
+                               ")");
+    }
+  }
+  void append(std::string_view line) { detail::write_all_synced(fd_, line, path_); }
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
+
+/// Explains how two sweep headers differ, key by key.
+std::string header_difference(const json& saved, const json& wanted) {
+  std::string text;
+  for (const auto& [key, value] : wanted.items()) {
+    const auto it = saved.find(key);
+    if (it == saved.end() || *it != value) {
+      std::string was = it == saved.end() ? std::string("absent") : it->dump();
+      if (key == "axes") was = "other axes";
+      text += (text.empty() ? "" : "; ") + key + ": file " + was + ", this sweep " +
+              (key == "axes" ? std::string("the grid asked for") : value.dump());
+    }
+  }
+  return text.empty() ? "unknown keys in the header" : text;
+}
+
+/// Reads the saved points of a results file (or starts it): fills `points` and `done`,
+/// returns how many were resumed.
+std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Grid& grid, const SweepOptions& options,
+                   std::vector<FieldPoint>& points, std::vector<bool>& done) {
+  const std::string text = detail::read_text_file(path);
+  const json header = sweep_header(grid, options);
+  // Only newline-terminated lines are complete: a line without its newline is the
+  // write of a killed run and is dropped (its point is computed again).
+  const std::size_t complete = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
+  const std::string file_name = path.string();
+  if (complete == 0) {
+    file.truncate_to(0);
+    file.append(header.dump() + "\n");
+    detail::sync_parent_folder(path);
+    return 0;
+  }
+  std::size_t resumed = 0;
+  std::size_t line_number = 0;
+  std::size_t begin = 0;
+  while (begin < complete) {
+    const std::size_t end = text.find('\n', begin);
+    const std::string_view line(text.data() + begin, end - begin);
+    begin = end + 1;
+    ++line_number;
+    const std::string at = "line " + std::to_string(line_number);
+    const std::string damaged = ": the results file is damaged; delete or move it to start the sweep again";
+    json value;
+    try {
+      value = json::parse(line);
+    } catch (const json::exception& e) {
+      throw std::invalid_argument(file_name + ": " + at + ": not valid JSON (" + e.what() + ")" + damaged);
+    }
+    if (line_number == 1) {
+      if (value != header) {
+        throw std::invalid_argument(file_name + ": line 1: this results file belongs to another sweep (" +
+                                    header_difference(value, header) +
+                                    "); delete or move it to start a new sweep, its points are not mixed in");
+      }
+      continue;
+    }
+    try {
+      const std::string context = file_name + ": " + at;
+      detail::StrictObject object(value, "", context);
+      const long long index = object.integer("index", 0, static_cast<long long>(grid.size()) - 1);
+      const auto k = static_cast<std::size_t>(index);
+      if (done[k]) object.fail("index", std::to_string(index) + " appears twice");
+      const DrivePoint node = drive_point(grid, k, options.clearance_m);
+      detail::StrictObject drive(object.required("drive"), "/drive", context);
+      const double f = drive.number("frequency_hz", true, "Hz");
+      const double x = drive.number("amplitude_m", true, "m");
+      drive.finish();
+      if (std::abs(f - node.frequency_hz) > kDriveTolerance * node.frequency_hz ||
+          std::abs(x - node.amplitude_m) > kDriveTolerance * node.amplitude_m) {
+        object.fail("drive", "(" + number(f) + " Hz, " + number(x) + " m) is not grid node " + std::to_string(k) +
+                                 " (" + number(node.frequency_hz) + " Hz, " + number(node.amplitude_m) + " m)");
+      }
+      auto nullable_number = [&](std::string_view key) {
+        const json& v = object.required(key);
+        return v.is_null() ? FieldPoint::kUnknown : object.number_value(v, object.pointer(key), false);
+      };
+      FieldPoint p;
+      p.eta_star = nullable_number("eta_star");
+      p.eta_star_stderr = nullable_number("eta_star_stderr");
+      p.e_diss_j = nullable_number("e_diss_j");
+      p.apparent_mass_kg = nullable_number("apparent_mass_kg");
+      p.apparent_mass_fraction = nullable_number("apparent_mass_fraction");
+      p.motion_mode = object.string("motion_mode");
+      const std::string status = object.string("status");
+      const auto parsed = point_status_from_string(status);
+      if (!parsed || *parsed == PointStatus::kMissing)
+        object.fail("status", "is \"" + status + "\", must be \"ok\" or \"failed\"");
+      p.status = *parsed;
+      if (p.status == PointStatus::kOk && (std::isnan(p.eta_star) || std::isnan(p.e_diss_j))) {
+        object.fail("eta_star", "null: an ok point needs eta_star and e_diss_j");
+      }
+      object.number("wall_time_s", false, "s");
+      object.finish();
+      points[k] = std::move(p);
+      done[k] = true;
+      ++resumed;
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(e.what() + damaged);
+    }
+  }
+  // Only now that every complete line was checked: drop the partial one and append after the rest.
+  file.truncate_to(complete);
+  return resumed;
+}
+
+}  // namespace
+
+std::vector<std::string> SweepOptions::validate() const {
+  std::vector<std::string> problems;
+  if (model_version < 0) problems.push_back("model_version = " + std::to_string(model_version) + ": must be >= 0");
+  if (!positive_finite(clearance_m))
+    problems.push_back("clearance_m = " + number(clearance_m) + ": must be > 0 and finite");
+  if (!positive_finite(bed_mass_kg))
+    problems.push_back("bed_mass_kg = " + number(bed_mass_kg) + ": must be > 0 and finite");
+  if (threads < 1 || threads > kMaxThreads) {
+    problems.push_back("threads = " + std::to_string(threads) + ": must be in [1, " + std::to_string(kMaxThreads) +
+                       "]");
+  }
+  return problems;
+}
+
+std::string SweepSummary::brief_report() const {
+  std::ostringstream out;
+  out.precision(3);
+  out << points_total << " points: " << points_resumed << " resumed, " << points_computed << " computed ("
+      << points_failed << " failed) in " << std::fixed << wall_time_s << " s";
+  return out.str();
+}
+
+SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options) {
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  detail::throw_if_any(options.validate(), "sweep options");
+  if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
+  const auto start = Clock::now();
+  const std::size_t total = grid.size();
+
+  std::vector<FieldPoint> points(total);
+  std::vector<bool> done(total, false);
+  std::optional<ResultsFile> file;
+  std::size_t resumed = 0;
+  if (!options.results_path.empty()) {
+    file.emplace(options.results_path);
+    resumed = resume(*file, options.results_path, grid, options, points, done);
+  }
+  std::vector<std::size_t> pending;
+  for (std::size_t k = 0; k < total; ++k) {
+    if (!done[k]) pending.push_back(k);
+  }
+
+  std::mutex mutex;  // guards points, the file, the counters, the progress callback and `error`
+  std::exception_ptr error;
+  std::atomic<bool> stop{false};
+  std::atomic<std::size_t> next{0};
+  std::size_t computed = 0;
+  auto report_progress = [&] {
+    if (!options.progress) return;
+    const double elapsed = seconds_since(start);
+    const std::size_t left = pending.size() - computed;
+    // Wall time per finished point of this run already reflects the parallelism.
+    const double eta_s = computed == 0 ? std::numeric_limits<double>::quiet_NaN()
+                                       : elapsed * static_cast<double>(left) / static_cast<double>(computed);
+    options.progress(resumed + computed, total, eta_s);
+  };
+  auto fail = [&](std::exception_ptr e) {
+    std::lock_guard lock(mutex);
+    if (!error) error = e;
+    stop = true;
+  };
+  auto worker = [&] {
+    while (!stop) {
+      const std::size_t slot = next++;
+      if (slot >= pending.size()) return;
+      const std::size_t k = pending[slot];
+      try {
+        const DrivePoint drive = drive_point(grid, k, options.clearance_m);
+        const auto point_start = Clock::now();
+        FieldPoint p = checked_point(evaluator(drive.frequency_hz, drive.amplitude_m), drive, options);
+        const double wall_time_s = seconds_since(point_start);
+        std::lock_guard lock(mutex);
+        if (file) file->append(point_line(k, drive, p, wall_time_s));
+        points[k] = std::move(p);
+        ++computed;
+        report_progress();
+      } catch (...) {
+        fail(std::current_exception());
+        return;
+      }
+    }
+  };
+
+  try {
+    report_progress();
+  } catch (...) {
+    fail(std::current_exception());
+  }
+  const std::size_t workers = std::min<std::size_t>(static_cast<std::size_t>(options.threads), pending.size());
+  if (workers <= 1) {
+    worker();
+  } else {
+    std::vector<std::jthread> threads;
+    for (std::size_t t = 0; t < workers; ++t) threads.emplace_back(worker);
+  }
+  if (error) std::rethrow_exception(error);
+
+  SweepResult result;
+  result.field.grid = grid;
+  result.field.points = std::move(points);
+  result.field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
+  result.field.clearance_m = options.clearance_m;
+  result.field.bed_mass_kg = options.bed_mass_kg;
+  result.summary.points_total = total;
+  result.summary.points_resumed = resumed;
+  result.summary.points_computed = computed;
+  for (const auto& p : result.field.points) {
+    if (p.status == PointStatus::kFailed) ++result.summary.points_failed;
+  }
+  result.summary.wall_time_s = seconds_since(start);
+  return result;
+}
+
+}  // namespace pdamp::surrogate

@@ -1,0 +1,42 @@
+// Shared set-ups of the DEM tests: worlds of a few spheres in a large static box.
+#pragma once
+
+#include "pdamp/dem_reference/world.hpp"
+
+namespace dem_test {
+
+namespace dr = pdamp::dem_reference;
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+/// `count` steel spheres of radius r in a static 0.2 m cubic box, no gravity.
+inline dr::WorldOptions box_world(int count, double radius_m, double restitution, double friction) {
+  dr::WorldOptions o;
+  o.gravity_m_s2 = {0.0, 0.0, 0.0};
+  auto& c = o.compartments.front();
+  c.container.shape = pdamp::formulas::ContainerShape::kBox;
+  c.container.box_inner_size_m = {0.2, 0.2, 0.2};
+  c.particles = {dr::ParticleGroupOptions{count, radius_m, 0.0, 0}};
+  c.lattice_counts.clear();
+  o.default_pair.restitution.constant = restitution;
+  o.default_pair.friction = friction;
+  o.default_pair.rolling_friction = 0.0;
+  return o;
+}
+
+/// Steps with the container at rest until particle `watch` has touched something and
+/// let go again (or max_steps pass); returns the steps taken.
+inline long run_one_impact(dr::World& world, long max_steps) {
+  const dr::ContainerState rest;
+  bool touched = false;
+  for (long k = 0; k < max_steps; ++k) {
+    world.step(rest);
+    const auto census = world.contact_census({0.0, 0.0, 0.0});
+    const bool touching = census.airborne < world.particle_count();
+    if (touching) touched = true;
+    if (touched && !touching) return k + 1;
+  }
+  return max_steps;
+}
+
+}  // namespace dem_test

@@ -1,0 +1,319 @@
+// Tests of the sweep engine: parallel evaluation, results file, resume after a kill, stale files.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pdamp/surrogate/sweep.hpp"
+
+namespace {
+
+using namespace pdamp::surrogate;
+namespace fs = std::filesystem;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kG = 9.80665;  // standard gravity, m/s^2
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("pdamp_test_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::string read_text(const fs::path& path) {
+  std::ostringstream text;
+  text << std::ifstream(path).rdbuf();
+  return text.str();
+}
+
+std::size_t line_count(const fs::path& path) {
+  const std::string text = read_text(path);
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+/// A deterministic stand-in for a DEM run that records every call (thread-safe) and can
+/// be told to "die" (throw) on its n-th call, as a killed process would stop.
+class RecordingEvaluator {
+ public:
+  explicit RecordingEvaluator(int die_on_call = 0) : die_on_call_(die_on_call) {}
+
+  FieldPoint operator()(double f, double x) {
+    const int call = ++calls_;
+    if (call == die_on_call_) throw std::runtime_error("simulated kill");
+    FieldPoint p;
+    p.eta_star = 0.5 + 0.1 * std::sin(f) + 3.0 * x;
+    p.eta_star_stderr = 0.01 * f;
+    p.apparent_mass_kg = 0.1 * x;
+    p.motion_mode = f < 2.0 ? "rolling" : "scattered";
+    p.status = PointStatus::kOk;
+    std::lock_guard lock(mutex_);
+    finished_.insert({f, x});
+    return p;
+  }
+  int calls() const { return calls_; }
+  std::set<std::pair<double, double>> finished() const {
+    std::lock_guard lock(mutex_);
+    return finished_;
+  }
+
+ private:
+  int die_on_call_;
+  std::atomic<int> calls_{0};
+  mutable std::mutex mutex_;
+  std::set<std::pair<double, double>> finished_;
+};
+
+PointEvaluator by_reference(RecordingEvaluator& evaluator) {
+  return [&evaluator](double f, double x) { return evaluator(f, x); };
+}
+
+Grid sweep_grid() {
+  return Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 3.0, 3, AxisSpacing::kLinear},
+                           {0.005, 0.04, 6, AxisSpacing::kLog});
+}
+
+SweepOptions sweep_options(const fs::path& results) {
+  SweepOptions options;
+  options.results_path = results;
+  options.source = FieldSource::kDem;
+  options.case_hash = "feedc0ffee123456";
+  options.model_version = 4;
+  options.clearance_m = 0.04;
+  options.bed_mass_kg = 0.74;
+  options.threads = 2;
+  return options;
+}
+
+/// The field an uninterrupted run without a results file gives.
+EffectiveField reference_field() {
+  RecordingEvaluator evaluator;
+  SweepOptions options = sweep_options({});
+  options.threads = 1;
+  return run_sweep(sweep_grid(), by_reference(evaluator), options).field;
+}
+
+}  // namespace
+
+TEST_CASE("a sweep evaluates every node once and fills the derived columns", "[surrogate]") {
+  RecordingEvaluator evaluator;
+  TempDir dir("sweep_plain");
+  std::vector<std::size_t> done;
+  double first_eta = 0.0;
+  SweepOptions options = sweep_options(dir.path / "sweep.jsonl");
+  options.progress = [&](std::size_t points_done, std::size_t total, double eta_s) {
+    if (done.empty()) first_eta = eta_s;
+    done.push_back(points_done);
+    CHECK(total == 18);
+  };
+  const SweepResult result = run_sweep(sweep_grid(), by_reference(evaluator), options);
+  CHECK(evaluator.calls() == 18);
+  CHECK(evaluator.finished().size() == 18);
+  CHECK(result.summary.points_computed == 18);
+  CHECK(result.summary.points_resumed == 0);
+  CHECK(done.size() == 19);  // once at the start, then once per point
+  CHECK(done.back() == 18);
+  CHECK(std::isnan(first_eta));
+  CHECK(line_count(options.results_path) == 19);  // header + one line per point
+  CHECK(result.field.validate().empty());
+  CHECK(result.field.provenance.case_hash == "feedc0ffee123456");
+  CHECK(result.field.provenance.model_version == 4);
+  CHECK(result.field.points == reference_field().points);
+  CHECK(result.field.clearance_m == 0.04);
+  CHECK(result.field.bed_mass_kg == 0.74);
+  // Derived columns (PHYSICS.md §1): E_diss = η*·½ m_bed (XΩ)², m_app/m_bed.
+  const Grid grid = sweep_grid();
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    const FieldPoint& p = result.field.points[k];
+    const double v = 2 * kPi * grid.coordinate0(k) * grid.coordinate1(k);
+    CHECK(p.e_diss_j == Approx(p.eta_star * 0.5 * 0.74 * v * v).epsilon(1e-14));
+    CHECK(p.apparent_mass_fraction == Approx(p.apparent_mass_kg / 0.74).epsilon(1e-15));
+  }
+  CHECK_THAT(result.summary.brief_report(), Catch::StartsWith("18 points: 0 resumed, 18 computed (0 failed)"));
+}
+
+TEST_CASE("a killed sweep resumes without recomputing any finished point", "[surrogate]") {
+  TempDir dir("sweep_kill");
+  const fs::path results = dir.path / "sweep.jsonl";
+  const SweepOptions options = sweep_options(results);
+
+  RecordingEvaluator dying(8);  // the 8th call "kills" the run
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(dying), options), "simulated kill");
+  const auto first_run = dying.finished();
+  // Everything finished before or alongside the kill is on disk (the other thread's
+  // point in flight finishes and is saved): 7 or more, one line each after the header.
+  CHECK(first_run.size() >= 7);
+  CHECK(line_count(results) == 1 + first_run.size());
+
+  RecordingEvaluator second;
+  const SweepResult resumed = run_sweep(sweep_grid(), by_reference(second), options);
+  CHECK(static_cast<std::size_t>(second.calls()) == 18 - first_run.size());
+  for (const auto& point : second.finished()) CHECK(first_run.count(point) == 0);
+  CHECK(resumed.summary.points_resumed == first_run.size());
+  CHECK(resumed.field.points == reference_field().points);
+
+  // A third run finds everything done and evaluates nothing.
+  RecordingEvaluator third;
+  CHECK(run_sweep(sweep_grid(), by_reference(third), options).field.points == reference_field().points);
+  CHECK(third.calls() == 0);
+}
+
+TEST_CASE("a last line cut by a kill is dropped and only that point is recomputed", "[surrogate]") {
+  TempDir dir("sweep_truncated");
+  const fs::path results = dir.path / "sweep.jsonl";
+  RecordingEvaluator first;
+  run_sweep(sweep_grid(), by_reference(first), sweep_options(results));
+  fs::resize_file(results, fs::file_size(results) - 25);  // mid-way through the last line
+
+  RecordingEvaluator second;
+  const SweepResult result = run_sweep(sweep_grid(), by_reference(second), sweep_options(results));
+  CHECK(second.calls() == 1);
+  CHECK(result.field.points == reference_field().points);
+  CHECK(line_count(results) == 19);  // the cut line replaced, not appended after
+  CHECK(read_text(results).back() == '\n');
+}
+
+TEST_CASE("a results file of another case, model version or grid is refused", "[surrogate]") {
+  TempDir dir("sweep_stale");
+  const fs::path results = dir.path / "sweep.jsonl";
+  RecordingEvaluator first;
+  run_sweep(sweep_grid(), by_reference(first), sweep_options(results));
+  const std::string before = read_text(results);
+
+  RecordingEvaluator never;
+  SweepOptions newer = sweep_options(results);
+  newer.model_version = 5;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), newer),
+                    Catch::StartsWith(results.string() + ": line 1: this results file belongs to another sweep") &&
+                        Catch::Contains("model_version: file 4, this sweep 5") && Catch::Contains("delete or move it"));
+  SweepOptions other_case = sweep_options(results);
+  other_case.case_hash = "0000000000000000";
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), other_case), Catch::Contains("case_hash"));
+  const Grid finer = Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 3.0, 5, AxisSpacing::kLinear},
+                                       {0.005, 0.04, 6, AxisSpacing::kLog});
+  CHECK_THROWS_WITH(run_sweep(finer, by_reference(never), sweep_options(results)),
+                    Catch::Contains("axes: file other axes"));
+  CHECK(never.calls() == 0);
+  CHECK(read_text(results) == before);  // a refused file is left as it was
+}
+
+TEST_CASE("a damaged line inside the results file is an error, not silently skipped", "[surrogate]") {
+  TempDir dir("sweep_damaged");
+  const fs::path results = dir.path / "sweep.jsonl";
+  RecordingEvaluator first;
+  run_sweep(sweep_grid(), by_reference(first), sweep_options(results));
+  const std::string original = read_text(results);
+  std::string text = original;
+  const auto third_line = text.find('\n', text.find('\n') + 1) + 1;
+  text.replace(third_line, 10, "#garbage##");
+  std::ofstream(results) << text;
+  RecordingEvaluator never;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
+                    Catch::Contains("line 3: not valid JSON") && Catch::Contains("damaged"));
+
+  // A complete line for a node the grid does not have.
+  std::ofstream(results) << original << R"({"index": 99})"
+                         << "\n";
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
+                    Catch::Contains("line 20: /index: 99 must be in [0, 17]") && Catch::Contains("damaged"));
+  CHECK(never.calls() == 0);
+}
+
+TEST_CASE("a second sweep on the same results file at the same time is refused", "[surrogate]") {
+  TempDir dir("sweep_lock");
+  const fs::path results = dir.path / "sweep.jsonl";
+  std::string nested_error;
+  PointEvaluator evaluator = [&](double f, double x) {
+    if (nested_error.empty()) {
+      RecordingEvaluator inner;
+      try {
+        run_sweep(sweep_grid(), by_reference(inner), sweep_options(results));
+        nested_error = "none";
+      } catch (const std::runtime_error& e) {
+        nested_error = e.what();
+      }
+    }
+    return RecordingEvaluator()(f, x);
+  };
+  SweepOptions options = sweep_options(results);
+  options.threads = 1;
+  run_sweep(sweep_grid(), evaluator, options);
+  CHECK_THAT(nested_error, Catch::Contains("another sweep is writing this results file"));
+}
+
+TEST_CASE("failed points are recorded, kept on resume and counted", "[surrogate]") {
+  TempDir dir("sweep_failed");
+  const fs::path results = dir.path / "sweep.jsonl";
+  std::atomic<int> calls{0};
+  const PointEvaluator evaluator = [&](double f, double x) {
+    ++calls;
+    FieldPoint p = RecordingEvaluator()(f, x);
+    if (f == 3.0 && x == 0.04) {
+      p.status = PointStatus::kFailed;
+      p.motion_mode = "unstable time step";
+    }
+    return p;
+  };
+  const SweepResult result = run_sweep(sweep_grid(), evaluator, sweep_options(results));
+  CHECK(result.summary.points_failed == 1);
+  const FieldPoint& failed = result.field.points.back();
+  CHECK(failed.status == PointStatus::kFailed);
+  CHECK(std::isnan(failed.eta_star));
+  CHECK(failed.motion_mode == "unstable time step");
+  const SweepResult again = run_sweep(sweep_grid(), evaluator, sweep_options(results));
+  CHECK(calls == 18);
+  CHECK(again.field.points == result.field.points);
+}
+
+TEST_CASE("an evaluator breaking its contract stops the sweep with a clear error", "[surrogate]") {
+  SweepOptions options = sweep_options({});
+  const PointEvaluator nan_ok = [](double, double) {
+    FieldPoint p;
+    p.status = PointStatus::kOk;
+    return p;
+  };
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), nan_ok, options),
+                    Catch::Contains("returned status \"ok\" with eta_star = nan"));
+  const PointEvaluator missing = [](double, double) { return FieldPoint{}; };
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), missing, options), Catch::Contains("returned status \"missing\""));
+  options.threads = 0;
+  options.bed_mass_kg = -1.0;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), missing, options), Catch::Contains("bed_mass_kg = -1: must be > 0") &&
+                                                                   Catch::Contains("threads = 0: must be in [1, 256]"));
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), PointEvaluator{}, sweep_options({})), Catch::Contains("must be callable"));
+}
+
+TEST_CASE("an intensity-stroke sweep drives the evaluator at the nodes' gamma and X/h", "[surrogate]") {
+  const Grid grid = Grid::from_ranges(GridAxes::kIntensityStrokeOverClearance, {0.2, 2.0, 3, AxisSpacing::kLog},
+                                      {0.1, 0.6, 4, AxisSpacing::kLinear});
+  const double h = 0.05;
+  const PointEvaluator evaluator = [&](double f, double x) {
+    FieldPoint p;
+    // Record the evaluator's view of Γ and X/h, computed from the definitions.
+    p.eta_star = x * (2 * kPi * f) * (2 * kPi * f) / kG;
+    p.apparent_mass_kg = x / h;
+    p.status = PointStatus::kOk;
+    return p;
+  };
+  SweepOptions options = sweep_options({});
+  options.clearance_m = h;
+  const SweepResult result = run_sweep(grid, evaluator, options);
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    CHECK(result.field.points[k].eta_star == Approx(grid.coordinate0(k)).epsilon(1e-13));
+    CHECK(result.field.points[k].apparent_mass_kg == Approx(grid.coordinate1(k)).epsilon(1e-15));
+  }
+}
