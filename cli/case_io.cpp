@@ -425,6 +425,51 @@ void read_dem(ObjectReader& r, Case& c) {
   world.threads = r.integer("threads", 1, 0, 1024);
 }
 
+void read_axis_range(ObjectReader& r, surrogate::AxisRange& range, const surrogate::AxisRange& defaults,
+                     const std::string& unit) {
+  range.min = r.number("min", defaults.min, kPositive, unit);
+  range.max = r.number("max", defaults.max, kPositive, unit);
+  range.count = r.integer("count", defaults.count, 1, 10000);
+  range.spacing = r.text("spacing", std::string(defaults.spacing == surrogate::AxisSpacing::kLog ? "log" : "linear"),
+                         {"linear", "log"}) == "log"
+                      ? surrogate::AxisSpacing::kLog
+                      : surrogate::AxisSpacing::kLinear;
+  if (range.max < range.min || (range.max == range.min && range.count != 1))
+    r.fail("max", "must be > min (or equal to min with count 1)");
+}
+
+/// Default grid: the case frequency and strokes from 0.1 h to 1.0 h (10 points), or
+/// Γ at that frequency and X/h over the same range.
+void read_field(ObjectReader& r, Case& c) {
+  FieldSpec& field = c.field;
+  const std::string axes =
+      r.text("axes", std::string("frequency_amplitude"), {"frequency_amplitude", "intensity_stroke_over_clearance"});
+  const double h = c.damper.clearance_m;
+  const double f = c.excitation.frequency_hz;
+  surrogate::AxisRange default0{f, f, 1, surrogate::AxisSpacing::kLinear};
+  surrogate::AxisRange default1{0.1 * h, 1.0 * h, 10, surrogate::AxisSpacing::kLinear};
+  std::string unit0 = " Hz", unit1 = " m";
+  if (axes == "intensity_stroke_over_clearance") {
+    field.axes = surrogate::GridAxes::kIntensityStrokeOverClearance;
+    default0 = {0.5, 0.5, 1, surrogate::AxisSpacing::kLinear};
+    default1 = {0.1, 1.0, 10, surrogate::AxisSpacing::kLinear};
+    unit0 = unit1 = "";
+  }
+  const auto read0 = [&](ObjectReader& a) { read_axis_range(a, field.axis0, default0, unit0); };
+  const auto read1 = [&](ObjectReader& a) { read_axis_range(a, field.axis1, default1, unit1); };
+  r.object("axis0", false, read0);
+  if (!r.has("axis0")) {
+    ObjectReader fallback(r.file(), kEmptyObject, r.pointer() + "/axis0", r.resolved()["axis0"]);
+    read0(fallback);
+  }
+  r.object("axis1", false, read1);
+  if (!r.has("axis1")) {
+    ObjectReader fallback(r.file(), kEmptyObject, r.pointer() + "/axis1", r.resolved()["axis1"]);
+    read1(fallback);
+  }
+  field.threads = r.integer("threads", 2, 1, 256);
+}
+
 }  // namespace
 
 dem_reference::DamperSimulationOptions dem_options(const Case& c, double amplitude_m, double frequency_hz) {
@@ -502,6 +547,11 @@ Case load_case(const std::string& path) {
   {
     const auto problems = dem_options(c, c.excitation.amplitude_m.value_or(1.0), c.excitation.frequency_hz).validate("");
     if (!problems.empty()) throw InputError(path, "/dem", problems.front());
+  }
+  r.object("field", false, [&](ObjectReader& f) { read_field(f, c); });
+  if (!root.contains("field")) {
+    ObjectReader defaults(path, kEmptyObject, "/field", c.resolved["field"]);
+    read_field(defaults, c);
   }
   r.object("buffer", false, [&](ObjectReader& b) {
     BufferSpec spec;

@@ -12,6 +12,7 @@
 #include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
+#include "pdamp/surrogate/grid.hpp"
 
 namespace pdamp::cli {
 
@@ -58,6 +59,14 @@ struct DemSpec {
   double stiffness_softening = 1.0;  ///< factor on every Young's modulus in the DEM only
 };
 
+/// The effective-field grid of `pdamp field` (docs/cases.md, `field`).
+struct FieldSpec {
+  surrogate::GridAxes axes = surrogate::GridAxes::kFrequencyAmplitude;
+  surrogate::AxisRange axis0;  ///< frequency_hz or intensity
+  surrogate::AxisRange axis1;  ///< amplitude_m or stroke_over_clearance
+  int threads = 2;             ///< DEM points run at once
+};
+
 struct Case {
   std::string path;
   std::string name;
@@ -69,6 +78,7 @@ struct Case {
   DesignSpec design;
   std::optional<BufferSpec> buffer;
   DemSpec dem;
+  FieldSpec field;
   nlohmann::json resolved;  ///< the case with every default resolved and derived values added
 };
 

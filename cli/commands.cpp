@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,10 @@
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
+#include "pdamp/surrogate/dem_evaluator.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/surrogate/scattered_fit.hpp"
+#include "pdamp/surrogate/sweep.hpp"
 
 namespace pdamp::cli {
 
@@ -46,6 +51,13 @@ fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
   if (const auto c = args.optional_number("--calibration", 0.0, 2.0)) {
     if (model == fm::DamperModel::kBouncing) options.bouncing_calibration = *c;
     else options.rolling_calibration = *c;
+  }
+  if (const auto file = args.optional_text("--scattered-fit")) {
+    try {
+      options.scattered = surrogate::read_scattered_fit(*file).fit;
+    } catch (const std::invalid_argument& e) {
+      throw InputError("--scattered-fit", "", e.what());
+    }
   }
   return options;
 }
@@ -463,6 +475,196 @@ int run_dem(const ParsedArgs& args) {
                {"run", result.summary.brief_report()}});
 }
 
+// ---------------------------------------------------------------- effective fields
+
+std::string axis_label(surrogate::AxisQuantity q) {
+  switch (q) {
+    case surrogate::AxisQuantity::kFrequencyHz: return "frequency f / Hz";
+    case surrogate::AxisQuantity::kAmplitudeM: return "stroke X / m";
+    case surrogate::AxisQuantity::kIntensity: return "intensity {/Symbol G}";
+    case surrogate::AxisQuantity::kStrokeOverClearance: return "stroke X / clearance h";
+  }
+  return "";
+}
+
+/// Short labels of motion modes and regimes for the heat map.
+std::string mode_code(const std::string& mode) {
+  static const std::vector<std::pair<std::string, std::string>> codes = {
+      {"rolling_collect_and_collide", "RC"}, {"bouncing_collect_and_collide", "BC"}, {"collect_and_collide", "CC"},
+      {"sub_peak", "SP"},  {"scattering", "SC"}, {"scattered", "SC"}, {"solid_like", "SL"},
+      {"local_fluidisation", "LF"}, {"global_fluidisation", "GF"}, {"decoupled", "DC"}};
+  for (const auto& [name, code] : codes)
+    if (mode == name) return code;
+  return "?";
+}
+
+/// An axis end widened by 4% of the axis span, so edge labels of the heat map show.
+double padded(const std::vector<double>& values, int side) {
+  const double span = values.back() - values.front();
+  return side < 0 ? values.front() - 0.04 * span : values.back() + 0.04 * span;
+}
+
+/// field_table.csv, field_map.dat (gnuplot grid blocks), field_cuts_formula.csv and the
+/// heat map (when both axes have >= 2 nodes) and eta*(axis 1) cuts with the closed form.
+std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field, const Case& c) {
+  const auto& g = field.grid;
+  std::ostringstream table, map;
+  table.precision(10);
+  map.precision(10);
+  table << "axis0,axis1,frequency_hz,amplitude_m,eta_star,eta_star_stderr,e_diss_j,apparent_mass_fraction,motion_mode,status\n";
+  map << "# axis0 axis1 eta_star mode_code (blocks of constant axis0 for gnuplot's pm3d)\n";
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const auto& p = field.points[k];
+    const auto drive = surrogate::drive_point(g, k, field.clearance_m);
+    table << g.coordinate0(k) << ',' << g.coordinate1(k) << ',' << drive.frequency_hz << ',' << drive.amplitude_m << ','
+          << p.eta_star << ',' << p.eta_star_stderr << ',' << p.e_diss_j << ',' << p.apparent_mass_fraction << ','
+          << p.motion_mode << ',' << surrogate::to_string(p.status) << '\n';
+    map << g.coordinate0(k) << ' ' << g.coordinate1(k) << ' ' << p.eta_star << ' ' << mode_code(p.motion_mode) << '\n';
+    if ((k + 1) % g.axis1.size() == 0) map << '\n';
+  }
+  out.add("field_table.csv", table.str());
+  out.add("field_map.dat", map.str());
+
+  // Closed-form eta* along axis 1 at every axis-0 node, finely sampled, for the cuts.
+  std::ostringstream formula;
+  formula.precision(10);
+  formula << "axis0,axis1,eta_star_formula\n";
+  const double a1 = g.axis1.values.front(), b1 = g.axis1.values.back();
+  for (std::size_t i0 = 0; i0 < g.axis0.size(); ++i0) {
+    for (int j = 0; j <= 200; ++j) {
+      const double v1 = a1 + (b1 - a1) * j / 200.0;
+      surrogate::Grid one{{g.axis0.quantity, g.axis0.spacing, {g.axis0.values[i0]}}, {g.axis1.quantity, g.axis1.spacing, {v1}}};
+      const auto drive = surrogate::drive_point(one, 0, field.clearance_m);
+      const auto loss = fm::reduced_loss_factor(c.damper.model, field.clearance_m, drive.amplitude_m, drive.frequency_hz,
+                                                c.damper.model_options);
+      formula << g.axis0.values[i0] << ',' << v1 << ',' << loss.eta_star << '\n';
+    }
+    formula << "\n\n";
+  }
+  out.add("field_cuts_formula.csv", formula.str());
+
+  const std::string source(surrogate::to_string(field.provenance.source));
+  std::vector<std::string> warnings;
+  std::ostringstream cuts;
+  cuts << "# eta* along axis 1 at each axis-0 node: field points (" << source << ") and the closed form\n"
+       << "set datafile separator ','\nset grid\nset key outside right\n"
+       << "set xlabel '" << axis_label(g.axis1.quantity) << "'\nset ylabel 'reduced loss factor {/Symbol h}*'\n"
+       << "set title \"" << c.name << ": effective field (" << source << ") and closed form\" noenhanced\n"
+       << "set yrange [0:*]\n"
+       << "do for [t in 'pngcairo svg'] {\n"
+       << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+       << "  set output (t eq 'svg') ? 'field_cuts.svg' : 'field_cuts.png'\n"
+       << "  plot for [i=0:" << g.axis0.size() - 1 << "] 'field_cuts_formula.csv' index i using 2:3 with lines dt 2 lw 1.5 lc i+1 "
+       << "title sprintf('closed form, axis0 = %g', word('";
+  for (double v : g.axis0.values) cuts << v << ' ';
+  cuts << "', i+1)+0), \\\n"
+       << "       for [i=0:" << g.axis0.size() - 1 << "] 'field_table.csv' every ::(i*" << g.axis1.size() << "+1)::((i+1)*"
+       << g.axis1.size() << ") using 2:5:6 with yerrorlines pt 7 lw 2 lc i+1 title sprintf('" << source
+       << ", axis0 = %g', word('";
+  for (double v : g.axis0.values) cuts << v << ' ';
+  cuts << "', i+1)+0)\n}\n";
+  for (auto& w : out.add_plot("field_cuts.gp", cuts.str(), {"field_cuts.png", "field_cuts.svg"})) warnings.push_back(w);
+
+  if (g.axis0.size() >= 2 && g.axis1.size() >= 2) {
+    std::ostringstream heat;
+    heat << "# heat map of eta* over the two axes, motion modes marked (" << source << ")\n"
+         << "set view map\nset pm3d map interpolate 0,0\nset palette rgb 33,13,10\n"
+         << "set xlabel '" << axis_label(g.axis0.quantity) << "'\nset ylabel '" << axis_label(g.axis1.quantity) << "'\n"
+         << "set cblabel 'reduced loss factor {/Symbol h}*'\n"
+         << "set title \"" << c.name << ": effective field (" << source << ")\" noenhanced\n"
+         << "set label 1 'RC/BC rolling/bouncing collect-and-collide, SP sub-peak orbit, SC scattered, SL solid-like, "
+            "LF/GF local/global fluidisation, DC decoupled' at screen 0.5, 0.02 center font ',9'\n"
+         << "set bmargin 5\n"
+         << "set xrange [" << padded(g.axis0.values, -1) << ":" << padded(g.axis0.values, 1) << "]\n"
+         << "set yrange [" << padded(g.axis1.values, -1) << ":" << padded(g.axis1.values, 1) << "]\n"
+         << "do for [t in 'pngcairo svg'] {\n"
+         << "  set terminal t size 1000,700 enhanced font 'Sans,11'\n"
+         << "  set output (t eq 'svg') ? 'field_map.svg' : 'field_map.png'\n"
+         << "  splot 'field_map.dat' using 1:2:3 with pm3d notitle, '' using 1:2:3:4 with labels tc rgb 'black' font ',10' notitle\n"
+         << "}\n";
+    for (auto& w : out.add_plot("field_map.gp", heat.str(), {"field_map.png", "field_map.svg"})) warnings.push_back(w);
+  }
+  return warnings;
+}
+
+/// The physics a field depends on: damper, materials and DEM settings (not names).
+std::string physics_hash(const Case& c, const std::string& source) {
+  json identity = {{"damper", c.resolved["damper"]}, {"materials", c.resolved["materials"]}, {"source", source}};
+  if (source == "dem") identity["dem"] = c.resolved["dem"];
+  return surrogate::case_hash(identity);
+}
+
+int run_field(const ParsedArgs& args) {
+  const Case c = load_case(args.positional().at(0));
+  const std::string source = args.text("--source");
+  if (source != "formulas" && source != "dem")
+    throw InputError("--source", "", "'" + source + "': must be formulas or dem");
+  const bool dem = source == "dem";
+  const std::string dir = args.optional_text("-o").value_or("out/" + c.name + "_field_" + source);
+  const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
+
+  surrogate::SweepOptions sweep;
+  sweep.source = dem ? surrogate::FieldSource::kDem : surrogate::FieldSource::kFormulas;
+  sweep.case_hash = physics_hash(c, source);
+  sweep.model_version = dem ? surrogate::dem_model_version() : 0;
+  sweep.clearance_m = c.damper.clearance_m;
+  sweep.bed_mass_kg = c.damper.bed_mass_kg;
+  sweep.threads = dem ? c.field.threads : 1;
+  std::mutex progress_mutex;
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  if (dem) {
+    std::filesystem::create_directories(dir);
+    sweep.results_path = std::filesystem::path(dir) / "field_sweep.jsonl";
+    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
+      std::lock_guard lock(progress_mutex);
+      std::cerr << (tty ? "\r" : "") << "pdamp field: " << done << "/" << total << " points";
+      if (std::isfinite(eta_s)) std::cerr << ", ETA " << static_cast<long>(eta_s) << " s";
+      std::cerr << (tty ? "   " : "\n") << std::flush;
+    };
+  }
+  surrogate::PointEvaluator evaluator;
+  if (dem) {
+    auto options = dem_options(c, 1.0, 1.0);
+    options.world.threads = 1;  // the sweep runs points in parallel instead
+    evaluator = surrogate::dem_evaluator(options);
+  } else {
+    evaluator = surrogate::formula_evaluator(c.damper.model, c.damper.clearance_m, c.damper.bed_mass_kg,
+                                             c.damper.model_options);
+  }
+  const auto result = surrogate::run_sweep(grid, evaluator, sweep);
+  if (dem && tty) std::cerr << "\n";
+
+  std::vector<std::string> warnings;
+  json out = {{"source", source}, {"points", result.field.grid.size()}, {"sweep", result.summary.brief_report()}};
+  OutputDir files(dir);
+  const auto field_path = files.staged_path("field.json");
+  surrogate::write_effective_field(result.field, field_path);
+  out["file"] = (std::filesystem::path(dir) / "field.json").string();
+  if (dem) {
+    try {
+      const auto samples = surrogate::scattered_samples(result.field, c.damper.model, c.damper.model_options);
+      const auto fit = surrogate::fit_scattered_law(samples, "pdamp field --source dem, case " + c.name);
+      surrogate::write_scattered_fit(fit, files.staged_path("scattered_fit.json"));
+      out["scattered_fit"] = {{"jump_fraction", fit.fit.jump_fraction}, {"exponent", fit.fit.exponent},
+                              {"s_min", fit.fit.s_min}, {"s_max", fit.s_max},
+                              {"reduced_chi_squared", fit.reduced_chi_squared}, {"points", fit.points}};
+    } catch (const std::exception& e) {
+      warnings.push_back(std::string("scattered-state fit not made: ") + e.what());
+    }
+  }
+  for (auto& w : write_field_pictures(files, result.field, c)) warnings.push_back(w);
+  out["files"] = files.commit();
+  out["warnings"] = warnings;
+  print_warnings(warnings);
+  std::vector<std::pair<std::string, std::string>> rows = {
+      {"source", source}, {"points", std::to_string(result.field.grid.size())}, {"sweep", result.summary.brief_report()}};
+  if (out.contains("scattered_fit"))
+    rows.push_back({"scattered fit", "jump_fraction = " + format_number(out["scattered_fit"]["jump_fraction"].get<double>(), 4) +
+                                         ", exponent = " + format_number(out["scattered_fit"]["exponent"].get<double>(), 4)});
+  for (const auto& path : out["files"]) rows.push_back({"wrote", path.get<std::string>()});
+  return emit(args, out, rows);
+}
+
 const FlagSpec kModelOverrides[] = {
     {"--calibration", "C", "design factor c in x_opt = c*x_opt_ideal (default 0.8976 rolling, 1.0 bouncing)"},
     {"--inertia-factor", "K", "rolling spheres' I/(m r^2) (default 0.4, solid spheres)"}};
@@ -495,6 +697,8 @@ const std::vector<Command>& commands() {
          {"--amplitude", "M", "container stroke X, m (> 0)"},
          {"--frequency", "HZ", "drive frequency f, Hz (> 0)"},
          {"--bed-mass", "KG", "bed mass for e_diss_j and energy_per_cycle_j, kg (default 1)"},
+         {"--scattered-fit", "FILE", "fitted scattered-state coefficients (scattered_fit.json of\n"
+                                     "                          pdamp field --source dem); default: provisional"},
          kModelOverrides[0], kModelOverrides[1], kOutFlag, kJsonFlag}},
        run_loss},
       {{"buffer",
@@ -525,6 +729,16 @@ const std::vector<Command>& commands() {
                        "                          force_velocity.png/.svg into DIR, atomically"},
          kJsonFlag}, 1},
        run_dem},
+      {{"field", "pdamp field CASE.json --source formulas|dem [-o DIR] [--json]",
+        "effective field: eta*, E_diss, apparent mass and motion mode over the case's grid\n"
+        "(frequency x amplitude or intensity x X/h); DEM sweeps resume where they stopped",
+        {{"--source", "SRC", "formulas (closed forms, microseconds) or dem (one DEM run per point,\n"
+                             "                          field.threads at once, saved as each finishes)"},
+         {"-o", "DIR", "output folder (default out/<case name>_field_<source>): field.json,\n"
+                       "                          field_table.csv, heat map and cuts (PNG, SVG); dem: also\n"
+                       "                          field_sweep.jsonl (resume) and scattered_fit.json"},
+         kJsonFlag}, 1},
+       run_field},
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",

@@ -207,3 +207,48 @@ TEST_CASE("pdamp dem reports the promised keys and writes its files", "[cli]") {
   CHECK(d["clearance_m"].get<double>() == Approx(0.100).margin(1e-9));
   for (const char* name : {"summary.json", "time_series.csv", "particles_0000.vtk"}) CHECK(fs::exists(dir / name));
 }
+
+TEST_CASE("pdamp field from the formulas writes a readable field with the promised keys", "[cli]") {
+  const auto path = edited_case("pdamp_field_case.json", [](json& c) {
+    c["field"] = {{"axis0", {{"min", 1.5}, {"max", 2.5}, {"count", 3}}},
+                  {"axis1", {{"min", 0.01}, {"max", 0.08}, {"count", 8}, {"spacing", "log"}}}};
+  });
+  const fs::path dir = fs::temp_directory_path() / "pdamp_field_out";
+  fs::remove_all(dir);
+  const auto r = run_pdamp("field " + path + " --source formulas -o " + dir.string() + " --json");
+  REQUIRE(r.exit_code == 0);
+  const json f = json::parse(r.out);
+  CHECK(f["source"] == "formulas");
+  CHECK(f["points"] == 24);
+  REQUIRE(fs::exists(f["file"].get<std::string>()));
+  std::ifstream in(f["file"].get<std::string>());
+  const json field = json::parse(in);
+  CHECK(field.dump().find("\"formulas\"") != std::string::npos);  // provenance names the source
+
+  require_one_line_error(run_pdamp("field " + path + " --source magic -o " + dir.string()), "--source: 'magic'");
+  const auto bad_axis = edited_case("pdamp_field_bad.json", [](json& c) {
+    c["field"] = {{"axis1", {{"min", 0.05}, {"max", 0.01}, {"count", 4}}}};
+  });
+  require_one_line_error(run_pdamp("validate " + bad_axis), "/field/axis1/max: must be > min");
+}
+
+TEST_CASE("loss takes a scattered-fit file and rejects a bad one", "[cli]") {
+  const fs::path fit = fs::temp_directory_path() / "pdamp_scattered_fit.json";
+  std::ofstream(fit) << R"({"format": "pdamp.scattered_fit", "format_version": 1, "jump_fraction": 0.25,
+    "exponent": 1.0, "s_min": 0.2, "s_max": 0.95, "source": "test", "residual": 1.1})";
+  const auto r = run_pdamp("loss --model rolling --clearance 0.1 --amplitude 0.03 --frequency 2 --json --scattered-fit " +
+                           fit.string());
+  REQUIRE(r.exit_code == 0);
+  const json l = json::parse(r.out);
+  // Independent value: 0.25 * eta*_onset(rolling) * s, eta*_onset = 4 pi/((pi^2+4)(7/5)),
+  // s = X/X_onset with X_onset = (7/5) h/sqrt(pi^2+4) (PHYSICS.md §3, §4).
+  const double onset = 1.4 * 0.1 / std::sqrt(kPi * kPi + 4.0);
+  const double eta_onset = 4.0 * kPi / ((kPi * kPi + 4.0) * 1.4);
+  CHECK(l["eta_star"].get<double>() == Approx(0.25 * eta_onset * 0.03 / onset).epsilon(1e-9));
+  CHECK(l["regime"] == "scattered");
+
+  std::ofstream(fit) << R"({"jump_fraction": 2.0})";
+  require_one_line_error(run_pdamp("loss --model rolling --clearance 0.1 --amplitude 0.03 --frequency 2 --scattered-fit " +
+                                   fit.string()),
+                         "--scattered-fit");
+}
