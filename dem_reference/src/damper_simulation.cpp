@@ -72,12 +72,13 @@ double period_correlation(const std::vector<double>& signal, int samples, int pe
 }
 
 /// The labels of PHYSICS.md from the indicators (docs/dem.md "Motion modes").
-MotionMode classify(const MotionIndicators& m, double eta_star, double intensity) {
+/// rolling_family: gravity across the drive exceeds the drive acceleration, so the bed
+/// stays on its base between impacts (low intensity).
+MotionMode classify(const MotionIndicators& m, double eta_star, double intensity, bool rolling_family) {
   if (m.relative_stroke_over_clearance < 0.1 && m.apparent_mass_fraction > 0.8) return MotionMode::kSolidLike;
   if (std::abs(m.apparent_mass_fraction) < 0.1 && eta_star < 0.1) return MotionMode::kDecoupled;
   if (m.relative_stroke_over_clearance > 0.5 && m.period_correlation > 0.8 && m.eta_star_variation < 0.25) {
-    return m.base_contact_fraction > 0.5 ? MotionMode::kRollingCollectAndCollide
-                                         : MotionMode::kBouncingCollectAndCollide;
+    return rolling_family ? MotionMode::kRollingCollectAndCollide : MotionMode::kBouncingCollectAndCollide;
   }
   if (m.spread_over_packed >= 2.0) return MotionMode::kGlobalFluidisation;
   if (m.spread_over_packed >= 1.2 && intensity > 1.0) return MotionMode::kLocalFluidisation;
@@ -261,6 +262,9 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     reporter.maybe_report("settling", k, total_steps, (k - settle_steps) * dt);
   }
 
+  // The drive starts with the bed at rest relative to the container: collected against
+  // its wall and riding with it, as on the collect-and-collide orbit at detachment.
+  world.add_velocity(start.velocity_m_s);
   const std::int64_t transient_steps = steps_per_period * options.transient_periods;
   for (std::int64_t k = 1; k <= transient_steps; ++k) {
     world.step(motion.state(static_cast<double>(k) * dt));
@@ -388,7 +392,10 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   mi.base_contact_fraction = base_sum / static_cast<double>(blocks);
   mi.airborne_fraction = airborne_sum / static_cast<double>(blocks);
   mi.spread_over_packed = spread_sum / static_cast<double>(blocks);
-  result.motion_mode = classify(mi, result.eta_star, result.intensity);
+  const double g_along = dot(g, axis);
+  const double g_across = std::sqrt(std::max(g_norm * g_norm - g_along * g_along, 0.0));
+  const double drive_acceleration = options.amplitude_m * motion.angular_frequency_rad_s() * motion.angular_frequency_rad_s();
+  result.motion_mode = classify(mi, result.eta_star, result.intensity, g_across > drive_acceleration);
 
   // Validity remarks.
   auto& warn = result.warnings;

@@ -773,6 +773,17 @@ void World::set_particle_state(int i, const Vec3& position_m, const Vec3& veloci
   w.rebuild_due = true;
 }
 
+void World::add_velocity(const Vec3& velocity_m_s) {
+  Impl& w = *impl_;
+  const double before = w.kinetic_energy();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(w.n); ++k) {
+    w.vx[k] += velocity_m_s[0];
+    w.vy[k] += velocity_m_s[1];
+    w.vz[k] += velocity_m_s[2];
+  }
+  w.initial_energy += w.kinetic_energy() - before;
+}
+
 double World::time_step_s() const { return impl_->dt; }
 double World::time_s() const { return impl_->time; }
 std::int64_t World::step_count() const { return impl_->steps; }

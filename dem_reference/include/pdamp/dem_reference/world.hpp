@@ -85,6 +85,10 @@ class World {
   void set_particle_state(int i, const Vec3& position_m, const Vec3& velocity_m_s,
                           const Vec3& angular_velocity_rad_s);
 
+  /// Adds the same velocity (m/s, world frame) to every particle: a Galilean boost that
+  /// leaves contacts unchanged (run_harmonic starts the bed moving with the container).
+  void add_velocity(const Vec3& velocity_m_s);
+
   double time_step_s() const;
   double time_s() const;
   std::int64_t step_count() const;
