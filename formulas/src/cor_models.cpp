@@ -1,5 +1,6 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
+#include "pdamp/formulas/csv_text.hpp"
 
 #include <nlopt.hpp>
 
@@ -234,25 +235,6 @@ double log_yield_speed_constant(double effective_modulus_pa, double effective_ra
 
 // ---------------------------------------------------------------------------
 // Impact CSV.
-
-std::string_view trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r\n");
-  return text.substr(first, last - first + 1);
-}
-
-std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    fields.push_back(
-        trim(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
-  }
-}
 
 // ---------------------------------------------------------------------------
 // NLopt plumbing: exceptions never cross NLopt's C boundary. The callback stores
@@ -713,10 +695,10 @@ ImpactData read_impact_csv(const std::string& path) {
   int line_number = 0;
   while (std::getline(file, line)) {
     ++line_number;
-    const std::string_view content = trim(line);
+    const std::string_view content = trim_blanks(line);
     if (content.empty() || content.front() == '#') continue;
     const std::string where = "impact CSV " + path + ":" + std::to_string(line_number) + ": ";
-    const std::vector<std::string_view> fields = split_fields(content);
+    const std::vector<std::string_view> fields = split_csv_line(content);
     if (!have_header) {
       auto find_column = [&](std::string_view name) {
         const auto found = std::find(fields.begin(), fields.end(), name);

@@ -1,6 +1,8 @@
 // CSV import of measured effective fields: column checks, number parsing, full-grid check.
 #include "pdamp/surrogate/measured_import.hpp"
 
+#include "pdamp/formulas/csv_text.hpp"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -25,25 +27,6 @@ enum Column : int { kFrequency, kAmplitude, kEta, kStderr, kApparentMass, kMotio
 constexpr std::array<std::string_view, kColumns> kNames = {"frequency_hz",    "amplitude_m",      "eta_star",
                                                            "eta_star_stderr", "apparent_mass_kg", "motion_mode"};
 constexpr int kRequiredColumns = 3;  // frequency_hz, amplitude_m, eta_star
-
-std::string_view trimmed(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
-std::vector<std::string_view> cells_of(std::string_view line) {
-  std::vector<std::string_view> cells;
-  std::size_t begin = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', begin);
-    cells.push_back(
-        trimmed(line.substr(begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin)));
-    if (comma == std::string_view::npos) return cells;
-    begin = comma + 1;
-  }
-}
 
 /// One data row as read, before it is placed on the grid.
 struct Row {
@@ -104,11 +87,11 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
   std::size_t begin = 0;
   while (begin <= text.size()) {
     const std::size_t end = std::min(text.find('\n', begin), text.size());
-    const std::string_view line = trimmed(text.substr(begin, end - begin));
+    const std::string_view line = formulas::trim_blanks(text.substr(begin, end - begin));
     begin = end + 1;
     ++line_number;
     if (line.empty() || line.front() == '#') continue;
-    const auto cells = cells_of(line);
+    const auto cells = formulas::split_csv_line(line);
     if (!have_header) {
       have_header = true;
       header_cells = cells.size();
