@@ -21,6 +21,7 @@
 #include "pdamp/formulas/hertz_impact.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/surrogate/measured_import.hpp"
 #include "pdamp/surrogate/scattered_fit.hpp"
 #include "pdamp/surrogate/sweep.hpp"
 
@@ -487,6 +488,11 @@ std::string axis_label(surrogate::AxisQuantity q) {
   return "";
 }
 
+/// "f = %g Hz" or "{/Symbol G} = %g": the legend of one cut (a gnuplot format).
+std::string axis_symbol(surrogate::AxisQuantity q) {
+  return q == surrogate::AxisQuantity::kFrequencyHz ? "f = %g Hz" : "{/Symbol G} = %g";
+}
+
 /// Short labels of motion modes and regimes for the heat map.
 std::string mode_code(const std::string& mode) {
   static const std::vector<std::pair<std::string, std::string>> codes = {
@@ -555,12 +561,12 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
        << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
        << "  set output (t eq 'svg') ? 'field_cuts.svg' : 'field_cuts.png'\n"
        << "  plot for [i=0:" << g.axis0.size() - 1 << "] 'field_cuts_formula.csv' index i using 2:3 with lines dt 2 lw 1.5 lc i+1 "
-       << "title sprintf('closed form, axis0 = %g', word('";
+       << "title sprintf('closed form, " << axis_symbol(g.axis0.quantity) << "', word('";
   for (double v : g.axis0.values) cuts << v << ' ';
   cuts << "', i+1)+0), \\\n"
        << "       for [i=0:" << g.axis0.size() - 1 << "] 'field_table.csv' every ::(i*" << g.axis1.size() << "+1)::((i+1)*"
        << g.axis1.size() << ") using 2:5:6 with yerrorlines pt 7 lw 2 lc i+1 title sprintf('" << source
-       << ", axis0 = %g', word('";
+       << ", " << axis_symbol(g.axis0.quantity) << "', word('";
   for (double v : g.axis0.values) cuts << v << ' ';
   cuts << "', i+1)+0)\n}\n";
   for (auto& w : out.add_plot("field_cuts.gp", cuts.str(), {"field_cuts.png", "field_cuts.svg"})) warnings.push_back(w);
@@ -594,13 +600,30 @@ std::string physics_hash(const Case& c, const std::string& source) {
   return surrogate::case_hash(identity);
 }
 
+int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
+                        const std::string& dir, json out);
+
+/// A test-rig field from CSV (docs/effective_fields.md) for the case's damper.
+int import_measured_field(const ParsedArgs& args, const Case& c, const std::string& dir) {
+  surrogate::MeasuredImportOptions options;
+  options.clearance_m = c.damper.clearance_m;
+  options.bed_mass_kg = c.damper.bed_mass_kg;
+  options.frequency_spacing = c.field.axis0.spacing;
+  options.amplitude_spacing = c.field.axis1.spacing;
+  options.case_hash = physics_hash(c, "measured");
+  const auto field = surrogate::import_measured_csv(args.text("--measured"), options);
+  return write_field_outputs(args, c, field, dir, json::object());
+}
+
 int run_field(const ParsedArgs& args) {
   const Case c = load_case(args.positional().at(0));
   const std::string source = args.text("--source");
-  if (source != "formulas" && source != "dem")
-    throw InputError("--source", "", "'" + source + "': must be formulas or dem");
+  if (source != "formulas" && source != "dem" && source != "measured")
+    throw InputError("--source", "", "'" + source + "': must be formulas, dem or measured");
   const bool dem = source == "dem";
   const std::string dir = args.optional_text("-o").value_or("out/" + c.name + "_field_" + source);
+  if (source == "measured") return import_measured_field(args, c, dir);
+  if (args.has("--measured")) throw InputError("--measured", "", "goes with --source measured");
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
 
   surrogate::SweepOptions sweep;
@@ -634,16 +657,23 @@ int run_field(const ParsedArgs& args) {
   const auto result = surrogate::run_sweep(grid, evaluator, sweep);
   if (dem && tty) std::cerr << "\n";
 
+  json out = {{"sweep", result.summary.brief_report()}};
+  return write_field_outputs(args, c, result.field, dir, out);
+}
+
+/// field.json, the scattered-state fit (DEM and measured fields), tables and pictures.
+int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
+                        const std::string& dir, json out) {
+  const std::string source(surrogate::to_string(field.provenance.source));
   std::vector<std::string> warnings;
-  json out = {{"source", source}, {"points", result.field.grid.size()}, {"sweep", result.summary.brief_report()}};
+  out.update({{"source", source}, {"points", field.grid.size()}});
   OutputDir files(dir);
-  const auto field_path = files.staged_path("field.json");
-  surrogate::write_effective_field(result.field, field_path);
+  surrogate::write_effective_field(field, files.staged_path("field.json"));
   out["file"] = (std::filesystem::path(dir) / "field.json").string();
-  if (dem) {
+  if (field.provenance.source != surrogate::FieldSource::kFormulas) {
     try {
-      const auto samples = surrogate::scattered_samples(result.field, c.damper.model, c.damper.model_options);
-      const auto fit = surrogate::fit_scattered_law(samples, "pdamp field --source dem, case " + c.name);
+      const auto samples = surrogate::scattered_samples(field, c.damper.model, c.damper.model_options);
+      const auto fit = surrogate::fit_scattered_law(samples, "pdamp field --source " + source + ", case " + c.name);
       surrogate::write_scattered_fit(fit, files.staged_path("scattered_fit.json"));
       out["scattered_fit"] = {{"jump_fraction", fit.fit.jump_fraction}, {"exponent", fit.fit.exponent},
                               {"s_min", fit.fit.s_min}, {"s_max", fit.s_max},
@@ -652,12 +682,12 @@ int run_field(const ParsedArgs& args) {
       warnings.push_back(std::string("scattered-state fit not made: ") + e.what());
     }
   }
-  for (auto& w : write_field_pictures(files, result.field, c)) warnings.push_back(w);
+  for (auto& w : write_field_pictures(files, field, c)) warnings.push_back(w);
   out["files"] = files.commit();
   out["warnings"] = warnings;
   print_warnings(warnings);
-  std::vector<std::pair<std::string, std::string>> rows = {
-      {"source", source}, {"points", std::to_string(result.field.grid.size())}, {"sweep", result.summary.brief_report()}};
+  std::vector<std::pair<std::string, std::string>> rows = {{"source", source}, {"points", std::to_string(field.grid.size())}};
+  if (out.contains("sweep")) rows.push_back({"sweep", out["sweep"].get<std::string>()});
   if (out.contains("scattered_fit"))
     rows.push_back({"scattered fit", "jump_fraction = " + format_number(out["scattered_fit"]["jump_fraction"].get<double>(), 4) +
                                          ", exponent = " + format_number(out["scattered_fit"]["exponent"].get<double>(), 4)});
@@ -729,11 +759,14 @@ const std::vector<Command>& commands() {
                        "                          force_velocity.png/.svg into DIR, atomically"},
          kJsonFlag}, 1},
        run_dem},
-      {{"field", "pdamp field CASE.json --source formulas|dem [-o DIR] [--json]",
+      {{"field", "pdamp field CASE.json --source formulas|dem|measured [--measured FILE] [-o DIR] [--json]",
         "effective field: eta*, E_diss, apparent mass and motion mode over the case's grid\n"
         "(frequency x amplitude or intensity x X/h); DEM sweeps resume where they stopped",
         {{"--source", "SRC", "formulas (closed forms, microseconds) or dem (one DEM run per point,\n"
-                             "                          field.threads at once, saved as each finishes)"},
+                             "                          field.threads at once, saved as each finishes) or\n"
+                             "                          measured (a test-rig CSV, see --measured)"},
+         {"--measured", "FILE", "CSV with columns frequency_hz, amplitude_m, eta_star [, eta_star_stderr,\n"
+                                "                          apparent_mass_kg, motion_mode] on a full grid"},
          {"-o", "DIR", "output folder (default out/<case name>_field_<source>): field.json,\n"
                        "                          field_table.csv, heat map and cuts (PNG, SVG); dem: also\n"
                        "                          field_sweep.jsonl (resume) and scattered_fit.json"},

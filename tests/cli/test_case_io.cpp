@@ -252,3 +252,24 @@ TEST_CASE("loss takes a scattered-fit file and rejects a bad one", "[cli]") {
                                    fit.string()),
                          "--scattered-fit");
 }
+
+TEST_CASE("pdamp field imports a measured field and rejects a broken CSV", "[cli]") {
+  const fs::path csv = fs::temp_directory_path() / "pdamp_measured.csv";
+  std::ofstream(csv) << "# rig data\nfrequency_hz,amplitude_m,eta_star,eta_star_stderr\n"
+                        "2,0.02,0.10,0.02\n2,0.04,0.80,0.05\n2,0.06,0.70,0.04\n"
+                        "3,0.02,0.12,0.02\n3,0.04,0.75,0.05\n3,0.06,0.66,0.04\n";
+  const fs::path dir = fs::temp_directory_path() / "pdamp_measured_out";
+  fs::remove_all(dir);
+  const auto r = run_pdamp("field " + case_path("low_intensity_36_spheres.json") + " --source measured --measured " +
+                           csv.string() + " -o " + dir.string() + " --json");
+  REQUIRE(r.exit_code == 0);
+  const json f = json::parse(r.out);
+  CHECK(f["source"] == "measured");
+  CHECK(f["points"] == 6);
+  CHECK(fs::exists(dir / "field.json"));
+
+  std::ofstream(csv) << "frequency_hz,amplitude_m,eta_star\n2,0.02,0.1\n2,0.04,abc\n";
+  const auto bad = run_pdamp("field " + case_path("low_intensity_36_spheres.json") + " --source measured --measured " +
+                             csv.string() + " -o " + dir.string());
+  require_one_line_error(bad, "pdamp_measured.csv: line 3");
+}
