@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+
+#include "support/temp_dir.hpp"
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,16 +20,7 @@ using namespace pdamp::surrogate;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-/// A fresh folder under the system temp folder, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("pdamp_test_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using pdamp::test::TempDir;
 
 void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 

@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+
+#include "support/temp_dir.hpp"
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -21,15 +23,7 @@ constexpr double kPi = 3.14159265358979323846;
 /// η*_onset of the bouncing block, 4π/(π²+4) (PHYSICS.md §2).
 const double kBouncingOnset = 4 * kPi / (kPi * kPi + 4);
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("pdamp_test_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using pdamp::test::TempDir;
 
 /// Samples of η* = J·η*_onset·s^p at n strokes in [0.2, 0.95], with Gaussian noise of
 /// standard deviation σ_i (given as the stderr) when `noisy`.

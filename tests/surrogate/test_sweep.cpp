@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <atomic>
 #include <catch2/catch.hpp>
+
+#include "support/temp_dir.hpp"
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -25,15 +27,7 @@ namespace fs = std::filesystem;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.80665;  // standard gravity, m/s^2
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("pdamp_test_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using pdamp::test::TempDir;
 
 std::string read_text(const fs::path& path) {
   std::ostringstream text;
