@@ -273,3 +273,22 @@ TEST_CASE("pdamp field imports a measured field and rejects a broken CSV", "[cli
                              csv.string() + " -o " + dir.string());
   require_one_line_error(bad, "pdamp_measured.csv: line 3");
 }
+
+TEST_CASE("a DEM instability exits with code 3 and advice and a refused time step with code 2", "[cli]") {
+  // An overlap limit of 1e-9 of the radius is exceeded by the first contact of the
+  // settled bed: the run stops as unstable (INTERFACE.md exit code 3).
+  const auto unstable = edited_case("pdamp_dem_unstable.json", [](json& c) {
+    c["dem"] = {{"stiffness_softening", 1e-3}, {"max_overlap_fraction", 1e-9}, {"transient_periods", 0},
+                {"analysed_periods", 1}};
+  });
+  const auto r = run_pdamp("dem " + unstable + " -o " + (fs::temp_directory_path() / "pdamp_unstable_out").string());
+  CHECK(r.exit_code == 3);
+  CHECK(r.out.empty());
+  CHECK_THAT(r.err, Catch::Contains("pdamp: error: DEM unstable"));
+  CHECK(!fs::exists(fs::temp_directory_path() / "pdamp_unstable_out" / "summary.json"));
+
+  const auto big_step = edited_case("pdamp_dem_step.json", [](json& c) { c["dem"] = {{"time_step_s", 1e-3}}; });
+  const auto s = run_pdamp("dem " + big_step);
+  CHECK(s.exit_code == 2);
+  CHECK_THAT(s.err, Catch::Contains("time_step_s"));
+}
