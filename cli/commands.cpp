@@ -370,7 +370,12 @@ int run_dem(const ParsedArgs& args) {
   if (!problems.empty()) throw InputError(path, "/dem", problems.front());
 
   ProgressLine progress("pdamp dem");
-  const auto result = dem_reference::run_harmonic(options, [&](const dem_reference::Progress& p) { progress(p); });
+  dem_reference::DamperResult result;
+  try {
+    result = dem_reference::run_harmonic(options, [&](const dem_reference::Progress& p) { progress(p); });
+  } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound
+    throw InputError(path, "/dem", e.what());
+  }
   if (result.summary.outcome == dem_reference::Outcome::kUnstable)
     throw NumericalError("DEM unstable: " + result.summary.message);
   if (result.summary.outcome != dem_reference::Outcome::kCompleted)

@@ -290,5 +290,5 @@ TEST_CASE("a DEM instability exits with code 3 and advice and a refused time ste
   const auto big_step = edited_case("pdamp_dem_step.json", [](json& c) { c["dem"] = {{"time_step_s", 1e-3}}; });
   const auto s = run_pdamp("dem " + big_step);
   CHECK(s.exit_code == 2);
-  CHECK_THAT(s.err, Catch::Contains("time_step_s"));
+  CHECK_THAT(s.err, Catch::Contains("pdamp_dem_step.json: /dem: dem.integration.time_step_s = 0.001: must be <="));
 }
