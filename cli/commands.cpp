@@ -279,6 +279,10 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
   auto rows = optimum_rows(optimum);
   rows.insert(rows.begin(), {"case", c.name});
   rows.push_back({"eta* at design", format_number(design_point.eta_star, 4)});
+  if (result.contains("operating_point"))
+    rows.push_back({"eta* at operating X", format_number(result["operating_point"]["eta_star"].get<double>(), 4) + "  (X = " +
+                                               format_number(*c.excitation.amplitude_m) + " m, " +
+                                               result["operating_point"]["regime"].get<std::string>() + ")"});
   if (result.contains("sizing"))
     rows.push_back({"clearance for target", format_number(result["sizing"]["clearance_m"].get<double>())});
   if (result.contains("buffer"))
