@@ -124,6 +124,21 @@ struct WallFeature {
   return 1e300;
 }
 
+/// Hertz curvature radius (WallFeature::curvature_radius_m convention: 0 flat, > 0
+/// convex, < 0 concave) of the wall part nearest to a sphere centred at p (body frame).
+/// A pin's end faces are flat: only its mantle (and, for want of a Hertz radius of a
+/// sharp edge, its rims) has the pin's curvature. Taken when a contact is listed, so a
+/// sphere that slides over a rim keeps the curvature of where it was listed.
+[[gnu::always_inline]] inline double contact_curvature_radius(const WallFeature& w, const double* p) {
+  if (w.kind != WallKind::kPin) return w.curvature_radius_m;
+  double rho2 = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    if (a != w.axis) rho2 += (p[a] - w.centre[a]) * (p[a] - w.centre[a]);
+  }
+  const bool beyond_end = std::abs(p[w.axis] - w.centre[w.axis]) > w.half[0];
+  return beyond_end && rho2 <= w.radius * w.radius ? 0.0 : w.curvature_radius_m;
+}
+
 /// Effective inner container of a compartment: the hard container less its layers.
 formulas::Container layered_container(const CompartmentOptions& c);
 /// All wall features of all compartments (body frame).

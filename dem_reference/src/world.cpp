@@ -422,7 +422,7 @@ void World::Impl::rebuild_lists() {
         Slot s;
         s.i = i;
         s.j = w;
-        s.params = law.particle_wall(radius[k], mass[k], material[k], wall.material, wall.curvature_radius_m);
+        s.params = law.particle_wall(radius[k], mass[k], material[k], wall.material, detail::contact_curvature_radius(wall, p));
         wall_slots.push_back(s);
       }
     }
