@@ -47,16 +47,24 @@ void CellGrid::bin(const double* x, const double* y, const double* z, int n) {
   }
   for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   // Stable fill: within a cell particles stay in index order.
-  counts_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (int i = 0; i < n; ++i) {
     const auto c = static_cast<std::size_t>(cell_[static_cast<std::size_t>(i)]);
-    sorted_[static_cast<std::size_t>(counts_[c]++)] = i;
+    sorted_[static_cast<std::size_t>(fill_[c]++)] = i;
+  }
+}
+
+void CellGrid::adopt_order() {
+  for (std::size_t c = 0; c + 1 < cell_start_.size(); ++c) {
+    for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+      cell_[static_cast<std::size_t>(k)] = static_cast<int>(c);
+      sorted_[static_cast<std::size_t>(k)] = k;
+    }
   }
 }
 
 std::size_t CellGrid::memory_bytes() const {
-  return sizeof(int) * (cell_start_.capacity() + sorted_.capacity() + cell_.capacity() + counts_.capacity() +
-                        offsets_.capacity());
+  return sizeof(int) * (cell_start_.capacity() + sorted_.capacity() + cell_.capacity() + fill_.capacity());
 }
 
 }  // namespace pdamp::dem_reference::detail

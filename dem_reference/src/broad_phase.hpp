@@ -1,5 +1,6 @@
-// Broad phase of the reference DEM: a uniform cell grid in the body frame and the
-// Verlet list of particle pairs closer than r_i + r_j + skin.
+// Broad phase of the reference DEM: a uniform cell grid in the body frame, the cell
+// order used to renumber particles, and the Verlet list of particle pairs closer than
+// r_i + r_j + skin as compressed rows.
 #pragma once
 
 #include <algorithm>
@@ -17,14 +18,23 @@ class CellGrid {
   /// would exceed max(64, 8·particles) cells.
   void configure(const std::array<double, 3>& lo, const std::array<double, 3>& hi, double cell_m,
                  int particles);
-  /// Counting sort of the particles into cells.
+  /// Counting sort of the particles into cells (cells in x-fastest row-major order;
+  /// within a cell by index).
   void bin(const double* x, const double* y, const double* z, int n);
-  /// Pairs i < j of equal `group` with |x_i − x_j| < r_i + r_j + skin, ordered by i then
-  /// j (deterministic for any thread count), written into the `i`, `j` members of
-  /// `out` (which keeps its capacity between calls). Uses the positions of bin().
-  template <class Pair>
+  /// The particles in cell order after bin(): order()[k] is the particle at place k.
+  const std::vector<int>& order() const { return sorted_; }
+  /// The caller has renumbered the particles so that particle k is the old order()[k]:
+  /// updates the binning to match without recomputing cells.
+  void adopt_order();
+  /// Pairs i < j of equal `group` with |x_i − x_j| < r_i + r_j + skin as compressed rows:
+  /// the partners of i are out[offsets[i] .. offsets[i+1]), ascending in j
+  /// (deterministic for any thread count). Writes the `j` member of each entry; `out` and
+  /// `offsets` keep their capacity between calls and grow by 1/8 when outgrown. Uses the
+  /// binning of bin().
+  template <class Entry>
   void find_pairs(const double* x, const double* y, const double* z, const double* radius,
-                  const int* group, int n, double skin_m, int threads, std::vector<Pair>& out);
+                  const int* group, int n, double skin_m, int threads, std::vector<int>& offsets,
+                  std::vector<Entry>& out);
   std::size_t memory_bytes() const;
 
  private:
@@ -38,12 +48,20 @@ class CellGrid {
   std::vector<int> cell_start_;  // size cells + 1
   std::vector<int> sorted_;      // particle indices by cell
   std::vector<int> cell_;        // cell of each particle
-  std::vector<int> counts_;      // pairs per particle (scratch)
-  std::vector<int> offsets_;     // prefix sums (scratch)
+  std::vector<int> fill_;        // next free place per cell (scratch of bin)
 };
 
 /// Below this many particles the list is built serially (thread start-up costs more).
 inline constexpr int kParallelListParticles = 4096;
+
+/// Grows `v` to `size` elements; when the capacity is outgrown it reserves 1/8 more
+/// than needed instead of the standard library's doubling (the lists are the largest
+/// arrays of the world and the memory per particle is a target).
+template <class T>
+void resize_with_margin(std::vector<T>& v, std::size_t size) {
+  if (size > v.capacity()) v.reserve(size + size / 8);
+  v.resize(size);
+}
 
 template <class Visit>
 void CellGrid::for_each_candidate(int i, Visit&& visit) const {
@@ -64,12 +82,12 @@ void CellGrid::for_each_candidate(int i, Visit&& visit) const {
   }
 }
 
-template <class Pair>
+template <class Entry>
 void CellGrid::find_pairs(const double* x, const double* y, const double* z, const double* radius,
-                          const int* group, int n, double skin_m, int threads, std::vector<Pair>& out) {
+                          const int* group, int n, double skin_m, int threads, std::vector<int>& offsets,
+                          std::vector<Entry>& out) {
   const auto un = static_cast<std::size_t>(n);
-  counts_.assign(un, 0);
-  offsets_.resize(un + 1);
+  resize_with_margin(offsets, un + 1);
   const auto near = [&](int i, int j) {
     if (group[i] != group[j]) return false;
     const double dx = x[i] - x[j];
@@ -79,28 +97,25 @@ void CellGrid::find_pairs(const double* x, const double* y, const double* z, con
     return dx * dx + dy * dy + dz * dz < cut * cut;
   };
   const bool parallel = threads > 1 && n > kParallelListParticles;
+  int* row = offsets.data();
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
   for (int i = 0; i < n; ++i) {
     int count = 0;
     for_each_candidate(i, [&](int j) { count += near(i, j) ? 1 : 0; });
-    counts_[static_cast<std::size_t>(i)] = count;
+    row[i + 1] = count;
   }
-  offsets_[0] = 0;
-  for (std::size_t i = 0; i < un; ++i) offsets_[i + 1] = offsets_[i] + counts_[i];
-  out.resize(static_cast<std::size_t>(offsets_[un]));
+  row[0] = 0;
+  for (std::size_t i = 0; i < un; ++i) offsets[i + 1] += offsets[i];
+  resize_with_margin(out, static_cast<std::size_t>(offsets[un]));
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
   for (int i = 0; i < n; ++i) {
-    const auto begin = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(i)]);
+    const auto begin = static_cast<std::size_t>(row[i]);
     auto k = begin;
     for_each_candidate(i, [&](int j) {
-      if (near(i, j)) {
-        out[k].i = i;
-        out[k].j = j;
-        ++k;
-      }
+      if (near(i, j)) out[k++].j = j;
     });
     std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.begin() + static_cast<std::ptrdiff_t>(k),
-              [](const Pair& a, const Pair& b) { return a.j < b.j; });
+              [](const Entry& a, const Entry& b) { return a.j < b.j; });
   }
 }
 

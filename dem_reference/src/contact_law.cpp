@@ -1,6 +1,7 @@
 // Material-pair table of the reference DEM and the per-contact parameters.
 #include "contact_law.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace pdamp::dem_reference::detail {
@@ -104,7 +105,12 @@ double ContactLaw::damping_coefficient(int pair_type, double impact_speed_m_s) c
   return damping_table().damping_for_restitution(restitution_[t]->restitution(impact_speed_m_s));
 }
 
-double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, double delta) {
+bool ContactLaw::any_rolling_friction() const {
+  return std::any_of(types_.begin(), types_.end(), [](const PairType& t) { return t.rolling_friction > 0.0; });
+}
+
+double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, const double* mr,
+                     double delta) {
   if (delta <= 0.0 || h.inv_kt_prev <= 0.0) return 0.0;
   const double hertz = 0.4 * p.stiffness * delta * delta * std::sqrt(delta);
   const double ft2 = h.ft[0] * h.ft[0] + h.ft[1] * h.ft[1] + h.ft[2] * h.ft[2];
@@ -112,7 +118,7 @@ double stored_energy(const ContactParams& p, const PairType& type, const Contact
   if (type.rolling_friction > 0.0) {
     const double root_r = p.stiffness * type.inv_hertz_modulus;
     const double r2 = root_r * root_r * root_r * root_r;
-    const double mr2 = h.mr[0] * h.mr[0] + h.mr[1] * h.mr[1] + h.mr[2] * h.mr[2];
+    const double mr2 = mr[0] * mr[0] + mr[1] * mr[1] + mr[2] * mr[2];
     springs += 0.5 * mr2 * h.inv_kt_prev / r2;
   }
   return hertz + springs;

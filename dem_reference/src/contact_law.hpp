@@ -19,8 +19,7 @@ struct PairType {
   double inv_hertz_modulus = 0.0;   ///< 1/((4/3)E*): √R* = K·inv_hertz_modulus, 1/Pa
 };
 
-/// Parameters of one contact, fixed while the pair stays in the Verlet list (kept
-/// small: a slot is 32 bytes).
+/// Parameters of one contact, fixed while it lasts (set at first touch).
 struct ContactParams {
   double stiffness = 0.0;      ///< K = (4/3)E*√R*, N/m^{3/2}
   double damping_scale = 0.0;  ///< √(m*K), kg^{1/2} N^{1/2} m^{-3/4}
@@ -28,9 +27,9 @@ struct ContactParams {
 };
 
 /// History of one contact. inv_kt_prev = 0 marks "not in contact at the last step".
+/// The rolling spring torque is kept apart (only pairs with rolling resistance use it).
 struct ContactHistory {
   double ft[3] = {0.0, 0.0, 0.0};  ///< tangential spring force on particle i, N
-  double mr[3] = {0.0, 0.0, 0.0};  ///< rolling spring torque on particle i, N·m
   double inv_kt_prev = 0.0;        ///< 1/k_t at the last step, m/N (stored inverted: saves divisions)
   double gamma = -1.0;             ///< γ_n set at first touch from ε(v_impact); < 0 = not yet touched
   double fd_prev = 0.0;            ///< realised damping force at the last step, N
@@ -80,6 +79,8 @@ class ContactLaw {
     return e_star_[static_cast<std::size_t>(pair_type(material_a, material_b))];
   }
   const PairType& type(int pair_type) const { return types_[static_cast<std::size_t>(pair_type)]; }
+  /// True if any material pair has rolling resistance (contacts then keep a rolling torque).
+  bool any_rolling_friction() const;
 
  private:
   int materials_ = 0;
@@ -145,10 +146,12 @@ class ContactLaw {
 /// The contact force kernel (docs/dem.md "Contact laws"):
 ///   F_n = max(0, Kδ^{3/2} + γ_n√(m*K)δ^{1/4}δ̇),  k_t = 8G*√(R*δ),  k_r = k_t R*²,
 ///   |F_t| <= μF_n,  |M_r| <= μ_r R* F_n.
-/// dt is the step; law is used once per contact, at first touch, for γ_n(ε(v)).
-[[gnu::always_inline]] inline void contact_force(const ContactParams& p, ContactHistory& h, const ContactKinematics& k,
-                          double dt, const ContactLaw& law, ContactResult& out,
-                          StepDissipation& diss) {
+/// mr: the contact's rolling spring torque on i (N·m, 3 values), used only when the
+/// pair type has rolling resistance (may be null otherwise). dt is the step; law is used
+/// once per contact, at first touch, for γ_n(ε(v)).
+[[gnu::always_inline]] inline void contact_force(const ContactParams& p, ContactHistory& h, double* mr,
+                                                 const ContactKinematics& k, double dt, const ContactLaw& law,
+                                                 ContactResult& out, StepDissipation& diss) {
   const double* n = k.n;
   const PairType& type = law.type(p.pair_type);
   const double vn = k.v[0] * n[0] + k.v[1] * n[1] + k.v[2] * n[2];  // approach speed δ̇
@@ -184,11 +187,11 @@ class ContactLaw {
                               (k.w[2] - wn * n[2]) * dt};
     const double r2 = r_eff * r_eff;
     const double inv_r2 = 1.0 / r2;
-    diss.rolling += update_spring(h.mr, n, kt * r2, inv_kt * inv_r2, h.inv_kt_prev * inv_r2, dtheta, lever * f_n,
+    diss.rolling += update_spring(mr, n, kt * r2, inv_kt * inv_r2, h.inv_kt_prev * inv_r2, dtheta, lever * f_n,
                                   lever * h.fn_prev);
-    out.m[0] = h.mr[0];
-    out.m[1] = h.mr[1];
-    out.m[2] = h.mr[2];
+    out.m[0] = mr[0];
+    out.m[1] = mr[1];
+    out.m[2] = mr[2];
   } else {
     out.m[0] = out.m[1] = out.m[2] = 0.0;
   }
@@ -197,7 +200,9 @@ class ContactLaw {
   ++diss.contacts;
 }
 
-/// Energy stored in a contact: (2/5)Kδ^{5/2} + |F_t|²/2k_t + |M_r|²/2k_r, J.
-double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, double delta);
+/// Energy stored in a contact: (2/5)Kδ^{5/2} + |F_t|²/2k_t + |M_r|²/2k_r, J. mr as in
+/// contact_force.
+double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, const double* mr,
+                     double delta);
 
 }  // namespace pdamp::dem_reference::detail

@@ -1,5 +1,5 @@
 // The reference DEM world: particle state (struct of arrays), the staged step
-// (integrate → neighbours → contact forces → wall forces → accumulate → record),
+// (neighbours → integrate → contact forces → wall forces → accumulate → record),
 // the energy account and the instability checks.
 #include "pdamp/dem_reference/world.hpp"
 
@@ -22,9 +22,11 @@ namespace pdamp::dem_reference {
 
 namespace {
 
-using detail::ContactHistory;
+using detail::Contact;
+using detail::ContactKey;
 using detail::ContactKinematics;
 using detail::ContactResult;
+using detail::RowList;
 using detail::Slot;
 using detail::StepDissipation;
 using detail::WallFeature;
@@ -38,25 +40,48 @@ constexpr int kParallelParticles = 1500;
 constexpr int kTimingStride = 32;
 /// NaN and energy-growth checks run every 1024 steps (they need an O(N) energy pass).
 constexpr int kHealthStride = 1024;
+/// Two particles whose places in the arrays differ by more than this are "far": their
+/// data (~130 bytes each in the force loop) are unlikely to share the L1/L2 working
+/// set of the sweep.
+constexpr int kLocalityWindow = 512;
+/// The force loop prefetches the history of the contact this many slots ahead (the
+/// pool is read in slot order, but sparsely: only touching pairs have an entry).
+constexpr int kPrefetchSlots = 8;
+/// ... from this pool size on (smaller pools stay in the L2 cache), bytes.
+constexpr std::size_t kPrefetchPoolBytes = 256 * 1024;
+/// The sweep integrates at least this many particles at a time ahead of its rows
+/// (long runs stream better than one particle per row).
+constexpr int kAheadChunk = 64;
+/// Rows per block of the sweep (pairs of the block, then its walls).
+constexpr int kRowBlock = 64;
+/// Work of a particle (integration, row) and of a contact (the contact law) in units of
+/// a listed slot's distance test, for splitting the particles between threads
+/// (measured at 100,000 spheres: ~20, ~35 and ~5 ns).
+constexpr long long kParticleWork = 4;
+constexpr long long kContactWork = 7;
+/// Every this many steps the split between threads is checked, and planned anew when
+/// the busiest thread has more than 1 + kImbalance times the mean work.
+constexpr int kBalanceStride = 256;
+constexpr double kImbalance = 0.05;
 
 /// Runs body(thread, team_size) on the calling thread alone when team is 1 (no OpenMP
 /// region at all: even an `if(false)` region costs a fork/join call and futex traffic,
-/// more than a 36-sphere step), else on an OpenMP team. Returns the team size used.
+/// more than a 36-sphere step), else on an OpenMP team.
 template <class Body>
-int run_team(int team, Body&& body) {
+void run_team(int team, Body&& body) {
   if (team <= 1) {
     body(0, 1);
-    return 1;
+    return;
   }
-  int used = 1;
 #pragma omp parallel num_threads(team)
-  {
-    const int size = omp_get_num_threads();
-#pragma omp single
-    used = size;
-    body(omp_get_thread_num(), size);
+  body(omp_get_thread_num(), omp_get_num_threads());
+}
+
+/// Barrier of the team running body(thread, team_size) in run_team.
+void sync(int team_size) {
+  if (team_size > 1) {
+#pragma omp barrier
   }
-  return used;
 }
 
 /// Contiguous static chunk [begin, end) of n items for thread t of a team of `size`.
@@ -68,6 +93,36 @@ std::pair<int, int> chunk(int n, int t, int size) {
 struct LoadSums {
   double force[3] = {0.0, 0.0, 0.0};
   double moment[3] = {0.0, 0.0, 0.0};
+};
+
+/// A contact touched for the first time in this step: it waits here until the
+/// partitions have finished and is then appended to the pool.
+struct StagedContact {
+  int slot = 0;
+  ContactKey key;
+  Contact contact;
+  double torque[3] = {0.0, 0.0, 0.0};
+};
+
+/// The work of one thread: a contiguous range of particles and their rows (pairs and
+/// walls). The step sweeps the rows in order and integrates the particles just ahead
+/// of the rows that need them, so that a particle's data is still in cache when its
+/// forces are computed. Forces on particles beyond `end` go to `halo` and are added by
+/// their owner after all partitions have finished, in partition order. The particles
+/// [begin, head_end) receive such forces from earlier partitions: they are integrated
+/// before the sweeps start. Aligned to a cache line: partitions never share one.
+struct alignas(64) Partition {
+  int begin = 0;     ///< first particle
+  int end = 0;       ///< one past the last particle
+  int head_end = 0;  ///< [begin, head_end): particles that earlier partitions' rows reach
+  int halo_end = 0;  ///< [end, halo_end): particles of later partitions that this one's rows reach
+  std::vector<double> halo;  ///< fx, fy, fz, tx, ty, tz per particle of [end, halo_end)
+  std::vector<StagedContact> fresh_pairs, fresh_walls;
+  StepDissipation dissipation;
+  LoadSums load;
+  // Inputs of the displacement bound (World::Impl::displacement_bound), m².
+  double max_d2 = 0.0;  ///< largest body-frame displacement² since the last rebuild
+  double max_u2 = 0.0;  ///< largest drift² of the coming step, |v_{n+1/2}·dt|²
 };
 
 std::string join_lines(const std::vector<std::string>& lines) {
@@ -136,24 +191,54 @@ TimeStepBound time_step_bound(const WorldOptions& options) {
   return bound;
 }
 
+
 struct World::Impl {
   explicit Impl(const WorldOptions& o, const ContainerState& start);
 
   // Stages of a step.
-  double integrate();
+  void advance(bool timed, const ContainerState& previous);
+  double displacement_bound(const ContainerState& previous) const;
   void rebuild_lists();
-  void compute_forces();
+  bool renumbering_pays();
+  void renumber_particles();
+  void plan_partitions();
+  bool imbalanced() const;
+  void integrate(int begin, int end, Partition& part);
+  template <bool kPrefetch>
+  void sweep(Partition& part, bool integrate_ahead);
+  void sweep(Partition& part, bool integrate_ahead) {
+    // Prefetching pays only when the histories do not stay in cache.
+    if (pairs.pool.size() * sizeof(Contact) > kPrefetchPoolBytes) {
+      sweep<true>(part, integrate_ahead);
+    } else {
+      sweep<false>(part, integrate_ahead);
+    }
+  }
+  void commit_fresh_contacts();
+  void reduce_halo(int owner);
+  void gather();
   void record(const ContainerState& previous);
   void check_health();
 
-  Vec3 full_velocity(int i) const;
-  Vec3 full_angular_velocity(int i) const;
+  double drift2(std::size_t k) const {
+    const double s = inv_mass[k] * dt;
+    const double ux = (vx[k] + fx[k] * s) * dt, uy = (vy[k] + fy[k] * s) * dt, uz = (vz[k] + fz[k] * s) * dt;
+    return ux * ux + uy * uy + uz * uz;
+  }
+  void refresh_bound();
+  Vec3 full_velocity(std::size_t k) const;
+  Vec3 full_angular_velocity(std::size_t k) const;
   double elastic_energy() const;
   double kinetic_energy() const;
   double potential_energy() const;
   void mark_unstable(const std::string& message);
   bool parallel() const { return threads > 1 && n > kParallelParticles; }
+  int team() const { return parallel() ? threads : 1; }
+  /// Internal place of particle `id` (the caller's numbering); throws std::out_of_range.
+  std::size_t place(int id) const { return static_cast<std::size_t>(index_of.at(static_cast<std::size_t>(id))); }
   void to_body(double px, double py, double pz, double* out) const;
+  Contact particle_pair_contact(std::size_t a, std::size_t b) const;
+  Contact particle_wall_contact(std::size_t a, int wall) const;
 
   WorldOptions options;
   detail::ContactLaw law;
@@ -167,29 +252,29 @@ struct World::Impl {
   double energy_scale = 0.0;
   int threads = 1;
 
-  // Particles (struct of arrays).
+  // Particles (struct of arrays) at internal places. The places follow the cell order
+  // when renumbering pays (renumbering_pays); order[k] is the caller's number of the
+  // particle at place k and index_of its inverse.
   int n = 0;
   std::vector<double> x, y, z, vx, vy, vz, wx, wy, wz;  // positions; half-step velocities
   std::vector<double> fx, fy, fz, tx, ty, tz;          // forces and torques at the current positions
   std::vector<double> radius, mass, inv_mass, inv_inertia;
-  std::vector<double> lx, ly, lz;  // body-frame positions at the current step
   std::vector<double> rx, ry, rz;  // body-frame positions at the last rebuild
   std::vector<int> material, compartment;
+  std::vector<int> order, index_of;
+  std::vector<double> scratch;     // one array of a renumbering
+  std::vector<int> scratch_index;  // ranks in cell order, then one int array of a renumbering
   std::vector<double> clearances;
   double bed_mass = 0.0;
 
-  // Per-thread force buffers (thread 0 writes the main arrays) and sums.
-  std::vector<std::vector<double>> buffers;
-  std::vector<StepDissipation> thread_dissipation;
-  std::vector<LoadSums> thread_load;
-  std::vector<double> thread_max;
-  int last_team = 1;  // team size of the last force computation
+  // Work split: one partition per thread of a parallel world, else one.
+  std::vector<Partition> parts;
+  double max_d2 = 0.0, max_u2 = 0.0;  // over all partitions, after the last step
+  double reach = 0.0;  // largest distance of a point of the grid box from the body origin, m
 
-  // Verlet lists and contact history.
+  // Neighbour rows and contact history.
   detail::CellGrid grid;
-  std::vector<Slot> pairs, wall_slots;
-  std::vector<ContactHistory> history, wall_history;
-  std::vector<detail::ActiveContact> active;  // scratch of a rebuild
+  RowList pairs, wall_rows;
   mutable std::vector<unsigned char> census_flags;  // scratch of contact_census()
   std::array<double, 3> grid_lo{}, grid_hi{};
 
@@ -256,11 +341,15 @@ World::Impl::Impl(const WorldOptions& o, const ContainerState& start) : options(
   n = static_cast<int>(bed.positions_m.size());
   const auto un = static_cast<std::size_t>(n);
   for (auto* v : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass,
-                  &inv_mass, &inv_inertia, &lx, &ly, &lz, &rx, &ry, &rz}) {
+                  &inv_mass, &inv_inertia, &rx, &ry, &rz, &scratch}) {
     v->assign(un, 0.0);
   }
   material = bed.materials;
   compartment = bed.compartments;
+  order.resize(un);
+  index_of.resize(un);
+  scratch_index.resize(un);
+  for (std::size_t i = 0; i < un; ++i) order[i] = index_of[i] = static_cast<int>(i);
   double r_max = 0.0;
   for (std::size_t i = 0; i < un; ++i) {
     const auto& p = bed.positions_m[i];
@@ -298,35 +387,42 @@ World::Impl::Impl(const WorldOptions& o, const ContainerState& start) : options(
     }
   }
   grid.configure(grid_lo, grid_hi, 2.0 * r_max + skin, n);
-
-  buffers.resize(static_cast<std::size_t>(std::max(threads - 1, 0)));
-  if (threads > 1 && n > kParallelParticles) {
-    for (auto& b : buffers) b.assign(6 * un, 0.0);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double far = std::max(std::abs(grid_lo[a]), std::abs(grid_hi[a]));
+    reach += far * far;
   }
-  thread_dissipation.resize(static_cast<std::size_t>(threads));
-  thread_load.resize(static_cast<std::size_t>(threads));
-  thread_max.resize(static_cast<std::size_t>(threads));
-  // Typical beds list a few neighbours per sphere; reserving avoids regrowth in the loop.
-  pairs.reserve(4 * un);
-  history.reserve(4 * un);
-  active.reserve(4 * un);
-  wall_slots.reserve(un);
-  wall_history.reserve(un);
+  reach = std::sqrt(reach);
 
-  for (int i = 0; i < n; ++i) {
-    double body[3];
-    to_body(x[static_cast<std::size_t>(i)], y[static_cast<std::size_t>(i)], z[static_cast<std::size_t>(i)], body);
-    lx[static_cast<std::size_t>(i)] = body[0];
-    ly[static_cast<std::size_t>(i)] = body[1];
-    lz[static_cast<std::size_t>(i)] = body[2];
+  parts.resize(parallel() ? static_cast<std::size_t>(threads) : 1);
+  for (auto& p : parts) {
+    // Contacts that start in one step are few; the reserve avoids regrowth in the loop.
+    p.fresh_pairs.reserve(64);
+    p.fresh_walls.reserve(16);
   }
+  // A bed lists a few neighbours per sphere and touches fewer; reserving avoids
+  // regrowth in the loop.
+  const bool with_rolling = law.any_rolling_friction();
+  pairs.pool.with_rolling = wall_rows.pool.with_rolling = with_rolling;
+  pairs.slots.reserve(4 * un);
+  pairs.pool.reserve(2 * un);
+  wall_rows.slots.reserve(un);
+  wall_rows.pool.reserve(un / 2 + 16);
+
   for (std::size_t i = 0; i < un; ++i) {
     fx[i] = mass[i] * g[0];
     fy[i] = mass[i] * g[1];
     fz[i] = mass[i] * g[2];
   }
   rebuild_lists();
-  compute_forces();
+  // The forces at the start: the sweep without integration.
+  const int count = static_cast<int>(parts.size());
+  run_team(team(), [&](int t, int size) {
+    for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], false);
+    sync(size);
+    if (t == 0) commit_fresh_contacts();
+    for (int p = t; p < count; p += size) reduce_halo(p);
+  });
+  gather();
   // Leapfrog start: store v(−dt/2) so that the first kick gives v(0) + F(0)dt/2m.
   for (std::size_t i = 0; i < un; ++i) {
     vx[i] -= 0.5 * dt * fx[i] * inv_mass[i];
@@ -336,6 +432,7 @@ World::Impl::Impl(const WorldOptions& o, const ContainerState& start) : options(
     wy[i] -= 0.5 * dt * ty[i] * inv_inertia[i];
     wz[i] -= 0.5 * dt * tz[i] * inv_inertia[i];
   }
+  refresh_bound();
   load_previous = load;
   normal_damping = friction = rolling = 0.0;
   initial_energy = kinetic_energy() + potential_energy() + elastic_energy();
@@ -355,86 +452,315 @@ void World::Impl::to_body(double px, double py, double pz, double* out) const {
   out[2] = R[2] * d[0] + R[5] * d[1] + R[8] * d[2];
 }
 
-double World::Impl::integrate() {
+Contact World::Impl::particle_pair_contact(std::size_t a, std::size_t b) const {
+  Contact c;
+  c.params = law.particle_pair(radius[a], mass[a], material[a], radius[b], mass[b], material[b]);
+  return c;
+}
+
+// The curvature is that of the wall part nearest to where the particle was when the
+// contact was listed (the last rebuild): a sphere sliding over a pin's rim keeps it.
+Contact World::Impl::particle_wall_contact(std::size_t a, int wall) const {
+  const auto& w = walls[static_cast<std::size_t>(wall)];
+  const double listed_at[3] = {rx[a], ry[a], rz[a]};
+  Contact c;
+  c.params = law.particle_wall(radius[a], mass[a], material[a], w.material,
+                               detail::contact_curvature_radius(w, listed_at));
+  return c;
+}
+
+// A step in one OpenMP region: the rebuild check (before: a rebuild has parallel loops
+// of its own), then per partition integrate the head, barrier, sweep (integrating just
+// ahead of the rows), barrier, fresh contacts and halo forces. On the steps that
+// sample the stage times the partitions are integrated whole before the sweep (the
+// same arithmetic: the results do not depend on it).
+void World::Impl::advance(bool timed, const ContainerState& previous) {
+  const auto t0 = timed ? Clock::now() : Clock::time_point{};
+  if (rebuild_due || displacement_bound(previous) > 0.5 * skin) {
+    rebuild_due = false;
+    rebuild_lists();
+  } else if (parts.size() > 1 && steps % kBalanceStride == 0 && imbalanced()) {
+    plan_partitions();
+  }
+  const auto t1 = timed ? Clock::now() : Clock::time_point{};
+  auto t2 = t1;
+  const int count = static_cast<int>(parts.size());
+  run_team(team(), [&](int t, int size) {
+    for (int p = t; p < count; p += size) {
+      Partition& part = parts[static_cast<std::size_t>(p)];
+      part.max_d2 = part.max_u2 = 0.0;
+      integrate(part.begin, timed ? part.end : part.head_end, part);
+    }
+    sync(size);
+    if (timed && t == 0) t2 = Clock::now();
+    for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], !timed);
+    sync(size);
+    if (t == 0) commit_fresh_contacts();
+    for (int p = t; p < count; p += size) reduce_halo(p);
+  });
+  gather();
+  if (timed) {
+    const auto t3 = Clock::now();
+    const auto span = [](Clock::time_point a, Clock::time_point b) {
+      return kTimingStride * std::chrono::duration<double>(b - a).count();
+    };
+    stage_times.neighbour_s += span(t0, t1);
+    stage_times.integrate_s += span(t1, t2);
+    stage_times.contact_forces_s += span(t2, t3);
+  }
+}
+
+// Upper bound of the body-frame displacement since the last rebuild that the coming
+// step can reach (the lists stay valid while it is below skin/2). With l = Rᵀ(x − c):
+//   |l_{n+1} − r| <= |l_n − r| + |x_{n+1} − x_n| + |c_{n+1} − c_n| + ‖R_{n+1} − R_n‖_F |l_n|,
+// where x_{n+1} − x_n = v_{n+1/2}·dt is known once the forces of step n are, and |l_n|
+// is at most the reach of the grid box (a particle outside the container has first
+// overlapped a wall by more than the instability limit). Taking each term's maximum
+// over the particles keeps it an upper bound. Deciding before the step (rather than
+// after integrating, as an exact check would) is what lets the sweep integrate just
+// ahead of the force rows. The drift term is a few nm per step against a skin/2 of
+// 0.1 r: rebuilds come at most a step earlier than with the exact check. (Without a
+// renumbering, when the lists are rebuilt does not change any result: a listed pair
+// that does not touch adds nothing, and the rows keep their order.)
+double World::Impl::displacement_bound(const ContainerState& previous) const {
+  double dc2 = 0.0, dr2 = 0.0;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double d = container.position_m[a] - previous.position_m[a];
+    dc2 += d * d;
+  }
+  for (std::size_t a = 0; a < 9; ++a) {
+    const double d = container.orientation[a] - previous.orientation[a];
+    dr2 += d * d;
+  }
+  return std::sqrt(max_d2) + std::sqrt(max_u2) + std::sqrt(dc2) + std::sqrt(dr2) * reach;
+}
+
+void World::Impl::integrate(int begin, int end, Partition& part) {
   const double h = dt;
   const double g0 = options.gravity_m_s2[0], g1 = options.gravity_m_s2[1], g2 = options.gravity_m_s2[2];
-  const int used = run_team(parallel() ? threads : 1, [&](int t, int size) {
-    const auto [begin, end] = chunk(n, t, size);
-    double max_d2 = 0.0;
-    for (int i = begin; i < end; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      const double im = inv_mass[k] * h;
-      const double ii = inv_inertia[k] * h;
-      vx[k] += fx[k] * im;
-      vy[k] += fy[k] * im;
-      vz[k] += fz[k] * im;
-      wx[k] += tx[k] * ii;
-      wy[k] += ty[k] * ii;
-      wz[k] += tz[k] * ii;
-      x[k] += vx[k] * h;
-      y[k] += vy[k] * h;
-      z[k] += vz[k] * h;
-      double body[3];
-      to_body(x[k], y[k], z[k], body);
-      lx[k] = body[0];
-      ly[k] = body[1];
-      lz[k] = body[2];
-      const double dx = body[0] - rx[k], dy = body[1] - ry[k], dz = body[2] - rz[k];
-      max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
-      fx[k] = mass[k] * g0;
-      fy[k] = mass[k] * g1;
-      fz[k] = mass[k] * g2;
-      tx[k] = ty[k] = tz[k] = 0.0;
-    }
-    thread_max[static_cast<std::size_t>(t)] = max_d2;
-  });
-  return *std::max_element(thread_max.begin(), thread_max.begin() + used);
+  double d2_max = part.max_d2;
+  for (int i = begin; i < end; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double im = inv_mass[k] * h;
+    const double ii = inv_inertia[k] * h;
+    vx[k] += fx[k] * im;
+    vy[k] += fy[k] * im;
+    vz[k] += fz[k] * im;
+    wx[k] += tx[k] * ii;
+    wy[k] += ty[k] * ii;
+    wz[k] += tz[k] * ii;
+    x[k] += vx[k] * h;
+    y[k] += vy[k] * h;
+    z[k] += vz[k] * h;
+    double body[3];
+    to_body(x[k], y[k], z[k], body);
+    const double dx = body[0] - rx[k], dy = body[1] - ry[k], dz = body[2] - rz[k];
+    d2_max = std::max(d2_max, dx * dx + dy * dy + dz * dz);
+    fx[k] = mass[k] * g0;
+    fy[k] = mass[k] * g1;
+    fz[k] = mass[k] * g2;
+    tx[k] = ty[k] = tz[k] = 0.0;
+  }
+  part.max_d2 = d2_max;
+}
+
+// The bound's inputs from scratch (after the start, or a velocity change by hand).
+void World::Impl::refresh_bound() {
+  max_d2 = max_u2 = 0.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+    double body[3];
+    to_body(x[k], y[k], z[k], body);
+    const double dx = body[0] - rx[k], dy = body[1] - ry[k], dz = body[2] - rz[k];
+    max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
+    max_u2 = std::max(max_u2, drift2(k));
+  }
 }
 
 void World::Impl::rebuild_lists() {
   ++rebuilds;
-  grid.bin(lx.data(), ly.data(), lz.data(), n);
-  detail::save_active(pairs, history, active);
-  const int list_threads = parallel() ? threads : 1;
-  grid.find_pairs(lx.data(), ly.data(), lz.data(), radius.data(), compartment.data(), n, skin, list_threads, pairs);
-  const int pair_count = static_cast<int>(pairs.size());
+  const auto un = static_cast<std::size_t>(n);
+  for (std::size_t k = 0; k < un; ++k) {
+    double body[3];
+    to_body(x[k], y[k], z[k], body);
+    rx[k] = body[0];
+    ry[k] = body[1];
+    rz[k] = body[2];
+  }
+  grid.bin(rx.data(), ry.data(), rz.data(), n);
+  // Only touching contacts carry history over; the pools shrink to them first.
+  pairs.pool.drop_ended();
+  wall_rows.pool.drop_ended();
+  const int list_threads = team();
+  grid.find_pairs(rx.data(), ry.data(), rz.data(), radius.data(), compartment.data(), n, skin, list_threads,
+                  pairs.offsets, pairs.slots);
+  if (renumbering_pays()) {
+    renumber_particles();
+    grid.find_pairs(rx.data(), ry.data(), rz.data(), radius.data(), compartment.data(), n, skin, list_threads,
+                    pairs.offsets, pairs.slots);
+  }
   run_team(list_threads, [&](int t, int size) {
-    const auto [begin, end] = chunk(pair_count, t, size);
-    for (int s = begin; s < end; ++s) {
-      Slot& slot = pairs[static_cast<std::size_t>(s)];
-      const auto a = static_cast<std::size_t>(slot.i), b = static_cast<std::size_t>(slot.j);
-      slot.params = law.particle_pair(radius[a], mass[a], material[a], radius[b], mass[b], material[b]);
-    }
-  });
-  detail::restore_active(pairs, history, active);
-
-  // Walls within the skin of each particle, in (particle, wall) order.
-  detail::save_active(wall_slots, wall_history, active);
-  wall_slots.clear();
-  for (int i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const auto c = static_cast<std::size_t>(compartment[k]);
-    const double p[3] = {lx[k], ly[k], lz[k]};
-    double nrm[3];
-    for (int w = wall_begin[c]; w < wall_end[c]; ++w) {
-      const auto& wall = walls[static_cast<std::size_t>(w)];
-      if (detail::wall_gap(wall, p, radius[k], nrm) < skin) {
-        Slot s;
-        s.i = i;
-        s.j = w;
-        s.params = law.particle_wall(radius[k], mass[k], material[k], wall.material, detail::contact_curvature_radius(wall, p));
-        wall_slots.push_back(s);
+    const auto [begin, end] = chunk(n, t, size);
+    for (int i = begin; i < end; ++i) {
+      const auto a = static_cast<std::size_t>(i);
+      for (int s = pairs.offsets[a]; s < pairs.offsets[a + 1]; ++s) {
+        Slot& slot = pairs.slots[static_cast<std::size_t>(s)];
+        slot.i = i;
+        const auto b = static_cast<std::size_t>(slot.j);
+        const double dx = rx[b] - rx[a], dy = ry[b] - ry[a], dz = rz[b] - rz[a];
+        const double sum = radius[a] + radius[b];
+        slot.contact = dx * dx + dy * dy + dz * dz < sum * sum ? detail::kFreshContact : -1;
       }
     }
+  });
+  detail::attach_contacts(pairs, [&](int a, int b) {
+    return particle_pair_contact(static_cast<std::size_t>(a), static_cast<std::size_t>(b)).params;
+  });
+
+  // Walls within the skin of each particle, in (particle, wall) order.
+  detail::resize_with_margin(wall_rows.offsets, un + 1);
+  wall_rows.slots.clear();
+  wall_rows.offsets[0] = 0;
+  for (std::size_t k = 0; k < un; ++k) {
+    const auto c = static_cast<std::size_t>(compartment[k]);
+    const double p[3] = {rx[k], ry[k], rz[k]};
+    double nrm[3];
+    for (int w = wall_begin[c]; w < wall_end[c]; ++w) {
+      const double gap = detail::wall_gap(walls[static_cast<std::size_t>(w)], p, radius[k], nrm);
+      if (gap < skin) {
+        if (wall_rows.slots.size() == wall_rows.slots.capacity()) {
+          wall_rows.slots.reserve(wall_rows.slots.size() + wall_rows.slots.size() / 8 + 16);
+        }
+        wall_rows.slots.push_back(Slot{static_cast<int>(k), w, gap < 0.0 ? detail::kFreshContact : -1});
+      }
+    }
+    wall_rows.offsets[k + 1] = static_cast<int>(wall_rows.slots.size());
   }
-  detail::restore_active(wall_slots, wall_history, active);
-  std::copy(lx.begin(), lx.end(), rx.begin());
-  std::copy(ly.begin(), ly.end(), ry.begin());
-  std::copy(lz.begin(), lz.end(), rz.begin());
+  detail::attach_contacts(wall_rows, [&](int a, int w) {
+    return particle_wall_contact(static_cast<std::size_t>(a), w).params;
+  });
+  plan_partitions();
 }
 
-void World::Impl::compute_forces() {
-  const int team = parallel() ? threads : 1;
+// Whether renumbering the particles in cell order (CellGrid::order) would bring the
+// neighbours of the new pair list markedly closer in memory: it counts the listed pairs
+// farther apart than kLocalityWindow places now and in cell order. Renumbering costs a
+// pass over all arrays and changes the order of the force sums; it is done when the
+// bed has mixed (a fluidised bed loses any order within a few periods), not when the
+// order is already good (a collected lattice is in lattice order, which serves the
+// sweep better than the cell order: cells are wider than the lattice spacing, so a
+// cell row mixes two lattice rows). Deterministic: integer counts of the same lists.
+bool World::Impl::renumbering_pays() {
+  const auto un = static_cast<std::size_t>(n);
+  if (pairs.offsets.size() != un + 1 || pairs.slots.empty()) return false;
+  const auto& cell_order = grid.order();
+  auto& rank = scratch_index;
+  for (std::size_t k = 0; k < un; ++k) rank[static_cast<std::size_t>(cell_order[k])] = static_cast<int>(k);
+  long long far_now = 0, far_cells = 0;
+  for (std::size_t i = 0; i < un; ++i) {
+    for (int s = pairs.offsets[i]; s < pairs.offsets[i + 1]; ++s) {
+      const auto j = static_cast<std::size_t>(pairs.slots[static_cast<std::size_t>(s)].j);
+      far_now += j - i > static_cast<std::size_t>(kLocalityWindow) ? 1 : 0;
+      far_cells += std::abs(rank[j] - rank[i]) > kLocalityWindow ? 1 : 0;
+    }
+  }
+  const auto listed = static_cast<long long>(pairs.slots.size());
+  return 2 * far_now > 3 * far_cells + listed / 10;
+}
+
+// Renumbers the particles in the grid's cell order. Each array is gathered into the
+// scratch array, which then takes its place (a swap of buffers, no copy back). Needs
+// the ranks left in scratch_index by renumbering_pays().
+void World::Impl::renumber_particles() {
+  const auto& perm = grid.order();  // perm[k]: old place of the particle at new place k
+  const auto& rank = scratch_index;  // rank[old place] = new place
+  const auto un = static_cast<std::size_t>(n);
+  // A pair keeps i < j: if the new numbers swap the two, the stored spring force and
+  // rolling torque (which act on i) change sign; everything else is symmetric.
+  auto& pool = pairs.pool;
+  for (std::size_t e = 0; e < pool.size(); ++e) {
+    auto& key = pool.keys[e];
+    int i = rank[static_cast<std::size_t>(key.i)];
+    int j = rank[static_cast<std::size_t>(key.j)];
+    if (i > j) {
+      std::swap(i, j);
+      double* ft = pool.state[e].history.ft;
+      double* mr = pool.rolling_torque(e);
+      for (std::size_t a = 0; a < 3; ++a) {
+        ft[a] = -ft[a];
+        if (mr) mr[a] = -mr[a];
+      }
+    }
+    key = ContactKey{i, j};
+  }
+  for (auto& key : wall_rows.pool.keys) key.i = rank[static_cast<std::size_t>(key.i)];
+  for (auto* v : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &mass, &inv_mass,
+                  &inv_inertia, &rx, &ry, &rz}) {
+    for (std::size_t k = 0; k < un; ++k) scratch[k] = (*v)[static_cast<std::size_t>(perm[k])];
+    v->swap(scratch);
+  }
+  for (auto* v : {&material, &compartment, &order}) {
+    for (std::size_t k = 0; k < un; ++k) scratch_index[k] = (*v)[static_cast<std::size_t>(perm[k])];
+    v->swap(scratch_index);
+  }
+  for (std::size_t k = 0; k < un; ++k) index_of[static_cast<std::size_t>(order[k])] = static_cast<int>(k);
+  grid.adopt_order();
+}
+
+// Splits the particles into contiguous ranges of about equal work (kParticleWork per
+// particle, 1 per listed slot, kContactWork per slot with a pool entry, i.e. a recent
+// contact) and finds each range's reach: the particles beyond its end that its rows
+// name.
+void World::Impl::plan_partitions() {
+  const int count = static_cast<int>(parts.size());
+  const auto weight = [&](std::size_t i) {
+    long long w = kParticleWork;
+    for (const RowList* rows : {&pairs, &wall_rows}) {
+      for (int s = rows->offsets[i]; s < rows->offsets[i + 1]; ++s) {
+        w += rows->slots[static_cast<std::size_t>(s)].contact >= 0 ? kContactWork : 1;
+      }
+    }
+    return w;
+  };
+  long long total = 0;
+  if (count > 1) {
+    for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) total += weight(i);
+  }
+  long long sum = 0;
+  int i = 0;
+  int reached = 0;  // largest halo_end of the partitions so far
+  for (int p = 0; p < count; ++p) {
+    Partition& part = parts[static_cast<std::size_t>(p)];
+    part.begin = i;
+    if (p == count - 1) {
+      i = n;
+    } else {
+      const long long goal = total * (p + 1) / count;
+      while (i < n && sum < goal) sum += weight(static_cast<std::size_t>(i++));
+    }
+    part.end = i;
+    part.head_end = std::clamp(reached, part.begin, part.end);
+    int reach = part.end;
+    for (int k = part.begin; k < part.end; ++k) {
+      const int row_end = pairs.offsets[static_cast<std::size_t>(k) + 1];
+      if (row_end > pairs.offsets[static_cast<std::size_t>(k)]) {
+        reach = std::max(reach, pairs.slots[static_cast<std::size_t>(row_end) - 1].j + 1);
+      }
+    }
+    part.halo_end = reach;
+    part.halo.assign(6 * static_cast<std::size_t>(reach - part.end), 0.0);
+    reached = std::max(reached, reach);
+  }
+}
+
+// Forces of the rows of one partition, in blocks of rows: the pairs of the block, then
+// its walls (flat loops over many slots: rows are short, and a loop per row would pay
+// a mispredicted exit per particle). A particle's walls thus follow all its pair forces
+// (from its own row and from earlier rows naming it), so its sums run in the same
+// order as with all walls after all pairs. With integrate_ahead, the particles a slot
+// needs are integrated just before it (a particle's data then come from memory once
+// per step).
+template <bool kPrefetch>
+void World::Impl::sweep(Partition& part, bool integrate_ahead) {
   const double h = dt;
   const double limit = overlap_limit;
   const auto& R = container.orientation;
@@ -443,40 +769,53 @@ void World::Impl::compute_forces() {
                         container.angular_velocity_rad_s[2]};
   const double cp[3] = {container.position_m[0], container.position_m[1], container.position_m[2]};
   const double cv[3] = {container_velocity[0], container_velocity[1], container_velocity[2]};
-  const auto un = static_cast<std::size_t>(n);
-  const int pair_count = static_cast<int>(pairs.size());
-  const int wall_count = static_cast<int>(wall_slots.size());
-  const int used = run_team(team, [&](int t, int size) {
-    double* Fx = fx.data();
-    double* Fy = fy.data();
-    double* Fz = fz.data();
-    double* Tx = tx.data();
-    double* Ty = ty.data();
-    double* Tz = tz.data();
-    if (t > 0) {
-      double* b = buffers[static_cast<std::size_t>(t - 1)].data();
-      Fx = b;
-      Fy = b + un;
-      Fz = b + 2 * un;
-      Tx = b + 3 * un;
-      Ty = b + 4 * un;
-      Tz = b + 5 * un;
-    }
-    StepDissipation diss;
-    LoadSums sums;
-    ContactKinematics k;
-    ContactResult out;
-    const auto [pair_begin, pair_end] = chunk(pair_count, t, size);
-    for (int s = pair_begin; s < pair_end; ++s) {
-      const Slot& slot = pairs[static_cast<std::size_t>(s)];
-      ContactHistory& hist = history[static_cast<std::size_t>(s)];
+  double* const Fx = fx.data();
+  double* const Fy = fy.data();
+  double* const Fz = fz.data();
+  double* const Tx = tx.data();
+  double* const Ty = ty.data();
+  double* const Tz = tz.data();
+  double* const halo = part.halo.data();
+  const Slot* const pair_slots = pairs.slots.data();
+  const int pair_slot_count = static_cast<int>(pairs.slots.size());
+  Contact* const pair_state = pairs.pool.state.data();
+  const int end = part.end;
+  int ahead = integrate_ahead ? part.head_end : end;
+  // Integrates up to particle `upto` (exclusive), at least kAheadChunk at a time.
+  const auto integrate_to = [&](int upto) {
+    const int to = std::min(end, std::max(upto, ahead + kAheadChunk));
+    integrate(ahead, to, part);
+    ahead = to;
+  };
+  double u2_max = part.max_u2;
+  StepDissipation diss;
+  LoadSums sums;
+  ContactKinematics k;
+  ContactResult out;
+  for (int block = part.begin; block < end; block += kRowBlock) {
+    const int block_end = std::min(end, block + kRowBlock);
+    if (block_end > ahead) integrate_to(block_end);
+    const int pair_last = pairs.offsets[static_cast<std::size_t>(block_end)];
+    for (int s = pairs.offsets[static_cast<std::size_t>(block)]; s < pair_last; ++s) {
+      if (kPrefetch && s + kPrefetchSlots < pair_slot_count) {
+        const int ahead_contact = pair_slots[s + kPrefetchSlots].contact;
+        if (ahead_contact >= 0) {
+          const auto* entry = reinterpret_cast<const char*>(pair_state + ahead_contact);
+          __builtin_prefetch(entry, 1);
+          __builtin_prefetch(entry + sizeof(Contact) - 1, 1);
+        }
+      }
+      const Slot& slot = pair_slots[s];
+      if (slot.j >= ahead && ahead < end) integrate_to(slot.j + 1);
       const auto i = static_cast<std::size_t>(slot.i), j = static_cast<std::size_t>(slot.j);
       const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
       const double ri = radius[i], rj = radius[j];
       const double d2 = dx * dx + dy * dy + dz * dz;
       const double sum = ri + rj;
       if (d2 >= sum * sum) {
-        if (hist.gamma >= 0.0) hist = ContactHistory{};
+        if (slot.contact >= 0 && pair_state[slot.contact].history.gamma >= 0.0) {
+          pairs.pool.reset(static_cast<std::size_t>(slot.contact));
+        }
         continue;
       }
       const double dist = std::sqrt(d2);
@@ -495,31 +834,56 @@ void World::Impl::compute_forces() {
       k.w[0] = wx[i] - wx[j];
       k.w[1] = wy[i] - wy[j];
       k.w[2] = wz[i] - wz[j];
-      detail::contact_force(slot.params, hist, k, h, law, out, diss);
+      Contact* contact = nullptr;
+      double* torque = nullptr;
+      if (slot.contact >= 0) {
+        contact = pair_state + slot.contact;
+        torque = pairs.pool.rolling_torque(static_cast<std::size_t>(slot.contact));
+      } else {
+        StagedContact& fresh = part.fresh_pairs.emplace_back();
+        fresh.slot = s;
+        fresh.key = ContactKey{slot.i, slot.j};
+        fresh.contact = particle_pair_contact(i, j);
+        contact = &fresh.contact;
+        torque = fresh.torque;
+      }
+      detail::contact_force(contact->params, contact->history, torque, k, h, law, out, diss);
       Fx[i] += out.f[0];
       Fy[i] += out.f[1];
       Fz[i] += out.f[2];
-      Fx[j] -= out.f[0];
-      Fy[j] -= out.f[1];
-      Fz[j] -= out.f[2];
       Tx[i] += ri * out.c[0] + out.m[0];
       Ty[i] += ri * out.c[1] + out.m[1];
       Tz[i] += ri * out.c[2] + out.m[2];
-      Tx[j] += rj * out.c[0] - out.m[0];
-      Ty[j] += rj * out.c[1] - out.m[1];
-      Tz[j] += rj * out.c[2] - out.m[2];
+      if (slot.j < end) {
+        Fx[j] -= out.f[0];
+        Fy[j] -= out.f[1];
+        Fz[j] -= out.f[2];
+        Tx[j] += rj * out.c[0] - out.m[0];
+        Ty[j] += rj * out.c[1] - out.m[1];
+        Tz[j] += rj * out.c[2] - out.m[2];
+      } else {
+        double* b = halo + 6 * (j - static_cast<std::size_t>(end));
+        b[0] -= out.f[0];
+        b[1] -= out.f[1];
+        b[2] -= out.f[2];
+        b[3] += rj * out.c[0] - out.m[0];
+        b[4] += rj * out.c[1] - out.m[1];
+        b[5] += rj * out.c[2] - out.m[2];
+      }
     }
-    const auto [wall_begin_s, wall_end_s] = chunk(wall_count, t, size);
-    for (int s = wall_begin_s; s < wall_end_s; ++s) {
-      const Slot& slot = wall_slots[static_cast<std::size_t>(s)];
-      ContactHistory& hist = wall_history[static_cast<std::size_t>(s)];
+    const int wall_last = wall_rows.offsets[static_cast<std::size_t>(block_end)];
+    for (int s = wall_rows.offsets[static_cast<std::size_t>(block)]; s < wall_last; ++s) {
+      const Slot& slot = wall_rows.slots[static_cast<std::size_t>(s)];
       const auto i = static_cast<std::size_t>(slot.i);
       const double ri = radius[i];
-      const double p[3] = {lx[i], ly[i], lz[i]};
+      double p[3];
+      to_body(x[i], y[i], z[i], p);
       double nb[3];
       const double gap = detail::wall_gap(walls[static_cast<std::size_t>(slot.j)], p, ri, nb);
       if (gap >= 0.0) {
-        if (hist.gamma >= 0.0) hist = ContactHistory{};
+        if (slot.contact >= 0 && wall_rows.pool.state[static_cast<std::size_t>(slot.contact)].history.gamma >= 0.0) {
+          wall_rows.pool.reset(static_cast<std::size_t>(slot.contact));
+        }
         continue;
       }
       if (rot) {
@@ -544,7 +908,20 @@ void World::Impl::compute_forces() {
       k.w[0] = wx[i] - cw[0];
       k.w[1] = wy[i] - cw[1];
       k.w[2] = wz[i] - cw[2];
-      detail::contact_force(slot.params, hist, k, h, law, out, diss);
+      Contact* contact = nullptr;
+      double* torque = nullptr;
+      if (slot.contact >= 0) {
+        contact = &wall_rows.pool.state[static_cast<std::size_t>(slot.contact)];
+        torque = wall_rows.pool.rolling_torque(static_cast<std::size_t>(slot.contact));
+      } else {
+        StagedContact& fresh = part.fresh_walls.emplace_back();
+        fresh.slot = s;
+        fresh.key = ContactKey{slot.i, slot.j};
+        fresh.contact = particle_wall_contact(i, slot.j);
+        contact = &fresh.contact;
+        torque = fresh.torque;
+      }
+      detail::contact_force(contact->params, contact->history, torque, k, h, law, out, diss);
       Fx[i] += out.f[0];
       Fy[i] += out.f[1];
       Fz[i] += out.f[2];
@@ -558,44 +935,92 @@ void World::Impl::compute_forces() {
       sums.moment[1] += rc[2] * out.f[0] - rc[0] * out.f[2] + out.m[1];
       sums.moment[2] += rc[0] * out.f[1] - rc[1] * out.f[0] + out.m[2];
     }
-    thread_dissipation[static_cast<std::size_t>(t)] = diss;
-    thread_load[static_cast<std::size_t>(t)] = sums;
-  });
-  last_team = used;
-  if (used > 1) {
-    // Ordered reduction of the thread buffers: identical results run to run.
-    const int extra = used - 1;
-    run_team(used, [&](int t, int size) {
-      const auto [begin, end] = chunk(n, t, size);
-      for (int i = begin; i < end; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        for (int b = 0; b < extra; ++b) {
-        double* buf = buffers[static_cast<std::size_t>(b)].data();
-        fx[k] += buf[k];
-        fy[k] += buf[un + k];
-        fz[k] += buf[2 * un + k];
-        tx[k] += buf[3 * un + k];
-        ty[k] += buf[4 * un + k];
-        tz[k] += buf[5 * un + k];
-        buf[k] = buf[un + k] = buf[2 * un + k] = buf[3 * un + k] = buf[4 * un + k] = buf[5 * un + k] = 0.0;
-        }
-      }
-    });
-  }
-  load = ContainerLoad{};
-  for (int t = 0; t < used; ++t) {
-    const auto& s = thread_load[static_cast<std::size_t>(t)];
-    for (std::size_t a = 0; a < 3; ++a) {
-      load.force_n[a] += s.force[a];
-      load.moment_nm[a] += s.moment[a];
+    // The block's forces are complete (but for what earlier partitions add: reduce_halo).
+    for (int row = std::max(block, part.head_end); row < block_end; ++row) {
+      u2_max = std::max(u2_max, drift2(static_cast<std::size_t>(row)));
     }
+  }
+  part.max_u2 = u2_max;
+  part.dissipation = diss;
+  part.load = sums;
+}
+
+// Whether the work of the last step (in the units of plan_partitions, with the contacts
+// actually computed) differs between the partitions by more than kImbalance. The
+// partitions are planned at a rebuild; a bed that settles or compresses afterwards
+// (a collected bed under gravity: contacts form at the bottom first) moves the work.
+// Deterministic: counts, not clocks.
+bool World::Impl::imbalanced() const {
+  long long most = 0, total = 0;
+  for (const auto& part : parts) {
+    const long long slots = (pairs.offsets[static_cast<std::size_t>(part.end)] -
+                             pairs.offsets[static_cast<std::size_t>(part.begin)]) +
+                            (wall_rows.offsets[static_cast<std::size_t>(part.end)] -
+                             wall_rows.offsets[static_cast<std::size_t>(part.begin)]);
+    const long long work = kParticleWork * (part.end - part.begin) + slots +
+                           (kContactWork - 1) * part.dissipation.contacts;
+    most = std::max(most, work);
+    total += work;
+  }
+  return static_cast<double>(most) * static_cast<double>(parts.size()) > (1.0 + kImbalance) * static_cast<double>(total);
+}
+
+// Appends the contacts first touched in this step to the pools, in partition order
+// (the place in the pool does not change any result).
+void World::Impl::commit_fresh_contacts() {
+  const auto commit = [](std::vector<StagedContact>& staged, RowList& rows) {
+    for (const auto& s : staged) {
+      rows.slots[static_cast<std::size_t>(s.slot)].contact = rows.pool.add(s.key, s.contact, s.torque);
+    }
+    staged.clear();
+  };
+  for (auto& part : parts) {
+    commit(part.fresh_pairs, pairs);
+    commit(part.fresh_walls, wall_rows);
+  }
+}
+
+// Adds to the particles of partition `owner` the halo forces of the partitions before
+// it, in partition order, and clears those halo entries.
+void World::Impl::reduce_halo(int owner) {
+  Partition& mine = parts[static_cast<std::size_t>(owner)];
+  for (int p = 0; p < owner; ++p) {
+    Partition& from = parts[static_cast<std::size_t>(p)];
+    const int first = std::max(from.end, mine.begin);
+    const int last = std::min(from.halo_end, mine.end);
+    for (int i = first; i < last; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      double* b = from.halo.data() + 6 * static_cast<std::size_t>(i - from.end);
+      fx[k] += b[0];
+      fy[k] += b[1];
+      fz[k] += b[2];
+      tx[k] += b[3];
+      ty[k] += b[4];
+      tz[k] += b[5];
+      b[0] = b[1] = b[2] = b[3] = b[4] = b[5] = 0.0;
+    }
+  }
+  for (int i = mine.begin; i < mine.head_end; ++i) mine.max_u2 = std::max(mine.max_u2, drift2(static_cast<std::size_t>(i)));
+}
+
+// Sums over the partitions, in partition order: the container load and the bound's inputs.
+void World::Impl::gather() {
+  load = ContainerLoad{};
+  max_d2 = max_u2 = 0.0;
+  for (const auto& part : parts) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      load.force_n[a] += part.load.force[a];
+      load.moment_nm[a] += part.load.moment[a];
+    }
+    max_d2 = std::max(max_d2, part.max_d2);
+    max_u2 = std::max(max_u2, part.max_u2);
   }
 }
 
 void World::Impl::record(const ContainerState& previous) {
   double max_ratio = 0.0;
-  for (int t = 0; t < last_team; ++t) {
-    const auto& d = thread_dissipation[static_cast<std::size_t>(t)];
+  for (const auto& part : parts) {
+    const auto& d = part.dissipation;
     normal_damping += d.normal_damping;
     friction += d.friction;
     rolling += d.rolling;
@@ -646,24 +1071,21 @@ void World::Impl::mark_unstable(const std::string& message) {
   status.message = message;
 }
 
-Vec3 World::Impl::full_velocity(int i) const {
-  const auto k = static_cast<std::size_t>(i);
+Vec3 World::Impl::full_velocity(std::size_t k) const {
   const double s = 0.5 * dt * inv_mass[k];
   return {vx[k] + s * fx[k], vy[k] + s * fy[k], vz[k] + s * fz[k]};
 }
 
-Vec3 World::Impl::full_angular_velocity(int i) const {
-  const auto k = static_cast<std::size_t>(i);
+Vec3 World::Impl::full_angular_velocity(std::size_t k) const {
   const double s = 0.5 * dt * inv_inertia[k];
   return {wx[k] + s * tx[k], wy[k] + s * ty[k], wz[k] + s * tz[k]};
 }
 
 double World::Impl::kinetic_energy() const {
   double e = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const Vec3 v = full_velocity(i);
-    const Vec3 w = full_angular_velocity(i);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+    const Vec3 v = full_velocity(k);
+    const Vec3 w = full_angular_velocity(k);
     e += 0.5 * mass[k] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
          0.5 / inv_inertia[k] * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
   }
@@ -681,19 +1103,32 @@ double World::Impl::potential_energy() const {
 
 double World::Impl::elastic_energy() const {
   double e = 0.0;
-  for (std::size_t s = 0; s < pairs.size(); ++s) {
-    const auto i = static_cast<std::size_t>(pairs[s].i), j = static_cast<std::size_t>(pairs[s].j);
-    const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
-    const double delta = radius[i] + radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
-    e += detail::stored_energy(pairs[s].params, law.type(pairs[s].params.pair_type), history[s], delta);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+    for (int s = pairs.offsets[i]; s < pairs.offsets[i + 1]; ++s) {
+      const Slot& slot = pairs.slots[static_cast<std::size_t>(s)];
+      if (slot.contact < 0) continue;
+      const auto c = static_cast<std::size_t>(slot.contact);
+      const auto j = static_cast<std::size_t>(slot.j);
+      const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
+      const double delta = radius[i] + radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+      const auto& params = pairs.pool.state[c].params;
+      e += detail::stored_energy(params, law.type(params.pair_type), pairs.pool.state[c].history,
+                                 pairs.pool.rolling_torque(c), delta);
+    }
   }
-  for (std::size_t s = 0; s < wall_slots.size(); ++s) {
-    const auto i = static_cast<std::size_t>(wall_slots[s].i);
-    const double p[3] = {lx[i], ly[i], lz[i]};
-    double nb[3];
-    const double gap = detail::wall_gap(walls[static_cast<std::size_t>(wall_slots[s].j)], p, radius[i], nb);
-    e += detail::stored_energy(wall_slots[s].params, law.type(wall_slots[s].params.pair_type), wall_history[s],
-                               -gap);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+    for (int s = wall_rows.offsets[i]; s < wall_rows.offsets[i + 1]; ++s) {
+      const Slot& slot = wall_rows.slots[static_cast<std::size_t>(s)];
+      if (slot.contact < 0) continue;
+      const auto c = static_cast<std::size_t>(slot.contact);
+      double p[3];
+      to_body(x[i], y[i], z[i], p);
+      double nb[3];
+      const double gap = detail::wall_gap(walls[static_cast<std::size_t>(slot.j)], p, radius[i], nb);
+      const auto& params = wall_rows.pool.state[c].params;
+      e += detail::stored_energy(params, law.type(params.pair_type), wall_rows.pool.state[c].history,
+                                 wall_rows.pool.rolling_torque(c), -gap);
+    }
   }
   return e;
 }
@@ -708,36 +1143,19 @@ const ContainerLoad& World::step(const ContainerState& next) {
   Impl& w = *impl_;
   if (w.status.outcome != Outcome::kCompleted) return w.load;
   const bool timed = w.steps % kTimingStride == 0;
-  const auto t0 = timed ? Clock::now() : Clock::time_point{};
   const ContainerState previous = w.container;
   w.container = next;
   w.rotated = next.orientation != kIdentity;
   for (std::size_t a = 0; a < 3; ++a) {
     w.container_velocity[a] = (next.position_m[a] - previous.position_m[a]) / w.dt;
   }
-  const double max_d2 = w.integrate();
-  const auto t1 = timed ? Clock::now() : Clock::time_point{};
-  if (w.rebuild_due || max_d2 > 0.25 * w.skin * w.skin) {
-    w.rebuild_due = false;
-    w.rebuild_lists();
-  }
-  const auto t2 = timed ? Clock::now() : Clock::time_point{};
-  w.compute_forces();
+  w.advance(timed, previous);
   const auto t3 = timed ? Clock::now() : Clock::time_point{};
   w.time += w.dt;
   ++w.steps;
   w.record(previous);
   if (w.steps % kHealthStride == 0) w.check_health();
-  if (timed) {
-    const auto t4 = Clock::now();
-    const auto span = [](Clock::time_point a, Clock::time_point b) {
-      return kTimingStride * std::chrono::duration<double>(b - a).count();
-    };
-    w.stage_times.integrate_s += span(t0, t1);
-    w.stage_times.neighbour_s += span(t1, t2);
-    w.stage_times.contact_forces_s += span(t2, t3);
-    w.stage_times.record_s += span(t3, t4);
-  }
+  if (timed) w.stage_times.record_s += kTimingStride * std::chrono::duration<double>(Clock::now() - t3).count();
   return w.load;
 }
 
@@ -748,9 +1166,18 @@ const ContainerLoad& World::step(const ContainerMotion& motion) {
 void World::set_particle_state(int i, const Vec3& position_m, const Vec3& velocity_m_s,
                                const Vec3& angular_velocity_rad_s) {
   Impl& w = *impl_;
-  const auto k = static_cast<std::size_t>(i);
-  (void)w.x.at(k);
-  const double before = w.kinetic_energy() + w.potential_energy();
+  const auto k = w.place(i);
+  // The energy set here is supplied, not created: keep the growth check honest (only
+  // this particle's kinetic and potential energy change).
+  const auto own_energy = [&]() {
+    const Vec3 v = w.full_velocity(k);
+    const Vec3 om = w.full_angular_velocity(k);
+    const auto& g = w.options.gravity_m_s2;
+    return 0.5 * w.mass[k] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
+           0.5 / w.inv_inertia[k] * (om[0] * om[0] + om[1] * om[1] + om[2] * om[2]) -
+           w.mass[k] * (g[0] * w.x[k] + g[1] * w.y[k] + g[2] * w.z[k]);
+  };
+  const double before = own_energy();
   w.x[k] = position_m[0];
   w.y[k] = position_m[1];
   w.z[k] = position_m[2];
@@ -763,13 +1190,7 @@ void World::set_particle_state(int i, const Vec3& position_m, const Vec3& veloci
   w.wx[k] = angular_velocity_rad_s[0] - r * w.tx[k];
   w.wy[k] = angular_velocity_rad_s[1] - r * w.ty[k];
   w.wz[k] = angular_velocity_rad_s[2] - r * w.tz[k];
-  double body[3];
-  w.to_body(w.x[k], w.y[k], w.z[k], body);
-  w.lx[k] = body[0];
-  w.ly[k] = body[1];
-  w.lz[k] = body[2];
-  // The energy set here is supplied, not created: keep the growth check honest.
-  w.initial_energy += w.kinetic_energy() + w.potential_energy() - before;
+  w.initial_energy += own_energy() - before;
   w.rebuild_due = true;
 }
 
@@ -782,6 +1203,7 @@ void World::add_velocity(const Vec3& velocity_m_s) {
     w.vz[k] += velocity_m_s[2];
   }
   w.initial_energy += w.kinetic_energy() - before;
+  w.refresh_bound();
 }
 
 double World::time_step_s() const { return impl_->dt; }
@@ -795,28 +1217,22 @@ int World::particle_count() const { return impl_->n; }
 int World::compartment_count() const { return static_cast<int>(impl_->options.compartments.size()); }
 
 Vec3 World::position(int i) const {
-  const auto k = static_cast<std::size_t>(i);
-  return {impl_->x.at(k), impl_->y[k], impl_->z[k]};
+  const auto k = impl_->place(i);
+  return {impl_->x[k], impl_->y[k], impl_->z[k]};
 }
-Vec3 World::velocity(int i) const {
-  (void)impl_->x.at(static_cast<std::size_t>(i));
-  return impl_->full_velocity(i);
-}
-Vec3 World::angular_velocity(int i) const {
-  (void)impl_->x.at(static_cast<std::size_t>(i));
-  return impl_->full_angular_velocity(i);
-}
-double World::radius(int i) const { return impl_->radius.at(static_cast<std::size_t>(i)); }
-double World::mass(int i) const { return impl_->mass.at(static_cast<std::size_t>(i)); }
-int World::compartment(int i) const { return impl_->compartment.at(static_cast<std::size_t>(i)); }
+Vec3 World::velocity(int i) const { return impl_->full_velocity(impl_->place(i)); }
+Vec3 World::angular_velocity(int i) const { return impl_->full_angular_velocity(impl_->place(i)); }
+double World::radius(int i) const { return impl_->radius[impl_->place(i)]; }
+double World::mass(int i) const { return impl_->mass[impl_->place(i)]; }
+int World::compartment(int i) const { return impl_->compartment[impl_->place(i)]; }
 double World::bed_mass_kg() const { return impl_->bed_mass; }
 double World::clearance_m(int c) const { return impl_->clearances.at(static_cast<std::size_t>(c)); }
 
 Vec3 World::bed_momentum() const {
   Vec3 p{0.0, 0.0, 0.0};
-  for (int i = 0; i < impl_->n; ++i) {
-    const Vec3 v = impl_->full_velocity(i);
-    const double m = impl_->mass[static_cast<std::size_t>(i)];
+  for (std::size_t k = 0; k < static_cast<std::size_t>(impl_->n); ++k) {
+    const Vec3 v = impl_->full_velocity(k);
+    const double m = impl_->mass[k];
     for (std::size_t a = 0; a < 3; ++a) p[a] += m * v[a];
   }
   return p;
@@ -851,21 +1267,24 @@ ContactCensus World::contact_census(const Vec3& down) const {
   const Impl& w = *impl_;
   auto& flags = w.census_flags;
   flags.assign(static_cast<std::size_t>(w.n), 0);
-  for (std::size_t s = 0; s < w.pairs.size(); ++s) {
-    if (w.history[s].gamma < 0.0) continue;
-    flags[static_cast<std::size_t>(w.pairs[s].i)] |= 1;
-    flags[static_cast<std::size_t>(w.pairs[s].j)] |= 1;
+  const auto& pair_pool = w.pairs.pool;
+  for (std::size_t e = 0; e < pair_pool.size(); ++e) {
+    if (pair_pool.state[e].history.gamma < 0.0) continue;
+    flags[static_cast<std::size_t>(pair_pool.keys[e].i)] |= 1;
+    flags[static_cast<std::size_t>(pair_pool.keys[e].j)] |= 1;
   }
   const double norm = std::sqrt(down[0] * down[0] + down[1] * down[1] + down[2] * down[2]);
   const auto& R = w.container.orientation;
-  for (std::size_t s = 0; s < w.wall_slots.size(); ++s) {
-    if (w.wall_history[s].gamma < 0.0) continue;
-    const auto i = static_cast<std::size_t>(w.wall_slots[s].i);
+  const auto& wall_pool = w.wall_rows.pool;
+  for (std::size_t e = 0; e < wall_pool.size(); ++e) {
+    if (wall_pool.state[e].history.gamma < 0.0) continue;
+    const auto i = static_cast<std::size_t>(wall_pool.keys[e].i);
     flags[i] |= 2;
     if (norm > 0.0) {
-      const double p[3] = {w.lx[i], w.ly[i], w.lz[i]};
+      double p[3];
+      w.to_body(w.x[i], w.y[i], w.z[i], p);
       double nb[3];
-      detail::wall_gap(w.walls[static_cast<std::size_t>(w.wall_slots[s].j)], p, w.radius[i], nb);
+      detail::wall_gap(w.walls[static_cast<std::size_t>(wall_pool.keys[e].j)], p, w.radius[i], nb);
       double along = 0.0;
       for (std::size_t a = 0; a < 3; ++a) along += (R[3 * a] * nb[0] + R[3 * a + 1] * nb[1] + R[3 * a + 2] * nb[2]) * down[a];
       if (along > 0.70710678 * norm) flags[i] |= 4;
@@ -882,7 +1301,7 @@ ContactCensus World::contact_census(const Vec3& down) const {
 
 int World::contact_count() const {
   int count = 0;
-  for (const auto& h : impl_->history) count += h.gamma >= 0.0 ? 1 : 0;
+  for (const auto& c : impl_->pairs.pool.state) count += c.history.gamma >= 0.0 ? 1 : 0;
   return count;
 }
 
@@ -893,15 +1312,18 @@ std::size_t World::memory_bytes() const {
   const Impl& w = *impl_;
   std::size_t bytes = 0;
   for (const auto* v : {&w.x, &w.y, &w.z, &w.vx, &w.vy, &w.vz, &w.wx, &w.wy, &w.wz, &w.fx, &w.fy, &w.fz, &w.tx,
-                        &w.ty, &w.tz, &w.radius, &w.mass, &w.inv_mass, &w.inv_inertia, &w.lx, &w.ly, &w.lz, &w.rx,
-                        &w.ry, &w.rz}) {
+                        &w.ty, &w.tz, &w.radius, &w.mass, &w.inv_mass, &w.inv_inertia, &w.rx, &w.ry, &w.rz,
+                        &w.scratch}) {
     bytes += v->capacity() * sizeof(double);
   }
-  bytes += (w.material.capacity() + w.compartment.capacity()) * sizeof(int);
-  for (const auto& b : w.buffers) bytes += b.capacity() * sizeof(double);
-  bytes += (w.pairs.capacity() + w.wall_slots.capacity()) * sizeof(Slot);
-  bytes += (w.history.capacity() + w.wall_history.capacity()) * sizeof(ContactHistory);
-  bytes += w.active.capacity() * sizeof(detail::ActiveContact);
+  for (const auto* v : {&w.material, &w.compartment, &w.order, &w.index_of, &w.scratch_index}) {
+    bytes += v->capacity() * sizeof(int);
+  }
+  for (const auto& p : w.parts) {
+    bytes += sizeof(Partition) + p.halo.capacity() * sizeof(double) +
+             (p.fresh_pairs.capacity() + p.fresh_walls.capacity()) * sizeof(StagedContact);
+  }
+  bytes += w.pairs.memory_bytes() + w.wall_rows.memory_bytes();
   bytes += w.grid.memory_bytes() + w.walls.capacity() * sizeof(WallFeature);
   return bytes;
 }
@@ -909,11 +1331,14 @@ std::size_t World::memory_bytes() const {
 std::uint64_t World::state_hash() const {
   const Impl& w = *impl_;
   std::uint64_t hash = 14695981039346656037ULL;
+  // In the caller's particle order: the hash does not see the internal numbering.
   for (const auto* v : {&w.x, &w.y, &w.z, &w.vx, &w.vy, &w.vz, &w.wx, &w.wy, &w.wz}) {
-    const auto* bytes = reinterpret_cast<const unsigned char*>(v->data());
-    for (std::size_t b = 0; b < v->size() * sizeof(double); ++b) {
-      hash ^= bytes[b];
-      hash *= 1099511628211ULL;
+    for (const int k : w.index_of) {
+      const auto* bytes = reinterpret_cast<const unsigned char*>(v->data() + k);
+      for (std::size_t b = 0; b < sizeof(double); ++b) {
+        hash ^= bytes[b];
+        hash *= 1099511628211ULL;
+      }
     }
   }
   return hash;
