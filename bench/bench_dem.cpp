@@ -119,15 +119,17 @@ double step_at_most_1us(dr::WorldOptions o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Optional argument: a scale factor for the timed step counts (default 1).
+  // Optional arguments: a scale factor for the timed step counts (default 1), and a
+  // particle count to run only the vibrated-box rows of that size (quick comparisons).
   const double scale = argc > 1 ? std::atof(argv[1]) : 1.0;
+  const int only_count = argc > 2 ? std::atoi(argv[2]) : 0;
   std::printf("# bench_dem: reference DEM, steel spheres (E = 210 GPa), particle-steps per second\n");
   std::printf("%-34s %9s %8s %10s %14s %12s\n", "case", "particles", "threads", "dt_s", "Mparticle-steps/s",
               "bytes/particle");
 
   // 36 spheres at steel stiffness and a 1 µs step (40 steps per contact at 0.3 m/s
   // impacts, the drive's velocity amplitude 0.5 m/s being shared by the rolling bed).
-  {
+  if (only_count == 0) {
     auto sim = low_intensity_case();
     sim.world.integration.steps_per_contact = 40;
     sim.world.integration.max_impact_speed_m_s = 0.3;
@@ -141,7 +143,7 @@ int main(int argc, char** argv) {
   }
   // The same case as a whole run_harmonic (settling, 1 + 1 periods, recording on) at its
   // automatic step.
-  {
+  if (only_count == 0) {
     auto sim = low_intensity_case();
     sim.transient_periods = 1;
     sim.analysed_periods = 1;
@@ -150,6 +152,7 @@ int main(int argc, char** argv) {
                 result.time_step_s, result.particle_steps_per_s / 1e6, "-");
   }
   for (const int count : {1000, 10000, 100000}) {
+    if (only_count != 0 && count != only_count) continue;
     const auto sim = vibrated_box(count);
     const double dt = step_at_most_1us(sim.world);
     const long timed = static_cast<long>(scale * 2e8 / count) + 10;
