@@ -150,6 +150,10 @@ struct alignas(64) Partition {
   int end = 0;       ///< one past the last particle
   int head_end = 0;  ///< [begin, head_end): particles that earlier partitions' rows reach
   int halo_end = 0;  ///< [end, halo_end): particles of later partitions that this one's rows reach
+  /// [begin, early_end): integrated before the sweeps start: the head, and on every
+  /// partition as many particles as the longest head has (a thread would otherwise wait
+  /// at the barrier while another integrates its head: 2-5% of a 2-thread step).
+  int early_end = 0;
   std::vector<double> halo;  ///< fx, fy, fz, tx, ty, tz per particle of [end, halo_end)
   std::vector<StagedContact> fresh_pairs, fresh_walls;
   StepDissipation dissipation;
@@ -563,8 +567,8 @@ inline void World::Impl::pair_kinematics_2(const PairGeometry& a, const PairGeom
 }
 
 // A step in one OpenMP region: the rebuild check (before: a rebuild has parallel loops
-// of its own), then per partition integrate the head, barrier, sweep (integrating just
-// ahead of the rows), barrier, fresh contacts and halo forces. On the steps that
+// of its own), then per partition integrate the head (up to early_end), barrier, sweep
+// (integrating just ahead of the rows), barrier, fresh contacts and halo forces. On the steps that
 // sample the stage times the partitions are integrated whole before the sweep (the
 // same arithmetic: the results do not depend on it).
 void World::Impl::advance(bool timed, const ContainerState& previous) {
@@ -582,7 +586,7 @@ void World::Impl::advance(bool timed, const ContainerState& previous) {
     for (int p = t; p < count; p += size) {
       Partition& part = parts[static_cast<std::size_t>(p)];
       part.max_d2 = part.max_u2 = 0.0;
-      integrate(part.begin, timed ? part.end : part.head_end, part);
+      integrate(part.begin, timed ? part.end : part.early_end, part);
     }
     sync(size);
     if (timed && t == 0) t2 = Clock::now();
@@ -850,6 +854,9 @@ void World::Impl::plan_partitions() {
     part.halo.assign(6 * static_cast<std::size_t>(reach - part.end), 0.0);
     reached = std::max(reached, reach);
   }
+  int longest_head = 0;
+  for (const auto& part : parts) longest_head = std::max(longest_head, part.head_end - part.begin);
+  for (auto& part : parts) part.early_end = std::min(part.end, part.begin + longest_head);
 }
 
 // Forces of the rows of one partition, in blocks of rows: the pairs of the block, then
@@ -881,7 +888,7 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
   const int pair_slot_count = static_cast<int>(pairs.slots.size());
   Contact* const pair_state = pairs.pool.state.data();
   const int end = part.end;
-  int ahead = integrate_ahead ? part.head_end : end;
+  int ahead = integrate_ahead ? part.early_end : end;
   // Integrates up to particle `upto` (exclusive), at least kAheadChunk at a time.
   const auto integrate_to = [&](int upto) {
     const int to = std::min(end, std::max(upto, ahead + kAheadChunk));
