@@ -229,6 +229,10 @@ class ContactLaw {
   const auto blend = [](V mask, V yes, V no) { return _mm_or_pd(_mm_and_pd(mask, yes), _mm_andnot_pd(mask, no)); };
   const auto lane0 = [](V v) { return _mm_cvtsd_f64(v); };
   const auto lane1 = [](V v) { return _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
+  const auto put = [](V v, double& a, double& b) {  // lane 0 to a, lane 1 to b
+    _mm_storel_pd(&a, v);
+    _mm_storeh_pd(&b, v);
+  };
   const V zero = _mm_setzero_pd();
   const V one = _mm_set1_pd(1.0);
   const V half = _mm_set1_pd(0.5);
@@ -253,8 +257,7 @@ class ContactLaw {
       _mm_mul_pd(_mm_mul_pd(_mm_mul_pd(half, _mm_add_pd(pack(ha.fd_prev, hb.fd_prev), f_damp)), vn), step);
   diss.normal_damping += lane0(damping);
   diss.normal_damping += lane1(damping);
-  ha.fd_prev = lane0(f_damp);
-  hb.fd_prev = lane1(f_damp);
+  put(f_damp, ha.fd_prev, hb.fd_prev);
 
   const V kt = _mm_mul_pd(_mm_mul_pd(stiffness, pack(ta.tangential_ratio, tb.tangential_ratio)), root);
   const V du0 = _mm_mul_pd(_mm_sub_pd(v0, _mm_mul_pd(vn, n0)), step);
@@ -309,38 +312,21 @@ class ContactLaw {
   }
   diss.friction += lane0(loss);
   diss.friction += lane1(loss);
-  ha.ft[0] = lane0(s0);
-  ha.ft[1] = lane0(s1);
-  ha.ft[2] = lane0(s2);
-  hb.ft[0] = lane1(s0);
-  hb.ft[1] = lane1(s1);
-  hb.ft[2] = lane1(s2);
+  put(s0, ha.ft[0], hb.ft[0]);
+  put(s1, ha.ft[1], hb.ft[1]);
+  put(s2, ha.ft[2], hb.ft[2]);
 
   const V minus_fn = _mm_xor_pd(f_n, _mm_set1_pd(-0.0));
-  const V f0 = _mm_add_pd(_mm_mul_pd(minus_fn, n0), s0);
-  const V f1 = _mm_add_pd(_mm_mul_pd(minus_fn, n1), s1);
-  const V f2 = _mm_add_pd(_mm_mul_pd(minus_fn, n2), s2);
-  const V c0 = _mm_sub_pd(_mm_mul_pd(n1, s2), _mm_mul_pd(n2, s1));
-  const V c1 = _mm_sub_pd(_mm_mul_pd(n2, s0), _mm_mul_pd(n0, s2));
-  const V c2 = _mm_sub_pd(_mm_mul_pd(n0, s1), _mm_mul_pd(n1, s0));
-  oa.f[0] = lane0(f0);
-  oa.f[1] = lane0(f1);
-  oa.f[2] = lane0(f2);
-  ob.f[0] = lane1(f0);
-  ob.f[1] = lane1(f1);
-  ob.f[2] = lane1(f2);
-  oa.c[0] = lane0(c0);
-  oa.c[1] = lane0(c1);
-  oa.c[2] = lane0(c2);
-  ob.c[0] = lane1(c0);
-  ob.c[1] = lane1(c1);
-  ob.c[2] = lane1(c2);
+  put(_mm_add_pd(_mm_mul_pd(minus_fn, n0), s0), oa.f[0], ob.f[0]);
+  put(_mm_add_pd(_mm_mul_pd(minus_fn, n1), s1), oa.f[1], ob.f[1]);
+  put(_mm_add_pd(_mm_mul_pd(minus_fn, n2), s2), oa.f[2], ob.f[2]);
+  put(_mm_sub_pd(_mm_mul_pd(n1, s2), _mm_mul_pd(n2, s1)), oa.c[0], ob.c[0]);
+  put(_mm_sub_pd(_mm_mul_pd(n2, s0), _mm_mul_pd(n0, s2)), oa.c[1], ob.c[1]);
+  put(_mm_sub_pd(_mm_mul_pd(n0, s1), _mm_mul_pd(n1, s0)), oa.c[2], ob.c[2]);
   oa.m[0] = oa.m[1] = oa.m[2] = 0.0;
   ob.m[0] = ob.m[1] = ob.m[2] = 0.0;
-  ha.inv_kt_prev = lane0(inv_kt);
-  hb.inv_kt_prev = lane1(inv_kt);
-  ha.fn_prev = lane0(f_n);
-  hb.fn_prev = lane1(f_n);
+  put(inv_kt, ha.inv_kt_prev, hb.inv_kt_prev);
+  put(f_n, ha.fn_prev, hb.fn_prev);
   diss.contacts += 2;
 }
 

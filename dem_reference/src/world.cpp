@@ -900,17 +900,33 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
   LoadSums sums;
   ContactKinematics k;
   ContactResult out;
-  // The history of a pooled contact, or of one staged in this step (by index: staging
-  // may move the staged ones).
-  const auto locate = [&](int contact, int fresh, Contact*& state, double*& torque) {
+  // The history of a contact of `rows`: pooled, or staged in this step in `staged` (by
+  // index: staging may move the staged ones).
+  struct Located {
+    Contact* state;
+    double* torque;
+  };
+  const auto locate = [](RowList& rows, std::vector<StagedContact>& staged, int contact, int fresh) {
     if (contact >= 0) {
-      state = pair_state + contact;
-      torque = pairs.pool.rolling_torque(static_cast<std::size_t>(contact));
-    } else {
-      StagedContact& staged = part.fresh_pairs[static_cast<std::size_t>(fresh)];
-      state = &staged.contact;
-      torque = staged.torque;
+      return Located{&rows.pool.state[static_cast<std::size_t>(contact)],
+                     rows.pool.rolling_torque(static_cast<std::size_t>(contact))};
     }
+    StagedContact& s = staged[static_cast<std::size_t>(fresh)];
+    return Located{&s.contact, s.torque};
+  };
+  // Forces of two contacts of `rows` (contact_force_2), or of one (contact_force).
+  const auto force_2 = [&](RowList& rows, std::vector<StagedContact>& staged, int contact_a, int fresh_a,
+                           const ContactKinematics& ka, int contact_b, int fresh_b, const ContactKinematics& kb,
+                           ContactResult& out_a, ContactResult& out_b) {
+    const Located a = locate(rows, staged, contact_a, fresh_a);
+    const Located b = locate(rows, staged, contact_b, fresh_b);
+    detail::contact_force_2(a.state->params, a.state->history, a.torque, ka, b.state->params, b.state->history,
+                            b.torque, kb, h, law, out_a, out_b, diss);
+  };
+  const auto force_1 = [&](RowList& rows, std::vector<StagedContact>& staged, int contact, int fresh,
+                           const ContactKinematics& kin, ContactResult& result) {
+    const Located c = locate(rows, staged, contact, fresh);
+    detail::contact_force(c.state->params, c.state->history, c.torque, kin, h, law, result, diss);
   };
   // Adds a pair's force and torques: on i, and on j directly or through the halo.
   const auto apply = [&](const ContactResult& r, const PairGeometry& g) {
@@ -942,16 +958,6 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
   const auto overlap = [&](double delta, const PairGeometry& g) {
     const double rmin = g.ri < g.rj ? g.ri : g.rj;
     if (delta > limit * rmin) diss.max_overlap_ratio = std::max(diss.max_overlap_ratio, delta / rmin);
-  };
-  const auto locate_wall = [&](int contact, int fresh, Contact*& state, double*& torque) {
-    if (contact >= 0) {
-      state = &wall_rows.pool.state[static_cast<std::size_t>(contact)];
-      torque = wall_rows.pool.rolling_torque(static_cast<std::size_t>(contact));
-    } else {
-      StagedContact& staged = part.fresh_walls[static_cast<std::size_t>(fresh)];
-      state = &staged.contact;
-      torque = staged.torque;
-    }
   };
   // Adds a wall contact's force and torque on i, and its share of the container load
   // (rc: the contact point relative to the container origin).
@@ -1016,15 +1022,8 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
       pair_kinematics_2(waiting.g, g, ka, kb);
       overlap(ka.delta, waiting.g);
       overlap(kb.delta, g);
-      Contact* contact_a = nullptr;
-      Contact* contact_b = nullptr;
-      double* torque_a = nullptr;
-      double* torque_b = nullptr;
-      locate(waiting.contact, waiting.fresh, contact_a, torque_a);
-      locate(slot.contact, fresh, contact_b, torque_b);
       ContactResult out_b;
-      detail::contact_force_2(contact_a->params, contact_a->history, torque_a, ka, contact_b->params,
-                              contact_b->history, torque_b, kb, h, law, out, out_b, diss);
+      force_2(pairs, part.fresh_pairs, waiting.contact, waiting.fresh, ka, slot.contact, fresh, kb, out, out_b);
       apply(out, waiting.g);
       apply(out_b, g);
       waiting.active = false;
@@ -1032,10 +1031,7 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
     if (waiting.active) {
       pair_kinematics(waiting.g, k);
       overlap(k.delta, waiting.g);
-      Contact* contact = nullptr;
-      double* torque = nullptr;
-      locate(waiting.contact, waiting.fresh, contact, torque);
-      detail::contact_force(contact->params, contact->history, torque, k, h, law, out, diss);
+      force_1(pairs, part.fresh_pairs, waiting.contact, waiting.fresh, k, out);
       apply(out, waiting.g);
       waiting.active = false;
     }
@@ -1088,24 +1084,15 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
         waiting_wall = WaitingWall{true, k, slot.contact, fresh, i, ri, {rc[0], rc[1], rc[2]}};
         continue;
       }
-      Contact* contact_a = nullptr;
-      Contact* contact_b = nullptr;
-      double* torque_a = nullptr;
-      double* torque_b = nullptr;
-      locate_wall(waiting_wall.contact, waiting_wall.fresh, contact_a, torque_a);
-      locate_wall(slot.contact, fresh, contact_b, torque_b);
       ContactResult out_b;
-      detail::contact_force_2(contact_a->params, contact_a->history, torque_a, waiting_wall.k, contact_b->params,
-                              contact_b->history, torque_b, k, h, law, out, out_b, diss);
+      force_2(wall_rows, part.fresh_walls, waiting_wall.contact, waiting_wall.fresh, waiting_wall.k, slot.contact,
+              fresh, k, out, out_b);
       apply_wall(out, waiting_wall.i, waiting_wall.ri, waiting_wall.rc);
       apply_wall(out_b, i, ri, rc);
       waiting_wall.active = false;
     }
     if (waiting_wall.active) {
-      Contact* contact = nullptr;
-      double* torque = nullptr;
-      locate_wall(waiting_wall.contact, waiting_wall.fresh, contact, torque);
-      detail::contact_force(contact->params, contact->history, torque, waiting_wall.k, h, law, out, diss);
+      force_1(wall_rows, part.fresh_walls, waiting_wall.contact, waiting_wall.fresh, waiting_wall.k, out);
       apply_wall(out, waiting_wall.i, waiting_wall.ri, waiting_wall.rc);
       waiting_wall.active = false;
     }
