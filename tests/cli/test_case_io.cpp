@@ -208,6 +208,25 @@ TEST_CASE("pdamp dem reports the promised keys and writes its files", "[cli]") {
   for (const char* name : {"summary.json", "time_series.csv", "particles_0000.vtk"}) CHECK(fs::exists(dir / name));
 }
 
+// Every shipped case runs in the DEM as shipped (issue 3: "pdamp dem on the shipped cases
+// works"), closes its energy account (< 2%) and sees the clearance that the closed forms
+// of `pdamp run` use (the buffered case: the clearance between the layers). About 25 s.
+TEST_CASE("pdamp dem runs every shipped case as shipped", "[cli][long]") {
+  for (const char* name : {"low_intensity_36_spheres.json", "high_intensity_cylinder.json", "buffered_wall_60hz.json"}) {
+    INFO(name);
+    const auto v = run_pdamp(std::string("validate ") + case_path(name));
+    REQUIRE(v.exit_code == 0);
+    const double clearance = json::parse(v.out)["damper"]["derived"]["clearance_m"].get<double>();
+    const auto r = run_pdamp(std::string("dem ") + case_path(name) + " --json");
+    REQUIRE(r.exit_code == 0);
+    const json d = json::parse(r.out);
+    CHECK(d["energy_balance_error"].get<double>() < 0.02);
+    CHECK(std::isfinite(d["eta_star"].get<double>()));
+    // Case geometry given to 10 µm: the lattice and layer thicknesses round below that.
+    CHECK(d["clearance_m"].get<double>() == Approx(clearance).margin(1e-5));
+  }
+}
+
 TEST_CASE("pdamp field from the formulas writes a readable field with the promised keys", "[cli]") {
   const auto path = edited_case("pdamp_field_case.json", [](json& c) {
     c["field"] = {{"axis0", {{"min", 1.5}, {"max", 2.5}, {"count", 3}}},
