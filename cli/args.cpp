@@ -15,7 +15,8 @@ std::optional<double> parse_number(const std::string& text) {
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value)) return std::nullopt;
+  if (end != text.c_str() + text.size() || !std::isfinite(value)) return std::nullopt;
+  if (errno == ERANGE && std::abs(value) > 1.0) return std::nullopt;  // overflow (HUGE_VAL)
   return value;
 }
 
@@ -78,28 +79,28 @@ std::string ParsedArgs::text(const std::string& flag) const {
   return *value;
 }
 
-static std::string range_text(double min, double max, bool min_exclusive) {
-  std::ostringstream out;
-  out << "must be a finite number " << (min_exclusive ? "> " : ">= ") << min;
-  if (std::isfinite(max)) out << " and <= " << max;
-  return out.str();
-}
-
-std::optional<double> ParsedArgs::optional_number(const std::string& flag, double min, double max,
-                                                  bool min_exclusive) const {
+std::optional<double> ParsedArgs::optional_number(const std::string& flag, const Range& range) const {
   const auto text_value = optional_text(flag);
   if (!text_value) return std::nullopt;
   const auto value = parse_number(*text_value);
-  const bool in_range = value && (min_exclusive ? *value > min : *value >= min) && *value <= max;
-  if (!in_range)
-    throw InputError(flag, "", "'" + *text_value + "': " + range_text(min, max, min_exclusive));
+  if (!value || !range.contains(*value)) throw InputError(flag, "", "'" + *text_value + "': " + range.text());
   return value;
 }
 
-double ParsedArgs::number(const std::string& flag, double min, double max, bool min_exclusive) const {
-  const auto value = optional_number(flag, min, max, min_exclusive);
-  if (!value) throw InputError(flag, "", "required, " + range_text(min, max, min_exclusive));
+double ParsedArgs::number(const std::string& flag, const Range& range) const {
+  const auto value = optional_number(flag, range);
+  if (!value) throw InputError(flag, "", "required, " + range.text());
   return *value;
+}
+
+std::optional<long long> ParsedArgs::optional_integer(const std::string& flag, long long min, long long max) const {
+  const auto text_value = optional_text(flag);
+  if (!text_value) return std::nullopt;
+  const auto value = parse_number(*text_value);
+  if (!value || *value != std::floor(*value) || *value < static_cast<double>(min) || *value > static_cast<double>(max))
+    throw InputError(flag, "", "'" + *text_value + "': must be a whole number in [" + std::to_string(min) + ", " +
+                                   std::to_string(max) + "]");
+  return static_cast<long long>(*value);
 }
 
 }  // namespace pdamp::cli

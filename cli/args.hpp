@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "limits.hpp"
+
 namespace pdamp::cli {
 
 struct FlagSpec {
@@ -34,9 +36,10 @@ class ParsedArgs {
   std::optional<std::string> optional_text(const std::string& flag) const;
   /// A finite number; InputError naming the flag and the allowed range when missing,
   /// malformed or outside [min, max] (min_exclusive: > min).
-  double number(const std::string& flag, double min, double max, bool min_exclusive = true) const;
-  std::optional<double> optional_number(const std::string& flag, double min, double max,
-                                        bool min_exclusive = true) const;
+  double number(const std::string& flag, const Range& range) const;
+  std::optional<double> optional_number(const std::string& flag, const Range& range) const;
+  /// A whole number in [min, max] ("1.5" is refused, not rounded).
+  std::optional<long long> optional_integer(const std::string& flag, long long min, long long max) const;
   const std::vector<std::string>& positional() const { return positional_; }
 
  private:
@@ -46,7 +49,9 @@ class ParsedArgs {
   bool help_ = false;
 };
 
-/// Strict number parsing: the whole text must be a finite number.
+/// Strict number parsing: the whole text must be a finite number (a value that
+/// underflows to a subnormal or to zero is returned as it is, for the range check to
+/// judge; one that overflows is not a number).
 std::optional<double> parse_number(const std::string& text);
 
 }  // namespace pdamp::cli

@@ -13,6 +13,7 @@
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
 #include "pdamp/surrogate/grid.hpp"
+#include "errors.hpp"
 
 namespace pdamp::cli {
 
@@ -86,6 +87,11 @@ struct Case {
 Case load_case(const std::string& path);
 
 std::string_view to_string(Task task);
+
+/// A line of dem_reference's validate() ("integration.time_step_s = 0.001: ...") as
+/// the case's error: the internal option name becomes the JSON pointer of the case key
+/// it comes from (/dem/time_step_s, /dem/inner_structures/pins/0, ...).
+InputError dem_input_error(const Case& c, const std::string& problem);
 
 /// The case's DEM options for one operating point (stroke X, frequency f).
 dem_reference::DamperSimulationOptions dem_options(const Case& c, double amplitude_m, double frequency_hz);

@@ -6,8 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <mutex>
 #include <sstream>
 
@@ -16,6 +19,7 @@
 #include "case_io.hpp"
 #include "errors.hpp"
 #include "output.hpp"
+#include "pdamp/formulas/input_file.hpp"
 #include "plots.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
@@ -32,7 +36,6 @@ namespace {
 
 using nlohmann::json;
 namespace fm = formulas;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 const FlagSpec kJsonFlag{"--json", "", "print exactly one JSON object on stdout"};
 const FlagSpec kOutFlag{"-o", "DIR", "write result files (JSON, CSV, plots) into DIR, atomically"};
@@ -49,8 +52,8 @@ fm::DamperModel model_flag(const ParsedArgs& args, const std::vector<std::string
 /// Calibration and inertia overrides shared by optimum, size and loss.
 fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
   fm::ModelOptions options;
-  if (const auto kappa = args.optional_number("--inertia-factor", 0.0, 1.0)) options.rolling_inertia_factor = *kappa;
-  if (const auto c = args.optional_number("--calibration", 0.0, 2.0)) {
+  if (const auto kappa = args.optional_number("--inertia-factor", Range{0.0, 1.0, true})) options.rolling_inertia_factor = *kappa;
+  if (const auto c = args.optional_number("--calibration", Range{0.0, 2.0, true})) {
     if (model == fm::DamperModel::kBouncing) options.bouncing_calibration = *c;
     else options.rolling_calibration = *c;
   }
@@ -68,11 +71,34 @@ void print_warnings(const std::vector<std::string>& warnings) {
   for (const auto& w : warnings) std::cerr << "pdamp: warning: " << w << "\n";
 }
 
-/// Prints the result: the JSON object with --json, else the readable table.
-int emit(const ParsedArgs& args, const json& result, const std::vector<std::pair<std::string, std::string>>& rows) {
+/// The JSON pointer of the first number in `value` that is not finite, if any.
+std::optional<std::string> non_finite_number(const json& value, const std::string& at = "") {
+  if (value.is_number_float() && !std::isfinite(value.get<double>())) return at.empty() ? "/" : at;
+  if (value.is_object() || value.is_array()) {
+    std::size_t i = 0;
+    for (auto it = value.begin(); it != value.end(); ++it, ++i)
+      if (auto bad = non_finite_number(*it, at + "/" + (value.is_object() ? it.key() : std::to_string(i)))) return bad;
+  }
+  return std::nullopt;
+}
+
+/// Prints the result: the JSON object with --json, else the readable table. A
+/// closed-form result that is not finite (a formula at the edge of its range) is a
+/// numerical failure, never printed as null or inf; a measured result (the DEM's) may
+/// hold an undefined statistic, e.g. the standard error of one period (null).
+int emit(const ParsedArgs& args, const json& result, const std::vector<std::pair<std::string, std::string>>& rows,
+         bool closed_form = true) {
+  if (const auto bad = closed_form ? non_finite_number(result) : std::nullopt)
+    throw NumericalError("the result " + *bad + " is not finite: the inputs lie where the model cannot be evaluated");
   if (args.has("--json")) std::cout << result.dump(2) << "\n";
   else std::cout << key_value_table(rows);
   return kExitOk;
+}
+
+/// The -o directory, checked before any work (OutputDir), or none.
+std::unique_ptr<OutputDir> output_dir(const ParsedArgs& args) {
+  if (const auto dir = args.optional_text("-o")) return std::make_unique<OutputDir>(*dir);
+  return nullptr;
 }
 
 json optimum_json(const fm::OptimumStroke& o) {
@@ -123,7 +149,7 @@ json loss_json(const fm::LossResult& loss, double bed_mass_kg, double frequency_
 
 int run_optimum(const ParsedArgs& args) {
   const auto model = model_flag(args, {"rolling", "bouncing"});
-  const double h = args.number("--clearance", 0.0, kInf);
+  const double h = args.number("--clearance", limits::kClearance);
   const auto result = fm::optimum_stroke(model, h, model_options(args, model));
   json out = optimum_json(result);
   out["warnings"] = json::array();
@@ -132,7 +158,7 @@ int run_optimum(const ParsedArgs& args) {
 
 int run_size(const ParsedArgs& args) {
   const auto model = model_flag(args, {"rolling", "bouncing"});
-  const double stroke = args.number("--stroke", 0.0, kInf);
+  const double stroke = args.number("--stroke", limits::kStroke);
   const auto options = model_options(args, model);
   const double h = fm::clearance_for_stroke(model, stroke, options);
   const auto check = fm::optimum_stroke(model, h, options);
@@ -146,26 +172,26 @@ int run_size(const ParsedArgs& args) {
 
 int run_loss(const ParsedArgs& args) {
   const auto model = model_flag(args, {"rolling", "bouncing", "scattered", "auto"});
-  const double h = args.number("--clearance", 0.0, kInf);
-  const double x = args.number("--amplitude", 0.0, kInf);
-  const double f = args.number("--frequency", 0.0, kInf);
-  const double bed_mass = args.optional_number("--bed-mass", 0.0, kInf).value_or(1.0);
+  const double h = args.number("--clearance", limits::kClearance);
+  const double x = args.number("--amplitude", limits::kStroke);
+  const double f = args.number("--frequency", limits::kFrequency);
+  const double bed_mass = args.optional_number("--bed-mass", limits::kMass).value_or(1.0);
   const auto options = model_options(args, model);
+  auto files = output_dir(args);
   const auto loss = fm::reduced_loss_factor(model, h, x, f, options);
   json out = loss_json(loss, bed_mass, f);
   out.update({{"clearance_m", h}, {"amplitude_m", x}, {"frequency_hz", f}});
   std::vector<std::string> warnings = loss.warnings;
-  if (const auto dir = args.optional_text("-o")) {
+  if (files) {
     const auto family = loss.model_used;
     const auto landmarks = fm::optimum_stroke(family, h, options);
     const double x_max = std::max(1.5 * h, 1.2 * x);
-    OutputDir files(*dir);
     const auto curve = eta_curve(model, h, f, options, 0.02 * h, x_max, 301);
-    for (auto& w : write_eta_curve(files, curve, landmarks, f, "pdamp loss --model " + std::string(fm::to_string(model))))
+    for (auto& w : write_eta_curve(*files, curve, landmarks, f, "pdamp loss --model " + std::string(fm::to_string(model))))
       warnings.push_back(w);
     out["warnings"] = warnings;
-    files.add_json("loss.json", out);
-    out["files"] = files.commit();
+    files->add_json("loss.json", out);
+    out["files"] = files->commit();
   }
   print_warnings(warnings);
   return emit(args, out, {{"model_used", std::string(fm::to_string(loss.model_used))},
@@ -187,21 +213,21 @@ json buffer_json(const fm::BufferDesign& b) {
 
 int run_buffer(const ParsedArgs& args) {
   fm::BufferDesignInput in;
-  in.frequency_hz = args.number("--frequency", 0.0, kInf);
-  const auto amplitude = args.optional_number("--amplitude", 0.0, kInf);
-  const auto intensity = args.optional_number("--intensity", 0.0, kInf);
+  in.frequency_hz = args.number("--frequency", limits::kFrequency);
+  const auto amplitude = args.optional_number("--amplitude", limits::kStroke);
+  const auto intensity = args.optional_number("--intensity", limits::kIntensity);
   if (amplitude.has_value() == intensity.has_value())
     throw InputError("--amplitude", "", "give exactly one of --amplitude M and --intensity G");
   in.amplitude_m = amplitude.value_or(0.0);
   in.intensity = intensity.value_or(0.0);
-  in.particle_radius_m = args.number("--radius", 0.0, kInf);
-  in.particle.density_kg_m3 = args.optional_number("--particle-density", 0.0, kInf).value_or(in.particle.density_kg_m3);
-  in.particle.youngs_modulus_pa = args.optional_number("--particle-modulus", 0.0, kInf).value_or(in.particle.youngs_modulus_pa);
-  in.particle.poisson_ratio = args.optional_number("--particle-poisson", 0.0, 0.4999, false).value_or(in.particle.poisson_ratio);
-  in.layer.youngs_modulus_pa = args.number("--layer-modulus", 0.0, kInf);
-  in.layer.poisson_ratio = args.optional_number("--layer-poisson", 0.0, 0.4999, false).value_or(0.45);
-  in.particles_per_contact = args.optional_number("--particles-per-contact", 1.0, kInf, false).value_or(1.0);
-  in.impact_velocity_m_s = args.optional_number("--impact-velocity", 0.0, kInf).value_or(0.0);
+  in.particle_radius_m = args.number("--radius", limits::kParticleRadius);
+  in.particle.density_kg_m3 = args.optional_number("--particle-density", limits::kDensity).value_or(in.particle.density_kg_m3);
+  in.particle.youngs_modulus_pa = args.optional_number("--particle-modulus", limits::kModulus).value_or(in.particle.youngs_modulus_pa);
+  in.particle.poisson_ratio = args.optional_number("--particle-poisson", limits::kPoisson).value_or(in.particle.poisson_ratio);
+  in.layer.youngs_modulus_pa = args.number("--layer-modulus", limits::kModulus);
+  in.layer.poisson_ratio = args.optional_number("--layer-poisson", limits::kPoisson).value_or(0.45);
+  in.particles_per_contact = args.optional_number("--particles-per-contact", Range{1.0, 1e9}).value_or(1.0);
+  in.impact_velocity_m_s = args.optional_number("--impact-velocity", limits::kImpactSpeed).value_or(0.0);
   const auto problems = in.validate();
   if (!problems.empty()) throw InputError("pdamp buffer", "", problems.front());
   const auto design = fm::size_buffer_layer(in);
@@ -215,11 +241,6 @@ int run_buffer(const ParsedArgs& args) {
                {"max_force_n", format_number(design.max_force_n)}});
 }
 
-int run_validate(const ParsedArgs& args) {
-  const Case c = load_case(args.positional().at(0));
-  std::cout << c.resolved.dump(2) << "\n";
-  return kExitOk;
-}
 
 /// `auto` in a design: rolling when its design stroke at the case frequency is below
 /// 1 g (PHYSICS.md §3: low intensity), else bouncing.
@@ -230,55 +251,83 @@ fm::DamperModel design_family(const Case& c) {
   return rolling.x_opt_m * omega * omega < fm::kStandardGravity ? fm::DamperModel::kRolling : fm::DamperModel::kBouncing;
 }
 
-int run_damper_design(const ParsedArgs& args, const Case& c) {
-  const auto& d = c.damper;
-  const auto family = design_family(c);
-  const double f = c.excitation.frequency_hz;
-  const auto optimum = fm::optimum_stroke(family, d.clearance_m, d.model_options);
-  json result = {{"task", to_string(c.task)}, {"case", c.name}, {"model", fm::to_string(family)},
-                 {"clearance_m", d.clearance_m}, {"bed_mass_kg", d.bed_mass_kg}, {"optimum", optimum_json(optimum)}};
+/// The damper_design task's numbers (no files): what `pdamp run` prints and writes.
+struct DamperDesign {
+  json result;
   std::vector<std::string> warnings;
-  const auto design_point = fm::reduced_loss_factor(family, d.clearance_m, optimum.x_opt_m, f, d.model_options);
-  result["optimum"]["eta_star_at_design"] = design_point.eta_star;
-  result["optimum"]["intensity_at_design"] = design_point.intensity;
-  warnings.insert(warnings.end(), design_point.warnings.begin(), design_point.warnings.end());
-  if (c.design.target_stroke_m) {
-    const double h = fm::clearance_for_stroke(family, *c.design.target_stroke_m, d.model_options);
-    result["sizing"] = {{"target_stroke_m", *c.design.target_stroke_m},
-                        {"clearance_m", h},
-                        {"container_inner_length_along_drive_m", d.bed.bed_extent_m + h}};
-  }
-  if (c.excitation.amplitude_m) {
-    const auto op = fm::reduced_loss_factor(d.model, d.clearance_m, *c.excitation.amplitude_m, f, d.model_options);
-    result["operating_point"] = loss_json(op, d.bed_mass_kg, f);
-    result["operating_point"]["amplitude_m"] = *c.excitation.amplitude_m;
-    warnings.insert(warnings.end(), op.warnings.begin(), op.warnings.end());
-  }
-  if (c.buffer) {
-    const auto design = fm::size_buffer_layer(c.buffer->input);
-    result["buffer"] = buffer_json(design);
-    result["buffer"]["layer_material"] = c.buffer->layer_material;
-    warnings.insert(warnings.end(), design.warnings.begin(), design.warnings.end());
-  }
+  fm::OptimumStroke optimum;
+  double eta_star_at_design = 0.0;
+  std::vector<CurvePoint> curve;
+};
 
-  const auto curve = eta_curve(d.model == fm::DamperModel::kAuto ? fm::DamperModel::kAuto : family, d.clearance_m, f,
-                               d.model_options, c.design.sweep_min_over_clearance * d.clearance_m,
-                               c.design.sweep_max_over_clearance * d.clearance_m, c.design.sweep_points);
+/// Computes the damper_design task. A closed form that refuses the case's numbers
+/// (std::invalid_argument) is bad input of that case file; a result that is not finite
+/// is refused as well, so `pdamp validate` catches whatever `pdamp run` would.
+DamperDesign damper_design(const Case& c) {
+  DamperDesign out;
+  try {
+    const auto& d = c.damper;
+    const auto family = design_family(c);
+    const double f = c.excitation.frequency_hz;
+    out.optimum = fm::optimum_stroke(family, d.clearance_m, d.model_options);
+    json& result = out.result;
+    result = {{"task", to_string(c.task)}, {"case", c.name}, {"model", fm::to_string(family)},
+              {"clearance_m", d.clearance_m}, {"bed_mass_kg", d.bed_mass_kg}, {"optimum", optimum_json(out.optimum)}};
+    auto& warnings = out.warnings;
+    const auto design_point = fm::reduced_loss_factor(family, d.clearance_m, out.optimum.x_opt_m, f, d.model_options);
+    out.eta_star_at_design = design_point.eta_star;
+    result["optimum"]["eta_star_at_design"] = design_point.eta_star;
+    result["optimum"]["intensity_at_design"] = design_point.intensity;
+    warnings.insert(warnings.end(), design_point.warnings.begin(), design_point.warnings.end());
+    if (c.design.target_stroke_m) {
+      const double h = fm::clearance_for_stroke(family, *c.design.target_stroke_m, d.model_options);
+      result["sizing"] = {{"target_stroke_m", *c.design.target_stroke_m},
+                          {"clearance_m", h},
+                          {"container_inner_length_along_drive_m", d.bed.bed_extent_m + h}};
+    }
+    if (c.excitation.amplitude_m) {
+      const auto op = fm::reduced_loss_factor(d.model, d.clearance_m, *c.excitation.amplitude_m, f, d.model_options);
+      result["operating_point"] = loss_json(op, d.bed_mass_kg, f);
+      result["operating_point"]["amplitude_m"] = *c.excitation.amplitude_m;
+      warnings.insert(warnings.end(), op.warnings.begin(), op.warnings.end());
+    }
+    if (c.buffer) {
+      const auto design = fm::size_buffer_layer(c.buffer->input);
+      result["buffer"] = buffer_json(design);
+      result["buffer"]["layer_material"] = c.buffer->layer_material;
+      warnings.insert(warnings.end(), design.warnings.begin(), design.warnings.end());
+    }
+    out.curve = eta_curve(d.model == fm::DamperModel::kAuto ? fm::DamperModel::kAuto : family, d.clearance_m, f,
+                          d.model_options, c.design.sweep_min_over_clearance * d.clearance_m,
+                          c.design.sweep_max_over_clearance * d.clearance_m, c.design.sweep_points);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path, "", std::string("the closed forms refuse this case: ") + e.what());
+  }
+  if (const auto bad = non_finite_number(out.result))
+    throw InputError(c.path, "", "the design result " + *bad + " is not finite: the case lies outside the closed forms");
+  return out;
+}
+
+int run_damper_design(const ParsedArgs& args, const Case& c) {
+  auto files = output_dir(args);
+  DamperDesign design = damper_design(c);
+  json& result = design.result;
+  auto& warnings = design.warnings;
   json outputs = json::array();
-  if (const auto dir = args.optional_text("-o")) {
-    OutputDir files(*dir);
-    for (auto& w : write_eta_curve(files, curve, optimum, f, c.name)) warnings.push_back(w);
-    files.add_json("case_resolved.json", c.resolved);
+  if (files) {
+    for (auto& w : write_eta_curve(*files, design.curve, design.optimum, c.excitation.frequency_hz, c.name))
+      warnings.push_back(w);
+    files->add_json("case_resolved.json", c.resolved);
     result["warnings"] = warnings;
-    files.add_json("design.json", result);
-    outputs = files.commit();
+    files->add_json("design.json", result);
+    outputs = files->commit();
   }
   result["warnings"] = warnings;
   result["outputs"] = outputs;
   print_warnings(warnings);
-  auto rows = optimum_rows(optimum);
+  auto rows = optimum_rows(design.optimum);
   rows.insert(rows.begin(), {"case", c.name});
-  rows.push_back({"eta* at design", format_number(design_point.eta_star, 4)});
+  rows.push_back({"eta* at design", format_number(design.eta_star_at_design, 4)});
   if (result.contains("operating_point"))
     rows.push_back({"eta* at operating X", format_number(result["operating_point"]["eta_star"].get<double>(), 4) + "  (X = " +
                                                format_number(*c.excitation.amplitude_m) + " m, " +
@@ -359,19 +408,78 @@ json dem_json(const dem_reference::DamperResult& r) {
             {"neighbour_rebuilds", r.summary.neighbour_rebuilds}}}};
 }
 
+/// Memory this process may still use, bytes: MemAvailable of /proc/meminfo, lowered to
+/// what a cgroup v2 limit leaves (a container or a batch job's slot). Infinity when
+/// neither can be read.
+double available_memory_bytes() {
+  double available = std::numeric_limits<double>::infinity();
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string key; meminfo >> key;) {
+    double kib = 0.0;
+    meminfo >> kib;
+    if (key == "MemAvailable:") available = kib * 1024.0;
+    meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  std::ifstream limit("/sys/fs/cgroup/memory.max"), current("/sys/fs/cgroup/memory.current");
+  double max_bytes = 0.0, used = 0.0;
+  if (limit >> max_bytes && current >> used) available = std::min(available, max_bytes - used);  // "max": no limit
+  return available;
+}
+
+std::string megabytes(double bytes) { return format_number(bytes / 1e6, 3) + " MB"; }
+
+/// The DEM would not fit: exit 2 naming the keys that set its memory.
+[[noreturn]] void refuse_memory(const Case& c, const dem_reference::RunEstimate& e, double runs_at_once, double available) {
+  throw InputError(c.path, "/dem",
+                   "the DEM needs about " + megabytes(runs_at_once * static_cast<double>(e.memory_bytes)) + " (" +
+                       std::to_string(e.particles) + " particles, " + std::to_string(e.recorded_samples) +
+                       " recorded samples = samples_per_period x analysed_periods, " + std::to_string(e.snapshots) +
+                       " snapshots" + (runs_at_once > 1 ? ", " + format_number(runs_at_once, 3) + " runs at once" : "") +
+                       "), more than the " + megabytes(available) +
+                       " available: reduce /dem/samples_per_period, /dem/analysed_periods, /dem/snapshots or "
+                       "/damper/particles/count");
+}
+
+/// A DEM run's options and cost, checked before it starts (issue 8: no job that cannot
+/// finish is started silently): every option in range (the case's JSON pointer named),
+/// the time step below its bound, the memory within what is available.
+dem_reference::RunEstimate check_dem_run(const Case& c, const dem_reference::DamperSimulationOptions& options) {
+  const auto problems = options.validate("");
+  if (!problems.empty()) throw dem_input_error(c, problems.front());
+  dem_reference::RunEstimate e;
+  try {
+    e = dem_reference::estimate_run(options);
+  } catch (const std::invalid_argument& error) {  // the time step above its bound
+    const std::string what = error.what();
+    throw dem_input_error(c, what.substr(0, what.find('\n')));
+  }
+  const double available = available_memory_bytes();
+  if (static_cast<double>(e.memory_bytes) > available) refuse_memory(c, e, 1.0, available);
+  return e;
+}
+
+/// The estimate of a DEM run, for stderr before it starts.
+std::string estimate_line(const std::string& label, const dem_reference::RunEstimate& e) {
+  return label + ": " + std::to_string(e.particles) + " particles, " + std::to_string(e.total_steps) + " steps of " +
+         format_number(e.time_step_s, 3) + " s = " + format_number(e.particle_steps, 3) + " particle-steps, about " +
+         format_number(e.wall_time_s, 2) + " s at " + format_number(e.particle_steps_per_s, 2) +
+         " particle-steps/s; memory about " + megabytes(static_cast<double>(e.memory_bytes));
+}
+
 int run_dem(const ParsedArgs& args) {
   const std::string& path = args.positional().at(0);
   const Case c = load_case(path);
-  const double f = args.optional_number("--frequency", 0.0, kInf).value_or(c.excitation.frequency_hz);
-  const auto amplitude = args.optional_number("--amplitude", 0.0, kInf);
+  const double f = args.optional_number("--frequency", limits::kFrequency).value_or(c.excitation.frequency_hz);
+  const auto amplitude = args.optional_number("--amplitude", limits::kStroke);
   if (!amplitude && !c.excitation.amplitude_m)
     throw InputError(path, "/excitation/amplitude_m", "required by pdamp dem (or give --amplitude M)");
   const double x = amplitude.value_or(c.excitation.amplitude_m.value_or(0.0));
   auto options = dem_options(c, x, f);
-  if (const auto periods = args.optional_number("--periods", 1.0, 1e6, false)) options.analysed_periods = static_cast<int>(*periods);
-  if (const auto threads = args.optional_number("--threads", 0.0, 1024, false)) options.world.threads = static_cast<int>(*threads);
-  const auto problems = options.validate("");
-  if (!problems.empty()) throw InputError(path, "/dem", problems.front());
+  if (const auto periods = args.optional_integer("--periods", 1, 1000000)) options.analysed_periods = static_cast<int>(*periods);
+  if (const auto threads = args.optional_integer("--threads", 0, 1024)) options.world.threads = static_cast<int>(*threads);
+  const auto estimate = check_dem_run(c, options);
+  auto files = output_dir(args);
+  std::cerr << estimate_line("pdamp dem", estimate) << std::endl;
 
   ProgressLine progress("pdamp dem");
   dem_reference::DamperResult result;
@@ -392,20 +500,19 @@ int run_dem(const ParsedArgs& args) {
   out["closed_form"] = {{"eta_star", closed.eta_star}, {"model_used", fm::to_string(closed.model_used)},
                         {"regime", fm::to_string(closed.regime)}};
   std::vector<std::string> warnings = result.warnings;
-  if (const auto dir = args.optional_text("-o")) {
-    OutputDir files(*dir);
-    dem_reference::write_time_series_csv(files.staged_path("time_series.csv").string(), result.series);
+  if (files) {
+    dem_reference::write_time_series_csv(files->staged_path("time_series.csv").string(), result.series);
     for (std::size_t i = 0; i < result.snapshots.size(); ++i) {
       char name[64];
       std::snprintf(name, sizeof name, "particles_%04zu.vtk", i);
-      dem_reference::write_vtk_snapshot(files.staged_path(name).string(), result.snapshots[i]);
+      dem_reference::write_vtk_snapshot(files->staged_path(name).string(), result.snapshots[i]);
     }
-    for (auto& w : write_force_velocity_plot(files, c.name + ": X = " + format_number(x * 1e3, 4) + " mm, f = " +
-                                                        format_number(f, 4) + " Hz"))
+    for (auto& w : write_force_velocity_plot(*files, c.name + ": X = " + format_number(x * 1e3, 4) + " mm, f = " +
+                                                         format_number(f, 4) + " Hz"))
       warnings.push_back(w);
     out["warnings"] = warnings;
-    files.add_json("summary.json", out);
-    out["files"] = files.commit();
+    files->add_json("summary.json", out);
+    out["files"] = files->commit();
   }
   out["warnings"] = warnings;
   print_warnings(warnings);
@@ -420,7 +527,8 @@ int run_dem(const ParsedArgs& args) {
                {"motion_mode", std::string(dem_reference::to_string(result.motion_mode))},
                {"clearance_m", format_number(result.clearance_m)},
                {"particle_steps_per_s", format_number(result.particle_steps_per_s, 3)},
-               {"run", result.summary.brief_report()}});
+               {"run", result.summary.brief_report()}},
+              false);
 }
 
 // ---------------------------------------------------------------- effective fields
@@ -433,19 +541,61 @@ std::string physics_hash(const Case& c, const std::string& source) {
 }
 
 int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
-                        const std::string& dir, json out);
+                        OutputDir& files, json out);
 
 /// A test-rig field from CSV (docs/effective_fields.md) for the case's damper.
-int import_measured_field(const ParsedArgs& args, const Case& c, const std::string& dir) {
+int import_measured_field(const ParsedArgs& args, const Case& c, OutputDir& files) {
   surrogate::MeasuredImportOptions options;
   options.clearance_m = c.damper.clearance_m;
   options.bed_mass_kg = c.damper.bed_mass_kg;
   options.frequency_spacing = c.field.axis0.spacing;
   options.amplitude_spacing = c.field.axis1.spacing;
   options.case_hash = physics_hash(c, "measured");
-  const auto field = surrogate::import_measured_csv(args.text("--measured"), options);
-  return write_field_outputs(args, c, field, dir, json::object());
+  const std::string csv = args.text("--measured");
+  surrogate::EffectiveField field;
+  try {
+    field = surrogate::import_measured_csv(csv, options);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--measured", "", e.what());
+  }
+  return write_field_outputs(args, c, field, files, json::object());
 }
+
+/// A DEM field's sweep checked before it starts: every point's run as check_dem_run,
+/// the memory of field.threads runs at once. Returns the estimate of the work still
+/// to do (the points already in the results file of `sweep` excluded), for stderr.
+std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const surrogate::SweepOptions* sweep) {
+  auto options = dem_options(c, 1.0, 1.0);
+  options.world.threads = 1;  // as the sweep runs each point
+  double wall_time_s = 0.0, particle_steps = 0.0;
+  dem_reference::RunEstimate largest;
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    const auto drive = surrogate::drive_point(grid, k, c.damper.clearance_m);
+    options.amplitude_m = drive.amplitude_m;
+    options.frequency_hz = drive.frequency_hz;
+    const auto e = check_dem_run(c, options);
+    wall_time_s += e.wall_time_s;
+    particle_steps += e.particle_steps;
+    if (e.memory_bytes > largest.memory_bytes) largest = e;
+  }
+  const double at_once = std::min<double>(c.field.threads, static_cast<double>(grid.size()));
+  const double available = available_memory_bytes();
+  if (at_once * static_cast<double>(largest.memory_bytes) > available) refuse_memory(c, largest, at_once, available);
+  std::size_t pending = grid.size();
+  try {
+    if (sweep != nullptr) pending = surrogate::pending_sweep_points(grid, *sweep);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path, "/field", e.what());
+  }
+  const double share = static_cast<double>(pending) / static_cast<double>(grid.size());
+  return std::to_string(pending) + " of " + std::to_string(grid.size()) + " points to run, " +
+         format_number(share * particle_steps, 3) + " particle-steps, about " +
+         format_number(share * wall_time_s / at_once, 2) + " s with " + format_number(at_once, 3) +
+         " points at once; memory about " + megabytes(at_once * static_cast<double>(largest.memory_bytes));
+}
+
+/// The DEM sweep's results log, written point by point into the output folder (resume).
+constexpr const char* kSweepLog = "field_sweep.jsonl";
 
 int run_field(const ParsedArgs& args) {
   const Case c = load_case(args.positional().at(0));
@@ -453,9 +603,23 @@ int run_field(const ParsedArgs& args) {
   if (source != "formulas" && source != "dem" && source != "measured")
     throw InputError("--source", "", "'" + source + "': must be formulas, dem or measured");
   const bool dem = source == "dem";
-  const std::string dir = args.optional_text("-o").value_or("out/" + c.name + "_field_" + source);
-  if (source == "measured") return import_measured_field(args, c, dir);
-  if (args.has("--measured")) throw InputError("--measured", "", "goes with --source measured");
+  if (source != "measured" && args.has("--measured")) throw InputError("--measured", "", "goes with --source measured");
+  std::string dir;
+  if (const auto given = args.optional_text("-o")) {
+    dir = *given;
+  } else {
+    // The default folder is built from the case name, which must not steer it
+    // elsewhere ("../x", "/etc/x"): one safe path component under out/.
+    const std::string safe = safe_file_name(c.name);
+    if (safe != c.name)
+      print_warnings({"case name '" + formulas::printable(c.name) + "' is not a safe folder name: writing to out/" +
+                      safe + "_field_" + source});
+    dir = "out/" + safe + "_field_" + source;
+  }
+  if (source == "measured") {
+    OutputDir files(dir);
+    return import_measured_field(args, c, files);
+  }
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
 
   surrogate::SweepOptions sweep;
@@ -467,9 +631,15 @@ int run_field(const ParsedArgs& args) {
   sweep.threads = dem ? c.field.threads : 1;
   std::mutex progress_mutex;
   const bool tty = ::isatty(STDERR_FILENO) == 1;
+  std::string estimate;
   if (dem) {
-    std::filesystem::create_directories(dir);
-    sweep.results_path = std::filesystem::path(dir) / "field_sweep.jsonl";
+    sweep.results_path = std::filesystem::path(dir) / kSweepLog;
+    estimate = check_dem_field(c, grid, &sweep);
+  }
+  OutputDir files(dir);
+  if (dem) {
+    files.in_place(kSweepLog);
+    std::cerr << "pdamp field: " << estimate << std::endl;
     sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
       std::lock_guard lock(progress_mutex);
       std::cerr << (tty ? "\r" : "") << "pdamp field: " << done << "/" << total << " points";
@@ -489,19 +659,18 @@ int run_field(const ParsedArgs& args) {
   const auto result = surrogate::run_sweep(grid, evaluator, sweep);
   if (dem && tty) std::cerr << "\n";
 
-  json out = {{"sweep", result.summary.brief_report()}};
-  return write_field_outputs(args, c, result.field, dir, out);
+  json out = {{"sweep", result.summary.brief_report()}, {"warnings", result.summary.warnings}};
+  return write_field_outputs(args, c, result.field, files, out);
 }
 
 /// field.json, the scattered-state fit (DEM and measured fields), tables and pictures.
 int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
-                        const std::string& dir, json out) {
+                        OutputDir& files, json out) {
   const std::string source(surrogate::to_string(field.provenance.source));
-  std::vector<std::string> warnings;
+  std::vector<std::string> warnings = out.value("warnings", std::vector<std::string>{});
   out.update({{"source", source}, {"points", field.grid.size()}});
-  OutputDir files(dir);
   surrogate::write_effective_field(field, files.staged_path("field.json"));
-  out["file"] = (std::filesystem::path(dir) / "field.json").string();
+  out["file"] = (files.dir() / "field.json").string();
   if (field.provenance.source != surrogate::FieldSource::kFormulas) {
     try {
       const auto samples = surrogate::scattered_samples(field, c.damper.model, c.damper.model_options);
@@ -524,7 +693,17 @@ int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::
     rows.push_back({"scattered fit", "jump_fraction = " + format_number(out["scattered_fit"]["jump_fraction"].get<double>(), 4) +
                                          ", exponent = " + format_number(out["scattered_fit"]["exponent"].get<double>(), 4)});
   for (const auto& path : out["files"]) rows.push_back({"wrote", path.get<std::string>()});
-  return emit(args, out, rows);
+  return emit(args, out, rows, false);
+}
+
+/// Every check that run, dem and field make on a case, without the work.
+int run_validate(const ParsedArgs& args) {
+  const Case c = load_case(args.positional().at(0));
+  (void)damper_design(c);
+  if (c.excitation.amplitude_m) (void)check_dem_run(c, dem_options(c, *c.excitation.amplitude_m, c.excitation.frequency_hz));
+  (void)check_dem_field(c, surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1), nullptr);
+  std::cout << c.resolved.dump(2) << "\n";
+  return kExitOk;
 }
 
 const FlagSpec kModelOverrides[] = {

@@ -12,12 +12,27 @@ class InputError : public std::runtime_error {
   /// where: a file name or a flag; key: a JSON pointer or key (may be empty).
   InputError(const std::string& where, const std::string& key, const std::string& what)
       : std::runtime_error(where + (key.empty() ? "" : ": " + key) + ": " + what) {}
+  /// A message that already reads "<where>: <key>: <what>" (a library's error).
+  explicit InputError(const std::string& formatted) : std::runtime_error(formatted) {}
 };
 
 /// A numerical failure detected at run time (e.g. DEM instability): exit code 3.
 class NumericalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// A signal (SIGINT, SIGTERM, SIGHUP) arrived while results were being written: the
+/// staged files are removed and pdamp ends by the signal (its default action).
+class Interrupted : public std::runtime_error {
+ public:
+  explicit Interrupted(int signal_number)
+      : std::runtime_error("interrupted by signal " + std::to_string(signal_number) + "; no result was written"),
+        signal_number_(signal_number) {}
+  int signal_number() const { return signal_number_; }
+
+ private:
+  int signal_number_;
 };
 
 inline constexpr int kExitOk = 0;

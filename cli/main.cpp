@@ -1,4 +1,6 @@
 // pdamp command-line front end: dispatch to a subcommand, map errors to exit codes.
+#include <csignal>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -6,6 +8,8 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "external_program.hpp"
+#include "pdamp/formulas/input_file.hpp"
 
 namespace {
 
@@ -21,14 +25,39 @@ void print_overview() {
                "2 bad input, 3 numerical failure at run time.\n";
 }
 
+/// One error line on stderr (INTERFACE.md); the message is made printable so that a
+/// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
+int report(const char* what, int exit_code) {
+  std::cerr << "pdamp: error: " << pdamp::formulas::printable(what) << "\n";
+  return exit_code;
+}
+
+/// Ends the process by `signal_number` with its default action, as if pdamp had not
+/// caught it, once the staged files are removed: the caller (a shell, a job script)
+/// sees "killed by SIGINT" and stops, as it would for any interrupted program.
+[[noreturn]] void die_by(int signal_number) {
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+  std::_Exit(128 + signal_number);  // not reached: the default action ends the process
+}
+
+/// The command's exit code, unless a signal arrived while it wrote its results (they
+/// are complete then): the signal's default action is taken now.
+int finished(int exit_code) {
+  if (const int s = pdamp::cli::pending_interrupt(); s != 0) die_by(s);
+  return exit_code;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace pdamp::cli;
+  install_interrupt_handlers();
   const std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+  if (args.empty()) return report("missing the command (usage: pdamp <command> [options]; see pdamp --help)", kExitBadInput);
+  if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     print_overview();
-    return args.empty() ? kExitBadInput : kExitOk;
+    return kExitOk;
   }
   try {
     for (const auto& command : commands()) {
@@ -38,20 +67,21 @@ int main(int argc, char** argv) {
         std::cout << help_text(command.spec);
         return kExitOk;
       }
-      return command.run(parsed);
+      return finished(command.run(parsed));
     }
     throw InputError(args[0], "", "unknown command (see pdamp --help)");
   } catch (const InputError& e) {
-    std::cerr << "pdamp: error: " << e.what() << "\n";
-    return kExitBadInput;
+    return report(e.what(), kExitBadInput);
   } catch (const std::invalid_argument& e) {
-    std::cerr << "pdamp: error: " << args[0] << ": " << e.what() << "\n";
-    return kExitBadInput;
+    return report(("pdamp " + args[0] + ": " + e.what()).c_str(), kExitBadInput);
   } catch (const NumericalError& e) {
-    std::cerr << "pdamp: error: " << e.what() << "\n";
-    return kExitNumerical;
+    return report(e.what(), kExitNumerical);
+  } catch (const Interrupted& e) {  // the OutputDir's destructor removed what was staged
+    report(e.what(), kExitOther);
+    die_by(e.signal_number());
+  } catch (const std::bad_alloc&) {
+    return report("out of memory (see the run's estimate on stderr; reduce the case's sizes)", kExitOther);
   } catch (const std::exception& e) {
-    std::cerr << "pdamp: error: " << e.what() << "\n";
-    return kExitOther;
+    return report(e.what(), kExitOther);
   }
 }

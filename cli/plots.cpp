@@ -59,8 +59,8 @@ std::vector<std::string> write_eta_curve(OutputDir& out, const std::vector<Curve
   gp << "# eta*(X) of pdamp's closed forms; run: gnuplot eta_curve.gp\n"
      << "set datafile separator ','\n"
      << "set xlabel 'stroke X / clearance h'\nset ylabel 'reduced loss factor {/Symbol h}*'\n"
-     << "set title \"" << title << " (h = " << format_number(h * 1e3, 4) << " mm, f = " << format_number(frequency_hz, 4)
-     << " Hz)\" noenhanced\n"
+     << "set title " << gnuplot_string(title + " (h = " + format_number(h * 1e3, 4) + " mm, f = " + format_number(frequency_hz, 4) + " Hz)")
+     << " noenhanced\n"
      << "set grid\nset key top right\nset yrange [0:*]\n"
      << "set arrow 1 from " << landmarks.x_onset_m / h << ", graph 0 to " << landmarks.x_onset_m / h
      << ", graph 1 nohead dt 2 lc rgb 'gray40'\n"
@@ -86,7 +86,7 @@ std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::st
   std::ostringstream gp;
   gp << "# container force and velocity of a pdamp dem run; run: gnuplot force_velocity.gp\n"
      << "set datafile separator ','\nset key autotitle columnhead\n"
-     << "set title \"" << title << "\" noenhanced\n"
+     << "set title " << gnuplot_string(title) << " noenhanced\n"
      << "set xlabel 'time t / s'\nset ylabel 'force on the bed F / N'\nset y2label 'container velocity v / (m/s)'\n"
      << "set ytics nomirror\nset y2tics\nset grid\nset key top right\n"
      << "do for [t in 'pngcairo svg'] {\n"
@@ -141,7 +141,7 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
   cuts << "# eta* along axis 1 at each axis-0 node: field points (" << source << ") and the closed form\n"
        << "set datafile separator ','\nset grid\nset key outside right\n"
        << "set xlabel '" << axis_label(g.axis1.quantity) << "'\nset ylabel 'reduced loss factor {/Symbol h}*'\n"
-       << "set title \"" << c.name << ": effective field (" << source << ") and closed form\" noenhanced\n"
+       << "set title " << gnuplot_string(c.name + ": effective field (" + source + ") and closed form") << " noenhanced\n"
        << "set yrange [0:*]\n"
        << "do for [t in 'pngcairo svg'] {\n"
        << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
@@ -163,7 +163,7 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
          << "set view map\nset pm3d map interpolate 0,0\nset palette rgb 33,13,10\n"
          << "set xlabel '" << axis_label(g.axis0.quantity) << "'\nset ylabel '" << axis_label(g.axis1.quantity) << "'\n"
          << "set cblabel 'reduced loss factor {/Symbol h}*'\n"
-         << "set title \"" << c.name << ": effective field (" << source << ")\" noenhanced\n"
+         << "set title " << gnuplot_string(c.name + ": effective field (" + source + ")") << " noenhanced\n"
          << "set label 1 'RC/BC rolling/bouncing collect-and-collide, SP sub-peak orbit, SC scattered, SL solid-like, "
             "LF/GF local/global fluidisation, DC decoupled' at screen 0.5, 0.02 center font ',9'\n"
          << "set bmargin 5\n"

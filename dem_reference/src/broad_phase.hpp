@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <exception>
 #include <vector>
 
 namespace pdamp::dem_reference::detail {
@@ -98,25 +99,45 @@ void CellGrid::find_pairs(const double* x, const double* y, const double* z, con
   };
   const bool parallel = threads > 1 && n > kParallelListParticles;
   int* row = offsets.data();
+  // Nothing in the two loops allocates or throws (the sort is in place); should that
+  // change, an exception must not leave the OpenMP region (std::terminate): each
+  // iteration catches, and the first exception is rethrown after the loop.
+  std::exception_ptr error;
+  const auto capture = [&error]() noexcept {
+#pragma omp critical(pdamp_dem_find_pairs)
+    {
+      if (!error) error = std::current_exception();
+    }
+  };
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
   for (int i = 0; i < n; ++i) {
-    int count = 0;
-    for_each_candidate(i, [&](int j) { count += near(i, j) ? 1 : 0; });
-    row[i + 1] = count;
+    try {
+      int count = 0;
+      for_each_candidate(i, [&](int j) { count += near(i, j) ? 1 : 0; });
+      row[i + 1] = count;
+    } catch (...) {
+      capture();
+    }
   }
+  if (error) std::rethrow_exception(error);
   row[0] = 0;
   for (std::size_t i = 0; i < un; ++i) offsets[i + 1] += offsets[i];
   resize_with_margin(out, static_cast<std::size_t>(offsets[un]));
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
   for (int i = 0; i < n; ++i) {
-    const auto begin = static_cast<std::size_t>(row[i]);
-    auto k = begin;
-    for_each_candidate(i, [&](int j) {
-      if (near(i, j)) out[k++].j = j;
-    });
-    std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.begin() + static_cast<std::ptrdiff_t>(k),
-              [](const Entry& a, const Entry& b) { return a.j < b.j; });
+    try {
+      const auto begin = static_cast<std::size_t>(row[i]);
+      auto k = begin;
+      for_each_candidate(i, [&](int j) {
+        if (near(i, j)) out[k++].j = j;
+      });
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.begin() + static_cast<std::ptrdiff_t>(k),
+                [](const Entry& a, const Entry& b) { return a.j < b.j; });
+    } catch (...) {
+      capture();
+    }
   }
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace pdamp::dem_reference::detail

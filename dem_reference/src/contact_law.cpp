@@ -102,7 +102,13 @@ ContactParams ContactLaw::particle_wall(double radius_i, double mass_i, int mate
 double ContactLaw::damping_coefficient(int pair_type, double impact_speed_m_s) const {
   const auto t = static_cast<std::size_t>(pair_type);
   if (!std::isnan(constant_gamma_[t])) return constant_gamma_[t];
-  return damping_table().damping_for_restitution(restitution_[t]->restitution(impact_speed_m_s));
+  // Validation keeps ε(v) in the table's range [0.01, 1] up to max_impact_speed_m_s;
+  // a faster first touch gets the nearest value of that range instead of an exception
+  // that would end the run (0.01 and less are both practically plastic). Values inside
+  // the range are unchanged, so are the results; NaN stays NaN and the table throws.
+  const double restitution = restitution_[t]->restitution(impact_speed_m_s);
+  return damping_table().damping_for_restitution(
+      std::clamp(restitution, formulas::DampingTable::kMinRestitution, 1.0));
 }
 
 bool ContactLaw::any_rolling_friction() const {

@@ -3,6 +3,7 @@
 #include "pdamp/dem_reference/damper_simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -14,6 +15,7 @@
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/formulas/complex_power.hpp"
+#include "world_data.hpp"
 
 namespace pdamp::dem_reference {
 
@@ -85,13 +87,34 @@ MotionMode classify(const MotionIndicators& m, double eta_star, double intensity
   return MotionMode::kScattering;
 }
 
-/// Reports progress about twice a second (the clock is read every 4096 steps).
+/// Reports progress about twice a second. The clock is read every `stride` steps, a
+/// power of two with stride × particles ≈ 65,536 particle-steps (every step from 65,536
+/// particles on, every 2048th for 36): one read costs ~20 ns, a step of a large world
+/// milliseconds, so that the first report of a 1e6-particle run comes after 0.5 s and
+/// not after 4096 steps (minutes), as with a fixed stride.
 class ProgressReporter {
  public:
-  ProgressReporter(const ProgressCallback& callback, double end_time_s)
-      : callback_(callback), end_time_s_(end_time_s), start_(Clock::now()), last_(start_) {}
+  ProgressReporter(const ProgressCallback& callback, double end_time_s, int particles)
+      : callback_(callback), end_time_s_(end_time_s), start_(Clock::now()), last_(start_) {
+    std::int64_t stride = 1;
+    while (stride < 4096 && stride * 2 * std::max(particles, 1) <= 65536) stride *= 2;
+    mask_ = stride - 1;
+  }
+  /// Reports now (the set-up stages, before any step).
+  void report_now(std::string_view stage, double time_s, double eta_s) {
+    if (!callback_) return;
+    Progress p;
+    p.stage = stage;
+    p.simulated_time_s = time_s;
+    p.end_time_s = end_time_s_;
+    p.eta_s = eta_s;
+    callback_(p);
+    last_ = Clock::now();
+  }
+  /// The stepping starts: the rate is measured from here.
+  void start_stepping() { start_ = Clock::now(); }
   void maybe_report(std::string_view stage, std::int64_t step, std::int64_t total_steps, double time_s) {
-    if (!callback_ || (step & 4095) != 0) return;
+    if (!callback_ || (step & mask_) != 0) return;
     const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last_).count() < 0.5) return;
     last_ = now;
@@ -111,7 +134,78 @@ class ProgressReporter {
   double end_time_s_;
   Clock::time_point start_;
   Clock::time_point last_;
+  std::int64_t mask_ = 0;
 };
+
+/// The drive's largest impact speed: a collected bed leaving one wall at the drive's
+/// peak velocity V meets the other wall coming at V (2V), plus a free fall through the
+/// container (PHYSICS.md §1), m/s.
+double drive_impact_speed(const DamperSimulationOptions& o) {
+  const double v_amp = o.amplitude_m * 2.0 * kPi * o.frequency_hz;
+  return 2.0 * v_amp + std::sqrt(2.0 * norm(o.world.gravity_m_s2) * fall_height(o.world));
+}
+
+/// What run_harmonic and estimate_run derive from the options before building a world.
+struct RunPlan {
+  WorldOptions world;  ///< with the raised max_impact_speed_m_s and the chosen time step
+  TimeStepBound bound;
+  double dt = 0.0;
+  std::int64_t steps_per_block = 0;
+  std::int64_t steps_per_period = 0;
+  std::int64_t settle_steps = 0;
+  std::int64_t transient_steps = 0;
+  std::int64_t analysed_steps = 0;
+  std::int64_t total_steps = 0;
+  int particles = 0;
+};
+
+/// Validates (std::invalid_argument: all violations) and plans: the automatic bound at
+/// the drive's largest impact speed, the time step reduced so that a period is a whole
+/// number of blocks of whole steps, the settling time, the step counts.
+RunPlan plan_run(const DamperSimulationOptions& options) {
+  if (const auto errors = options.validate(); !errors.empty()) throw std::invalid_argument(join_lines(errors));
+  RunPlan plan;
+  plan.world = options.world;
+  auto& integ = plan.world.integration;
+  integ.max_impact_speed_m_s = std::max(integ.max_impact_speed_m_s, drive_impact_speed(options));
+  const double user_step = integ.time_step_s;
+  integ.time_step_s = 0.0;
+  plan.bound = time_step_bound(plan.world);
+  const TimeStepBound& bound = plan.bound;
+  if (user_step > bound.max_time_step_s) {
+    std::ostringstream msg;
+    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << bound.max_time_step_s
+        << " s (contact time " << bound.contact_time_s << " s at " << integ.max_impact_speed_m_s << " m/s over "
+        << integ.steps_per_contact << " steps, or " << integ.rayleigh_fraction << " of the Rayleigh time "
+        << bound.rayleigh_time_s << " s)";
+    throw std::invalid_argument(msg.str());
+  }
+  const double target_step = user_step > 0.0 ? user_step : bound.max_time_step_s;
+  const double period = 1.0 / options.frequency_hz;
+  const int samples = options.samples_per_period;
+  plan.steps_per_block = static_cast<std::int64_t>(std::ceil(period / (samples * target_step) - 1e-9));
+  plan.steps_per_period = plan.steps_per_block * samples;
+  plan.dt = period / static_cast<double>(plan.steps_per_period);
+  integ.time_step_s = plan.dt;
+
+  // Settling: automatic = long enough for the bed to come to rest under gravity.
+  double settling = options.settling_time_s;
+  if (settling < 0.0) {
+    bool random = false;
+    for (const auto& c : plan.world.compartments) random = random || c.placement == InitialPlacement::kRandom;
+    const double g_norm = norm(plan.world.gravity_m_s2);
+    settling = g_norm == 0.0 ? 0.0
+                             : (random ? 2.0 * std::sqrt(2.0 * fall_height(plan.world) / g_norm) + 0.02 : 0.01);
+  }
+  plan.settle_steps = static_cast<std::int64_t>(std::ceil(settling / plan.dt));
+  plan.transient_steps = plan.steps_per_period * options.transient_periods;
+  plan.analysed_steps = plan.steps_per_period * options.analysed_periods;
+  plan.total_steps = plan.settle_steps + plan.transient_steps + plan.analysed_steps;
+  for (const auto& c : plan.world.compartments) {
+    for (const auto& g : c.particles) plan.particles += g.count;
+  }
+  return plan;
+}
 
 ParticleSnapshot snapshot_of(const World& world, double time_s) {
   ParticleSnapshot s;
@@ -151,12 +245,13 @@ std::string_view to_string(MotionMode mode) {
 
 std::vector<std::string> DamperSimulationOptions::validate(const std::string& prefix) const {
   std::vector<std::string> errors = world.validate(prefix);
-  const auto add = [&](bool ok, const std::string& field, double value, const std::string& rule) {
+  const auto add = [&](bool ok, const std::string& field, auto value, const std::string& rule) {
     if (ok) return;
     std::ostringstream line;
     line << prefix << field << " = " << value << ": " << rule;
     errors.push_back(line.str());
   };
+  const auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   const double axis = norm(drive_axis);
   if (!(std::isfinite(axis) && axis > 0.0)) {
     std::ostringstream line;
@@ -164,55 +259,154 @@ std::vector<std::string> DamperSimulationOptions::validate(const std::string& pr
          << "]: must be a finite non-zero vector";
     errors.push_back(line.str());
   }
-  add(std::isfinite(amplitude_m) && amplitude_m > 0.0, "amplitude_m", amplitude_m, "must be > 0");
-  add(std::isfinite(frequency_hz) && frequency_hz > 0.0, "frequency_hz", frequency_hz, "must be > 0");
-  add(std::isfinite(settling_time_s) && (settling_time_s >= 0.0 || settling_time_s == -1.0), "settling_time_s",
-      settling_time_s, "must be >= 0 or -1 (automatic)");
-  add(transient_periods >= 0, "transient_periods", transient_periods, "must be >= 0");
-  add(analysed_periods >= 1, "analysed_periods", analysed_periods, "must be >= 1");
-  add(samples_per_period >= 16, "samples_per_period", samples_per_period, "must be >= 16");
-  add(snapshots >= 0, "snapshots", snapshots, "must be >= 0");
+  std::ostringstream amplitude_rule, frequency_rule;
+  amplitude_rule << "must be in (0, " << limits::kMaxAmplitude_m << "] m";
+  frequency_rule << "must be in [" << limits::kMinFrequency_hz << ", " << limits::kMaxFrequency_hz << "] Hz";
+  const bool amplitude_ok = in(amplitude_m, 0.0, limits::kMaxAmplitude_m) && amplitude_m > 0.0;
+  const bool frequency_ok = in(frequency_hz, limits::kMinFrequency_hz, limits::kMaxFrequency_hz);
+  add(amplitude_ok, "amplitude_m", amplitude_m, amplitude_rule.str());
+  add(frequency_ok, "frequency_hz", frequency_hz, frequency_rule.str());
+  add(settling_time_s == -1.0 || in(settling_time_s, 0.0, limits::kMaxSettlingTime_s), "settling_time_s",
+      settling_time_s, "must be -1 (automatic) or in [0, " + std::to_string(static_cast<int>(limits::kMaxSettlingTime_s)) + "] s");
+  const std::string periods = std::to_string(limits::kMaxPeriods);
+  add(transient_periods >= 0 && transient_periods <= limits::kMaxPeriods, "transient_periods", transient_periods,
+      "must be in [0, " + periods + "]");
+  add(analysed_periods >= 1 && analysed_periods <= limits::kMaxPeriods, "analysed_periods", analysed_periods,
+      "must be in [1, " + periods + "]");
+  const bool samples_ok =
+      samples_per_period >= limits::kMinSamplesPerPeriod && samples_per_period <= limits::kMaxSamplesPerPeriod;
+  add(samples_ok, "samples_per_period", samples_per_period,
+      "must be in [" + std::to_string(limits::kMinSamplesPerPeriod) + ", " +
+          std::to_string(limits::kMaxSamplesPerPeriod) + "]");
+  const long long recorded = static_cast<long long>(samples_per_period) * analysed_periods;
+  if (samples_ok && analysed_periods >= 1) {
+    add(recorded <= limits::kMaxRecordedSamples, "samples_per_period", samples_per_period,
+        "samples_per_period x analysed_periods = " + std::to_string(recorded) + " recorded samples must be <= " +
+            std::to_string(limits::kMaxRecordedSamples) + " (72 bytes each)");
+  }
+  const long long max_snapshots =
+      samples_ok && analysed_periods >= 1 ? std::min<long long>(limits::kMaxSnapshots, recorded) : limits::kMaxSnapshots;
+  add(snapshots >= 0 && snapshots <= max_snapshots, "snapshots", snapshots,
+      "must be in [0, " + std::to_string(max_snapshots) + "] (at most one per recorded sample and " +
+          std::to_string(limits::kMaxSnapshots) + ")");
+  // The run raises integration.max_impact_speed_m_s to the drive's impact speed: that
+  // speed must be in range too, and the restitution laws are checked up to it.
+  if (errors.empty() && amplitude_ok && frequency_ok) {
+    const double drive = drive_impact_speed(*this);
+    std::ostringstream rule;
+    rule << "the drive's impact speed 2XΩ + √(2|g|L) = " << drive << " m/s (frequency_hz = " << frequency_hz
+         << ") must be <= " << limits::kMaxImpactSpeed_m_s << " m/s";
+    add(drive <= limits::kMaxImpactSpeed_m_s, "amplitude_m", amplitude_m, rule.str());
+    if (drive <= limits::kMaxImpactSpeed_m_s && drive > world.integration.max_impact_speed_m_s) {
+      WorldOptions raised = world;
+      raised.integration.max_impact_speed_m_s = drive;
+      errors = raised.validate(prefix);
+    }
+  }
   return errors;
 }
 
+namespace {
+
+/// Bytes of the world's arrays right after construction (World::Impl's reserves).
+void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
+  const auto n = static_cast<std::size_t>(plan.particles);
+  // 23 double arrays (state, forces, radii, masses, rebuild positions, scratch) and 5 int
+  // arrays (material, compartment, order, index_of, scratch) per particle.
+  e.particle_bytes = n * (23 * sizeof(double) + 5 * sizeof(int));
+  // Row offsets get 1/8 margin (resize_with_margin); slots as reserved: 4 pair slots and
+  // 1 wall slot per particle.
+  const std::size_t offsets = 2 * (n + 1 + (n + 1) / 8) * sizeof(int);
+  const std::size_t slots = (4 * n + n) * sizeof(detail::Slot);
+  // The cell grid: at most max(64, 8n) cells (CellGrid::configure), 3 ints per particle.
+  double r_max = 0.0;
+  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const auto& c : plan.world.compartments) {
+    for (const auto& g : c.particles) r_max = std::max(r_max, g.radius_m * (1.0 + g.radius_spread));
+    for (int a = 0; a < 3; ++a) {
+      const auto k = static_cast<std::size_t>(a);
+      lo[k] = std::min(lo[k], c.offset_m[k] - 0.5 * c.container.inner_length(a));
+      hi[k] = std::max(hi[k], c.offset_m[k] + 0.5 * c.container.inner_length(a));
+    }
+  }
+  const double cell = (2.0 + plan.world.integration.skin_fraction) * r_max;
+  double cells = 1.0;
+  for (std::size_t a = 0; a < 3; ++a) cells *= std::max(1.0, std::ceil((hi[a] - lo[a]) / cell));
+  cells = std::min(cells, std::max(64.0, 8.0 * static_cast<double>(n)));
+  const std::size_t grid = (static_cast<std::size_t>(cells) + 1 + 3 * n) * sizeof(int);
+  e.neighbour_bytes = offsets + slots + grid;
+  // Contact pools as reserved: 2 pair contacts and n/2 + 16 wall contacts per particle,
+  // each a Contact and a key (and a rolling torque with rolling resistance).
+  bool rolling = plan.world.default_pair.rolling_friction > 0.0;
+  for (const auto& p : plan.world.pairs) rolling = rolling || p.rolling_friction > 0.0;
+  const std::size_t entry = sizeof(detail::Contact) + sizeof(detail::ContactKey) + (rolling ? 3 * sizeof(double) : 0);
+  e.contact_bytes = (2 * n + n / 2 + 16) * entry;
+}
+
+/// Rates of bench/results/cpp-2core/bench_dem.txt (see RunEstimate::particle_steps_per_s).
+double assumed_rate(int particles, int threads) {
+  const bool parallel = threads != 1 && particles > 1500;  // World: kParallelParticles
+  if (particles < 10'000) return 25e6;
+  return parallel ? 21e6 : 11e6;
+}
+
+}  // namespace
+
+RunEstimate estimate_run(const DamperSimulationOptions& options) {
+  const RunPlan plan = plan_run(options);
+  RunEstimate e;
+  e.particles = plan.particles;
+  e.time_step_s = plan.dt;
+  e.steps_per_period = plan.steps_per_period;
+  e.settling_steps = plan.settle_steps;
+  e.transient_steps = plan.transient_steps;
+  e.analysed_steps = plan.analysed_steps;
+  e.total_steps = plan.total_steps;
+  e.particle_steps = static_cast<double>(plan.total_steps) * plan.particles;
+  e.recorded_samples = static_cast<std::int64_t>(options.analysed_periods) * options.samples_per_period;
+  e.snapshots = options.snapshots;
+  estimate_world_bytes(plan, e);
+  // 7 TimeSeries columns and the 2 block-average signals per sample; η* per period.
+  e.signal_bytes = static_cast<std::size_t>(e.recorded_samples) * 9 * sizeof(double) +
+                   static_cast<std::size_t>(options.analysed_periods) * sizeof(double);
+  // Per particle and snapshot: 3 Vec3, a radius, a compartment.
+  e.snapshot_bytes = static_cast<std::size_t>(options.snapshots) * static_cast<std::size_t>(plan.particles) *
+                     (3 * sizeof(Vec3) + sizeof(double) + sizeof(int));
+  e.memory_bytes = e.particle_bytes + e.neighbour_bytes + e.contact_bytes + e.signal_bytes + e.snapshot_bytes;
+  e.particle_steps_per_s = assumed_rate(plan.particles, options.world.threads);
+  e.wall_time_s = e.particle_steps / e.particle_steps_per_s;
+  return e;
+}
+
 DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress) {
-  if (const auto errors = options.validate(); !errors.empty()) throw std::invalid_argument(join_lines(errors));
   const auto wall_start = Clock::now();
+  const RunPlan plan = plan_run(options);
   const HarmonicMotion motion(options.drive_axis, options.amplitude_m, options.frequency_hz);
   const Vec3& axis = motion.axis();
   const double v_amp = motion.velocity_amplitude_m_s();
   const Vec3& g = options.world.gravity_m_s2;
   const double g_norm = norm(g);
-
-  // Time step: the automatic bound at the drive's largest impact speed, reduced so that
-  // a period is a whole number of blocks of whole steps.
-  WorldOptions world_options = options.world;
-  auto& integ = world_options.integration;
-  integ.max_impact_speed_m_s =
-      std::max(integ.max_impact_speed_m_s, 2.0 * v_amp + std::sqrt(2.0 * g_norm * fall_height(world_options)));
-  const double user_step = integ.time_step_s;
-  integ.time_step_s = 0.0;
-  const TimeStepBound bound = time_step_bound(world_options);
-  if (user_step > bound.max_time_step_s) {
-    std::ostringstream msg;
-    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << bound.max_time_step_s
-        << " s (contact time " << bound.contact_time_s << " s at " << integ.max_impact_speed_m_s << " m/s over "
-        << integ.steps_per_contact << " steps, or " << integ.rayleigh_fraction << " of the Rayleigh time "
-        << bound.rayleigh_time_s << " s)";
-    throw std::invalid_argument(msg.str());
-  }
-  const double target_step = user_step > 0.0 ? user_step : bound.max_time_step_s;
-  const double period = motion.period_s();
+  const WorldOptions& world_options = plan.world;
+  const double dt = plan.dt;
   const int samples = options.samples_per_period;
-  const auto steps_per_block = static_cast<std::int64_t>(std::ceil(period / (samples * target_step) - 1e-9));
-  const std::int64_t steps_per_period = steps_per_block * samples;
-  const double dt = period / static_cast<double>(steps_per_period);
-  integ.time_step_s = dt;
+  const std::int64_t steps_per_block = plan.steps_per_block;
+  const std::int64_t steps_per_period = plan.steps_per_period;
+  const std::int64_t settle_steps = plan.settle_steps;
+  const std::int64_t drive_steps = plan.transient_steps + plan.analysed_steps;
+  const std::int64_t total_steps = plan.total_steps;
+  ProgressReporter reporter(progress, static_cast<double>(drive_steps) * dt, plan.particles);
+  // Before the world is built (placement, lists and first forces take seconds for a
+  // million spheres) and after: the estimate's wall time is the best ETA there is.
+  const double eta_s = static_cast<double>(plan.particles) * static_cast<double>(total_steps) /
+                       assumed_rate(plan.particles, options.world.threads);
+  reporter.report_now("setup", -static_cast<double>(settle_steps) * dt, eta_s);
 
   const ContainerState start = motion.state(0.0);
   ContainerState rest = start;
   rest.velocity_m_s = {0.0, 0.0, 0.0};
   World world(world_options, rest);
+  reporter.report_now("setup", -static_cast<double>(settle_steps) * dt, eta_s);
+  reporter.start_stepping();
 
   DamperResult result;
   result.bed_mass_kg = world.bed_mass_kg();
@@ -223,19 +417,6 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   for (int c = 0; c < world.compartment_count(); ++c) result.compartment_clearances_m.push_back(world.clearance_m(c));
   result.clearance_m = result.compartment_clearances_m.front();
   const int n = world.particle_count();
-
-  // Settling: automatic = long enough for the bed to come to rest under gravity.
-  double settling = options.settling_time_s;
-  if (settling < 0.0) {
-    bool random = false;
-    for (const auto& c : world_options.compartments) random = random || c.placement == InitialPlacement::kRandom;
-    settling = g_norm == 0.0 ? 0.0
-                             : (random ? 2.0 * std::sqrt(2.0 * fall_height(world_options) / g_norm) + 0.02 : 0.01);
-  }
-  const auto settle_steps = static_cast<std::int64_t>(std::ceil(settling / dt));
-  const std::int64_t drive_steps = steps_per_period * (options.transient_periods + options.analysed_periods);
-  const std::int64_t total_steps = settle_steps + drive_steps;
-  ProgressReporter reporter(progress, drive_steps * dt);
 
   const auto finish = [&](Outcome outcome, const std::string& message) {
     auto& s = result.summary;
@@ -251,12 +432,13 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     s.stage_times = world.stage_times();
     result.particle_steps_per_s = s.wall_time_s > 0.0 ? static_cast<double>(s.particle_steps) / s.wall_time_s : 0.0;
   };
+  // The world stops on an instability (kUnstable) or a failed step (kFailed).
   const auto unstable = [&]() { return world.status().outcome != Outcome::kCompleted; };
 
   for (std::int64_t k = 0; k < settle_steps; ++k) {
     world.step(rest);
     if (unstable()) {
-      finish(Outcome::kUnstable, world.status().message);
+      finish(world.status().outcome, world.status().message);
       return result;
     }
     reporter.maybe_report("settling", k, total_steps, (k - settle_steps) * dt);
@@ -269,7 +451,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   for (std::int64_t k = 1; k <= transient_steps; ++k) {
     world.step(motion.state(static_cast<double>(k) * dt));
     if (unstable()) {
-      finish(Outcome::kUnstable, world.status().message);
+      finish(world.status().outcome, world.status().message);
       return result;
     }
     reporter.maybe_report("transient", settle_steps + k, total_steps, static_cast<double>(k) * dt);
@@ -305,7 +487,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
       const ContainerState state = motion.state(static_cast<double>(step) * dt);
       const ContainerLoad& load = world.step(state);
       if (unstable()) {
-        finish(Outcome::kUnstable, world.status().message);
+        finish(world.status().outcome, world.status().message);
         return result;
       }
       force_sum += dot(load.force_n, axis);

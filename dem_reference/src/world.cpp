@@ -4,7 +4,9 @@
 #include "pdamp/dem_reference/world.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <exception>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -70,24 +72,65 @@ constexpr long long kContactWork = 7;
 constexpr int kBalanceStride = 256;
 constexpr double kImbalance = 0.05;
 
-/// Runs body(thread, team_size) on the calling thread alone when team is 1 (no OpenMP
-/// region at all: even an `if(false)` region costs a fork/join call and futex traffic,
-/// more than a 36-sphere step), else on an OpenMP team.
-template <class Body>
-void run_team(int team, Body&& body) {
+/// The first exception thrown by a thread of a run_team region. An exception must not
+/// leave an OpenMP region (the runtime calls std::terminate), and a thread that leaves
+/// its phase early must still reach every barrier (the others would wait forever):
+/// threads catch, record here, and carry on to the barriers.
+class TeamFailure {
+ public:
+  /// Call inside a catch block.
+  void capture() noexcept {
+#pragma omp critical(pdamp_dem_team_failure)
+    {
+      if (!error_) error_ = std::current_exception();
+    }
+    failed_.store(true, std::memory_order_release);
+  }
+  bool failed() const noexcept { return failed_.load(std::memory_order_acquire); }
+  void rethrow_if_failed() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::exception_ptr error_;
+  std::atomic<bool> failed_{false};
+};
+
+/// Runs the phases phase(thread, team_size) one after the other with a barrier between
+/// consecutive phases: on the calling thread alone when team is 1 (no OpenMP region at
+/// all: even an `if(false)` region costs a fork/join call and futex traffic, more than
+/// a 36-sphere step; an exception then simply propagates), else on an OpenMP team. A
+/// phase that throws on a team thread is caught (TeamFailure); every thread still
+/// passes every barrier, the phases after a failure are skipped, and the first
+/// exception is rethrown on the calling thread after the region. The barriers are
+/// here, not in the phases, so that no phase can skip one.
+template <class... Phases>
+void run_team(int team, Phases&&... phases) {
   if (team <= 1) {
-    body(0, 1);
+    (phases(0, 1), ...);
     return;
   }
+  TeamFailure failure;
 #pragma omp parallel num_threads(team)
-  body(omp_get_thread_num(), omp_get_num_threads());
-}
-
-/// Barrier of the team running body(thread, team_size) in run_team.
-void sync(int team_size) {
-  if (team_size > 1) {
+  {
+    const int thread = omp_get_thread_num();
+    const int size = omp_get_num_threads();
+    bool first = true;
+    const auto run = [&](auto& phase) {
+      if (!first) {
 #pragma omp barrier
+      }
+      first = false;
+      if (failure.failed()) return;
+      try {
+        phase(thread, size);
+      } catch (...) {
+        failure.capture();
+      }
+    };
+    (run(phases), ...);
   }
+  failure.rethrow_if_failed();
 }
 
 /// Contiguous static chunk [begin, end) of n items for thread t of a team of `size`.
@@ -270,6 +313,7 @@ struct World::Impl {
   double kinetic_energy() const;
   double potential_energy() const;
   void mark_unstable(const std::string& message);
+  void mark_failed(const std::string& what);
   bool parallel() const { return threads > 1 && n > kParallelParticles; }
   int team() const { return parallel() ? threads : 1; }
   /// Internal place of particle `id` (the caller's numbering); throws std::out_of_range.
@@ -457,12 +501,12 @@ World::Impl::Impl(const WorldOptions& o, const ContainerState& start) : options(
   rebuild_lists();
   // The forces at the start: the sweep without integration.
   const int count = static_cast<int>(parts.size());
-  run_team(team(), [&](int t, int size) {
-    for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], false);
-    sync(size);
-    if (t == 0) commit_fresh_contacts();
-    for (int p = t; p < count; p += size) reduce_halo(p);
-  });
+  run_team(
+      team(), [&](int t, int size) { for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], false); },
+      [&](int t, int size) {
+        if (t == 0) commit_fresh_contacts();
+        for (int p = t; p < count; p += size) reduce_halo(p);
+      });
   gather();
   // Leapfrog start: store v(−dt/2) so that the first kick gives v(0) + F(0)dt/2m.
   for (std::size_t i = 0; i < un; ++i) {
@@ -582,19 +626,23 @@ void World::Impl::advance(bool timed, const ContainerState& previous) {
   const auto t1 = timed ? Clock::now() : Clock::time_point{};
   auto t2 = t1;
   const int count = static_cast<int>(parts.size());
-  run_team(team(), [&](int t, int size) {
-    for (int p = t; p < count; p += size) {
-      Partition& part = parts[static_cast<std::size_t>(p)];
-      part.max_d2 = part.max_u2 = 0.0;
-      integrate(part.begin, timed ? part.end : part.early_end, part);
-    }
-    sync(size);
-    if (timed && t == 0) t2 = Clock::now();
-    for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], !timed);
-    sync(size);
-    if (t == 0) commit_fresh_contacts();
-    for (int p = t; p < count; p += size) reduce_halo(p);
-  });
+  run_team(
+      team(),
+      [&](int t, int size) {
+        for (int p = t; p < count; p += size) {
+          Partition& part = parts[static_cast<std::size_t>(p)];
+          part.max_d2 = part.max_u2 = 0.0;
+          integrate(part.begin, timed ? part.end : part.early_end, part);
+        }
+      },
+      [&](int t, int size) {
+        if (timed && t == 0) t2 = Clock::now();
+        for (int p = t; p < count; p += size) sweep(parts[static_cast<std::size_t>(p)], !timed);
+      },
+      [&](int t, int size) {
+        if (t == 0) commit_fresh_contacts();
+        for (int p = t; p < count; p += size) reduce_halo(p);
+      });
   gather();
   if (timed) {
     const auto t3 = Clock::now();
@@ -1226,6 +1274,13 @@ void World::Impl::check_health() {
   }
 }
 
+void World::Impl::mark_failed(const std::string& what) {
+  std::ostringstream msg;
+  msg << "step " << steps + 1 << " (t = " << time + dt << " s) failed: " << what;
+  status.outcome = Outcome::kFailed;
+  status.message = msg.str();
+}
+
 void World::Impl::mark_unstable(const std::string& message) {
   if (status.outcome == Outcome::kUnstable) return;
   status.outcome = Outcome::kUnstable;
@@ -1310,7 +1365,18 @@ const ContainerLoad& World::step(const ContainerState& next) {
   for (std::size_t a = 0; a < 3; ++a) {
     w.container_velocity[a] = (next.position_m[a] - previous.position_m[a]) / w.dt;
   }
-  w.advance(timed, previous);
+  // A failure inside the step (a restitution law that throws, memory for a list that
+  // outgrew its reserve) leaves the particles half advanced: the world stops, as on an
+  // instability, and says why; the caller's loop sees status() and ends the run.
+  try {
+    w.advance(timed, previous);
+  } catch (const std::exception& e) {
+    w.mark_failed(e.what());
+    return w.load;
+  } catch (...) {
+    w.mark_failed("unknown exception");
+    return w.load;
+  }
   const auto t3 = timed ? Clock::now() : Clock::time_point{};
   w.time += w.dt;
   ++w.steps;

@@ -1,6 +1,7 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/formulas/csv_text.hpp"
+#include "pdamp/formulas/input_file.hpp"
 
 #include <nlopt.hpp>
 
@@ -684,8 +685,18 @@ std::unique_ptr<RestitutionModel> make_thornton_restitution_from_yield_stress(
 }
 
 ImpactData read_impact_csv(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw std::invalid_argument("impact CSV " + path + ": cannot open the file");
+  // read_input_file refuses a directory, a FIFO (at once, it never blocks), a device or a
+  // huge file with "<path>: <reason>"; the prefix keeps this reader's message form.
+  std::string contents;
+  try {
+    contents = read_input_file(path);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("impact CSV ") + e.what());
+  }
+  // Every message goes through printable(): a binary file's NUL or control bytes in a
+  // quoted cell would otherwise cut or break the one-line message.
+  const std::string file_label = "impact CSV " + printable(path);
+  std::istringstream file(contents);
   constexpr std::string_view kSpeedColumn = "impact_speed_m_s";
   constexpr std::string_view kRestitutionColumn = "restitution";
   ImpactData data;
@@ -697,13 +708,13 @@ ImpactData read_impact_csv(const std::string& path) {
     ++line_number;
     const std::string_view content = trim_blanks(line);
     if (content.empty() || content.front() == '#') continue;
-    const std::string where = "impact CSV " + path + ":" + std::to_string(line_number) + ": ";
+    const std::string where = file_label + ":" + std::to_string(line_number) + ": ";
     const std::vector<std::string_view> fields = split_csv_line(content);
     if (!have_header) {
       auto find_column = [&](std::string_view name) {
         const auto found = std::find(fields.begin(), fields.end(), name);
         if (found == fields.end()) {
-          throw std::invalid_argument(where + "header '" + std::string(content) +
+          throw std::invalid_argument(where + "header '" + printable(std::string(content)) +
                                       "' has no column '" + std::string(name) + "'");
         }
         return static_cast<std::size_t>(found - fields.begin());
@@ -723,11 +734,11 @@ ImpactData read_impact_csv(const std::string& path) {
       double value = 0.0;
       const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
       if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
-        throw std::invalid_argument(where + std::string(name) + " = '" + std::string(text) +
+        throw std::invalid_argument(where + std::string(name) + " = '" + printable(std::string(text)) +
                                     "': not a number");
       }
       if (!std::isfinite(value)) {
-        throw std::invalid_argument(where + std::string(name) + " = " + std::string(text) +
+        throw std::invalid_argument(where + std::string(name) + " = " + printable(std::string(text)) +
                                     ": must be finite");
       }
       return value;
@@ -745,8 +756,8 @@ ImpactData read_impact_csv(const std::string& path) {
     data.speed_m_s.push_back(speed);
     data.restitution.push_back(restitution);
   }
-  if (!have_header) throw std::invalid_argument("impact CSV " + path + ": no header line");
-  if (data.speed_m_s.empty()) throw std::invalid_argument("impact CSV " + path + ": no data rows");
+  if (!have_header) throw std::invalid_argument(file_label + ": no header line");
+  if (data.speed_m_s.empty()) throw std::invalid_argument(file_label + ": no data rows");
   return data;
 }
 

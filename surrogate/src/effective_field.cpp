@@ -11,6 +11,7 @@
 
 #include "field_format.hpp"
 #include "file_io.hpp"
+#include "pdamp/formulas/input_file.hpp"
 #include "strict_json.hpp"
 #include "text_util.hpp"
 
@@ -265,6 +266,11 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
   p.apparent_mass_kg = nullable_number(kFirstValue + kApparentMass);
   p.apparent_mass_fraction = nullable_number(kFirstValue + kApparentMassFraction);
   p.motion_mode = text(kFirstValue + kMotionMode);
+  if (detail::has_control_byte(p.motion_mode)) {
+    detail::fail_at(file, cell_at(kFirstValue + kMotionMode),
+                    "\"" + formulas::printable(p.motion_mode) +
+                        "\" holds control characters; a motion mode must be printable text");
+  }
   const bool ok = p.status == PointStatus::kOk;
   for (const int c : {kEtaStar, kEDiss}) {
     const bool missing = std::isnan(c == kEtaStar ? p.eta_star : p.e_diss_j);
@@ -425,6 +431,11 @@ EffectiveField effective_field_from_json(const json& document, const std::string
   } catch (const std::invalid_argument& e) {
     root.fail("axes", e.what());
   }
+  if (field.grid.size() > kMaxGridNodes) {
+    root.fail("axes", std::to_string(field.grid.axis0.size()) + " x " + std::to_string(field.grid.axis1.size()) +
+                          " = " + std::to_string(field.grid.size()) + " nodes, must be <= " +
+                          std::to_string(kMaxGridNodes));
+  }
   root.expect_string("storage_order", kStorageOrder);
 
   const TableLayout layout = read_columns(root.array("columns"), root.pointer("columns"), field.grid, file_name);
@@ -443,14 +454,8 @@ EffectiveField effective_field_from_json(const json& document, const std::string
 }
 
 EffectiveField read_effective_field(const std::filesystem::path& path) {
-  const std::string text = detail::read_text_file(path);
-  json document;
-  try {
-    document = json::parse(text);
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(path.string() + ": /: not valid JSON (" + e.what() + ")");
-  }
-  return effective_field_from_json(document, path.string());
+  // read_json_file refuses directories, FIFOs and duplicate keys with "<path>: ..." messages.
+  return effective_field_from_json(detail::read_json_file(path), detail::file_label(path));
 }
 
 void write_effective_field(const EffectiveField& field, const std::filesystem::path& path) {

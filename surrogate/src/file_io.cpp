@@ -1,4 +1,4 @@
-// Atomic file replacement and fsynced appends (POSIX), shared by field and sweep files.
+// Safe reads, atomic file replacement and fsynced appends (POSIX), shared by field and sweep files.
 #include "file_io.hpp"
 
 #include <fcntl.h>
@@ -6,9 +6,9 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
+
+#include "pdamp/formulas/input_file.hpp"
 
 namespace pdamp::surrogate::detail {
 
@@ -18,13 +18,12 @@ std::string errno_text() { return std::strerror(errno); }
 
 }  // namespace
 
-std::string read_text_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path.string() + ": cannot be read (" + errno_text() + ")");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw std::invalid_argument(path.string() + ": read failed");
-  return text.str();
+std::string file_label(const std::filesystem::path& path) { return formulas::printable(path.string()); }
+
+std::string read_text_file(const std::filesystem::path& path) { return formulas::read_input_file(path.string()); }
+
+nlohmann::json read_json_file(const std::filesystem::path& path) {
+  return formulas::parse_json_document(read_text_file(path), path.string());
 }
 
 void write_all_synced(int fd, std::string_view data, const std::filesystem::path& path) {

@@ -1,14 +1,26 @@
-// Private file helpers of the surrogate module: atomic replacement and synced appends.
+// Private file helpers of the surrogate module: safe reads of users' files, atomic
+// replacement and synced appends.
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 
 namespace pdamp::surrogate::detail {
 
-/// The whole file as text; std::invalid_argument "<path>: cannot be read (reason)" if it cannot be opened.
+/// The path as it appears in messages: formulas::printable(path), so a name holding a
+/// newline or a control byte still gives a one-line message.
+std::string file_label(const std::filesystem::path& path);
+
+/// The whole file as bytes, through formulas::read_input_file: a directory, FIFO,
+/// socket or device, a missing file or one above 256 MiB throws std::invalid_argument
+/// "<path>: <reason>" at once (a FIFO never blocks the reader).
 std::string read_text_file(const std::filesystem::path& path);
+
+/// read_text_file + formulas::parse_json_document: std::invalid_argument
+/// "<path>: malformed JSON: ..." or "<path>: <pointer>: duplicate key".
+nlohmann::json read_json_file(const std::filesystem::path& path);
 
 /// Writes `contents` to a temporary file next to `path`, fsyncs it, renames it over
 /// `path` and fsyncs the folder: readers see the old file or the new one, never a

@@ -16,6 +16,13 @@ namespace {
 
 constexpr int kMaxAxisCount = 100000;
 
+/// "n0 x n1 = N nodes: must be <= kMaxGridNodes" if the grid is too large, "" otherwise.
+std::string size_problem(std::size_t n0, std::size_t n1) {
+  if (n0 * n1 <= kMaxGridNodes) return {};
+  return std::to_string(n0) + " x " + std::to_string(n1) + " = " + std::to_string(n0 * n1) +
+         " nodes: must be <= " + std::to_string(kMaxGridNodes) + " (1000 x 1000)";
+}
+
 }  // namespace
 
 std::string_view to_string(AxisQuantity quantity) {
@@ -110,6 +117,12 @@ std::vector<std::string> Axis::validate(const std::string& prefix) const {
 
 Grid Grid::from_ranges(GridAxes axes, const AxisRange& range0, const AxisRange& range1) {
   const bool fa = axes == GridAxes::kFrequencyAmplitude;
+  // Checked before the axes are built: each count alone is in range, their product may not be.
+  if (range0.count > 0 && range1.count > 0) {
+    const std::string problem =
+        size_problem(static_cast<std::size_t>(range0.count), static_cast<std::size_t>(range1.count));
+    if (!problem.empty()) throw std::invalid_argument("grid: " + problem);
+  }
   return {Axis::from_range(fa ? AxisQuantity::kFrequencyHz : AxisQuantity::kIntensity, range0),
           Axis::from_range(fa ? AxisQuantity::kAmplitudeM : AxisQuantity::kStrokeOverClearance, range1)};
 }
@@ -135,6 +148,9 @@ std::vector<std::string> Grid::validate() const {
     (void)axes();
   } catch (const std::invalid_argument& e) {
     problems.emplace_back(e.what());
+  }
+  if (const std::string problem = size_problem(axis0.size(), axis1.size()); !problem.empty()) {
+    problems.push_back("grid: " + problem);
   }
   return problems;
 }

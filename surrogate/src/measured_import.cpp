@@ -2,6 +2,7 @@
 #include "pdamp/surrogate/measured_import.hpp"
 
 #include "pdamp/formulas/csv_text.hpp"
+#include "pdamp/formulas/input_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -40,9 +41,12 @@ class CsvReader {
  public:
   explicit CsvReader(const std::string& file_name) : file_(file_name) {}
 
+  /// The message goes through printable(): a file name, column name or cell from a
+  /// binary file must not cut (NUL) or break (newline) the one-line message.
   [[noreturn]] void fail(std::size_t line, std::string_view column, const std::string& rule) const {
-    throw std::invalid_argument(file_ + ": line " + std::to_string(line) +
-                                (column.empty() ? "" : ", column " + std::string(column)) + ": " + rule);
+    throw std::invalid_argument(formulas::printable(file_ + ": line " + std::to_string(line) +
+                                                    (column.empty() ? "" : ", column " + std::string(column)) + ": " +
+                                                    rule));
   }
 
   /// A finite number filling the whole cell.
@@ -83,6 +87,10 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
   bool have_header = false;
   std::vector<Row> rows;
 
+  // Spreadsheets often save CSV as UTF-8 with a byte-order mark; it is not part of the
+  // first column's name.
+  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+  if (text.substr(0, kUtf8Bom.size()) == kUtf8Bom) text.remove_prefix(kUtf8Bom.size());
   std::size_t line_number = 0;
   std::size_t begin = 0;
   while (begin <= text.size()) {
@@ -90,6 +98,15 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     const std::string_view line = formulas::trim_blanks(text.substr(begin, end - begin));
     begin = end + 1;
     ++line_number;
+    // A NUL byte means a binary file (a spreadsheet's native format, a UTF-16 export):
+    // say so, instead of an "unknown column" quoting bytes the user never typed.
+    if (const auto nul = line.find('\0'); nul != std::string_view::npos) {
+      reader.fail(line_number, "",
+                  "byte " + std::to_string(nul + 1) +
+                      " is NUL: this is a binary file, not CSV text (save it as CSV, UTF-8); the line starts \"" +
+                      std::string(line.substr(0, std::min<std::size_t>(line.size(), 24))) +
+                      "\"");
+    }
     if (line.empty() || line.front() == '#') continue;
     const auto cells = formulas::split_csv_line(line);
     if (!have_header) {
@@ -126,16 +143,36 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     row.frequency_hz = reader.parse_number(cell(kFrequency), line_number, kNames[kFrequency]);
     row.amplitude_m = reader.parse_number(cell(kAmplitude), line_number, kNames[kAmplitude]);
     for (auto [c, value] : {std::pair{kFrequency, row.frequency_hz}, std::pair{kAmplitude, row.amplitude_m}}) {
-      if (!(value > 0.0)) reader.fail(line_number, kNames[c], number(value) + ": must be > 0");
+      if (!(value > 0.0)) reader.fail(line_number, kNames[c], number(value) + ": must be > 0 (in " +
+                                          std::string(c == kFrequency ? "Hz" : "m") + ")");
     }
     FieldPoint& p = row.point;
     p.eta_star = reader.parse_number(cell(kEta), line_number, kNames[kEta]);
+    // η* = E_diss/(½ m_bed V²) with E_diss = Re(P)/Ω the mean power the container puts
+    // into the bed (docs/complex_power.md): a passive damper only dissipates, so η* >= 0
+    // (0: a bed locked to the container). A negative value is a sign or phase error of
+    // the rig; near-zero noise should be recorded as 0 with its standard error.
+    // No upper bound: the free, fully plastic bed of the ideal collect-and-collide orbit
+    // peaks at 4/π, but an elastic bed (polymer walls) can resonate and exceed it, so a
+    // cap would reject real data.
+    if (p.eta_star < 0.0)
+      reader.fail(line_number, kNames[kEta], number(p.eta_star) + ": must be >= 0 (a passive damper dissipates)");
     p.eta_star_stderr = optional_number(kStderr);
     if (p.eta_star_stderr < 0.0)
       reader.fail(line_number, kNames[kStderr], number(p.eta_star_stderr) + ": must be >= 0");
     p.apparent_mass_kg = optional_number(kApparentMass);
+    // m_app of a particle bed lies between about 0 (bed detached) and m_bed (locked to
+    // the container); m_app < 0 would be a spring-like reaction (−k/Ω²,
+    // docs/complex_power.md) that a bed far below its contact frequencies does not
+    // show, so it is taken as a sign error of the rig.
+    if (p.apparent_mass_kg < 0.0)
+      reader.fail(line_number, kNames[kApparentMass], number(p.apparent_mass_kg) + ": must be >= 0 (in kg)");
     p.apparent_mass_fraction = p.apparent_mass_kg / options.bed_mass_kg;  // NaN stays NaN
     p.motion_mode = std::string(cell(kMotionMode));
+    if (detail::has_control_byte(p.motion_mode)) {
+      reader.fail(line_number, kNames[kMotionMode],
+                  "\"" + p.motion_mode + "\" holds control characters (must be printable text)");
+    }
     const double velocity = 2.0 * formulas::kPi * row.frequency_hz * row.amplitude_m;  // |V*| = XΩ
     p.e_diss_j = p.eta_star * 0.5 * options.bed_mass_kg * velocity * velocity;
     p.status = PointStatus::kOk;
@@ -191,6 +228,8 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
 }
 
 EffectiveField import_measured_csv(const std::filesystem::path& path, const MeasuredImportOptions& options) {
+  // read_text_file refuses a directory ("is a directory", not "no header") and a FIFO
+  // (at once, no hang) before any parsing.
   return measured_field_from_csv(detail::read_text_file(path), path.string(), options);
 }
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "file_io.hpp"
+#include "pdamp/formulas/input_file.hpp"
 #include "strict_json.hpp"
 #include "text_util.hpp"
 
@@ -198,13 +199,9 @@ void write_scattered_fit(const ScatteredFitResult& result, const std::filesystem
 }
 
 ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  json doc;
-  try {
-    doc = json::parse(detail::read_text_file(path));
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(file + ": /: not valid JSON (" + e.what() + ")");
-  }
+  const std::string file = detail::file_label(path);
+  // read_json_file refuses directories, FIFOs and duplicate keys ("<path>: ...").
+  const json doc = detail::read_json_file(path);
   detail::StrictObject root(doc, "", file);
   if (root.optional("format") != nullptr) root.expect_string("format", kFormat);
   if (root.optional("format_version") != nullptr) root.integer("format_version", kFormatVersion, kFormatVersion);
@@ -214,10 +211,15 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   result.fit.s_min = root.number("s_min", false);
   result.s_max = root.number("s_max", false);
   result.fit.source = root.string("source");
+  if (detail::has_control_byte(result.fit.source)) {
+    root.fail("source", "\"" + formulas::printable(result.fit.source) +
+                            "\" holds control characters (must be printable text: it is printed in reports)");
+  }
   result.fit.provisional = false;
   result.reduced_chi_squared = root.number("residual", false);
   if (root.optional("points") != nullptr) {
-    result.points = static_cast<std::size_t>(root.integer("points", 0, std::numeric_limits<int>::max()));
+    // fit_scattered_law needs 3 samples (2 coefficients and 1 degree of freedom): fewer is no fit.
+    result.points = static_cast<std::size_t>(root.integer("points", 3, std::numeric_limits<int>::max()));
   }
   auto optional_stderr = [&](std::string_view key) {
     const json* value = root.optional(key);

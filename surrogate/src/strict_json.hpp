@@ -8,6 +8,8 @@
 #include <string>
 #include <string_view>
 
+#include "pdamp/formulas/input_file.hpp"
+
 namespace pdamp::surrogate::detail {
 
 /// JSON pointer reference token for `key` (RFC 6901: "~" -> "~0", "/" -> "~1").
@@ -26,8 +28,10 @@ inline std::string pointer_token(std::string_view key) {
 }
 
 /// Throws std::invalid_argument("<file>: <pointer>: <rule>"); the pointer of the root is "/".
+/// The message goes through formulas::printable: keys and strings quoted from a user's
+/// file may hold newlines or NUL ("\u0000"), which would break or cut a one-line message.
 [[noreturn]] inline void fail_at(const std::string& file, const std::string& pointer, const std::string& rule) {
-  throw std::invalid_argument(file + ": " + (pointer.empty() ? "/" : pointer) + ": " + rule);
+  throw std::invalid_argument(formulas::printable(file + ": " + (pointer.empty() ? "/" : pointer) + ": " + rule));
 }
 
 /// One JSON object read strictly: required and optional keys are marked as read, and

@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 
 #include "field_format.hpp"
 #include "file_io.hpp"
+#include "pdamp/formulas/input_file.hpp"
 #include "strict_json.hpp"
 #include "text_util.hpp"
 
@@ -102,13 +104,23 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
 class ResultsFile {
  public:
   explicit ResultsFile(const std::filesystem::path& path) : path_(path) {
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    const std::string label = detail::file_label(path);
+    // O_NONBLOCK: a FIFO given as the results file must fail here, not hang a read later.
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NONBLOCK | O_NOCTTY | O_CLOEXEC, 0644);
     if (fd_ < 0) {
-      throw std::runtime_error(path.string() + ": cannot open the sweep results file (" + std::strerror(errno) + ")");
+      const int error = errno;
+      if (error == EISDIR) throw std::invalid_argument(label + ": is a directory, not a sweep results file");
+      throw std::runtime_error(label + ": cannot open the sweep results file (" + std::strerror(error) + ")");
+    }
+    struct stat info {};
+    if (::fstat(fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
+      ::close(fd_);
+      throw std::invalid_argument(
+          label + ": is not a regular file (a FIFO, socket or device); a sweep results file must be one");
     }
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       ::close(fd_);
-      throw std::runtime_error(path.string() +
+      throw std::runtime_error(label +
                                ": another sweep is writing this results file; wait for it or use "
                                "another file");
     }
@@ -146,37 +158,48 @@ std::string header_difference(const json& saved, const json& wanted) {
   return text.empty() ? "unknown keys in the header" : text;
 }
 
-/// Reads the saved points of a results file (or starts it): fills `points` and `done`,
-/// returns how many were resumed.
-std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Grid& grid, const SweepOptions& options,
-                   std::vector<FieldPoint>& points, std::vector<bool>& done) {
-  const std::string text = detail::read_text_file(path);
-  const json header = sweep_header(grid, options);
-  // Only newline-terminated lines are complete: a line without its newline is the
-  // write of a killed run and is dropped (its point is computed again).
-  const std::size_t complete = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
-  const std::string file_name = path.string();
-  if (complete == 0) {
-    file.truncate_to(0);
-    file.append(header.dump() + "\n");
-    detail::sync_parent_folder(path);
-    return 0;
+/// What a results file holds, checked against this sweep.
+struct SavedPoints {
+  std::size_t resumed = 0;         ///< points read back (marked in `done`)
+  std::size_t complete_bytes = 0;  ///< bytes of newline-terminated lines; the rest is a cut write
+  std::string warning;             ///< about a dropped partial last line ("" if none)
+};
+
+/// Reads the newline-terminated lines of a results file's `text` into `points` and
+/// `done`. Only complete lines count: a last line without its newline is the append of
+/// a killed run (SIGTERM or power loss mid-write) and is dropped with a warning, so its
+/// point is computed again. Every complete line is checked strictly: a damaged line
+/// before the end cannot come from a kill, so it throws std::invalid_argument, as does a
+/// header of another sweep.
+SavedPoints read_saved_points(const std::string& text, const std::string& file_name, const Grid& grid,
+                              const SweepOptions& options, std::vector<FieldPoint>& points, std::vector<bool>& done) {
+  SavedPoints saved;
+  const std::size_t last_newline = text.rfind('\n');
+  saved.complete_bytes = last_newline == std::string::npos ? 0 : last_newline + 1;
+  const auto complete_end = text.begin() + static_cast<std::ptrdiff_t>(saved.complete_bytes);
+  const auto complete_lines = static_cast<std::size_t>(std::count(text.begin(), complete_end, '\n'));
+  if (saved.complete_bytes < text.size()) {
+    saved.warning = file_name + ": line " + std::to_string(complete_lines + 1) + ": cut short (" +
+                    std::to_string(text.size() - saved.complete_bytes) +
+                    " bytes without a newline, the write of a killed run); dropped, " +
+                    (complete_lines == 0 ? "the sweep starts again" : "its point is computed again");
   }
-  std::size_t resumed = 0;
+  const json header = sweep_header(grid, options);
+  const std::string damaged = ": the results file is damaged; delete or move it to start the sweep again";
   std::size_t line_number = 0;
   std::size_t begin = 0;
-  while (begin < complete) {
+  while (begin < saved.complete_bytes) {
     const std::size_t end = text.find('\n', begin);
-    const std::string_view line(text.data() + begin, end - begin);
+    const std::string line = text.substr(begin, end - begin);
     begin = end + 1;
     ++line_number;
-    const std::string at = "line " + std::to_string(line_number);
-    const std::string damaged = ": the results file is damaged; delete or move it to start the sweep again";
+    const std::string context = file_name + ": line " + std::to_string(line_number);
     json value;
     try {
-      value = json::parse(line);
-    } catch (const json::exception& e) {
-      throw std::invalid_argument(file_name + ": " + at + ": not valid JSON (" + e.what() + ")" + damaged);
+      // parse_json_document also refuses a repeated key, which no writer of ours produces.
+      value = formulas::parse_json_document(line, context);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(e.what() + damaged);
     }
     if (line_number == 1) {
       if (value != header) {
@@ -187,7 +210,6 @@ std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const G
       continue;
     }
     try {
-      const std::string context = file_name + ": " + at;
       detail::StrictObject object(value, "", context);
       const long long index = object.integer("index", 0, static_cast<long long>(grid.size()) - 1);
       const auto k = static_cast<std::size_t>(index);
@@ -209,10 +231,13 @@ std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const G
       FieldPoint p;
       p.eta_star = nullable_number("eta_star");
       p.eta_star_stderr = nullable_number("eta_star_stderr");
+      if (p.eta_star_stderr < 0.0) object.fail("eta_star_stderr", number(p.eta_star_stderr) + ": must be >= 0 or null");
       p.e_diss_j = nullable_number("e_diss_j");
       p.apparent_mass_kg = nullable_number("apparent_mass_kg");
       p.apparent_mass_fraction = nullable_number("apparent_mass_fraction");
       p.motion_mode = object.string("motion_mode");
+      if (detail::has_control_byte(p.motion_mode))
+        object.fail("motion_mode", "\"" + p.motion_mode + "\" holds control characters (must be printable text)");
       const std::string status = object.string("status");
       const auto parsed = point_status_from_string(status);
       if (!parsed || *parsed == PointStatus::kMissing)
@@ -221,18 +246,36 @@ std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const G
       if (p.status == PointStatus::kOk && (std::isnan(p.eta_star) || std::isnan(p.e_diss_j))) {
         object.fail("eta_star", "null: an ok point needs eta_star and e_diss_j");
       }
-      object.number("wall_time_s", false, "s");
+      const double wall_time_s = object.number("wall_time_s", false, "s");
+      if (wall_time_s < 0.0) object.fail("wall_time_s", number(wall_time_s) + ": must be >= 0 (in s)");
       object.finish();
       points[k] = std::move(p);
       done[k] = true;
-      ++resumed;
+      ++saved.resumed;
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(e.what() + damaged);
     }
   }
+  return saved;
+}
+
+/// Reads the saved points of a results file (or starts it): fills `points` and `done`,
+/// returns how many were resumed and adds a warning for a dropped partial last line.
+std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Grid& grid, const SweepOptions& options,
+                   std::vector<FieldPoint>& points, std::vector<bool>& done, std::vector<std::string>& warnings) {
+  // read_text_file (formulas::read_input_file) again refuses anything but a regular file.
+  const std::string text = detail::read_text_file(path);
+  const SavedPoints saved = read_saved_points(text, detail::file_label(path), grid, options, points, done);
+  if (!saved.warning.empty()) warnings.push_back(saved.warning);
+  if (saved.complete_bytes == 0) {  // new file, or only a cut header: start it
+    file.truncate_to(0);
+    file.append(sweep_header(grid, options).dump() + "\n");
+    detail::sync_parent_folder(path);
+    return 0;
+  }
   // Only now that every complete line was checked: drop the partial one and append after the rest.
-  file.truncate_to(complete);
-  return resumed;
+  file.truncate_to(saved.complete_bytes);
+  return saved.resumed;
 }
 
 }  // namespace
@@ -270,9 +313,10 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
   std::vector<bool> done(total, false);
   std::optional<ResultsFile> file;
   std::size_t resumed = 0;
+  std::vector<std::string> warnings;
   if (!options.results_path.empty()) {
     file.emplace(options.results_path);
-    resumed = resume(*file, options.results_path, grid, options, points, done);
+    resumed = resume(*file, options.results_path, grid, options, points, done, warnings);
   }
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < total; ++k) {
@@ -343,11 +387,28 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
   result.summary.points_total = total;
   result.summary.points_resumed = resumed;
   result.summary.points_computed = computed;
+  result.summary.warnings = std::move(warnings);
   for (const auto& p : result.field.points) {
     if (p.status == PointStatus::kFailed) ++result.summary.points_failed;
   }
   result.summary.wall_time_s = seconds_since(start);
   return result;
+}
+
+std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options) {
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  detail::throw_if_any(options.validate(), "sweep options");
+  if (options.results_path.empty()) return grid.size();
+  std::error_code error;
+  // exists() follows links: a dangling link is "nothing saved yet", as run_sweep creates its target.
+  if (!std::filesystem::exists(options.results_path, error)) return grid.size();
+  std::vector<FieldPoint> points(grid.size());
+  std::vector<bool> done(grid.size(), false);
+  // Read only, without the lock: a sweep running now may append meanwhile, which at worst
+  // makes the count a little high (a cut last line is dropped, as on resume).
+  const SavedPoints saved = read_saved_points(detail::read_text_file(options.results_path),
+                                              detail::file_label(options.results_path), grid, options, points, done);
+  return grid.size() - saved.resumed;
 }
 
 }  // namespace pdamp::surrogate

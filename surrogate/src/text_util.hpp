@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pdamp::surrogate::detail {
@@ -18,6 +19,17 @@ inline std::string number(double value, int digits = 12) {
 }
 
 inline bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
+
+/// True if `text` holds a control byte (below 0x20, or DEL): a label (motion mode, fit
+/// source) is printed in tables and one-line messages, where such a byte breaks the
+/// line or, for NUL, cuts the text.
+inline bool has_control_byte(std::string_view text) {
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7F) return true;
+  }
+  return false;
+}
 
 /// The lines joined by "; " (one exception message from a validate() list).
 inline std::string joined(const std::vector<std::string>& lines) {

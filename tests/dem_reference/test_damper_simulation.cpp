@@ -111,9 +111,9 @@ TEST_CASE("run_harmonic refuses bad options naming each violation", "[dem_refere
     FAIL("no exception");
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
-    CHECK_THAT(what, Catch::Contains("dem.compartments[0].particles[0].radius_m = 0: must be > 0"));
-    CHECK_THAT(what, Catch::Contains("dem.amplitude_m = -0.01: must be > 0"));
-    CHECK_THAT(what, Catch::Contains("dem.analysed_periods = 0: must be >= 1"));
+    CHECK_THAT(what, Catch::Contains("dem.compartments[0].particles[0].radius_m = 0: must be in [1e-05, 1] m"));
+    CHECK_THAT(what, Catch::Contains("dem.amplitude_m = -0.01: must be in (0, 10] m"));
+    CHECK_THAT(what, Catch::Contains("dem.analysed_periods = 0: must be in [1, 100000]"));
   }
   auto step = low_intensity(0.4, 100.0);
   step.world.integration.time_step_s = 1e-3;

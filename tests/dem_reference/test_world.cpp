@@ -184,9 +184,9 @@ TEST_CASE("invalid world options are refused with every violation named", "[dem_
   o.integration.steps_per_contact = 10;
   const auto errors = o.validate();
   REQUIRE(errors.size() == 3);
-  CHECK(errors[0] == "dem.default_pair.friction = -1: must be >= 0");
-  CHECK(errors[1] == "dem.compartments[0].particles[0].radius_m = -0.002: must be > 0");
-  CHECK(errors[2] == "dem.integration.steps_per_contact = 10: must be >= 40");
+  CHECK(errors[0] == "dem.default_pair.friction = -1: must be in [0, 10]");
+  CHECK(errors[1] == "dem.compartments[0].particles[0].radius_m = -0.002: must be in [1e-05, 1] m");
+  CHECK(errors[2] == "dem.integration.steps_per_contact = 10: must be in [40, 10000]");
   CHECK_THROWS_AS(dr::World(o), std::invalid_argument);
 }
 

@@ -3,10 +3,16 @@
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <numbers>
 #include <random>
 #include <string>
@@ -389,7 +395,50 @@ TEST_CASE("impact CSV errors name the file and the line and the problem", "[form
   const auto empty = write_temp_csv("empty", header);
   CHECK_THROWS_WITH(pf::read_impact_csv(empty), Contains("no data rows"));
   CHECK_THROWS_WITH(pf::read_impact_csv("/nonexistent/impacts.csv"),
-                    Contains("/nonexistent/impacts.csv: cannot open"));
+                    Catch::Equals("impact CSV /nonexistent/impacts.csv: no such file"));
+}
+
+TEST_CASE("a directory, a FIFO or a binary file given as the impact CSV fails at once with one line",
+          "[formulas][cor]") {
+  const auto dir = std::filesystem::temp_directory_path() / ("pdamp_test_cor_hostile_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  // The old reader took a directory for an empty file ("no header line").
+  CHECK_THROWS_WITH(pf::read_impact_csv(dir.string()),
+                    Catch::Equals("impact CSV " + dir.string() + ": is a directory, not a file"));
+  const auto fifo = dir / "impacts.csv";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // The old reader (std::ifstream) blocked in open() until a writer came: run it on a
+  // thread and, after 10 s, open the FIFO for writing and close it (end of file) so the
+  // test fails instead of hanging.
+  auto read = std::async(std::launch::async, [&]() -> std::string {
+    try {
+      pf::read_impact_csv(fifo.string());
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no exception";
+  });
+  if (read.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+    for (int attempt = 0; attempt < 100 && read.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready;
+         ++attempt) {
+      const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) ::close(fd);
+    }
+    FAIL("read_impact_csv blocked on a FIFO for more than 10 s");
+  }
+  CHECK(read.get() == "impact CSV " + fifo.string() + ": is a FIFO (named pipe), not a file");
+  // A NUL in a quoted cell is escaped, so the message is not cut at it.
+  const auto binary = (dir / "binary.csv").string();
+  std::ofstream(binary, std::ios::binary) << std::string("impact_speed_m_s,restitution\n0.1,0.9\0x\n", 39);
+  std::string message;
+  try {
+    pf::read_impact_csv(binary);
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  CHECK(message == "impact CSV " + binary + ":2: restitution = '0.9\\0x': not a number");
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("impact CSV tolerates spaces and CRLF line ends and extra columns", "[formulas][cor]") {

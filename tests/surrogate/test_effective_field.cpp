@@ -13,6 +13,7 @@
 #include <string>
 
 #include "pdamp/surrogate/effective_field.hpp"
+#include "surrogate/hostile_files.hpp"
 
 namespace {
 
@@ -176,13 +177,51 @@ TEST_CASE("files that are not JSON or not there are rejected naming the file", "
   std::string with_nan = text;
   with_nan.replace(with_nan.find("0.04"), 4, "NaN");  // clearance_m: JSON has no NaN
   write_text(nan_file, with_nan);
-  CHECK_THROWS_WITH(read_effective_field(nan_file), Catch::StartsWith(nan_file.string() + ": /: not valid JSON"));
+  CHECK_THROWS_WITH(read_effective_field(nan_file), Catch::StartsWith(nan_file.string() + ": malformed JSON: "));
   const fs::path inf_file = dir.path / "inf.json";
   std::string with_inf = text;
   with_inf.replace(with_inf.find("0.04"), 4, "1e999");
   write_text(inf_file, with_inf);
   CHECK_THROWS_WITH(read_effective_field(inf_file), Catch::Contains("number overflow"));
-  CHECK_THROWS_WITH(read_effective_field(dir.path / "absent.json"), Catch::Contains("absent.json: cannot be read"));
+  CHECK_THROWS_WITH(read_effective_field(dir.path / "absent.json"), Catch::EndsWith("absent.json: no such file"));
+}
+
+TEST_CASE("a field file with a repeated key is refused naming the key's pointer", "[surrogate]") {
+  // nlohmann::json keeps the last of two equal keys: an edit of the first would be ignored.
+  TempDir dir("field_duplicate_key");
+  std::string text = to_json(sample_field()).dump();
+  text.replace(text.find("\"clearance_m\":0.04"), 18, "\"clearance_m\":0.04,\"clearance_m\":0.05");
+  const fs::path path = dir.path / "dup.json";
+  write_text(path, text);
+  CHECK_THROWS_WITH(read_effective_field(path), Catch::Equals(path.string() +
+                                                             ": /clearance_m: duplicate key (each key may appear "
+                                                             "once in an object)"));
+}
+
+TEST_CASE("a directory or a FIFO given as a field file is refused at once, naming it", "[surrogate]") {
+  TempDir dir("field_hostile");
+  CHECK_THROWS_WITH(read_effective_field(dir.path), Catch::Equals(dir.path.string() + ": is a directory, not a file"));
+  const fs::path fifo = dir.path / "field.json";
+  pdamp::test::make_fifo(fifo);
+  // The old reader (std::ifstream) blocked in open() forever; the guard turns that into a failure.
+  CHECK(pdamp::test::invalid_argument_within_timeout([&] { read_effective_field(fifo); }, fifo) ==
+        fifo.string() + ": is a FIFO (named pipe), not a file");
+}
+
+TEST_CASE("a motion mode with control characters and a grid above the node limit are refused", "[surrogate]") {
+  const json good = to_json(sample_field());
+  json doc = good;
+  doc["table"][0][7] = std::string("roll\0ing\n", 9);
+  check_rejected(doc, "/table/0/7", "\"roll\\0ing\\n\" holds control characters");
+  doc = good;
+  // 1001 x 1000 nodes: one more row of nodes than kMaxGridNodes allows.
+  json& f = doc["axes"][0]["values"];
+  json& x = doc["axes"][1]["values"];
+  f = json::array();
+  x = json::array();
+  for (int k = 1; k <= 1001; ++k) f.push_back(k);
+  for (int k = 1; k <= 1000; ++k) x.push_back(1e-4 * k);
+  check_rejected(doc, "/axes", "1001 x 1000 = 1001000 nodes, must be <= 1000000");
 }
 
 TEST_CASE("invalid fields are not written", "[surrogate]") {

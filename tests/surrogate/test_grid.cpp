@@ -81,3 +81,20 @@ TEST_CASE("drive points of an intensity grid reproduce the node's intensity and 
                                     {0.02, 0.02, 1, AxisSpacing::kLinear});
   CHECK(drive_point(fa, 0, 0.0).frequency_hz == 3.0);  // a drive grid needs no clearance
 }
+
+TEST_CASE("a grid of more than a million nodes is refused, each axis alone may be long", "[surrogate]") {
+  // Each count is within AxisRange's [1, 100000]; 2000 x 2000 DEM points would run for years.
+  CHECK_THROWS_WITH(Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 100.0, 2000, AxisSpacing::kLinear},
+                                      {0.001, 0.1, 2000, AxisSpacing::kLog}),
+                    Catch::Equals("grid: 2000 x 2000 = 4000000 nodes: must be <= 1000000 (1000 x 1000)"));
+  const Grid line = Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 1.0, 1, AxisSpacing::kLinear},
+                                      {0.001, 0.1, 100000, AxisSpacing::kLog});
+  CHECK(line.size() == 100000);
+  CHECK(line.validate().empty());
+  const Grid largest = Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 100.0, 1000, AxisSpacing::kLinear},
+                                         {0.001, 0.1, 1000, AxisSpacing::kLog});
+  CHECK(largest.size() == kMaxGridNodes);
+  Grid too_large = largest;
+  too_large.axis0.values.push_back(200.0);
+  CHECK(contains(too_large.validate(), "grid: 1001 x 1000 = 1001000 nodes: must be <= 1000000"));
+}

@@ -1,10 +1,13 @@
 // Tests of the CSV import of measured fields: columns, grid assembly, clear errors.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
 #include "pdamp/surrogate/measured_import.hpp"
+#include "support/temp_dir.hpp"
+#include "surrogate/hostile_files.hpp"
 
 namespace {
 
@@ -81,5 +84,66 @@ TEST_CASE("measured CSV errors name the file, line and column", "[surrogate]") {
   MeasuredImportOptions bad = rig();
   bad.bed_mass_kg = 0.0;
   CHECK_THROWS_WITH(measured_field_from_csv("", "rig.csv", bad), Catch::Contains("bed_mass_kg = 0: must be > 0"));
-  CHECK_THROWS_WITH(import_measured_csv("/nonexistent/rig.csv", rig()), Catch::Contains("cannot be read"));
+  CHECK_THROWS_WITH(import_measured_csv("/nonexistent/rig.csv", rig()),
+                    Catch::Equals("/nonexistent/rig.csv: no such file"));
+}
+
+TEST_CASE("physically meaningless measured values are refused with line and column", "[surrogate]") {
+  const std::string header = "frequency_hz,amplitude_m,eta_star,eta_star_stderr,apparent_mass_kg\n";
+  // η* = E_diss/(½ m_bed V²) >= 0 for a passive damper (docs/complex_power.md); the old
+  // import accepted -5.
+  check_rejected(header + "2,0.01,-5,0.01,0.1\n", "line 2, column eta_star", "-5: must be >= 0");
+  check_rejected(header + "2,0.01,-1e-9,0.01,0.1\n", "line 2, column eta_star", "must be >= 0");
+  check_rejected(header + "2,0.01,0.3,-0.01,0.1\n", "line 2, column eta_star_stderr", "-0.01: must be >= 0");
+  check_rejected(header + "2,0.01,0.3,0.01,-0.1\n", "line 2, column apparent_mass_kg", "-0.1: must be >= 0");
+  check_rejected(header + "0,0.01,0.3,0.01,0.1\n", "line 2, column frequency_hz", "0: must be > 0 (in Hz)");
+  check_rejected(header + "2,0,0.3,0.01,0.1\n", "line 2, column amplitude_m", "0: must be > 0 (in m)");
+  check_rejected(header + "2,0.01,inf,0.01,0.1\n", "line 2, column eta_star", "\"inf\" is not a finite number");
+  check_rejected(header + "2,0.01,0.3,0.01,-inf\n", "line 2, column apparent_mass_kg", "not a finite number");
+  check_rejected(header + "2,0.01,0.3,nan,0.1\n", "line 2, column eta_star_stderr", "not a finite number");
+  check_rejected(header + "2,1e999,0.3,0.01,0.1\n", "line 2, column amplitude_m", "not a finite number");
+  check_rejected("frequency_hz,amplitude_m,eta_star,motion_mode\n2,0.01,0.3,roll\x1b[2Jing\n",
+                 "line 2, column motion_mode", "\"roll\\x1b[2Jing\" holds control characters");
+  // η* = 0 (a locked bed) and large η* (an elastic bed can exceed the ideal 4/π) are data.
+  const EffectiveField field =
+      measured_field_from_csv(header + "2,0.01,0,0,0.74\n2,0.02,3.5,0.2,0\n", "rig.csv", rig());
+  CHECK(field.points[0].eta_star == 0.0);
+  CHECK(field.points[1].eta_star == 3.5);
+}
+
+TEST_CASE("a binary measured CSV gives one line naming the NUL byte, not a message cut at it", "[surrogate]") {
+  std::string binary = "frequency_hz,amplitude_m,eta_star\n";
+  binary += std::string("PK\x03\x04\0\0\x08\0rest of a zip", 21);
+  std::string message;
+  try {
+    measured_field_from_csv(binary, "rig.xlsx", rig());
+  } catch (const std::invalid_argument& e) {
+    message = e.what();  // what() is a C string: an unescaped NUL would end it here
+  }
+  CHECK_THAT(message, Catch::StartsWith("rig.xlsx: line 2: byte 5 is NUL: this is a binary file, not CSV text") &&
+                          Catch::Contains("the line starts \"PK\\x03\\x04\\0\\0\\x08\\0rest of a zip\""));
+  CHECK(message.find('\n') == std::string::npos);
+  // A NUL in the header line (UTF-16 text) is caught before the column names are checked.
+  CHECK_THROWS_WITH(measured_field_from_csv(std::string("f\0r\0e\0q", 7), "rig.csv", rig()),
+                    Catch::StartsWith("rig.csv: line 1: byte 2 is NUL"));
+  // A file name with a newline stays on one line too.
+  CHECK_THROWS_WITH(measured_field_from_csv("eta\n", "rig\n.csv", rig()), Catch::StartsWith("rig\\n.csv: line 1"));
+}
+
+TEST_CASE("a UTF-8 byte-order mark before the header is skipped", "[surrogate]") {
+  const EffectiveField field =
+      measured_field_from_csv("\xEF\xBB\xBF" "frequency_hz,amplitude_m,eta_star\n2,0.01,0.1\n", "rig.csv", rig());
+  CHECK(field.points.size() == 1);
+}
+
+TEST_CASE("a directory or a FIFO given as the measured CSV is refused at once, naming it", "[surrogate]") {
+  pdamp::test::TempDir dir("measured_hostile");
+  // The old import reported a directory as "no header line".
+  CHECK_THROWS_WITH(import_measured_csv(dir.path, rig()),
+                    Catch::Equals(dir.path.string() + ": is a directory, not a file"));
+  const auto fifo = dir.path / "rig.csv";
+  pdamp::test::make_fifo(fifo);
+  // The old import blocked in open() forever (no writer); the guard turns that into a failure.
+  CHECK(pdamp::test::invalid_argument_within_timeout([&] { import_measured_csv(fifo, rig()); }, fifo) ==
+        fifo.string() + ": is a FIFO (named pipe), not a file");
 }

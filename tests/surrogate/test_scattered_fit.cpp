@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pdamp/surrogate/scattered_fit.hpp"
+#include "surrogate/hostile_files.hpp"
 
 namespace {
 
@@ -182,5 +183,52 @@ TEST_CASE("the coefficient file round-trips and is read strictly", "[surrogate]"
       Catch::Contains("/s_max: 1.2: must be in [s_min, 1]"));
   CHECK_THROWS_WITH(read_scattered_fit(write(minimal + R"(, "format_version": 2})")),
                     Catch::Contains("/format_version"));
-  CHECK_THROWS_WITH(read_scattered_fit(write("{jump")), Catch::Contains("not valid JSON"));
+  CHECK_THROWS_WITH(read_scattered_fit(write("{jump")), Catch::StartsWith(path.string() + ": malformed JSON: "));
+}
+
+TEST_CASE("a coefficient file outside the law's ranges, repeated keys or too few points is refused", "[surrogate]") {
+  TempDir dir("scattered_fit_ranges");
+  const fs::path path = dir.path / "fit.json";
+  auto read = [&](const std::string& members) {
+    std::ofstream(path) << "{" << members << "}";
+    return read_scattered_fit(path);
+  };
+  const std::string base = R"("source": "hand", "residual": 1.1, )";
+  auto check = [&](const std::string& members, const std::string& message) {
+    INFO(members);
+    CHECK_THROWS_WITH(read(base + members), Catch::Equals(path.string() + ": " + message));
+  };
+  check(R"("jump_fraction": -0.1, "exponent": 2, "s_min": 0.3, "s_max": 0.9)",
+        "/jump_fraction: jump_fraction = -0.1: must be in [0, 1]");
+  check(R"("jump_fraction": 0.5, "exponent": 12, "s_min": 0.3, "s_max": 0.9)",
+        "/exponent: exponent = 12: must be in [0, 10]");
+  check(R"("jump_fraction": 0.5, "exponent": -1, "s_min": 0.3, "s_max": 0.9)",
+        "/exponent: exponent = -1: must be in [0, 10]");
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 1, "s_max": 1)", "/s_min: s_min = 1: must be in [0, 1)");
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": -0.2, "s_max": 0.9)",
+        "/s_min: s_min = -0.2: must be in [0, 1)");
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 0.6, "s_max": 0.5)",
+        "/s_max: 0.5: must be in [s_min, 1] = [0.6, 1]");
+  // A fit needs 3 samples (2 coefficients and 1 degree of freedom): the old reader took 0.
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "points": 2)",
+        "/points: 2 must be in [3, 2147483647]");
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "exponent_stderr": -1)",
+        "/exponent_stderr: -1: must be >= 0 or null");
+  // nlohmann::json would keep the last jump_fraction silently.
+  check(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "jump_fraction": 0.7)",
+        "/jump_fraction: duplicate key (each key may appear once in an object)");
+  CHECK_THROWS_WITH(read(R"("jump_fraction": 0.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "residual": 1, )"
+                         R"("source": "dem\u0000x")"),
+                    Catch::Equals(path.string() + ": /source: \"dem\\0x\" holds control characters (must be printable "
+                                                  "text: it is printed in reports)"));
+}
+
+TEST_CASE("a directory or a FIFO given as the coefficient file is refused at once, naming it", "[surrogate]") {
+  TempDir dir("scattered_fit_hostile");
+  CHECK_THROWS_WITH(read_scattered_fit(dir.path), Catch::Equals(dir.path.string() + ": is a directory, not a file"));
+  const fs::path fifo = dir.path / "fit.json";
+  pdamp::test::make_fifo(fifo);
+  // The old reader (std::ifstream) blocked in open() forever; the guard turns that into a failure.
+  CHECK(pdamp::test::invalid_argument_within_timeout([&] { read_scattered_fit(fifo); }, fifo) ==
+        fifo.string() + ": is a FIFO (named pipe), not a file");
 }

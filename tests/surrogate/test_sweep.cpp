@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pdamp/surrogate/sweep.hpp"
+#include "surrogate/hostile_files.hpp"
 
 namespace {
 
@@ -217,7 +218,7 @@ TEST_CASE("a damaged line inside the results file is an error, not silently skip
   std::ofstream(results) << text;
   RecordingEvaluator never;
   CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
-                    Catch::Contains("line 3: not valid JSON") && Catch::Contains("damaged"));
+                    Catch::Contains("line 3: malformed JSON") && Catch::Contains("damaged"));
 
   // A complete line for a node the grid does not have.
   std::ofstream(results) << original << R"({"index": 99})"
@@ -310,4 +311,160 @@ TEST_CASE("an intensity-stroke sweep drives the evaluator at the nodes' gamma an
     CHECK(result.field.points[k].eta_star == Approx(grid.coordinate0(k)).epsilon(1e-13));
     CHECK(result.field.points[k].apparent_mass_kg == Approx(grid.coordinate1(k)).epsilon(1e-15));
   }
+}
+
+TEST_CASE("a last line cut at any byte by a kill is dropped with a warning and its point recomputed", "[surrogate]") {
+  TempDir dir("sweep_cut_anywhere");
+  const fs::path results = dir.path / "sweep.jsonl";
+  RecordingEvaluator first;
+  const SweepResult complete = run_sweep(sweep_grid(), by_reference(first), sweep_options(results));
+  CHECK(complete.summary.warnings.empty());
+  const std::string original = read_text(results);
+  const std::size_t last_line = original.rfind('\n', original.size() - 2) + 1;
+  // Every cut a SIGTERM during the append can leave: from 1 byte of the line to all of
+  // it but the newline (a write is never reordered, so only a prefix reaches the file).
+  for (std::size_t kept = 1; kept < original.size() - last_line; ++kept) {
+    std::ofstream(results, std::ios::binary | std::ios::trunc) << original.substr(0, last_line + kept);
+    RecordingEvaluator again;
+    const SweepResult result = run_sweep(sweep_grid(), by_reference(again), sweep_options(results));
+    INFO("kept " << kept << " bytes of the last line");
+    CHECK(again.calls() == 1);
+    CHECK(result.summary.points_resumed == 17);
+    CHECK(result.field.points == reference_field().points);
+    REQUIRE(result.summary.warnings.size() == 1);
+    CHECK_THAT(result.summary.warnings[0],
+               Catch::Equals(results.string() + ": line 19: cut short (" + std::to_string(kept) +
+                             " bytes without a newline, the write of a killed run); dropped, its point is computed "
+                             "again"));
+    CHECK(line_count(results) == 19);
+    CHECK(read_text(results).back() == '\n');
+  }
+  // A header cut short: nothing was saved, the file starts again.
+  std::ofstream(results, std::ios::binary | std::ios::trunc) << original.substr(0, 30);
+  RecordingEvaluator restart;
+  const SweepResult restarted = run_sweep(sweep_grid(), by_reference(restart), sweep_options(results));
+  CHECK(restart.calls() == 18);
+  REQUIRE(restarted.summary.warnings.size() == 1);
+  CHECK_THAT(restarted.summary.warnings[0], Catch::Contains("line 1: cut short (30 bytes") &&
+                                                Catch::EndsWith("dropped, the sweep starts again"));
+  CHECK(line_count(results) == 19);
+}
+
+TEST_CASE("a damaged line before a cut last line is still an error, as is a repeated key", "[surrogate]") {
+  TempDir dir("sweep_damaged_and_cut");
+  const fs::path results = dir.path / "sweep.jsonl";
+  RecordingEvaluator first;
+  run_sweep(sweep_grid(), by_reference(first), sweep_options(results));
+  const std::string original = read_text(results);
+  // Line 5 emptied of its closing brace (a torn write in the middle cannot come from a
+  // kill of the appending process) and the last line cut.
+  std::string text = original.substr(0, original.size() - 10);
+  std::size_t line5 = 0;
+  for (int k = 0; k < 4; ++k) line5 = text.find('\n', line5) + 1;
+  const std::size_t end5 = text.find('\n', line5);
+  text.erase(end5 - 1, 1);
+  std::ofstream(results, std::ios::binary | std::ios::trunc) << text;
+  RecordingEvaluator never;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
+                    Catch::StartsWith(results.string() + ": line 5: malformed JSON: ") &&
+                        Catch::EndsWith("the results file is damaged; delete or move it to start the sweep again"));
+  CHECK_THROWS_WITH(pending_sweep_points(sweep_grid(), sweep_options(results)),
+                    Catch::Contains("line 5: malformed JSON"));
+  CHECK(read_text(results) == text);  // a refused file is left as it was, cut line included
+
+  // A repeated key: the parser would keep the second value silently.
+  text = original;
+  const std::size_t line3 = text.find('\n', text.find('\n') + 1) + 1;
+  text.insert(line3 + 1, R"("index":0,)");
+  std::ofstream(results, std::ios::binary | std::ios::trunc) << text;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
+                    Catch::Contains("line 3: /index: duplicate key") && Catch::Contains("damaged"));
+  CHECK(never.calls() == 0);
+}
+
+TEST_CASE("progress is reported once before the first point is evaluated", "[surrogate]") {
+  TempDir dir("sweep_first_progress");
+  const fs::path results = dir.path / "sweep.jsonl";
+  struct Call {
+    std::size_t done, total;
+    double eta_s;
+    int evaluations_before;
+  };
+  std::vector<Call> calls;
+  std::atomic<int> evaluations{0};
+  const PointEvaluator evaluator = [&](double f, double x) {
+    ++evaluations;
+    return RecordingEvaluator()(f, x);
+  };
+  SweepOptions options = sweep_options(results);
+  options.threads = 1;
+  options.progress = [&](std::size_t done, std::size_t total, double eta_s) {
+    calls.push_back({done, total, eta_s, evaluations.load()});
+  };
+  run_sweep(sweep_grid(), evaluator, options);
+  REQUIRE(calls.size() == 19);
+  CHECK(calls[0].done == 0);
+  CHECK(calls[0].total == 18);
+  CHECK(std::isnan(calls[0].eta_s));
+  CHECK(calls[0].evaluations_before == 0);  // the user sees "0 of 18" before the first (long) point
+  // Resumed with 4 points missing: the first line says what is already done.
+  std::string text = read_text(results);
+  for (int k = 0; k < 4; ++k) text.erase(text.rfind('\n', text.size() - 2) + 1);
+  std::ofstream(results, std::ios::binary | std::ios::trunc) << text;
+  calls.clear();
+  evaluations = 0;
+  run_sweep(sweep_grid(), evaluator, options);
+  REQUIRE(calls.size() == 5);
+  CHECK(calls[0].done == 14);
+  CHECK(calls[0].evaluations_before == 0);
+  CHECK(calls[4].done == 18);
+}
+
+TEST_CASE("pending_sweep_points counts the nodes a run would still evaluate", "[surrogate]") {
+  TempDir dir("sweep_pending");
+  const fs::path results = dir.path / "sweep.jsonl";
+  CHECK(pending_sweep_points(sweep_grid(), sweep_options({})) == 18);
+  CHECK(pending_sweep_points(sweep_grid(), sweep_options(results)) == 18);  // no file yet
+  CHECK_FALSE(fs::exists(results));                                         // and none created
+  RecordingEvaluator dying(8);
+  CHECK_THROWS(run_sweep(sweep_grid(), by_reference(dying), sweep_options(results)));
+  const std::size_t saved = line_count(results) - 1;
+  CHECK(pending_sweep_points(sweep_grid(), sweep_options(results)) == 18 - saved);
+  fs::resize_file(results, fs::file_size(results) - 5);  // the last saved point cut: computed again
+  const std::string cut = read_text(results);
+  CHECK(pending_sweep_points(sweep_grid(), sweep_options(results)) == 18 - saved + 1);
+  CHECK(read_text(results) == cut);  // read only: the cut line is still there
+  SweepOptions other = sweep_options(results);
+  other.model_version = 5;
+  CHECK_THROWS_WITH(pending_sweep_points(sweep_grid(), other), Catch::Contains("belongs to another sweep"));
+  other = sweep_options(results);
+  other.threads = 0;
+  CHECK_THROWS_WITH(pending_sweep_points(sweep_grid(), other), Catch::Contains("threads = 0"));
+  Grid huge = sweep_grid();
+  huge.axis0 = Axis::from_range(AxisQuantity::kFrequencyHz, {1.0, 3.0, 2000, AxisSpacing::kLinear});
+  huge.axis1 = Axis::from_range(AxisQuantity::kAmplitudeM, {0.005, 0.04, 2000, AxisSpacing::kLog});
+  CHECK_THROWS_WITH(pending_sweep_points(huge, sweep_options({})),
+                    Catch::Contains("2000 x 2000 = 4000000 nodes: must be <= 1000000"));
+  CHECK_THROWS_WITH(run_sweep(huge, by_reference(dying), sweep_options({})),
+                    Catch::Contains("2000 x 2000 = 4000000 nodes: must be <= 1000000"));
+}
+
+TEST_CASE("a directory or a FIFO given as the results file is refused at once, naming it", "[surrogate]") {
+  TempDir dir("sweep_hostile");
+  RecordingEvaluator never;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(dir.path)),
+                    Catch::Equals(dir.path.string() + ": is a directory, not a sweep results file"));
+  CHECK_THROWS_WITH(pending_sweep_points(sweep_grid(), sweep_options(dir.path)),
+                    Catch::Equals(dir.path.string() + ": is a directory, not a file"));
+  const fs::path fifo = dir.path / "sweep.jsonl";
+  pdamp::test::make_fifo(fifo);
+  // The old sweep opened the FIFO read-write, then blocked reading it; the guard turns that
+  // into a failure instead of a hung test.
+  CHECK(pdamp::test::invalid_argument_within_timeout(
+            [&] { run_sweep(sweep_grid(), by_reference(never), sweep_options(fifo)); }, fifo) ==
+        fifo.string() + ": is not a regular file (a FIFO, socket or device); a sweep results file must be one");
+  CHECK(pdamp::test::invalid_argument_within_timeout(
+            [&] { pending_sweep_points(sweep_grid(), sweep_options(fifo)); }, fifo) ==
+        fifo.string() + ": is a FIFO (named pipe), not a file");
+  CHECK(never.calls() == 0);
 }

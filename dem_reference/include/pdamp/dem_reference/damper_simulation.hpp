@@ -1,6 +1,7 @@
 // One damper under harmonic container motion: transient, analysed periods, measures.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -11,21 +12,46 @@
 
 namespace pdamp::dem_reference {
 
+namespace limits {
+/// Stroke X, m: (0, 10]; no damper strokes further (and 2XΩ must stay <= 1000 m/s).
+inline constexpr double kMaxAmplitude_m = 10.0;
+/// Drive frequency, Hz: [0.01, 10000]. Below 0.01 Hz a period is over 100 s of tiny
+/// steps (~1e9 of them); above 10 kHz the container is no rigid body.
+inline constexpr double kMinFrequency_hz = 0.01;
+inline constexpr double kMaxFrequency_hz = 1e4;
+/// Settling, s: -1 (automatic) or [0, 100]; a bed falls through any damper in < 1 s.
+inline constexpr double kMaxSettlingTime_s = 100.0;
+/// Transient [0, 100000] and analysed [1, 100000] periods: more is no design run.
+inline constexpr int kMaxPeriods = 100'000;
+/// Samples per period [16, 100000]: 16 resolve the harmonics the measures use; above
+/// 1e5 the blocks get shorter than a contact and the time step is cut to fit.
+inline constexpr int kMinSamplesPerPeriod = 16;
+inline constexpr int kMaxSamplesPerPeriod = 100'000;
+/// samples_per_period × analysed_periods: the recorded signals keep 9 doubles per
+/// sample (RunEstimate::signal_bytes), 1e7 samples are ~720 MB.
+inline constexpr long long kMaxRecordedSamples = 10'000'000;
+/// Snapshots: [0, min(recorded samples, 10000)] (one per block at most; each holds
+/// every particle: RunEstimate::snapshot_bytes).
+inline constexpr int kMaxSnapshots = 10'000;
+}  // namespace limits
+
 /// A harmonic DEM run (PHYSICS.md §1): x_c = X sin(Ωt) along drive_axis.
 struct DamperSimulationOptions {
   WorldOptions world;
   Vec3 drive_axis{1.0, 0.0, 0.0};  ///< direction of the drive (normalised), world = body frame at rest
-  double amplitude_m = 0.04;       ///< stroke X, m, > 0
-  double frequency_hz = 2.0;       ///< f, Hz, > 0
-  /// Settling under gravity with the container at rest before the drive starts, s;
-  /// −1 = automatic (lattice: 0.01 s; random: 2√(2L/|g|) + 0.02 s; no gravity: 0).
+  double amplitude_m = 0.04;       ///< stroke X, m, in (0, 10]
+  double frequency_hz = 2.0;       ///< f, Hz, in [0.01, 10000]
+  /// Settling under gravity with the container at rest before the drive starts, s, in
+  /// [0, 100]; −1 = automatic (lattice: 0.01 s; random: 2√(2L/|g|) + 0.02 s; no gravity: 0).
   double settling_time_s = -1.0;
-  int transient_periods = 5;       ///< periods discarded before the analysis, >= 0
-  int analysed_periods = 10;       ///< whole periods analysed, >= 1
+  int transient_periods = 5;       ///< periods discarded before the analysis, in [0, 100000]
+  int analysed_periods = 10;       ///< whole periods analysed, in [1, 100000]
   /// Samples per period of the recorded signals (block averages of whole steps; the
-  /// time step is reduced so that a period is a whole number of blocks), >= 16.
+  /// time step is reduced so that a period is a whole number of blocks), in [16, 100000];
+  /// samples_per_period × analysed_periods <= 1e7.
   int samples_per_period = 1000;
-  /// Particle snapshots kept, evenly spaced over the analysed periods, >= 0.
+  /// Particle snapshots kept, evenly spaced over the analysed periods, in
+  /// [0, min(samples_per_period × analysed_periods, 10000)].
   int snapshots = 0;
 
   /// All violations, one line each, prefixed by `prefix` (world fields included).
@@ -127,9 +153,11 @@ struct DamperResult {
   std::vector<std::string> warnings;   ///< validity-range remarks (INTERFACE.md)
 };
 
-/// Progress of a run, reported about twice a second.
+/// Progress of a run: once at the start ("setup", before the world is built, with the
+/// RunEstimate's wall time as eta_s), once the world is built, then about twice a
+/// second (the clock is read every step for large worlds).
 struct Progress {
-  std::string_view stage;        ///< "settling", "transient", "analysis"
+  std::string_view stage;        ///< "setup", "settling", "transient", "analysis"
   double simulated_time_s = 0.0; ///< since the drive started (negative while settling)
   double end_time_s = 0.0;       ///< simulated time at the end of the run
   double steps_per_s = 0.0;
@@ -137,10 +165,49 @@ struct Progress {
 };
 using ProgressCallback = std::function<void(const Progress&)>;
 
+/// What a run will cost, computed without building the world (run_harmonic's time step
+/// and step counts exactly; memory from the sizes the world reserves; wall time at a
+/// measured rate). Hostile inputs (a huge sample count, snapshots of a large bed)
+/// show here before they exhaust memory.
+struct RunEstimate {
+  int particles = 0;
+  double time_step_s = 0.0;            ///< exactly as run_harmonic chooses it, s
+  std::int64_t steps_per_period = 0;
+  std::int64_t settling_steps = 0;
+  std::int64_t transient_steps = 0;
+  std::int64_t analysed_steps = 0;
+  std::int64_t total_steps = 0;        ///< settling + transient + analysed (= Summary::steps of a completed run)
+  double particle_steps = 0.0;         ///< total_steps × particles (double: may exceed 2^63 for hostile input)
+  /// analysed_periods × samples_per_period: the length of every TimeSeries column.
+  std::int64_t recorded_samples = 0;
+  int snapshots = 0;                   ///< snapshots kept
+  // Memory, bytes.
+  std::size_t particle_bytes = 0;      ///< particle arrays (struct of arrays)
+  std::size_t neighbour_bytes = 0;     ///< Verlet rows (pairs and walls) and the cell grid, as reserved
+  std::size_t contact_bytes = 0;       ///< contact history pools, as reserved
+  std::size_t signal_bytes = 0;        ///< recorded signals and time series (9 doubles per sample) and per-period η*
+  std::size_t snapshot_bytes = 0;      ///< snapshots × particles × 84 bytes
+  std::size_t memory_bytes = 0;        ///< sum of the above
+  /// Assumed rate, particle-steps/s: bench/results/cpp-2core/bench_dem.txt (2-core
+  /// machine, steel spheres): serial worlds (threads = 1 or <= 1500 particles) below
+  /// 10,000 particles 25e6 (36 and 1000 spheres: 24-28e6), larger serial worlds 11e6
+  /// (100,000 spheres, 1 thread: 10.3-11.0e6), larger parallel worlds 21e6 (100,000
+  /// spheres, 2 threads: 18.3-22.6e6; more threads are not measured and not assumed
+  /// faster). Dense, colliding beds run slower than this by up to ~2.
+  double particle_steps_per_s = 0.0;
+  double wall_time_s = 0.0;            ///< particle_steps / particle_steps_per_s, s
+};
+
+/// The estimate of run_harmonic(options). Throws std::invalid_argument as run_harmonic
+/// does for invalid options (all violations, one per line) or a time step above the bound.
+RunEstimate estimate_run(const DamperSimulationOptions& options);
+
 /// Runs settling, transient_periods and analysed_periods of the harmonic drive and
 /// computes the measures. Bad options: std::invalid_argument (all violations, one per
 /// line; particles that do not fit name the numbers). A detected instability returns
-/// with summary.outcome = kUnstable and advice in summary.message (measures unset).
+/// with summary.outcome = kUnstable and advice in summary.message (measures unset); a
+/// failure during a step (e.g. a restitution model that throws, on any thread) returns
+/// with kFailed and the exception's message.
 DamperResult run_harmonic(const DamperSimulationOptions& options,
                           const ProgressCallback& progress = {});
 

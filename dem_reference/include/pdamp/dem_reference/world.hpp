@@ -46,10 +46,12 @@ struct ContactCensus {
   int airborne = 0;        ///< particles touching nothing
 };
 
-/// Status of a world: instability stops meaningful stepping.
+/// Status of a world: instability or a failure stops meaningful stepping.
 struct WorldStatus {
-  Outcome outcome = Outcome::kCompleted;  ///< kCompleted while healthy, kUnstable once detected
-  std::string message;                    ///< reason and advice when unstable
+  /// kCompleted while healthy, kUnstable once an instability is detected, kFailed once
+  /// a step threw (e.g. a user restitution model): step() catches it on every thread.
+  Outcome outcome = Outcome::kCompleted;
+  std::string message;                    ///< reason and advice when not kCompleted
 };
 
 /// A world of spheres in one or more compartments of a rigid damper body.
@@ -73,7 +75,9 @@ class World {
   /// Advances one time step; `container` is the container's state at time_s() + dt.
   /// Returns what the container applies to the particles at the new time. Does not
   /// allocate (except when a Verlet-list rebuild outgrows the reserved capacity).
-  /// After an instability (status().outcome == kUnstable) it does nothing.
+  /// Never throws: an exception inside the step (any thread) sets status() to kFailed
+  /// with its message. After an instability or a failure (status().outcome !=
+  /// kCompleted) it does nothing.
   const ContainerLoad& step(const ContainerState& container);
   /// step(motion.state(time_s() + dt)).
   const ContainerLoad& step(const ContainerMotion& motion);

@@ -85,8 +85,12 @@ nlohmann::json to_json(const EffectiveField& field);
 /// increasing, non-finite numbers, null where a value is required, table shape or
 /// coordinates not matching the axes.
 EffectiveField effective_field_from_json(const nlohmann::json& document, const std::string& file_name);
-/// Reads a field file (std::invalid_argument "<path>: ..." for unreadable files, bad JSON and
-/// every rule of effective_field_from_json).
+/// Reads a field file through formulas::read_input_file and parse_json_document:
+/// std::invalid_argument "<path>: <reason>" for a missing file, a directory, a FIFO
+/// (refused at once, never read), a device or a file above 256 MiB, "<path>: malformed
+/// JSON: ..." or "<path>: <pointer>: duplicate key", and every rule of
+/// effective_field_from_json (which also refuses more than kMaxGridNodes nodes at /axes
+/// and a motion_mode holding control characters).
 EffectiveField read_effective_field(const std::filesystem::path& path);
 /// Writes the field atomically: a temporary file in the same folder, fsync, then rename
 /// over `path`, so readers see the old file or the new one, never a partial one.

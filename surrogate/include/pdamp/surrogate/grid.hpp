@@ -60,6 +60,11 @@ struct Axis {
   bool operator==(const Axis&) const = default;
 };
 
+/// Most nodes a grid may have (1000 x 1000). A finer field is never needed for
+/// interpolation, its file would approach the 256 MiB input-file limit, and its DEM
+/// sweep (minutes per point) would run for years: a 2000 x 2000 request is a typo.
+inline constexpr std::size_t kMaxGridNodes = 1'000'000;
+
 /// Which pair of quantities a grid spans.
 enum class GridAxes {
   kFrequencyAmplitude,            ///< axis 0 frequency_hz, axis 1 amplitude_m
@@ -72,7 +77,8 @@ struct Grid {
   Axis axis0;  ///< frequency_hz or intensity (slow index i0)
   Axis axis1;  ///< amplitude_m or stroke_over_clearance (fast index i1)
 
-  /// Grid of the given kind from two ranges (throws std::invalid_argument on bad ranges).
+  /// Grid of the given kind from two ranges (throws std::invalid_argument on bad ranges
+  /// or more than kMaxGridNodes nodes in all).
   static Grid from_ranges(GridAxes axes, const AxisRange& range0, const AxisRange& range1);
   /// The pair of quantities; throws std::invalid_argument if the pair is not one of GridAxes.
   GridAxes axes() const;
@@ -82,7 +88,7 @@ struct Grid {
   /// Axis values of storage entry k: {axis0.values[k / n1], axis1.values[k % n1]}.
   double coordinate0(std::size_t k) const { return axis0.values[k / axis1.size()]; }
   double coordinate1(std::size_t k) const { return axis1.values[k % axis1.size()]; }
-  /// Both axes' rules plus the pairing rule; empty if valid.
+  /// Both axes' rules, the pairing rule and size() <= kMaxGridNodes; empty if valid.
   std::vector<std::string> validate() const;
   bool operator==(const Grid&) const = default;
 };

@@ -55,8 +55,11 @@ ScatteredFitResult fit_scattered_law(std::span<const ScatteredSample> samples, s
 void write_scattered_fit(const ScatteredFitResult& result, const std::filesystem::path& path);
 /// Reads a coefficient file strictly: jump_fraction, exponent, s_min, s_max, source and
 /// residual required; format, format_version, points and the two *_stderr optional;
-/// unknown keys, wrong types, values outside formulas::ScatteredFit's ranges, s_max
-/// outside [s_min, 1] or residual < 0 throw std::invalid_argument("<path>: <pointer>: <rule>").
+/// unknown or repeated keys, wrong types, values outside formulas::ScatteredFit's ranges
+/// (jump_fraction in [0, 1], exponent in [0, 10], s_min in [0, 1)), s_max outside
+/// [s_min, 1], residual < 0, points < 3, negative *_stderr or a source with control
+/// characters throw std::invalid_argument("<path>: <pointer>: <rule>"); so do a missing
+/// file, a directory or a FIFO ("<path>: <reason>", at once).
 /// The returned fit has provisional = false; pass result.fit as ModelOptions::scattered.
 ScatteredFitResult read_scattered_fit(const std::filesystem::path& path);
 

@@ -21,9 +21,11 @@ namespace pdamp::surrogate {
 /// computed; throwing stops the sweep (the exception reaches run_sweep's caller).
 using PointEvaluator = std::function<FieldPoint(double frequency_hz, double amplitude_m)>;
 
-/// Progress after each finished point: points done (resumed ones included), points in
-/// the grid, and the estimated seconds left (NaN until this run has finished a point).
-/// Called from worker threads, one call at a time.
+/// Progress: called once before the first point is evaluated (points_done = the resumed
+/// points, 0 for a new sweep, so the user sees a line at once) and after each finished
+/// point: points done (resumed ones included), points in the grid, and the estimated
+/// seconds left (NaN until this run has finished a point). Called from worker threads,
+/// one call at a time.
 using SweepProgress = std::function<void(std::size_t points_done, std::size_t points_total, double eta_s)>;
 
 /// What a sweep writes where, and the identity that guards its results file.
@@ -48,6 +50,9 @@ struct SweepSummary {
   std::size_t points_computed = 0;  ///< evaluated in this run (ok or failed)
   std::size_t points_failed = 0;    ///< status kFailed among all points
   double wall_time_s = 0.0;         ///< this run
+  /// One line each, for the user: a partial last line of the results file (a write cut
+  /// by a kill) that was dropped, "<file>: line N: cut short (...); dropped, ...".
+  std::vector<std::string> warnings;
   /// "18 points: 6 resumed, 12 computed (0 failed) in 12.3 s".
   std::string brief_report() const;
 };
@@ -67,9 +72,11 @@ struct SweepResult {
 /// file: a header that differs from this sweep's (another case, model version, source,
 /// clearance, bed mass or grid) throws std::invalid_argument telling the user to delete
 /// or move the file, so stale points are never mixed in; a last line without its newline
-/// (a killed write) is dropped and recomputed; any other damaged line throws
-/// std::invalid_argument. A second sweep on the same file at the same time is refused
-/// (std::runtime_error; the file is locked with flock).
+/// (a write cut by SIGTERM or a crash) is truncated away, recomputed and reported in
+/// SweepSummary::warnings; any other damaged line (bad JSON, a repeated key, a value
+/// out of range) throws std::invalid_argument naming the line. A results path that is a
+/// directory, FIFO or device throws std::invalid_argument at once. A second sweep on the
+/// same file at the same time is refused (std::runtime_error; the file is locked with flock).
 ///
 /// Ok points with NaN e_diss_j get η*·½ m_bed (XΩ)² (PHYSICS.md §1), and NaN
 /// apparent_mass_fraction gets apparent_mass_kg/m_bed.
@@ -80,6 +87,15 @@ struct SweepResult {
 /// non-finite η*, or status missing, counts as throwing std::runtime_error.
 /// Throws std::invalid_argument for an invalid grid or options, std::runtime_error for I/O.
 SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options);
+
+/// Grid nodes a run_sweep(grid, evaluator, options) would evaluate now: grid.size()
+/// minus the points already saved in options.results_path (0 saved if the path is
+/// empty or does not exist; a cut last line counts as not saved). Reads the file without
+/// writing or locking it, so a caller can estimate the run time (the CLI multiplies by
+/// its time per point) before starting. Throws what run_sweep would throw before its
+/// first point: std::invalid_argument for an invalid grid or options (kMaxGridNodes
+/// included), a results file of another sweep, a damaged line, a directory or FIFO.
+std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options);
 
 /// Evaluator of the closed forms (formulas::reduced_loss_factor) for one damper: η*,
 /// stderr 0 (exact), E_diss = η*·½ m_bed (XΩ)², apparent mass not given (NaN; the closed

@@ -1,0 +1,102 @@
+// External programs through fork/exec with an argument vector, and signal handling.
+#include "external_program.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <sstream>
+
+#include "errors.hpp"
+
+namespace pdamp::cli {
+
+namespace fs = std::filesystem;
+
+std::optional<fs::path> find_executable(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path != nullptr ? path : "/usr/local/bin:/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (dir.empty() || dir[0] != '/') continue;  // relative PATH entries would depend on -o
+    const fs::path candidate = fs::path(dir) / name;
+    struct stat info {};
+    if (::stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
+      return candidate;
+  }
+  return std::nullopt;
+}
+
+int run_program(const fs::path& program, const std::vector<std::string>& arguments, const fs::path& directory,
+                const fs::path& log_file) {
+  // Everything the child needs is prepared before fork(): after it, only
+  // async-signal-safe calls (open, dup2, chdir, execv, _exit).
+  std::vector<std::string> argv_text;
+  argv_text.push_back(program.string());
+  argv_text.insert(argv_text.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string dir = directory.string(), log = log_file.string();
+
+  const pid_t child = ::fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    // The child takes the default signal actions: a Ctrl-C ends it as it ends pdamp.
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    ::signal(SIGHUP, SIG_DFL);
+    const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (in < 0 || out < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0) ::_exit(127);
+    if (::chdir(dir.c_str()) != 0) ::_exit(127);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+namespace {
+
+std::atomic<int> g_output_phase{0};
+volatile sig_atomic_t g_pending_signal = 0;
+
+extern "C" void on_interrupt(int signal_number) {
+  if (g_output_phase.load() > 0) {
+    g_pending_signal = signal_number;
+    return;
+  }
+  // Outside the output phase: end as the default action would (the signal is blocked
+  // while this handler runs and is delivered again, with SIG_DFL, when it returns).
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+}  // namespace
+
+void install_interrupt_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: a blocked read or wait returns with EINTR
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(s, &action, nullptr);
+}
+
+void begin_output_phase() { ++g_output_phase; }
+void end_output_phase() { --g_output_phase; }
+int pending_interrupt() { return g_pending_signal; }
+
+void stop_if_interrupted() {
+  if (const int s = g_pending_signal; s != 0) throw Interrupted(s);
+}
+
+}  // namespace pdamp::cli

@@ -1,0 +1,42 @@
+// Starting external programs (gnuplot) without a shell, and the interruption state
+// that a signal leaves (INTERFACE.md: "No shell: external programs start with an
+// argument vector; nothing in a case file or a path can run a command").
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pdamp::cli {
+
+/// The executable `name` on PATH (an absolute path), or nothing. Searched directly,
+/// never through `sh -c "command -v ..."`.
+std::optional<std::filesystem::path> find_executable(const std::string& name);
+
+/// Runs `program` with `arguments` (argv[1...], passed verbatim: no word splitting,
+/// no globbing, no quoting, no substitution) in working directory `directory`, with
+/// stdin from /dev/null and stdout and stderr appended to `log_file`. Returns the exit
+/// status (0 success), or -1 when the program could not be started or was killed.
+int run_program(const std::filesystem::path& program, const std::vector<std::string>& arguments,
+                const std::filesystem::path& directory, const std::filesystem::path& log_file);
+
+/// Installs pdamp's handlers for SIGINT, SIGTERM and SIGHUP. Outside an output phase a
+/// signal ends the process at once as it would without pdamp's handler (nothing is
+/// half-written then: results are only staged later; a staging folder left behind is
+/// removed by the next run into that directory). Inside one (OutputDir staging and
+/// committing files) the signal is recorded and the writer stops at its next step,
+/// removes what it staged and ends by the signal's default action.
+void install_interrupt_handlers();
+
+/// Marks the output phase (nesting counts). While it lasts signals are deferred.
+void begin_output_phase();
+void end_output_phase();
+
+/// The signal received during an output phase, or 0.
+int pending_interrupt();
+
+/// Throws Interrupted (errors.hpp) when a signal arrived during the output phase.
+void stop_if_interrupted();
+
+}  // namespace pdamp::cli

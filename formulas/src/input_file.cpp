@@ -1,0 +1,183 @@
+// Safe reading of users' input files (see input_file.hpp).
+#include "pdamp/formulas/input_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <set>
+#include <stdexcept>
+#include <vector>
+
+namespace pdamp::formulas {
+
+namespace {
+
+[[noreturn]] void refuse(const std::string& path, const std::string& reason) {
+  throw std::invalid_argument(printable(path) + ": " + reason);
+}
+
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  return "not a regular file";
+}
+
+/// Length of the valid UTF-8 sequence starting at s[i] (0 when invalid).
+std::size_t utf8_length(const std::string& s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char lead = byte(i);
+  std::size_t n = lead >= 0xF0 && lead <= 0xF4 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 && lead < 0xE0 ? 2 : 0;
+  if (n == 0 || i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((byte(i + k) & 0xC0) != 0x80) return 0;
+  return n;
+}
+
+}  // namespace
+
+std::string printable(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (c == '\n') {
+      out += "\\n";
+      ++i;
+    } else if (c == '\t') {
+      out += "\\t";
+      ++i;
+    } else if (c == '\r') {
+      out += "\\r";
+      ++i;
+    } else if (c == 0) {
+      out += "\\0";
+      ++i;
+    } else if (const std::size_t n = c >= 0x80 ? utf8_length(text, i) : 0; n > 0) {
+      out.append(text, i, n);  // printable non-ASCII text (names in other scripts) stays
+      i += n;
+    } else {
+      char escape[8];
+      std::snprintf(escape, sizeof escape, "\\x%02x", c);
+      out += escape;
+      ++i;
+    }
+  }
+  return out;
+}
+
+std::string read_input_file(const std::string& path) {
+  if (path.empty()) refuse("''", "empty file name");
+  // O_NONBLOCK: opening a FIFO for reading with no writer would block forever.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int error = errno;
+    struct stat info {};
+    if (error == ENOENT) refuse(path, "no such file");
+    if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) refuse(path, std::string("is ") + kind_of(info.st_mode) + ", not a file");
+    refuse(path, std::string("cannot be opened (") + std::strerror(error) + ")");
+  }
+  struct FileCloser {
+    int fd;
+    ~FileCloser() { ::close(fd); }
+  } closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) refuse(path, std::string("cannot be read (") + std::strerror(errno) + ")");
+  if (!S_ISREG(info.st_mode)) refuse(path, std::string("is ") + kind_of(info.st_mode) + ", not a file");
+  if (static_cast<unsigned long long>(info.st_size) > kMaxInputFileBytes)
+    refuse(path, "is " + std::to_string(info.st_size >> 20) + " MiB, larger than the " +
+                     std::to_string(kMaxInputFileBytes >> 20) + " MiB an input file may have");
+  std::string bytes;
+  bytes.resize(static_cast<std::size_t>(info.st_size));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) refuse(path, std::string("read failed (") + std::strerror(errno) + ")");
+    if (n == 0) break;  // the file shrank while being read: take what is there
+    done += static_cast<std::size_t>(n);
+  }
+  bytes.resize(done);
+  return bytes;
+}
+
+namespace {
+
+/// RFC 6901 reference token of an object key ("~" -> "~0", "/" -> "~1").
+std::string pointer_token(const std::string& key) {
+  std::string token;
+  for (char c : key) token += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+  return token;
+}
+
+/// The parser's position: one frame per open object or array, for duplicate-key
+/// detection and for naming where a duplicate sits.
+struct Frame {
+  bool object = true;
+  std::set<std::string> keys;
+  std::string key;        // the object's current key
+  std::size_t index = 0;  // the array's current element
+};
+
+std::string pointer_of(const std::vector<Frame>& frames) {
+  std::string pointer;
+  // The last frame is the object holding the duplicate; its parents give the path.
+  for (std::size_t i = 0; i + 1 < frames.size(); ++i)
+    pointer += "/" + (frames[i].object ? pointer_token(frames[i].key) : std::to_string(frames[i].index));
+  return pointer;
+}
+
+struct DuplicateKey {
+  std::string pointer;
+};
+
+}  // namespace
+
+nlohmann::json parse_json_document(const std::string& text, const std::string& path) {
+  using nlohmann::json;
+  std::vector<Frame> frames;
+  const auto element_done = [&] {
+    if (!frames.empty() && !frames.back().object) ++frames.back().index;
+  };
+  const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start: frames.push_back({true, {}, {}, 0}); break;
+      case json::parse_event_t::array_start: frames.push_back({false, {}, {}, 0}); break;
+      case json::parse_event_t::key: {
+        Frame& top = frames.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second) throw DuplicateKey{pointer_of(frames) + "/" + pointer_token(top.key)};
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames.pop_back();
+        element_done();
+        break;
+      case json::parse_event_t::value: element_done(); break;
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, track);
+  } catch (const DuplicateKey& duplicate) {
+    throw std::invalid_argument(printable(path) + ": " + printable(duplicate.pointer) +
+                                ": duplicate key (each key may appear once in an object)");
+  } catch (const json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 9: ...".
+    std::string what = e.what();
+    const auto start = what.find("] ");
+    throw std::invalid_argument(printable(path) + ": malformed JSON: " +
+                                printable(start == std::string::npos ? what : what.substr(start + 2)));
+  }
+}
+
+}  // namespace pdamp::formulas

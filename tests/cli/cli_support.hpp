@@ -1,0 +1,37 @@
+// Helpers of the command-line tests: shipped and edited case files, the error contract.
+#pragma once
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/run_pdamp.hpp"
+
+namespace pdamp::test {
+
+inline std::string case_path(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/cases/" + name; }
+
+/// Writes a case built from the shipped low-intensity case with one edit applied.
+inline std::string edited_case(const std::string& name, const std::function<void(nlohmann::json&)>& edit) {
+  std::ifstream in(case_path("low_intensity_36_spheres.json"));
+  nlohmann::json c = nlohmann::json::parse(in);
+  edit(c);
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << c.dump(2);
+  return path.string();
+}
+
+/// INTERFACE.md: exit 2, nothing on stdout, one line `pdamp: error: ...` on stderr.
+inline void require_one_line_error(const RunResult& r, const std::string& must_contain) {
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.empty());
+  CHECK(r.err.rfind("pdamp: error: ", 0) == 0);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK_THAT(r.err, Catch::Contains(must_contain));
+}
+
+}  // namespace pdamp::test

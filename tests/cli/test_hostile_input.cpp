@@ -1,0 +1,305 @@
+// Hostile and nonsensical input (issue 8, docs/bad_inputs.md): no command runs from a
+// case file or a path, nothing hangs, every refusal is exit 2 with one line naming the
+// file or flag and the key, and an interrupted run leaves no partial result.
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/cli_support.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+bool gnuplot_installed() {
+  for (const char* dir : {"/usr/bin", "/usr/local/bin", "/bin"})
+    if (::access((fs::path(dir) / "gnuplot").c_str(), X_OK) == 0) return true;
+  return false;
+}
+
+/// Shell and gnuplot payloads that would create `marker` if anything expanded them:
+/// backquotes (gnuplot and sh), $(...), quotes closing a string, gnuplot's system(),
+/// a newline starting a new gnuplot command, a macro.
+std::vector<std::string> payloads(const fs::path& marker) {
+  const std::string m = marker.string();
+  return {"`touch " + m + "`",
+          "$(touch " + m + ")",
+          "'; system('touch " + m + "'); '",
+          "\"; system(\"touch " + m + "\"); \"",
+          "x\nsystem(\"touch " + m + "\")\nset title 'y",
+          "a'b\"c`d$(e) @f \\",
+          "'`touch " + m + "`'"};
+}
+
+/// stdout is exactly one JSON object.
+void require_one_json_object(const std::string& out) {
+  json value;
+  REQUIRE_NOTHROW(value = json::parse(out));
+  CHECK(value.is_object());
+}
+
+void require_plot(const fs::path& dir, const std::string& name) {
+  if (!gnuplot_installed()) return;  // without gnuplot the scripts are written instead
+  INFO(dir / name);
+  REQUIRE(fs::exists(dir / name));
+  CHECK(fs::file_size(dir / name) > 100);
+}
+
+pid_t dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+}  // namespace
+
+TEST_CASE("a case name cannot run a command through the plots", "[cli]") {
+  TempDir tmp("hostile_names");
+  const fs::path marker = tmp.path / "MARK";
+  int i = 0;
+  for (const auto& name : payloads(marker)) {
+    INFO(name);
+    const auto path = edited_case("pdamp_hostile_name.json", [&](json& c) { c["name"] = name; });
+    const fs::path out = tmp.path / ("run" + std::to_string(i++));
+    const auto r = run_pdamp({"run", path, "-o", out.string(), "--json"});
+    REQUIRE(r.exit_code == 0);
+    require_one_json_object(r.out);
+    require_plot(out, "eta_curve.png");
+    CHECK(!fs::exists(marker));
+    // The DEM picture and the field pictures carry the name as well.
+    const auto field = run_pdamp({"field", path, "--source", "formulas", "-o", (out / "field").string(), "--json"});
+    REQUIRE(field.exit_code == 0);
+    require_one_json_object(field.out);
+    require_plot(out / "field", "field_cuts.png");
+    CHECK(!fs::exists(marker));
+  }
+}
+
+TEST_CASE("an output path cannot run a command and still gets its plots", "[cli]") {
+  TempDir tmp("hostile_paths");
+  const fs::path marker = tmp.path / "MARK";
+  const std::string m = marker.string();
+  const std::vector<std::string> names = {"o'; touch " + m + "; '", "$(touch " + m + ")", "`touch " + m + "`",
+                                          "new\nline", "sp ace", "quote\"d"};
+  for (const auto& name : names) {
+    INFO(name);
+    const fs::path out = tmp.path / name;
+    const auto r = run_pdamp({"loss", "--model", "rolling", "--clearance", "0.1", "--amplitude", "0.04", "--frequency",
+                              "2", "-o", out.string(), "--json"});
+    REQUIRE(r.exit_code == 0);
+    require_one_json_object(r.out);
+    require_plot(out, "eta_curve.png");
+    CHECK(!fs::exists(marker));
+  }
+  // A relative folder whose name starts with '-' (given after -o, so it is a value).
+  RunOptions in_tmp;
+  in_tmp.directory = tmp.path;
+  const auto r = run_pdamp({"run", case_path("low_intensity_36_spheres.json"), "-o", "-dash", "--json"}, in_tmp);
+  REQUIRE(r.exit_code == 0);
+  require_plot(tmp.path / "-dash", "eta_curve.png");
+  CHECK(!fs::exists(marker));
+}
+
+TEST_CASE("a case name cannot steer the default output folder", "[cli]") {
+  TempDir tmp("hostile_default_dir");
+  fs::create_directories(tmp.path / "work");
+  RunOptions in_work;
+  in_work.directory = tmp.path / "work";
+  for (const std::string name : {"../../escaped", "/tmp/absolute_escape", ".."}) {
+    INFO(name);
+    const auto path = edited_case("pdamp_steer.json", [&](json& c) { c["name"] = name; });
+    const auto r = run_pdamp({"field", path, "--source", "formulas", "--json"}, in_work);
+    REQUIRE(r.exit_code == 0);
+    const json f = json::parse(r.out);
+    const fs::path written = fs::weakly_canonical(in_work.directory / f["file"].get<std::string>());
+    // Inside work/out/, whatever the name says.
+    CHECK(written.string().rfind(fs::weakly_canonical(in_work.directory / "out").string() + "/", 0) == 0);
+    CHECK_THAT(r.err, Catch::Contains("not a safe folder name"));
+  }
+  CHECK(!fs::exists(tmp.path.parent_path() / "escaped_field_formulas"));
+  CHECK(!fs::exists("/tmp/absolute_escape_field_formulas"));
+}
+
+TEST_CASE("a FIFO or a directory given as an input file is refused at once", "[cli]") {
+  TempDir tmp("fifo");
+  const fs::path fifo = tmp.path / "case.fifo";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  const fs::path folder = tmp.path / "folder.json";
+  fs::create_directories(folder);
+  RunOptions quick;
+  quick.time_limit_s = 30.0;  // a hang (the old behaviour) is a time-out, exit_code -2
+  for (const fs::path& input : {fifo, folder}) {
+    INFO(input);
+    const std::string kind = input == fifo ? "FIFO" : "directory";
+    for (const std::string command : {"validate", "run", "dem", "field"}) {
+      std::vector<std::string> args = {command, input.string()};
+      if (command == "field") args.insert(args.end(), {"--source", "formulas"});
+      require_one_line_error(run_pdamp(args, quick), input.string() + ": is a " + kind);
+    }
+    require_one_line_error(run_pdamp({"field", case_path("low_intensity_36_spheres.json"), "--source", "measured",
+                                      "--measured", input.string(), "-o", (tmp.path / "m").string()},
+                                     quick),
+                           "is a " + kind);
+    require_one_line_error(run_pdamp({"loss", "--model", "rolling", "--clearance", "0.1", "--amplitude", "0.03",
+                                      "--frequency", "2", "--scattered-fit", input.string()},
+                                     quick),
+                           "is a " + kind);
+  }
+  require_one_line_error(run_pdamp({"validate", (tmp.path / "missing.json").string()}, quick), "missing.json: no such file");
+}
+
+TEST_CASE("the output directory is checked before any work", "[cli]") {
+  TempDir tmp("bad_out");
+  const fs::path file = tmp.path / "a_file";
+  std::ofstream(file) << "x";
+  const std::string low = case_path("low_intensity_36_spheres.json");
+  require_one_line_error(run_pdamp({"run", low, "-o", file.string()}), "exists and is not a directory");
+  require_one_line_error(run_pdamp({"run", low, "-o", ""}), "-o: '': an empty path");
+  require_one_line_error(run_pdamp({"run", low, "-o", (file / "below").string()}), "cannot create the output directory");
+  // /proc refuses new entries even to root (CI runs as root, so permissions prove nothing).
+  require_one_line_error(run_pdamp({"run", low, "-o", "/proc/pdamp_out"}), "-o: '/proc/pdamp_out'");
+  // The DEM finds out before it starts: no progress line was printed.
+  const auto dem = run_pdamp({"dem", low, "-o", "/proc/pdamp_out"});
+  require_one_line_error(dem, "-o: '/proc/pdamp_out'");
+  CHECK(dem.err.find("pdamp dem:") == std::string::npos);
+  const auto field = run_pdamp({"field", low, "--source", "dem", "-o", file.string()});
+  require_one_line_error(field, "exists and is not a directory");
+  CHECK(field.err.find("pdamp field:") == std::string::npos);
+}
+
+TEST_CASE("a reused output folder holds one run's set; stale staging folders are removed", "[cli]") {
+  TempDir tmp("reuse");
+  const fs::path out = tmp.path / "out";
+  fs::create_directories(out);
+  const fs::path stale = out / (".pdamp-staging-" + std::to_string(dead_pid()));
+  fs::create_directories(stale);
+  std::ofstream(stale / "big.vtk") << "partial";
+  const fs::path alive = out / (".pdamp-staging-" + std::to_string(::getpid()));  // this test is alive
+  fs::create_directories(alive);
+  std::ofstream(out / "notes.txt") << "the user's own file";
+
+  const fs::path csv = tmp.path / "measured.csv";
+  std::ofstream(csv) << "frequency_hz,amplitude_m,eta_star,eta_star_stderr\n"
+                        "2,0.02,0.10,0.02\n2,0.04,0.80,0.05\n2,0.06,0.70,0.04\n"
+                        "3,0.02,0.12,0.02\n3,0.04,0.75,0.05\n3,0.06,0.66,0.04\n";
+  const std::string low = case_path("low_intensity_36_spheres.json");
+  REQUIRE(run_pdamp({"field", low, "--source", "measured", "--measured", csv.string(), "-o", out.string()}).exit_code == 0);
+  CHECK(!fs::exists(stale));
+  CHECK(fs::exists(alive));
+  const bool had_fit = fs::exists(out / "scattered_fit.json");
+  REQUIRE(run_pdamp({"field", low, "--source", "formulas", "-o", out.string()}).exit_code == 0);
+  // The measured run's fit does not stay beside the formulas field.
+  if (had_fit) CHECK(!fs::exists(out / "scattered_fit.json"));
+  std::ifstream in(out / "field.json");
+  CHECK(json::parse(in).dump().find("\"formulas\"") != std::string::npos);
+  CHECK(fs::exists(out / "notes.txt"));
+  fs::remove_all(alive);
+}
+
+TEST_CASE("an interrupted run exits non-zero and leaves no partial result", "[cli]") {
+  // A formulas field of 40 x 60 points with pictures takes about a second; signals at
+  // delays across its run hit the computation, gnuplot and the commit. Whatever the
+  // moment: either the run completed (exit 0, every listed file whole) or it exited
+  // non-zero and no result file is in the folder.
+  TempDir tmp("interrupt");
+  const auto path = edited_case("pdamp_interrupt.json", [](json& c) {
+    c["field"] = {{"axis0", {{"min", 1.0}, {"max", 5.0}, {"count", 40}}},
+                  {"axis1", {{"min", 0.005}, {"max", 0.12}, {"count", 60}}}};
+  });
+  int interrupted = 0;
+  for (int k = 0; k < 12; ++k) {
+    const int signal_number = k % 2 == 0 ? SIGINT : SIGTERM;
+    const int delay_ms = 40 + 90 * k;
+    INFO("signal " << signal_number << " after " << delay_ms << " ms");
+    const fs::path out = tmp.path / ("out" + std::to_string(k));
+    RunOptions options;
+    options.while_running = [&](pid_t pid) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+      ::kill(-pid, signal_number);  // the process group: pdamp and a running gnuplot
+    };
+    const auto r = run_pdamp({"field", path, "--source", "formulas", "-o", out.string()}, options);
+    if (r.exit_code == 0) {
+      for (const auto& entry : fs::directory_iterator(out))
+        if (entry.is_regular_file()) CHECK(fs::file_size(entry.path()) > 0);
+      continue;
+    }
+    ++interrupted;
+    CHECK(r.exit_code == 128 + signal_number);
+    if (fs::exists(out))
+      for (const auto& entry : fs::directory_iterator(out)) {
+        INFO(entry.path());
+        CHECK(!entry.is_regular_file());  // at most a staging folder, removed by the next run
+      }
+  }
+  CHECK(interrupted > 0);
+}
+
+TEST_CASE("flags take physical ranges and whole numbers where counts are meant", "[cli]") {
+  require_one_line_error(run_pdamp("buffer --frequency 60 --intensity 20 --radius 0.0025 --layer-modulus 60e6 "
+                                   "--impact-velocity 1e308 --json"),
+                         "--impact-velocity: '1e308': must be a finite number > 0 and <= 1000");
+  require_one_line_error(run_pdamp("size --model bouncing --stroke 1e308 --json"), "--stroke: '1e308'");
+  require_one_line_error(run_pdamp("loss --model auto --clearance 0.1 --amplitude 0.04 --frequency 1e308"),
+                         "--frequency: '1e308': must be a finite number >= 0.01 and <= 10000");
+  // A subnormal is a number, too small for a clearance (not "not > 0").
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance 1e-320"),
+                         "--clearance: '1e-320': must be a finite number >= 1e-06");
+  require_one_line_error(run_pdamp("dem " + case_path("low_intensity_36_spheres.json") + " --periods 1.5"),
+                         "--periods: '1.5': must be a whole number");
+  require_one_line_error(run_pdamp(std::vector<std::string>{}), "missing the command");
+  // With --json an error is still only the error line (stdout stays empty).
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance -1 --json"), "--clearance");
+}
+
+TEST_CASE("case keys take physical ranges and validate makes every check", "[cli]") {
+  const auto check = [](const std::string& name, const std::function<void(json&)>& edit, const std::string& message) {
+    INFO(name);
+    const auto path = edited_case(name, edit);
+    require_one_line_error(run_pdamp({"validate", path}), name + ": " + message);
+    // run refuses it the same way
+    require_one_line_error(run_pdamp({"run", path}), name + ": " + message);
+  };
+  check("pdamp_tiny_radius.json", [](json& c) { c["damper"]["particles"]["radius_m"] = 1e-300; },
+        "/damper/particles/radius_m: = 1e-300: must be a finite number >= 1e-05");
+  check("pdamp_huge_frequency.json", [](json& c) { c["excitation"]["frequency_hz"] = 1e308; },
+        "/excitation/frequency_hz: = 1e+308");
+  check("pdamp_fast_impact.json", [](json& c) { c["dem"]["max_impact_speed_m_s"] = 1e200; },
+        "/dem/max_impact_speed_m_s: = 1e+200: must be a finite number > 0 and <= 1000");
+  check("pdamp_big_clearance.json", [](json& c) { c["damper"]["clearance_m"] = 100.0; },
+        "/damper/clearance_m: = 100: must be <= the free length along the drive");
+  check("pdamp_empty_table.json",
+        [](json& c) { c["dem"]["contact"] = {{"restitution", {{"speeds_m_s", json::array()}, {"values", json::array()}}}}; },
+        "/dem/contact/restitution/speeds_m_s: has 0 entries: needs at least 2");
+  check("pdamp_low_cor.json", [](json& c) { c["dem"]["contact"] = {{"restitution", 0.001}}; },
+        "/dem/contact/restitution: = 0.001: must be a finite number >= 0.01");
+  check("pdamp_table_order.json",
+        [](json& c) { c["dem"]["contact"] = {{"restitution", {{"speeds_m_s", {1.0, 0.5}}, {"values", {0.9, 0.8}}}}}; },
+        "/dem/contact/restitution/speeds_m_s/1: speeds must increase strictly");
+}
+
+TEST_CASE("duplicate keys and binary bytes in a case file are refused on one line", "[cli]") {
+  TempDir tmp("dup");
+  const fs::path dup = tmp.path / "dup.json";
+  std::ofstream(dup) << R"({"name": "a", "damper": {"model": "auto", "model": "rolling"}})";
+  require_one_line_error(run_pdamp({"validate", dup.string()}), "dup.json: /damper/model: duplicate key");
+  const fs::path binary = tmp.path / "binary.json";
+  std::ofstream(binary, std::ios::binary) << std::string("{\"name\": \"a\0b\n\x1b[31m\", \x01}", 22);
+  const auto r = run_pdamp({"validate", binary.string()});
+  require_one_line_error(r, "binary.json: malformed JSON");
+  CHECK(r.err.find('\x1b') == std::string::npos);  // no terminal escape reaches the screen
+}
