@@ -426,7 +426,9 @@ double available_memory_bytes() {
   return available;
 }
 
-std::string megabytes(double bytes) { return format_number(bytes / 1e6, 3) + " MB"; }
+std::string megabytes(double bytes) {
+  return bytes >= 1e9 ? format_number(bytes / 1e9, 3) + " GB" : format_number(bytes / 1e6, 3) + " MB";
+}
 
 /// The DEM would not fit: exit 2 naming the keys that set its memory.
 [[noreturn]] void refuse_memory(const Case& c, const dem_reference::RunEstimate& e, double runs_at_once, double available) {
@@ -475,8 +477,8 @@ int run_dem(const ParsedArgs& args) {
     throw InputError(path, "/excitation/amplitude_m", "required by pdamp dem (or give --amplitude M)");
   const double x = amplitude.value_or(c.excitation.amplitude_m.value_or(0.0));
   auto options = dem_options(c, x, f);
-  if (const auto periods = args.optional_integer("--periods", 1, 1000000)) options.analysed_periods = static_cast<int>(*periods);
-  if (const auto threads = args.optional_integer("--threads", 0, 1024)) options.world.threads = static_cast<int>(*threads);
+  if (const auto periods = args.optional_integer("--periods", 1, dem_reference::limits::kMaxPeriods)) options.analysed_periods = static_cast<int>(*periods);
+  if (const auto threads = args.optional_integer("--threads", 0, dem_reference::limits::kMaxThreads)) options.world.threads = static_cast<int>(*threads);
   const auto estimate = check_dem_run(c, options);
   auto files = output_dir(args);
   std::cerr << estimate_line("pdamp dem", estimate) << std::endl;
@@ -490,8 +492,8 @@ int run_dem(const ParsedArgs& args) {
   }
   if (result.summary.outcome == dem_reference::Outcome::kUnstable)
     throw NumericalError("DEM unstable: " + result.summary.message);
-  if (result.summary.outcome != dem_reference::Outcome::kCompleted)
-    throw std::runtime_error("DEM failed: " + result.summary.message);
+  if (result.summary.outcome != dem_reference::Outcome::kCompleted)  // a step threw (on any thread)
+    throw NumericalError("DEM failed: " + result.summary.message);
 
   json out = dem_json(result);
   out.update({{"case", c.name}, {"amplitude_m", x}, {"frequency_hz", f}});

@@ -290,6 +290,40 @@ TEST_CASE("case keys take physical ranges and validate makes every check", "[cli
   check("pdamp_table_order.json",
         [](json& c) { c["dem"]["contact"] = {{"restitution", {{"speeds_m_s", {1.0, 0.5}}, {"values", {0.9, 0.8}}}}}; },
         "/dem/contact/restitution/speeds_m_s/1: speeds must increase strictly");
+  // Checks made by the DEM's own validation come back with the case key's pointer.
+  check("pdamp_pin_outside.json",
+        [](json& c) { c["dem"]["inner_structures"] = {{"pins", {{{"centre_m", {1.0, 0.0, 0.0}}, {"radius_m", 0.005}, {"length_m", 0.05}}}}}; },
+        "/dem/inner_structures/pins/0/centre_m: = [1, 0, 0]: pin 0 spans x [0.995, 1.005]");
+  check("pdamp_samples.json", [](json& c) { c["dem"]["samples_per_period"] = 100000; c["dem"]["analysed_periods"] = 1000; },
+        "/dem/samples_per_period: = 100000: samples_per_period x analysed_periods = 100000000 recorded samples must be <= 10000000");
+  check("pdamp_drive_speed.json", [](json& c) { c["excitation"] = {{"frequency_hz", 100.0}, {"amplitude_m", 10.0}}; },
+        "/excitation/amplitude_m: = 10: the drive's impact speed");
+}
+
+TEST_CASE("a DEM run announces its cost first and one that cannot fit in memory is refused", "[cli]") {
+  // A million 0.1 mm spheres with 10,000 snapshots: 1e6 x 1e4 x 84 bytes = 840 GB.
+  const auto big = edited_case("pdamp_memory.json", [](json& c) {
+    c["damper"]["container"] = {{"shape", "box"}, {"inner_size_m", {0.05, 0.02, 0.02}}};
+    c["damper"]["particles"] = {{"count", 1000000}, {"radius_m", 1e-4}};
+    c["excitation"] = {{"frequency_hz", 50.0}, {"amplitude_m", 0.001}};
+    c["dem"] = {{"snapshots", 10000}};
+  });
+  for (const std::string command : {"validate", "dem"}) {
+    const auto r = run_pdamp({command, big});
+    require_one_line_error(r, "pdamp_memory.json: /dem: the DEM needs about 841 GB (1000000 particles");
+    CHECK_THAT(r.err, Catch::Contains("reduce /dem/samples_per_period, /dem/analysed_periods, /dem/snapshots"));
+  }
+  // A run that fits says what it will cost before its first step.
+  const auto quick = edited_case("pdamp_quick_estimate.json", [](json& c) {
+    c["dem"] = {{"stiffness_softening", 1e-3}, {"transient_periods", 0}, {"analysed_periods", 1}};
+  });
+  const auto r = run_pdamp({"dem", quick, "--json"});
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.rfind("pdamp dem: 36 particles, ", 0) == 0);
+  CHECK_THAT(r.err, Catch::Contains("particle-steps, about"));
+  const json d = json::parse(r.out);
+  // The estimate's steps are the run's (estimate_run plans the run exactly).
+  CHECK_THAT(r.err, Catch::Contains(std::to_string(d["run"]["steps"].get<long long>()) + " steps of"));
 }
 
 TEST_CASE("duplicate keys and binary bytes in a case file are refused on one line", "[cli]") {

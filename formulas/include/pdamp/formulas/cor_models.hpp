@@ -74,7 +74,8 @@ struct ImpactData {
 /// (any order, extra columns ignored, blank lines and lines starting with '#'
 /// skipped); std::invalid_argument naming file and line for a missing column, a
 /// short row, a non-numeric or non-finite value, a negative speed, ε outside (0, 1]
-/// or a file without data rows; std::runtime_error if the file cannot be opened.
+/// or a file without data rows, and if the file cannot be read (missing, a directory,
+/// a FIFO: formulas::read_input_file).
 ImpactData read_impact_csv(const std::string& path);
 
 enum class RestitutionLaw {
