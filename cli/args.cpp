@@ -11,7 +11,9 @@
 namespace pdamp::cli {
 
 std::optional<double> parse_number(const std::string& text) {
-  if (text.empty()) return std::nullopt;
+  // Decimal notation only: strtod also takes hexadecimal ("0x10" = 16), "inf" and
+  // "nan", which no user means as a clearance or a count.
+  if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos) return std::nullopt;
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);

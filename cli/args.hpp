@@ -49,7 +49,7 @@ class ParsedArgs {
   bool help_ = false;
 };
 
-/// Strict number parsing: the whole text must be a finite number (a value that
+/// Strict number parsing: the whole text must be a finite decimal number (a value that
 /// underflows to a subnormal or to zero is returned as it is, for the range check to
 /// judge; one that overflows is not a number).
 std::optional<double> parse_number(const std::string& text);

@@ -100,11 +100,14 @@ class ObjectReader {
     resolved_[key] = value;
     return value;
   }
+  /// Absent: nothing. null is not "absent" (it would hide a half-edited value): a
+  /// number must be given or the key omitted.
   std::optional<double> optional_number(const std::string& key, Range range, const std::string& unit = "") {
-    if (!object_.contains(key) || object_.at(key).is_null()) {
+    if (!object_.contains(key)) {
       known_.insert(key);
       return std::nullopt;
     }
+    if (object_.at(key).is_null()) fail(key, "must be a number" + unit + " (omit the key for the default), got null");
     return number(key, std::nullopt, range, unit);
   }
   int integer(const std::string& key, std::optional<int> fallback, int min, int max) {
@@ -352,7 +355,9 @@ void read_dem(ObjectReader& r, Case& c) {
   dr::WorldOptions& world = sim.world;
   const dr::DamperSimulationOptions defaults;
 
-  dem.stiffness_softening = r.number("stiffness_softening", 1.0, {0.0, 1.0, true});
+  // Softer than 1e-6 leaves steel at 0.2 MPa: the contacts would overlap far beyond
+  // Hertz and the time step no longer resolves anything meaningful.
+  dem.stiffness_softening = r.number("stiffness_softening", 1.0, {1e-6, 1.0});
   world.materials.clear();
   for (const auto& [name, material] : c.materials) {
     dr::MaterialOptions m{name, material};
@@ -389,6 +394,16 @@ void read_dem(ObjectReader& r, Case& c) {
     pair.material_a = material_index(p, "material_a", p.text("material_a", std::nullopt), world.materials);
     pair.material_b = material_index(p, "material_b", p.text("material_b", std::nullopt), world.materials);
     read_contact_pair(p, pair);
+    // One entry per pair of materials, in either order: two would leave it unclear
+    // which one the DEM takes.
+    for (std::size_t k = 0; k < world.pairs.size(); ++k) {
+      const auto& other = world.pairs[k];
+      if ((other.material_a == pair.material_a && other.material_b == pair.material_b) ||
+          (other.material_a == pair.material_b && other.material_b == pair.material_a))
+        p.fail("", "the pair " + p.resolved()["material_a"].get<std::string>() + "/" +
+                       p.resolved()["material_b"].get<std::string>() + " is already given by " + r.pointer() + "/pairs/" +
+                       std::to_string(k));
+    }
     world.pairs.push_back(pair);
   });
   r.object("inner_structures", false, [&](ObjectReader& s) {
@@ -505,8 +520,17 @@ InputError dem_input_error(const Case& c, const std::string& problem) {
   // "<path> = <value>: <rule>" (dem_reference's validate(); "dem." before the path in
   // the time-step bound's message) or "<path> size = <n>: <rule>".
   std::string line = problem.rfind("dem.", 0) == 0 ? problem.substr(4) : problem;
+  // Placement: "compartments[0]: lattice site 0 at (...) overlaps inner structure 0" —
+  // named after what the user changes to make the bed fit.
+  if (line.rfind("compartments[0]: ", 0) == 0) {
+    const std::string what = line.substr(17);
+    const std::string key = what.find("inner structure") != std::string::npos ? "/dem/inner_structures"
+                            : what.find("layer") != std::string::npos        ? "/dem/wall_layer"
+                                                                             : "/damper/particles";
+    return InputError(c.path, key, what);
+  }
   const auto cut = line.find(" = ");
-  if (cut == std::string::npos) return InputError(c.path, "/dem", problem);
+  if (cut == std::string::npos) return InputError(c.path, "/dem", line);
   std::string path = line.substr(0, cut);
   const std::string rest = line.substr(cut + 1);
   if (path.size() > 5 && path.compare(path.size() - 5, 5, " size") == 0) path.resize(path.size() - 5);
@@ -575,6 +599,7 @@ Case load_case(const std::string& path) {
   ObjectReader r(path, root, "", c.resolved);
   r.integer("format_version", 1, 1, 1);
   c.name = r.text("name", std::nullopt);
+  if (c.name.empty()) r.fail("name", "must not be empty (it names the plots and the default output folder)");
   c.description = r.text("description", std::string());
   r.text("task", std::string("damper_design"), {"damper_design"});
   c.task = Task::kDamperDesign;
@@ -583,6 +608,7 @@ Case load_case(const std::string& path) {
   r.object("materials", false, [&](ObjectReader& m) {
     for (const auto& [name, value] : root.at("materials").items()) {
       (void)value;
+      if (name.empty()) m.fail("", "a material needs a name (the key \"\" is empty)");
       const fm::Material defaults = c.materials.count(name) ? c.materials.at(name) : fm::Material{};
       m.object(name, true, [&](ObjectReader& one) { c.materials[name] = read_material(one, defaults); });
     }

@@ -361,8 +361,13 @@ class ProgressLine {
     last_ = now;
     printed_ = true;
     char line[200];
-    std::snprintf(line, sizeof line, "%s: %-9s t = %7.3f / %.3f s  %6.2f M steps/s  ETA %5.0f s", label_.c_str(),
-                  std::string(p.stage).c_str(), p.simulated_time_s, p.end_time_s, p.steps_per_s * 1e-6, p.eta_s);
+    const std::string eta = std::isfinite(p.eta_s) ? std::to_string(static_cast<long long>(p.eta_s)) + " s" : "?";
+    if (p.stage == "setup")  // before the first step: no rate yet
+      std::snprintf(line, sizeof line, "%s: setup     building the bed and its contact lists, ETA %s", label_.c_str(),
+                    eta.c_str());
+    else
+      std::snprintf(line, sizeof line, "%s: %-9s t = %7.3f / %.3f s  %6.2f M steps/s  ETA %s", label_.c_str(),
+                    std::string(p.stage).c_str(), p.simulated_time_s, p.end_time_s, p.steps_per_s * 1e-6, eta.c_str());
     std::cerr << (tty_ ? "\r" : "") << line << (tty_ ? "" : "\n") << std::flush;
   }
 
@@ -460,6 +465,17 @@ dem_reference::RunEstimate check_dem_run(const Case& c, const dem_reference::Dam
   return e;
 }
 
+/// The DEM's initial bed built as a run would build it (inner structures, wall layers),
+/// so a bed that does not fit is refused before any output (and by `pdamp validate`).
+void check_dem_placement(const Case& c, const dem_reference::DamperSimulationOptions& options) {
+  try {
+    dem_reference::check_initial_placement(options);
+  } catch (const std::invalid_argument& error) {
+    const std::string what = error.what();
+    throw dem_input_error(c, what.substr(0, what.find('\n')));
+  }
+}
+
 /// The estimate of a DEM run, for stderr before it starts.
 std::string estimate_line(const std::string& label, const dem_reference::RunEstimate& e) {
   return label + ": " + std::to_string(e.particles) + " particles, " + std::to_string(e.total_steps) + " steps of " +
@@ -480,6 +496,7 @@ int run_dem(const ParsedArgs& args) {
   if (const auto periods = args.optional_integer("--periods", 1, dem_reference::limits::kMaxPeriods)) options.analysed_periods = static_cast<int>(*periods);
   if (const auto threads = args.optional_integer("--threads", 0, dem_reference::limits::kMaxThreads)) options.world.threads = static_cast<int>(*threads);
   const auto estimate = check_dem_run(c, options);
+  check_dem_placement(c, options);
   auto files = output_dir(args);
   std::cerr << estimate_line("pdamp dem", estimate) << std::endl;
 
@@ -576,6 +593,7 @@ std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const su
     options.amplitude_m = drive.amplitude_m;
     options.frequency_hz = drive.frequency_hz;
     const auto e = check_dem_run(c, options);
+    if (k == 0) check_dem_placement(c, options);  // the same bed at every node
     wall_time_s += e.wall_time_s;
     particle_steps += e.particle_steps;
     if (e.memory_bytes > largest.memory_bytes) largest = e;
@@ -703,6 +721,7 @@ int run_validate(const ParsedArgs& args) {
   const Case c = load_case(args.positional().at(0));
   (void)damper_design(c);
   if (c.excitation.amplitude_m) (void)check_dem_run(c, dem_options(c, *c.excitation.amplitude_m, c.excitation.frequency_hz));
+  // check_dem_field places the bed as every DEM run of the case would.
   (void)check_dem_field(c, surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1), nullptr);
   std::cout << c.resolved.dump(2) << "\n";
   return kExitOk;

@@ -76,7 +76,10 @@ extern "C" void on_interrupt(int signal_number) {
     return;
   }
   // Outside the output phase: end as the default action would (the signal is blocked
-  // while this handler runs and is delivered again, with SIG_DFL, when it returns).
+  // while this handler runs and is delivered again, with SIG_DFL, when it returns),
+  // after one line that says so (write() is async-signal-safe; iostreams are not).
+  static const char kMessage[] = "pdamp: error: interrupted; no result was written\n";
+  [[maybe_unused]] const auto written = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
   ::signal(signal_number, SIG_DFL);
   ::raise(signal_number);
 }

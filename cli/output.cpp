@@ -176,11 +176,19 @@ std::vector<std::string> OutputDir::add_plot(const std::string& script_name, con
 std::vector<std::string> OutputDir::commit() {
   start_writing();
   std::vector<std::string> paths;
+  // A result name taken by a folder (or a device) would stop the renames half-way:
+  // refused before the first one, so the set is moved whole or not at all.
+  std::error_code error;
+  for (const auto& name : names_) {
+    const auto status = fs::symlink_status(dir_ / name, error);
+    if (fs::exists(status) && !fs::is_regular_file(status))
+      throw InputError("-o", "", "'" + formulas::printable((dir_ / name).string()) +
+                                     "' exists and is not a file: move it away (pdamp writes " + name + " there)");
+  }
   const SignalBlock whole;
   std::set<std::string> current(names_.begin(), names_.end());
   current.insert(in_place_.begin(), in_place_.end());
   for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
-  std::error_code error;
   for (const auto& old : previous_outputs(dir_))
     if (!current.count(old) && fs::is_regular_file(fs::symlink_status(dir_ / old, error))) fs::remove(dir_ / old, error);
   write_file_atomically(dir_ / kManifest,

@@ -15,6 +15,8 @@
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/formulas/complex_power.hpp"
+#include "initial_state.hpp"
+#include "walls.hpp"
 #include "world_data.hpp"
 
 namespace pdamp::dem_reference {
@@ -376,6 +378,13 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   e.particle_steps_per_s = assumed_rate(plan.particles, options.world.threads);
   e.wall_time_s = e.particle_steps / e.particle_steps_per_s;
   return e;
+}
+
+void check_initial_placement(const DamperSimulationOptions& options) {
+  if (const auto errors = options.validate(); !errors.empty()) throw std::invalid_argument(join_lines(errors));
+  // run_harmonic starts the container at rest in its reference orientation, so gravity
+  // in the body frame is gravity itself.
+  (void)detail::place_particles(options.world, detail::build_walls(options.world), options.world.gravity_m_s2);
 }
 
 DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress) {

@@ -171,8 +171,9 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
   } catch (const DuplicateKey& duplicate) {
     throw std::invalid_argument(printable(path) + ": " + printable(duplicate.pointer) +
                                 ": duplicate key (each key may appear once in an object)");
-  } catch (const json::parse_error& e) {
-    // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 9: ...".
+  } catch (const json::exception& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 9: ..."
+    // or "[json.exception.out_of_range.406] number overflow parsing '1e400'".
     std::string what = e.what();
     const auto start = what.find("] ");
     throw std::invalid_argument(printable(path) + ": malformed JSON: " +

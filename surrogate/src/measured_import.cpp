@@ -15,6 +15,7 @@
 
 #include "file_io.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
+#include "pdamp/dem_reference/damper_simulation.hpp"
 #include "text_util.hpp"
 
 namespace pdamp::surrogate {
@@ -28,6 +29,11 @@ enum Column : int { kFrequency, kAmplitude, kEta, kStderr, kApparentMass, kMotio
 constexpr std::array<std::string_view, kColumns> kNames = {"frequency_hz",    "amplitude_m",      "eta_star",
                                                            "eta_star_stderr", "apparent_mass_kg", "motion_mode"};
 constexpr int kRequiredColumns = 3;  // frequency_hz, amplitude_m, eta_star
+/// Largest η* a measured field may hold: 100 × the ideal peak 4/π would need a bed
+/// dissipating a hundred times its relative kinetic energy per radian.
+constexpr double kMaxEtaStar = 100.0;
+/// Smallest stroke, m (0.1 µm, as the case files): below, no rig resolves X.
+constexpr double kMinAmplitude_m = 1e-7;
 
 /// One data row as read, before it is placed on the grid.
 struct Row {
@@ -142,21 +148,28 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     row.line = line_number;
     row.frequency_hz = reader.parse_number(cell(kFrequency), line_number, kNames[kFrequency]);
     row.amplitude_m = reader.parse_number(cell(kAmplitude), line_number, kNames[kAmplitude]);
-    for (auto [c, value] : {std::pair{kFrequency, row.frequency_hz}, std::pair{kAmplitude, row.amplitude_m}}) {
-      if (!(value > 0.0)) reader.fail(line_number, kNames[c], number(value) + ": must be > 0 (in " +
-                                          std::string(c == kFrequency ? "Hz" : "m") + ")");
-    }
+    // The drive ranges of the DEM (dem_reference::limits) and of the case file: a rig
+    // cannot drive outside them, and a value there is a unit or column mistake.
+    namespace lim = dem_reference::limits;
+    if (!(row.frequency_hz >= lim::kMinFrequency_hz && row.frequency_hz <= lim::kMaxFrequency_hz))
+      reader.fail(line_number, kNames[kFrequency], number(row.frequency_hz) + ": must be in [" + number(lim::kMinFrequency_hz) +
+                                                      ", " + number(lim::kMaxFrequency_hz) + "] (in Hz)");
+    if (!(row.amplitude_m >= kMinAmplitude_m && row.amplitude_m <= lim::kMaxAmplitude_m))
+      reader.fail(line_number, kNames[kAmplitude], number(row.amplitude_m) + ": must be in [" + number(kMinAmplitude_m) +
+                                                      ", " + number(lim::kMaxAmplitude_m) + "] (in m)");
     FieldPoint& p = row.point;
     p.eta_star = reader.parse_number(cell(kEta), line_number, kNames[kEta]);
     // η* = E_diss/(½ m_bed V²) with E_diss = Re(P)/Ω the mean power the container puts
     // into the bed (docs/complex_power.md): a passive damper only dissipates, so η* >= 0
     // (0: a bed locked to the container). A negative value is a sign or phase error of
     // the rig; near-zero noise should be recorded as 0 with its standard error.
-    // No upper bound: the free, fully plastic bed of the ideal collect-and-collide orbit
-    // peaks at 4/π, but an elastic bed (polymer walls) can resonate and exceed it, so a
-    // cap would reject real data.
-    if (p.eta_star < 0.0)
-      reader.fail(line_number, kNames[kEta], number(p.eta_star) + ": must be >= 0 (a passive damper dissipates)");
+    // The free, fully plastic bed of the ideal collect-and-collide orbit peaks at 4/π;
+    // an elastic bed (polymer walls) can resonate and exceed it, so the bound is set far
+    // above, at kMaxEtaStar: a value beyond is a unit or column mistake (a percentage,
+    // E_diss in the η* column), not a damper.
+    if (!(p.eta_star >= 0.0 && p.eta_star <= kMaxEtaStar))
+      reader.fail(line_number, kNames[kEta], number(p.eta_star) + ": must be in [0, " + number(kMaxEtaStar) +
+                                                 "] (>= 0: a passive damper dissipates)");
     p.eta_star_stderr = optional_number(kStderr);
     if (p.eta_star_stderr < 0.0)
       reader.fail(line_number, kNames[kStderr], number(p.eta_star_stderr) + ": must be >= 0");

@@ -290,6 +290,20 @@ TEST_CASE("case keys take physical ranges and validate makes every check", "[cli
   check("pdamp_table_order.json",
         [](json& c) { c["dem"]["contact"] = {{"restitution", {{"speeds_m_s", {1.0, 0.5}}, {"values", {0.9, 0.8}}}}}; },
         "/dem/contact/restitution/speeds_m_s/1: speeds must increase strictly");
+  check("pdamp_soft.json", [](json& c) { c["dem"]["stiffness_softening"] = 1e-300; },
+        "/dem/stiffness_softening: = 1e-300: must be a finite number >= 1e-06 and <= 1");
+  // null is not "absent": a half-edited value must not silently become the default.
+  check("pdamp_null.json", [](json& c) { c["damper"]["clearance_m"] = nullptr; },
+        "/damper/clearance_m: must be a number m (omit the key for the default), got null");
+  check("pdamp_empty_name.json", [](json& c) { c["name"] = ""; }, "/name: must not be empty");
+  check("pdamp_empty_material.json", [](json& c) { c["materials"] = {{"", {{"density_kg_m3", 1000.0}}}}; },
+        "/materials: a material needs a name");
+  check("pdamp_pairs_twice.json",
+        [](json& c) {
+          c["dem"]["pairs"] = {{{"material_a", "steel"}, {"material_b", "steel"}, {"restitution", 0.3}},
+                               {{"material_a", "steel"}, {"material_b", "steel"}, {"restitution", 0.95}}};
+        },
+        "/dem/pairs/1: the pair steel/steel is already given by /dem/pairs/0");
   // Checks made by the DEM's own validation come back with the case key's pointer.
   check("pdamp_pin_outside.json",
         [](json& c) { c["dem"]["inner_structures"] = {{"pins", {{{"centre_m", {1.0, 0.0, 0.0}}, {"radius_m", 0.005}, {"length_m", 0.05}}}}}; },
@@ -298,6 +312,44 @@ TEST_CASE("case keys take physical ranges and validate makes every check", "[cli
         "/dem/samples_per_period: = 100000: samples_per_period x analysed_periods = 100000000 recorded samples must be <= 10000000");
   check("pdamp_drive_speed.json", [](json& c) { c["excitation"] = {{"frequency_hz", 100.0}, {"amplitude_m", 10.0}}; },
         "/excitation/amplitude_m: = 10: the drive's impact speed");
+}
+
+TEST_CASE("validate builds the DEM's bed: a pin through the collected bed is refused before any output", "[cli]") {
+  TempDir tmp("pin_in_bed");
+  const auto path = edited_case("pdamp_pin_in_bed.json", [](json& c) {
+    c["dem"]["inner_structures"] = {{"pins", {{{"centre_m", {-0.075, 0.0, 0.0}}, {"radius_m", 0.004}, {"length_m", 0.04}}}}};
+  });
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"validate", path}, {"dem", path, "-o", (tmp.path / "dem").string()},
+        {"field", path, "--source", "dem", "-o", (tmp.path / "field").string()}}) {
+    INFO(args[0]);
+    const auto r = run_pdamp(args);
+    require_one_line_error(r, "pdamp_pin_in_bed.json: /dem/inner_structures: lattice site");
+  }
+  CHECK(!fs::exists(tmp.path / "dem"));  // refused before the output folder was made
+  CHECK(!fs::exists(tmp.path / "field"));
+}
+
+TEST_CASE("a result name taken by a folder is refused before any file moves", "[cli]") {
+  TempDir tmp("commit_blocked");
+  fs::create_directories(tmp.path / "design.json");
+  const auto r = run_pdamp({"run", case_path("low_intensity_36_spheres.json"), "-o", tmp.path.string()});
+  require_one_line_error(r, "design.json' exists and is not a file");
+  for (const char* name : {"case_resolved.json", "eta_curve.csv", "eta_curve.png"}) CHECK(!fs::exists(tmp.path / name));
+}
+
+TEST_CASE("numbers too large for a double, hexadecimal flags and absurd measured values are refused", "[cli]") {
+  TempDir tmp("overflow");
+  const fs::path huge = tmp.path / "huge.json";
+  std::ofstream(huge) << R"({"name": 1e400})";
+  require_one_line_error(run_pdamp({"validate", huge.string()}), "huge.json: malformed JSON: number overflow");
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance 0x10 --json"), "--clearance: '0x10'");
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance inf"), "--clearance: 'inf'");
+  const fs::path csv = tmp.path / "rig.csv";
+  std::ofstream(csv) << "frequency_hz,amplitude_m,eta_star\n2,0.03,1e300\n";
+  require_one_line_error(run_pdamp({"field", case_path("low_intensity_36_spheres.json"), "--source", "measured",
+                                    "--measured", csv.string(), "-o", (tmp.path / "m").string()}),
+                         "--measured: " + csv.string() + ": line 2, column eta_star: 1e+300: must be in [0, 100]");
 }
 
 TEST_CASE("a DEM run announces its cost first and one that cannot fit in memory is refused", "[cli]") {

@@ -73,7 +73,7 @@ TEST_CASE("measured CSV errors name the file, line and column", "[surrogate]") {
   check_rejected("frequency_hz,amplitude_m,eta_star\n2,0.01,high\n", "line 2, column eta_star",
                  "\"high\" is not a finite number");
   check_rejected("frequency_hz,amplitude_m,eta_star\n2,0.01,nan\n", "line 2, column eta_star", "not a finite number");
-  check_rejected("frequency_hz,amplitude_m,eta_star\n2,-0.01,0.1\n", "line 2, column amplitude_m", "must be > 0");
+  check_rejected("frequency_hz,amplitude_m,eta_star\n2,-0.01,0.1\n", "line 2, column amplitude_m", "must be in [1e-07, 10] (in m)");
   check_rejected("frequency_hz,amplitude_m,eta_star,eta_star_stderr\n2,0.01,0.1,-1\n", "line 2, column eta_star_stderr",
                  "must be >= 0");
   check_rejected("frequency_hz,amplitude_m,eta_star\n2,0.01,0.1\n2,0.01,0.2\n", "line 3", "repeats line 2");
@@ -92,12 +92,16 @@ TEST_CASE("physically meaningless measured values are refused with line and colu
   const std::string header = "frequency_hz,amplitude_m,eta_star,eta_star_stderr,apparent_mass_kg\n";
   // η* = E_diss/(½ m_bed V²) >= 0 for a passive damper (docs/complex_power.md); the old
   // import accepted -5.
-  check_rejected(header + "2,0.01,-5,0.01,0.1\n", "line 2, column eta_star", "-5: must be >= 0");
-  check_rejected(header + "2,0.01,-1e-9,0.01,0.1\n", "line 2, column eta_star", "must be >= 0");
+  check_rejected(header + "2,0.01,-5,0.01,0.1\n", "line 2, column eta_star", "-5: must be in [0, 100]");
+  check_rejected(header + "2,0.01,-1e-9,0.01,0.1\n", "line 2, column eta_star", "must be in [0, 100]");
   check_rejected(header + "2,0.01,0.3,-0.01,0.1\n", "line 2, column eta_star_stderr", "-0.01: must be >= 0");
   check_rejected(header + "2,0.01,0.3,0.01,-0.1\n", "line 2, column apparent_mass_kg", "-0.1: must be >= 0");
-  check_rejected(header + "0,0.01,0.3,0.01,0.1\n", "line 2, column frequency_hz", "0: must be > 0 (in Hz)");
-  check_rejected(header + "2,0,0.3,0.01,0.1\n", "line 2, column amplitude_m", "0: must be > 0 (in m)");
+  check_rejected(header + "0,0.01,0.3,0.01,0.1\n", "line 2, column frequency_hz", "0: must be in [0.01, 10000] (in Hz)");
+  check_rejected(header + "1e308,0.01,0.3,0.01,0.1\n", "line 2, column frequency_hz", "must be in [0.01, 10000] (in Hz)");
+  check_rejected(header + "2,1e-320,0.3,0.01,0.1\n", "line 2, column amplitude_m", "must be in [1e-07, 10] (in m)");
+  // 1e300 would give E_diss ~ 1e298 J: a column or unit mistake, not a damper.
+  check_rejected(header + "2,0.01,1e300,0.01,0.1\n", "line 2, column eta_star", "must be in [0, 100]");
+  check_rejected(header + "2,0,0.3,0.01,0.1\n", "line 2, column amplitude_m", "0: must be in [1e-07, 10] (in m)");
   check_rejected(header + "2,0.01,inf,0.01,0.1\n", "line 2, column eta_star", "\"inf\" is not a finite number");
   check_rejected(header + "2,0.01,0.3,0.01,-inf\n", "line 2, column apparent_mass_kg", "not a finite number");
   check_rejected(header + "2,0.01,0.3,nan,0.1\n", "line 2, column eta_star_stderr", "not a finite number");

@@ -202,6 +202,12 @@ struct RunEstimate {
 /// does for invalid options (all violations, one per line) or a time step above the bound.
 RunEstimate estimate_run(const DamperSimulationOptions& options);
 
+/// Places the particles as run_harmonic would (lattice or random, inner structures and
+/// wall layers in place) without building the world, and throws std::invalid_argument
+/// as the world would when they do not fit ("compartments[0]: lattice site 0 at (...)
+/// overlaps inner structure 0"). O(particles): the check that `pdamp validate` makes.
+void check_initial_placement(const DamperSimulationOptions& options);
+
 /// Runs settling, transient_periods and analysed_periods of the harmonic drive and
 /// computes the measures. Bad options: std::invalid_argument (all violations, one per
 /// line; particles that do not fit name the numbers). A detected instability returns
