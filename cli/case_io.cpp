@@ -224,17 +224,23 @@ void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
   options.rolling_calibration = r.number("rolling_calibration", defaults.rolling_calibration, {0.0, 2.0, true});
   options.bouncing_calibration = r.number("bouncing_calibration", defaults.bouncing_calibration, {0.0, 2.0, true});
   r.object("scattered", false, [&](ObjectReader& s) {
-    options.scattered.jump_fraction = s.number("jump_fraction", defaults.scattered.jump_fraction, {0.0, 1.0});
+    options.scattered.jump_fraction =
+        s.number("jump_fraction", defaults.scattered.jump_fraction, {0.0, formulas::kMaxJumpFraction});
     options.scattered.exponent = s.number("exponent", defaults.scattered.exponent, {0.0, 10.0});
     options.scattered.s_min = s.number("s_min", defaults.scattered.s_min, {0.0, 0.999});
-    options.scattered.source = s.text("source", std::string("case file"));
-    options.scattered.provisional = false;
+    options.scattered.s_max = s.number("s_max", defaults.scattered.s_max, {options.scattered.s_min, 1.0});
+    // Fitted only when both coefficients are given: a partial object keeps a default
+    // coefficient, which stays provisional (and says so in the warnings).
+    options.scattered.provisional = !(s.has("jump_fraction") && s.has("exponent"));
+    options.scattered.source =
+        s.text("source", options.scattered.provisional ? defaults.scattered.source : std::string("case file"));
   });
   if (!r.has("scattered")) {
     auto& s = r.resolved()["scattered"];
     s["jump_fraction"] = defaults.scattered.jump_fraction;
     s["exponent"] = defaults.scattered.exponent;
     s["s_min"] = defaults.scattered.s_min;
+    s["s_max"] = defaults.scattered.s_max;
     s["source"] = defaults.scattered.source;
   }
 }
@@ -288,6 +294,8 @@ void read_damper(ObjectReader& r, Case& c) {
   }
   // Gravity along the drive breaks the closed forms' assumption (PHYSICS.md §2).
   d.model_options.gravity_along_drive = g_norm > 0.0 && std::abs(d.gravity_m_s2[d.drive_axis]) > 0.01 * g_norm;
+  const double g_across = std::sqrt(std::max(0.0, g_norm * g_norm - d.gravity_m_s2[d.drive_axis] * d.gravity_m_s2[d.drive_axis]));
+  d.model_options.gravity_across_drive = g_across > 0.01 * std::max(g_norm, 1e-300);
 
   for (const auto& line : d.container.validate("damper/container")) r.fail("container", line);
   if (!c.materials.count(d.particle_material))

@@ -182,6 +182,10 @@ int run_loss(const ParsedArgs& args) {
   json out = loss_json(loss, bed_mass, f);
   out.update({{"clearance_m", h}, {"amplitude_m", x}, {"frequency_hz", f}});
   std::vector<std::string> warnings = loss.warnings;
+  // eta* needs no mass, the energies do: say which mass they are for.
+  if (!args.has("--bed-mass"))
+    warnings.push_back("no --bed-mass given: e_diss_j, energy_per_cycle_j and equivalent_damping_n_s_m are for a 1 kg bed "
+                       "(they scale with the bed mass; eta* does not)");
   if (files) {
     const auto family = loss.model_used;
     const auto landmarks = fm::optimum_stroke(family, h, options);
@@ -193,6 +197,7 @@ int run_loss(const ParsedArgs& args) {
     files->add_json("loss.json", out);
     out["files"] = files->commit();
   }
+  out["warnings"] = warnings;
   print_warnings(warnings);
   return emit(args, out, {{"model_used", std::string(fm::to_string(loss.model_used))},
                           {"regime", std::string(fm::to_string(loss.regime))},
@@ -697,8 +702,8 @@ int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::
       const auto fit = surrogate::fit_scattered_law(samples, "pdamp field --source " + source + ", case " + c.name);
       surrogate::write_scattered_fit(fit, files.staged_path("scattered_fit.json"));
       out["scattered_fit"] = {{"jump_fraction", fit.fit.jump_fraction}, {"exponent", fit.fit.exponent},
-                              {"s_min", fit.fit.s_min}, {"s_max", fit.s_max},
-                              {"reduced_chi_squared", fit.reduced_chi_squared}, {"points", fit.points}};
+                              {"s_min", fit.fit.s_min}, {"s_max", fit.fit.s_max},
+                              {"reduced_chi_squared", fit.fit.reduced_chi_squared}, {"points", fit.fit.points}};
     } catch (const std::exception& e) {
       warnings.push_back(std::string("scattered-state fit not made: ") + e.what());
     }

@@ -23,7 +23,7 @@ namespace {
 constexpr std::string_view kFormat = "pdamp.scattered_fit";
 constexpr int kFormatVersion = 1;
 /// Parameter box of formulas::ScatteredFit (its validate() rules).
-constexpr double kJumpMax = 1.0;
+constexpr double kJumpMax = formulas::kMaxJumpFraction;
 constexpr double kExponentMax = 10.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -174,10 +174,10 @@ ScatteredFitResult fit_scattered_law(std::span<const ScatteredSample> samples, s
   const auto [s_min, s_max] =
       std::minmax_element(samples.begin(), samples.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
   result.fit.s_min = s_min->s;
-  result.s_max = s_max->s;
-  result.reduced_chi_squared = chi2 / static_cast<double>(samples.size() - 2);
-  std::tie(result.jump_fraction_stderr, result.exponent_stderr) = coefficient_errors(samples, x[0], x[1]);
-  result.points = samples.size();
+  result.fit.s_max = s_max->s;
+  result.fit.reduced_chi_squared = chi2 / static_cast<double>(samples.size() - 2);
+  std::tie(result.fit.jump_fraction_stderr, result.fit.exponent_stderr) = coefficient_errors(samples, x[0], x[1]);
+  result.fit.points = samples.size();
   return result;
 }
 
@@ -189,12 +189,12 @@ void write_scattered_fit(const ScatteredFitResult& result, const std::filesystem
   doc["jump_fraction"] = result.fit.jump_fraction;
   doc["exponent"] = result.fit.exponent;
   doc["s_min"] = result.fit.s_min;
-  doc["s_max"] = result.s_max;
+  doc["s_max"] = result.fit.s_max;
   doc["source"] = result.fit.source;
-  doc["residual"] = result.reduced_chi_squared;
-  doc["points"] = result.points;
-  doc["jump_fraction_stderr"] = nullable(result.jump_fraction_stderr);
-  doc["exponent_stderr"] = nullable(result.exponent_stderr);
+  doc["residual"] = result.fit.reduced_chi_squared;
+  doc["points"] = result.fit.points;
+  doc["jump_fraction_stderr"] = nullable(result.fit.jump_fraction_stderr);
+  doc["exponent_stderr"] = nullable(result.fit.exponent_stderr);
   detail::write_file_atomically(path, doc.dump(2) + "\n");
 }
 
@@ -209,17 +209,17 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   result.fit.jump_fraction = root.number("jump_fraction", false);
   result.fit.exponent = root.number("exponent", false);
   result.fit.s_min = root.number("s_min", false);
-  result.s_max = root.number("s_max", false);
+  result.fit.s_max = root.number("s_max", false);
   result.fit.source = root.string("source");
   if (detail::has_control_byte(result.fit.source)) {
     root.fail("source", "\"" + formulas::printable(result.fit.source) +
                             "\" holds control characters (must be printable text: it is printed in reports)");
   }
   result.fit.provisional = false;
-  result.reduced_chi_squared = root.number("residual", false);
+  result.fit.reduced_chi_squared = root.number("residual", false);
   if (root.optional("points") != nullptr) {
     // fit_scattered_law needs 3 samples (2 coefficients and 1 degree of freedom): fewer is no fit.
-    result.points = static_cast<std::size_t>(root.integer("points", 3, std::numeric_limits<int>::max()));
+    result.fit.points = static_cast<std::size_t>(root.integer("points", 3, std::numeric_limits<int>::max()));
   }
   auto optional_stderr = [&](std::string_view key) {
     const json* value = root.optional(key);
@@ -228,9 +228,12 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
     if (x < 0.0) root.fail(key, number(x) + ": must be >= 0 or null");
     return x;
   };
-  result.jump_fraction_stderr = optional_stderr("jump_fraction_stderr");
-  result.exponent_stderr = optional_stderr("exponent_stderr");
+  result.fit.jump_fraction_stderr = optional_stderr("jump_fraction_stderr");
+  result.fit.exponent_stderr = optional_stderr("exponent_stderr");
   root.finish();
+  if (!(result.fit.s_max >= result.fit.s_min && result.fit.s_max <= 1.0)) {
+    root.fail("s_max", number(result.fit.s_max) + ": must be in [s_min, 1] = [" + number(result.fit.s_min) + ", 1]");
+  }
   // Range rules, each reported at its key.
   const std::vector<std::string> problems = result.fit.validate();
   if (!problems.empty()) {
@@ -238,10 +241,7 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
     const std::string key = line.substr(0, line.find_first_of(" ="));
     root.fail(key, line);
   }
-  if (!(result.s_max >= result.fit.s_min && result.s_max <= 1.0)) {
-    root.fail("s_max", number(result.s_max) + ": must be in [s_min, 1] = [" + number(result.fit.s_min) + ", 1]");
-  }
-  if (result.reduced_chi_squared < 0.0) root.fail("residual", number(result.reduced_chi_squared) + ": must be >= 0");
+  if (result.fit.reduced_chi_squared < 0.0) root.fail("residual", number(result.fit.reduced_chi_squared) + ": must be >= 0");
   return result;
 }
 

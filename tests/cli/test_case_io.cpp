@@ -264,3 +264,29 @@ TEST_CASE("a DEM instability exits with code 3 and advice and a refused time ste
   CHECK(s.exit_code == 2);
   CHECK_THAT(s.err, Catch::Contains("pdamp_dem_step.json: /dem/time_step_s: = 0.001: must be <="));
 }
+
+TEST_CASE("loss says which bed mass its energies are for", "[cli]") {
+  const auto r = run_pdamp("loss --model bouncing --clearance 0.01 --amplitude 0.005 --frequency 50 --json");
+  REQUIRE(r.exit_code == 0);
+  const json l = json::parse(r.out);
+  bool said = false;
+  for (const auto& w : l["warnings"]) said = said || w.get<std::string>().find("1 kg bed") != std::string::npos;
+  CHECK(said);
+  CHECK_THAT(r.err, Catch::Contains("no --bed-mass given"));
+  const auto with_mass = run_pdamp("loss --model bouncing --clearance 0.01 --amplitude 0.005 --frequency 50 --bed-mass 2 --json");
+  CHECK(with_mass.err.find("no --bed-mass") == std::string::npos);
+}
+
+TEST_CASE("a partial scattered-state fit in a case stays provisional", "[cli]") {
+  const auto source_of = [](const std::function<void(json&)>& edit) {
+    const auto r = run_pdamp("validate " + edited_case("pdamp_scattered.json", edit));
+    REQUIRE(r.exit_code == 0);
+    return json::parse(r.out)["damper"]["model_options"]["scattered"]["source"].get<std::string>();
+  };
+  // Only s_min given: both coefficients are the provisional defaults.
+  CHECK(source_of([](json& c) { c["damper"]["model_options"] = {{"scattered", {{"s_min", 0.2}}}}; }) ==
+        "provisional default");
+  CHECK(source_of([](json& c) {
+          c["damper"]["model_options"] = {{"scattered", {{"jump_fraction", 0.3}, {"exponent", 1.5}}}};
+        }) == "case file");
+}

@@ -636,9 +636,23 @@ TEST_CASE("below the onset every model gives the scattered-state fit", "[formula
   // kScattered above the onset and below s_min: the fit, flagged as extrapolated.
   const fm::LossResult forced = fm::reduced_loss_factor(fm::DamperModel::kScattered, h, 2.0 * onset, 60.0, options);
   REQUIRE(forced.regime == fm::MotionRegime::kScattered);
-  REQUIRE(has_warning(forced, "outside its range"));
+  REQUIRE(has_warning(forced, "outside the range it was fitted on"));
   REQUIRE(has_warning(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.1 * onset, 60.0, options),
-                      "outside its range"));
+                      "outside the range it was fitted on"));
+  // Fitted on [s_min, s_max] = [0.3, 0.85]: s = 0.9, between the data and the cliff, is
+  // an extrapolation and says so with the fit's quality; s = 0.6 is inside.
+  fm::ModelOptions fitted = options;
+  fitted.scattered.s_min = 0.3;
+  fitted.scattered.s_max = 0.85;
+  fitted.scattered.points = 12;
+  fitted.scattered.reduced_chi_squared = 1.3;
+  fitted.scattered.jump_fraction_stderr = 0.04;
+  const auto near_cliff = fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.9 * onset, 60.0, fitted);
+  REQUIRE(has_warning(near_cliff, "[0.3, 0.85]: extrapolated (fitted on 12 points, reduced chi^2 = 1.3"));
+  REQUIRE(!has_warning(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.6 * onset, 60.0, fitted), "extrapolated"));
+  // A jump fraction above 1 is a fit result the DEM shows (1.10 at s = 0.93), not an error.
+  fitted.scattered.jump_fraction = 1.1;
+  REQUIRE(fitted.validate().empty());
 }
 
 TEST_CASE("validity warnings name the violated range with numbers, and none appear inside it",
@@ -663,10 +677,19 @@ TEST_CASE("validity warnings name the violated range with numbers, and none appe
   const fm::LossResult large = fm::reduced_loss_factor(fm::DamperModel::kBouncing, h, 12.0 * h, 60.0);
   REQUIRE(has_warning(large, "X/h = 12"));
   REQUIRE(large.warnings.size() == 1);
-  // Inside every range: no warning (and no allocation on that path).
+  // Gravity across a horizontal drive (the default): below X = h the decoupled state
+  // can replace the bouncing orbit (the issue's case: h = 10 mm, X = 3.2 mm, 50 Hz).
+  const auto floating = fm::reduced_loss_factor(fm::DamperModel::kAuto, 0.01, 0.0032, 50.0);
+  REQUIRE(floating.model_used == fm::DamperModel::kBouncing);
+  REQUIRE(has_warning(floating, "decoupled state"));
+  REQUIRE(!has_warning(fm::reduced_loss_factor(fm::DamperModel::kBouncing, h, 1.5 * h, 60.0), "decoupled"));
+  // Inside every range: no warning (and no allocation on that path); bouncing without
+  // gravity across the drive (a vertical drive or a weightless bed).
+  fm::ModelOptions weightless;
+  weightless.gravity_across_drive = false;
   REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kRolling, h, 0.4 * h, 2.0).warnings.empty());
-  REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kBouncing, h, h / kPi, 60.0).warnings.empty());
-  REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.5 * h, 60.0).warnings.empty());
+  REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kBouncing, h, h / kPi, 60.0, weightless).warnings.empty());
+  REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.5 * h, 60.0, weightless).warnings.empty());
 }
 
 TEST_CASE("bad inputs throw std::invalid_argument naming the quantity, value and range",
@@ -718,7 +741,7 @@ TEST_CASE("validate() reports every violated option, one line each", "[formulas]
   options.rolling_inertia_factor = 0.0;
   options.rolling_calibration = 2.5;
   options.bouncing_calibration = -1.0;
-  options.scattered.jump_fraction = 1.2;
+  options.scattered.jump_fraction = 2.2;
   options.scattered.exponent = 11.0;
   options.scattered.s_min = 1.0;
   const std::vector<std::string> problems = options.validate();
@@ -726,7 +749,7 @@ TEST_CASE("validate() reports every violated option, one line each", "[formulas]
                           "rolling_inertia_factor = 0: must be in (0, 1]",
                           "rolling_calibration = 2.5: must be in (0, 2]",
                           "bouncing_calibration = -1: must be in (0, 2]",
-                          "scattered.jump_fraction = 1.2: must be in [0, 1]",
+                          "scattered.jump_fraction = 2.2: must be in [0, 2]",
                           "scattered.exponent = 11: must be in [0, 10]",
                           "scattered.s_min = 1: must be in [0, 1)",
                       });

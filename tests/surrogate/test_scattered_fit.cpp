@@ -85,10 +85,10 @@ TEST_CASE("the fit recovers a noise-free law exactly", "[surrogate]") {
   // tolerance (xtol 1e-12) and rounding remain.
   CHECK(r.fit.jump_fraction == Approx(0.42).epsilon(1e-8));
   CHECK(r.fit.exponent == Approx(1.7).epsilon(1e-8));
-  CHECK(r.reduced_chi_squared < 1e-12);
+  CHECK(r.fit.reduced_chi_squared < 1e-12);
   CHECK(r.fit.s_min == Approx(0.2));
-  CHECK(r.s_max == Approx(0.95));
-  CHECK(r.points == 15);
+  CHECK(r.fit.s_max == Approx(0.95));
+  CHECK(r.fit.points == 15);
   CHECK_FALSE(r.fit.provisional);
   CHECK(r.fit.source == "synthetic");
   CHECK(r.fit.validate().empty());
@@ -102,11 +102,11 @@ TEST_CASE("the weighted fit of noisy points is the chi-square minimum and within
   CHECK(r.fit.jump_fraction == Approx(jump).epsilon(1e-6));
   CHECK(r.fit.exponent == Approx(exponent).epsilon(1e-6));
   // The truth lies within 4 reported standard errors (a 4σ band fails with p < 1e-4).
-  CHECK(std::abs(r.fit.jump_fraction - 0.35) < 4 * r.jump_fraction_stderr);
-  CHECK(std::abs(r.fit.exponent - 2.4) < 4 * r.exponent_stderr);
+  CHECK(std::abs(r.fit.jump_fraction - 0.35) < 4 * r.fit.jump_fraction_stderr);
+  CHECK(std::abs(r.fit.exponent - 2.4) < 4 * r.fit.exponent_stderr);
   // Reduced χ² of correctly weighted data: mean 1, standard deviation √(2/38) ≈ 0.23.
-  CHECK(r.reduced_chi_squared > 0.3);
-  CHECK(r.reduced_chi_squared < 2.0);
+  CHECK(r.fit.reduced_chi_squared > 0.3);
+  CHECK(r.fit.reduced_chi_squared < 2.0);
 }
 
 TEST_CASE("the fit refuses samples it cannot weight or fit", "[surrogate]") {
@@ -156,10 +156,10 @@ TEST_CASE("the coefficient file round-trips and is read strictly", "[surrogate]"
   CHECK(back.fit.jump_fraction == r.fit.jump_fraction);
   CHECK(back.fit.exponent == r.fit.exponent);
   CHECK(back.fit.s_min == r.fit.s_min);
-  CHECK(back.s_max == r.s_max);
-  CHECK(back.reduced_chi_squared == r.reduced_chi_squared);
-  CHECK(back.exponent_stderr == r.exponent_stderr);
-  CHECK(back.points == 20);
+  CHECK(back.fit.s_max == r.fit.s_max);
+  CHECK(back.fit.reduced_chi_squared == r.fit.reduced_chi_squared);
+  CHECK(back.fit.exponent_stderr == r.fit.exponent_stderr);
+  CHECK(back.fit.points == 20);
   CHECK(back.fit.source == "dem field x.json");
   CHECK_FALSE(back.fit.provisional);
 
@@ -175,8 +175,12 @@ TEST_CASE("the coefficient file round-trips and is read strictly", "[surrogate]"
   CHECK_THROWS_WITH(read_scattered_fit(write(R"({"jump_fraction": 0.5})")), Catch::Contains("/exponent: missing"));
   CHECK_THROWS_WITH(
       read_scattered_fit(
-          write(R"({"jump_fraction": 1.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "source": "x", "residual": 1})")),
-      Catch::Contains("/jump_fraction: jump_fraction = 1.5"));
+          write(R"({"jump_fraction": 2.5, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "source": "x", "residual": 1})")),
+      Catch::Contains("/jump_fraction: jump_fraction = 2.5"));
+  // Above 1: the DEM shows 1.10 just below the cliff (formulas::kMaxJumpFraction).
+  CHECK(read_scattered_fit(write(R"({"jump_fraction": 1.1, "exponent": 2, "s_min": 0.3, "s_max": 0.9, "source": "x",
+                                     "residual": 1})"))
+            .fit.jump_fraction == 1.1);
   CHECK_THROWS_WITH(
       read_scattered_fit(
           write(R"({"jump_fraction": 0.5, "exponent": 2, "s_min": 0.3, "s_max": 1.2, "source": "x", "residual": 1})")),
@@ -199,7 +203,7 @@ TEST_CASE("a coefficient file outside the law's ranges, repeated keys or too few
     CHECK_THROWS_WITH(read(base + members), Catch::Equals(path.string() + ": " + message));
   };
   check(R"("jump_fraction": -0.1, "exponent": 2, "s_min": 0.3, "s_max": 0.9)",
-        "/jump_fraction: jump_fraction = -0.1: must be in [0, 1]");
+        "/jump_fraction: jump_fraction = -0.1: must be in [0, 2]");
   check(R"("jump_fraction": 0.5, "exponent": 12, "s_min": 0.3, "s_max": 0.9)",
         "/exponent: exponent = 12: must be in [0, 10]");
   check(R"("jump_fraction": 0.5, "exponent": -1, "s_min": 0.3, "s_max": 0.9)",

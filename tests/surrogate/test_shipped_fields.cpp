@@ -80,7 +80,7 @@ TEST_CASE("the fitted auto curve follows the DEM field of the 36-sphere case", "
               above.points, above.mean_abs, above.mean_signed, above.max_abs);
   std::printf("scattered (s < 1, %d points): mean |dev| %.3f, mean dev %+.3f, max %.3f; fit J = %.3f p = %.3f chi2 %.1f\n",
               below.points, below.mean_abs, below.mean_signed, below.max_abs, fit.fit.jump_fraction, fit.fit.exponent,
-              fit.reduced_chi_squared);
+              fit.fit.reduced_chi_squared);
   // Collect-and-collide: the ideal rolling/bouncing curves describe the DEM's mean level
   // (measured: mean |deviation| 7%, bias +4%, 21 points); a regenerated field scatters
   // by its per-point standard errors (about 5% of η*), hence 12% on the mean. Single

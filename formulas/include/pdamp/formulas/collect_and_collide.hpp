@@ -11,6 +11,8 @@
 #pragma once
 
 #include <optional>
+#include <cstddef>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,10 +40,21 @@ std::string_view to_string(MotionRegime regime);
 ///   η*(s) = jump_fraction · η*_onset · s^exponent
 /// where η*_onset is the ideal orbit's value at the onset of the model in use, so
 /// jump_fraction < 1 is the height of the jump into the collect-and-collide state.
+/// Largest jump_fraction: the scattered state just below the cliff can dissipate more
+/// than the ideal orbit at its onset (the DEM of the 36-sphere case: 1.10 at s = 0.93);
+/// twice the onset value is far beyond anything seen and catches unit mistakes.
+inline constexpr double kMaxJumpFraction = 2.0;
+
 struct ScatteredFit {
-  double jump_fraction = 0.5;  ///< η*(s→1⁻)/η*_onset, dimensionless, in [0, 1]
+  double jump_fraction = 0.5;  ///< η*(s→1⁻)/η*_onset, dimensionless, in [0, kMaxJumpFraction]
   double exponent = 2.0;       ///< power of s, dimensionless, in [0, 10]
   double s_min = 0.0;          ///< lowest s the fit was made on (validity), [0, 1)
+  double s_max = 1.0;          ///< highest s the fit was made on, [s_min, 1]: above it the law is extrapolated
+  // Quality of a fit to data (NaN or 0 when not fitted: the provisional default).
+  double reduced_chi_squared = std::numeric_limits<double>::quiet_NaN();  ///< χ²/(n − 2), ≈ 1 for a good fit
+  double jump_fraction_stderr = std::numeric_limits<double>::quiet_NaN(); ///< standard error of jump_fraction
+  double exponent_stderr = std::numeric_limits<double>::quiet_NaN();      ///< standard error of exponent
+  std::size_t points = 0;                                                 ///< samples fitted
   /// Defaults are provisional until fitted to DEM points (effective-field issue).
   bool provisional = true;
   std::string source = "provisional default";
@@ -61,6 +74,12 @@ struct ModelOptions {
   ScatteredFit scattered;
   /// The ideal models assume no gravity along the drive; true adds a warning.
   bool gravity_along_drive = false;
+  /// Gravity presses the bed on a base across the drive (a horizontal drive on Earth:
+  /// the default, and what the rolling model needs). With it, at high intensity the
+  /// bed can stay nearly at rest on the base while the container moves around it (the
+  /// decoupled state, docs/dem.md), in place of the bouncing orbit: true makes the
+  /// bouncing model warn for X < h. false: no gravity, or gravity along the drive only.
+  bool gravity_across_drive = true;
   /// One line per violated rule ("rolling_inertia_factor = 1.5: must be in (0, 1]"),
   /// the fit's lines prefixed "scattered."; empty if valid.
   std::vector<std::string> validate() const;

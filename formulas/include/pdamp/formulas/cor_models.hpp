@@ -50,8 +50,9 @@ std::unique_ptr<RestitutionModel> make_thornton_restitution(double limiting_pres
                                                             double effective_modulus_pa,
                                                             double effective_radius_m,
                                                             double effective_mass_kg);
-/// Mean contact pressure over yield stress at first yield of a Hertz contact
-/// (Johnson, Contact Mechanics 1985, ch. 6: p₀ = 1.60 Y for ν = 0.3, von Mises).
+/// Peak (centre) contact pressure over yield stress at first yield of a Hertz contact
+/// (Johnson, Contact Mechanics 1985, ch. 6: p₀ = 1.60 Y for ν = 0.3, von Mises; the
+/// mean pressure is then 2/3 p₀ = 1.07 Y). Thornton's p_y limits the peak pressure.
 inline constexpr double kLimitingPressurePerYieldStress = 1.6;
 /// Thornton's law from the yield stress Y (Pa) of the softer body: p_y = 1.6·Y.
 std::unique_ptr<RestitutionModel> make_thornton_restitution_from_yield_stress(

@@ -32,17 +32,17 @@ std::vector<ScatteredSample> scattered_samples(const EffectiveField& field,
 
 /// Fitted coefficients with their quality and range.
 struct ScatteredFitResult {
-  /// jump_fraction, exponent, s_min (lowest s fitted), provisional = false, source.
+  /// jump_fraction, exponent, the fitted range [s_min, s_max], provisional = false,
+  /// source, and the fit's quality: reduced_chi_squared = χ²/(n − 2) (≈ 1 if the law
+  /// fits within the standard errors), jump_fraction_stderr and exponent_stderr =
+  /// √diag((JᵀWJ)⁻¹) at the optimum (NaN if not determined, e.g. when jump_fraction
+  /// sits at 0), points = samples fitted. All travel with the law into ModelOptions, so
+  /// evaluations outside the fitted range warn.
   formulas::ScatteredFit fit;
-  double s_max = 0.0;                 ///< highest s fitted (< 1): the law is validated on [s_min, s_max]
-  double reduced_chi_squared = 0.0;   ///< χ²/(n − 2): ≈ 1 if the law fits within the standard errors
-  double jump_fraction_stderr = 0.0;  ///< √diag((JᵀWJ)⁻¹) at the optimum; NaN if not determined
-  double exponent_stderr = 0.0;       ///< ditto (NaN e.g. when jump_fraction sits at 0)
-  std::size_t points = 0;             ///< samples fitted
 };
 
 /// Fits η*(s) = jump_fraction·η*_onset·s^exponent by weighted least squares,
-///   min Σ ((η*_i − J·η*_onset,i·s_i^p)/σ_i)²  over J in [0, 1], p in [0, 10]
+///   min Σ ((η*_i − J·η*_onset,i·s_i^p)/σ_i)²  over J in [0, 2], p in [0, 10]
 /// (the ranges of formulas::ScatteredFit), with NLopt's bounded L-BFGS and the analytic
 /// gradient, started from a weighted log-log regression. Needs at least 3 samples with
 /// s in (0, 1), finite η*, η*_onset > 0 and σ > 0 finite (std::invalid_argument naming
@@ -56,7 +56,7 @@ void write_scattered_fit(const ScatteredFitResult& result, const std::filesystem
 /// Reads a coefficient file strictly: jump_fraction, exponent, s_min, s_max, source and
 /// residual required; format, format_version, points and the two *_stderr optional;
 /// unknown or repeated keys, wrong types, values outside formulas::ScatteredFit's ranges
-/// (jump_fraction in [0, 1], exponent in [0, 10], s_min in [0, 1)), s_max outside
+/// (jump_fraction in [0, 2], exponent in [0, 10], s_min in [0, 1)), s_max outside
 /// [s_min, 1], residual < 0, points < 3, negative *_stderr or a source with control
 /// characters throw std::invalid_argument("<path>: <pointer>: <rule>"); so do a missing
 /// file, a directory or a FIFO ("<path>: <reason>", at once).
