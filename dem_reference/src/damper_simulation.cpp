@@ -8,7 +8,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,7 +35,8 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return text;
 }
 
-/// Largest free-fall height: the inner extent of a compartment projected on gravity, m.
+/// The inner extent of the tallest compartment along gravity, m (the settling time of a
+/// random placement).
 double fall_height(const WorldOptions& w) {
   const double g = norm(w.gravity_m_s2);
   if (g == 0.0) return 0.0;
@@ -45,6 +45,27 @@ double fall_height(const WorldOptions& w) {
     double h = 0.0;
     for (int a = 0; a < 3; ++a) h += std::abs(w.gravity_m_s2[static_cast<std::size_t>(a)]) / g * c.container.inner_length(a);
     height = std::max(height, h);
+  }
+  return height;
+}
+
+/// Largest free fall of a sphere, m: per compartment, its inner extent H along gravity
+/// less the smallest sphere diameter 2r_min, the largest of these (0 without gravity).
+/// A sphere's centre moves between r from the floor and r from the ceiling, so it falls
+/// at most H − 2r (from rest at the ceiling onto the floor). Not H − h_bed: a sphere
+/// thrown up from a multi-layer bed can land beside it, in the clearance of a collected
+/// bed; for one layer (h_bed = 2r) the two agree. The drive's own speed is in 2XΩ.
+double free_fall_height(const WorldOptions& w) {
+  const double g = norm(w.gravity_m_s2);
+  if (g == 0.0) return 0.0;
+  double height = 0.0;
+  for (const auto& c : w.compartments) {
+    double h = 0.0;
+    for (int a = 0; a < 3; ++a) h += std::abs(w.gravity_m_s2[static_cast<std::size_t>(a)]) / g * c.container.inner_length(a);
+    double r_min = std::numeric_limits<double>::infinity();
+    for (const auto& p : c.particles) r_min = std::min(r_min, p.radius_m * (1.0 - p.radius_spread));
+    if (!std::isfinite(r_min)) r_min = 0.0;
+    height = std::max(height, std::max(0.0, h - 2.0 * r_min));
   }
   return height;
 }
@@ -140,11 +161,45 @@ class ProgressReporter {
 };
 
 /// The drive's largest impact speed: a collected bed leaving one wall at the drive's
-/// peak velocity V meets the other wall coming at V (2V), plus a free fall through the
-/// container (PHYSICS.md §1), m/s.
+/// peak velocity V meets the other wall coming at V (2V), plus the largest free fall of
+/// a sphere, √(2|g|H_free) with H_free = H − 2r_min (free_fall_height), m/s.
 double drive_impact_speed(const DamperSimulationOptions& o) {
   const double v_amp = o.amplitude_m * 2.0 * kPi * o.frequency_hz;
-  return 2.0 * v_amp + std::sqrt(2.0 * norm(o.world.gravity_m_s2) * fall_height(o.world));
+  return 2.0 * v_amp + std::sqrt(2.0 * norm(o.world.gravity_m_s2) * free_fall_height(o.world));
+}
+
+/// Fewest steps per contact at the impact speed that a user time step may give
+/// (docs/dem.md "Integration and time step"): the single-impact restitution error of
+/// the leapfrog with the half-step damping velocity follows −(0.6 ln²ε + 0.1)/N from
+/// here on for every ε >= 0.05; below it heavily damped contacts overshoot (ε = 0.05
+/// realises up to 0.11 at 10 steps, ε = 0.01 up to 1.0 at 20).
+constexpr double kMinStepsPerContact = 20.0;
+
+/// The largest relative restitution error of one impact at N steps per contact, for
+/// the target ε: (0.6 ln²ε + 0.1)/N (measured bound, tests/dem_reference/test_measures.cpp).
+double restitution_error_bound(double restitution, double steps_per_contact) {
+  const double l = std::log(restitution);
+  return (0.6 * l * l + 0.1) / steps_per_contact;
+}
+
+/// The smallest restitution the pairs can give (constant or table nodes); NaN when a
+/// pair uses a model.
+double smallest_restitution(const WorldOptions& w) {
+  double e = 1.0;
+  bool model = false;
+  const auto consider = [&](const ContactPairOptions& p) {
+    const auto& r = p.restitution;
+    if (r.model) {
+      model = true;
+    } else if (!r.table_values.empty()) {
+      e = std::min(e, *std::min_element(r.table_values.begin(), r.table_values.end()));
+    } else {
+      e = std::min(e, r.constant);
+    }
+  };
+  consider(w.default_pair);
+  for (const auto& p : w.pairs) consider(p);
+  return model ? kNaN : e;
 }
 
 /// What run_harmonic and estimate_run derive from the options before building a world.
@@ -159,6 +214,10 @@ struct RunPlan {
   std::int64_t analysed_steps = 0;
   std::int64_t total_steps = 0;
   int particles = 0;
+  double impact_speed_m_s = 0.0;   ///< the speed the bound is taken at (before any lowering below)
+  double stability_limit_s = 0.0;  ///< min(T_R, t_c/kMinStepsPerContact): the largest user step accepted
+  double steps_per_contact = 0.0;  ///< t_c(impact speed)/dt
+  std::vector<std::string> warnings;
 };
 
 /// Validates (std::invalid_argument: all violations) and plans: the automatic bound at
@@ -174,12 +233,17 @@ RunPlan plan_run(const DamperSimulationOptions& options) {
   integ.time_step_s = 0.0;
   plan.bound = time_step_bound(plan.world);
   const TimeStepBound& bound = plan.bound;
-  if (user_step > bound.max_time_step_s) {
+  plan.impact_speed_m_s = integ.max_impact_speed_m_s;
+  // Stability limit: the Rayleigh time (the explicit critical step of the wave through a
+  // sphere, Li, Xu & Thornton 2005) and kMinStepsPerContact at the impact speed.
+  plan.stability_limit_s = std::min(bound.rayleigh_time_s, bound.contact_time_s / kMinStepsPerContact);
+  if (user_step > plan.stability_limit_s) {
     std::ostringstream msg;
-    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << bound.max_time_step_s
-        << " s (contact time " << bound.contact_time_s << " s at " << integ.max_impact_speed_m_s << " m/s over "
-        << integ.steps_per_contact << " steps, or " << integ.rayleigh_fraction << " of the Rayleigh time "
-        << bound.rayleigh_time_s << " s)";
+    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << plan.stability_limit_s
+        << " s, the stability limit: the Rayleigh time " << bound.rayleigh_time_s << " s or "
+        << kMinStepsPerContact << " steps of the contact time " << bound.contact_time_s << " s at "
+        << integ.max_impact_speed_m_s << " m/s (the automatic step is " << bound.max_time_step_s << " s: "
+        << integ.steps_per_contact << " steps per contact or " << integ.rayleigh_fraction << " of the Rayleigh time)";
     throw std::invalid_argument(msg.str());
   }
   const double target_step = user_step > 0.0 ? user_step : bound.max_time_step_s;
@@ -189,6 +253,35 @@ RunPlan plan_run(const DamperSimulationOptions& options) {
   plan.steps_per_period = plan.steps_per_block * samples;
   plan.dt = period / static_cast<double>(plan.steps_per_period);
   integ.time_step_s = plan.dt;
+  plan.steps_per_contact = bound.contact_time_s / plan.dt;
+  if (plan.dt > bound.max_time_step_s) {
+    // A user step between the automatic bound and the stability limit: accepted, with
+    // what it costs. The world checks its step against its own bound at
+    // max_impact_speed_m_s, so it is built at the (lower) speed whose bound this step
+    // is: t_c ∝ v^{−1/5}, v_w = v·(t_c(v)/(N_c·dt))^5. That speed only sets the world's
+    // bound and its energy-growth threshold (½m_bed v_w²); restitution laws were
+    // validated up to v above.
+    std::ostringstream w;
+    w << "dem.integration.time_step_s = " << user_step << " s is above the automatic bound "
+      << bound.max_time_step_s << " s: " << plan.steps_per_contact << " steps per contact at the impact speed "
+      << plan.impact_speed_m_s << " m/s (automatic: " << integ.steps_per_contact << ")";
+    const double e_min = smallest_restitution(plan.world);
+    if (std::isfinite(e_min)) {
+      w << "; one impact then realises a restitution low by up to (0.6 ln^2(e) + 0.1)/N = "
+        << 100.0 * restitution_error_bound(e_min, plan.steps_per_contact) << "% at e = " << e_min;
+    } else {
+      w << "; one impact then realises a restitution low by up to (0.6 ln^2(e) + 0.1)/N of e";
+    }
+    w << " (docs/dem.md)";
+    plan.warnings.push_back(w.str());
+    const double ratio = bound.contact_time_s / (integ.steps_per_contact * plan.dt);
+    integ.max_impact_speed_m_s = plan.impact_speed_m_s * std::pow(ratio, 5.0);
+    integ.rayleigh_fraction = std::min(1.0, std::max(integ.rayleigh_fraction, plan.dt / bound.rayleigh_time_s));
+    for (int k = 0; k < 8 && time_step_bound(plan.world).max_time_step_s < plan.dt; ++k) {
+      integ.max_impact_speed_m_s *= 1.0 - 1e-9 * (1 << (2 * k));
+      if (integ.rayleigh_fraction < 1.0) integ.rayleigh_fraction = std::min(1.0, integ.rayleigh_fraction * (1.0 + 1e-12));
+    }
+  }
 
   // Settling: automatic = long enough for the bed to come to rest under gravity.
   double settling = options.settling_time_s;
@@ -296,7 +389,7 @@ std::vector<std::string> DamperSimulationOptions::validate(const std::string& pr
   if (errors.empty() && amplitude_ok && frequency_ok) {
     const double drive = drive_impact_speed(*this);
     std::ostringstream rule;
-    rule << "the drive's impact speed 2XΩ + √(2|g|L) = " << drive << " m/s (frequency_hz = " << frequency_hz
+    rule << "the drive's impact speed 2XΩ + √(2|g|(H − 2r_min)) = " << drive << " m/s (frequency_hz = " << frequency_hz
          << ") must be <= " << limits::kMaxImpactSpeed_m_s << " m/s";
     add(drive <= limits::kMaxImpactSpeed_m_s, "amplitude_m", amplitude_m, rule.str());
     if (drive <= limits::kMaxImpactSpeed_m_s && drive > world.integration.max_impact_speed_m_s) {
@@ -359,6 +452,10 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   RunEstimate e;
   e.particles = plan.particles;
   e.time_step_s = plan.dt;
+  e.impact_speed_m_s = plan.impact_speed_m_s;
+  e.steps_per_contact = plan.steps_per_contact;
+  e.stability_limit_s = plan.stability_limit_s;
+  e.warnings = plan.warnings;
   e.steps_per_period = plan.steps_per_period;
   e.settling_steps = plan.settle_steps;
   e.transient_steps = plan.transient_steps;
@@ -466,9 +563,10 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     reporter.maybe_report("transient", settle_steps + k, total_steps, static_cast<double>(k) * dt);
   }
 
-  // Analysis: block averages of the force and the container velocity along the drive
-  // (the same boxcar filter on both leaves η* and m_app exactly unchanged), and
-  // instantaneous samples of the bed at block ends.
+  // Analysis: the drive bin (Fourier coefficient at Ω) of the force and the container
+  // velocity along the drive, accumulated every step and per period (the measures; no
+  // aliasing, whatever samples_per_period), block averages of both (the recorded series,
+  // for plots), and instantaneous samples of the bed at block ends.
   const int periods = options.analysed_periods;
   const std::int64_t blocks = static_cast<std::int64_t>(periods) * samples;
   TimeSeries& series = result.series;
@@ -488,6 +586,10 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   for (int s = 0; s < options.snapshots; ++s) {
     snapshot_blocks.push_back(static_cast<std::int64_t>((s + 1.0) * static_cast<double>(blocks) / options.snapshots) - 1);
   }
+  // F_k of a step is the leapfrog impulse F_k·dt over [t_k − dt/2, t_k + dt/2]: held
+  // constant there (formulas::StepForce::kConstant).
+  formulas::DriveBinAccumulator period_bin(steps_per_period), all_bin(steps_per_period);
+  const double m_bed = result.bed_mass_kg;
   std::int64_t step = transient_steps;
   for (std::int64_t b = 0; b < blocks; ++b) {
     double force_sum = 0.0, velocity_sum = 0.0;
@@ -499,8 +601,11 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
         finish(world.status().outcome, world.status().message);
         return result;
       }
-      force_sum += dot(load.force_n, axis);
-      velocity_sum += dot(state.velocity_m_s, axis);
+      const double force_along = dot(load.force_n, axis);
+      const double velocity_along = dot(state.velocity_m_s, axis);
+      force_sum += force_along;
+      velocity_sum += velocity_along;
+      period_bin.add(step, force_along, velocity_along);
       reporter.maybe_report("analysis", settle_steps + step, total_steps, static_cast<double>(step) * dt);
     }
     const double t_mid = (static_cast<double>(step - steps_per_block) + 0.5 * static_cast<double>(steps_per_block + 1)) * dt;
@@ -530,25 +635,20 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     if (std::find(snapshot_blocks.begin(), snapshot_blocks.end(), b) != snapshot_blocks.end()) {
       result.snapshots.push_back(snapshot_of(world, static_cast<double>(step) * dt));
     }
+    if ((b + 1) % samples == 0) {
+      result.eta_star_per_period.push_back(period_bin.result(options.frequency_hz).reduced_loss_factor(m_bed));
+      all_bin.merge(period_bin);
+      period_bin.clear();
+    }
   }
   const EnergyAccount e_end = world.energy();
 
-  // Complex power over all analysed periods and per period (PHYSICS.md §1).
-  const double block_dt = dt * static_cast<double>(steps_per_block);
-  const auto cp = formulas::complex_power(force_blocks, velocity_blocks, block_dt, options.frequency_hz);
-  const double m_bed = result.bed_mass_kg;
+  // Complex power over all analysed periods (PHYSICS.md §1): the sum of the periods' bins.
+  const auto cp = all_bin.result(options.frequency_hz);
   result.eta_star = cp.reduced_loss_factor(m_bed);
   result.e_diss_j = cp.e_diss_j;
   result.energy_per_cycle_j = cp.energy_per_cycle_j;
   result.apparent_mass_kg = cp.apparent_mass_kg;
-  for (int p = 0; p < periods; ++p) {
-    const auto offset = static_cast<std::size_t>(p) * static_cast<std::size_t>(samples);
-    const auto one = formulas::complex_power(
-        std::span<const double>(force_blocks).subspan(offset, static_cast<std::size_t>(samples)),
-        std::span<const double>(velocity_blocks).subspan(offset, static_cast<std::size_t>(samples)), block_dt,
-        options.frequency_hz);
-    result.eta_star_per_period.push_back(one.reduced_loss_factor(m_bed));
-  }
   const auto& per = result.eta_star_per_period;
   const double mean = std::accumulate(per.begin(), per.end(), 0.0) / periods;
   double var = 0.0;
@@ -590,6 +690,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
 
   // Validity remarks.
   auto& warn = result.warnings;
+  warn.insert(warn.end(), plan.warnings.begin(), plan.warnings.end());
   if (g_norm > 0.0 && std::abs(dot(g, axis)) > 1e-6 * g_norm) {
     warn.push_back("gravity has a component along the drive: the ideal collect-and-collide models do not apply");
   }

@@ -156,6 +156,18 @@ FundamentalAmplitude fundamental(std::span<const double> signal, const char* nam
   return {{scale * y[0], scale * y[1]}, max_abs_average};
 }
 
+/// P, E_diss, energy per cycle and m_app from F* and V* (V* non-zero).
+void finish_measures(ComplexPower& result, double frequency_hz) {
+  const double omega = kTwoPi * frequency_hz;
+  const double v_norm = std::norm(result.velocity_amplitude);
+  const std::complex<double> f_conj_v = result.force_amplitude * std::conj(result.velocity_amplitude);
+  result.power = 0.5 * f_conj_v;
+  result.angular_frequency = omega;
+  result.e_diss_j = result.power.real() / omega;
+  result.energy_per_cycle_j = kTwoPi * result.e_diss_j;
+  result.apparent_mass_kg = f_conj_v.imag() / (omega * v_norm);
+}
+
 }  // namespace
 
 double ComplexPower::reduced_loss_factor(double bed_mass_kg) const {
@@ -222,15 +234,81 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
            number(frequency_hz) + " Hz, so m_app and eta* are undefined");
   }
 
-  const double omega = kTwoPi * frequency_hz;
-  const std::complex<double> f_conj_v = result.force_amplitude * std::conj(result.velocity_amplitude);
-  result.power = 0.5 * f_conj_v;
-  result.angular_frequency = omega;
-  result.e_diss_j = result.power.real() / omega;
-  result.energy_per_cycle_j = kTwoPi * result.e_diss_j;
-  result.apparent_mass_kg = f_conj_v.imag() / (omega * v_norm);
+  finish_measures(result, frequency_hz);
   result.periods = periods;
   result.samples_per_period = samples_per_period;
+  return result;
+}
+
+DriveBinAccumulator::DriveBinAccumulator(std::int64_t steps_per_period, StepForce force_model)
+    : steps_per_period_(steps_per_period) {
+  if (steps_per_period < 3) {
+    reject("DriveBinAccumulator: steps_per_period = " + std::to_string(steps_per_period) + ": must be >= 3");
+  }
+  const double half_step = kPi / static_cast<double>(steps_per_period);  // Ωdt/2
+  const double sinc = std::sin(half_step) / half_step;
+  weight_ = force_model == StepForce::kConstant ? sinc : sinc * sinc;
+  rotor_ = std::polar(1.0, -2.0 * half_step);
+}
+
+void DriveBinAccumulator::add(std::int64_t step, double force_n, double velocity_m_s) {
+  // e^{−2πi k/M} depends on k mod M only; recomputed from it every 64 steps (and after a
+  // jump in k), rotated by e^{−2πi/M} in between.
+  const std::int64_t m = ((step % steps_per_period_) + steps_per_period_) % steps_per_period_;
+  if (!started_ || step != next_step_ || (m & 63) == 0) {
+    phase_ = std::polar(1.0, -kTwoPi * static_cast<double>(m) / static_cast<double>(steps_per_period_));
+  }
+  started_ = true;
+  next_step_ = step + 1;
+  force_sum_ += force_n * phase_;
+  velocity_sum_ += velocity_m_s * phase_;
+  max_abs_velocity_ = std::max(max_abs_velocity_, std::abs(velocity_m_s));
+  ++samples_;
+  phase_ *= rotor_;
+}
+
+void DriveBinAccumulator::merge(const DriveBinAccumulator& other) {
+  if (other.steps_per_period_ != steps_per_period_ || other.weight_ != weight_) {
+    reject("DriveBinAccumulator::merge: steps_per_period " + std::to_string(other.steps_per_period_) + " vs " +
+           std::to_string(steps_per_period_) + ": must be equal, with the same force model");
+  }
+  force_sum_ += other.force_sum_;
+  velocity_sum_ += other.velocity_sum_;
+  max_abs_velocity_ = std::max(max_abs_velocity_, other.max_abs_velocity_);
+  samples_ += other.samples_;
+}
+
+void DriveBinAccumulator::clear() {
+  force_sum_ = velocity_sum_ = {0.0, 0.0};
+  max_abs_velocity_ = 0.0;
+  samples_ = 0;
+  started_ = false;
+}
+
+ComplexPower DriveBinAccumulator::result(double frequency_hz) const {
+  if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
+    reject("frequency_hz = " + number(frequency_hz) + ": must be > 0 and finite");
+  }
+  if (samples_ <= 0 || samples_ % steps_per_period_ != 0) {
+    reject("N = " + std::to_string(samples_) + " samples, T/dt = " + std::to_string(steps_per_period_) +
+           ": N must be a positive multiple of T/dt (a whole number of periods)");
+  }
+  if (!std::isfinite(std::abs(force_sum_)) || !std::isfinite(std::abs(velocity_sum_))) {
+    reject("the sums over " + std::to_string(samples_) + " samples are not finite: samples must be finite");
+  }
+  ComplexPower result;
+  const double scale = 2.0 / static_cast<double>(samples_);
+  result.force_amplitude = scale * weight_ * force_sum_;
+  result.velocity_amplitude = scale * velocity_sum_;
+  const double v_abs = std::abs(result.velocity_amplitude);
+  if (!(v_abs > kZeroVelocityFraction * max_abs_velocity_)) {
+    reject("|V*| = " + number(v_abs) + " m/s with max|v| = " + number(max_abs_velocity_) +
+           " m/s: the velocity has no component at the drive frequency " + number(frequency_hz) +
+           " Hz, so m_app and eta* are undefined");
+  }
+  finish_measures(result, frequency_hz);
+  result.periods = static_cast<int>(std::min<std::int64_t>(samples_ / steps_per_period_, std::numeric_limits<int>::max()));
+  result.samples_per_period = static_cast<int>(std::min<std::int64_t>(steps_per_period_, std::numeric_limits<int>::max()));
   return result;
 }
 

@@ -23,8 +23,9 @@ inline constexpr double kMaxFrequency_hz = 1e4;
 inline constexpr double kMaxSettlingTime_s = 100.0;
 /// Transient [0, 100000] and analysed [1, 100000] periods: more is no design run.
 inline constexpr int kMaxPeriods = 100'000;
-/// Samples per period [16, 100000]: 16 resolve the harmonics the measures use; above
-/// 1e5 the blocks get shorter than a contact and the time step is cut to fit.
+/// Samples per period [16, 100000] of the recorded block series (the measures come from
+/// every step and do not depend on it); above 1e5 the blocks get shorter than a contact
+/// and the time step is cut to fit.
 inline constexpr int kMinSamplesPerPeriod = 16;
 inline constexpr int kMaxSamplesPerPeriod = 100'000;
 /// samples_per_period × analysed_periods: the recorded signals keep 9 doubles per
@@ -48,7 +49,16 @@ struct DamperSimulationOptions {
   int analysed_periods = 10;       ///< whole periods analysed, in [1, 100000]
   /// Samples per period of the recorded signals (block averages of whole steps; the
   /// time step is reduced so that a period is a whole number of blocks), in [16, 100000];
-  /// samples_per_period × analysed_periods <= 1e7.
+  /// samples_per_period × analysed_periods <= 1e7. Only the series use it: η*, E_diss,
+  /// m_app and the per-period η* come from the Fourier coefficient at Ω accumulated every
+  /// step (formulas::DriveBinAccumulator), so they do not alias and do not depend on it.
+  ///
+  /// Time step (world.integration): automatic = min(t_c(v)/steps_per_contact,
+  /// rayleigh_fraction·T_R) at v = max(max_impact_speed_m_s, 2XΩ + √(2|g|H_free)),
+  /// H_free = H − 2r_min (the largest free fall of a sphere). A user time_step_s above
+  /// that is accepted up to the stability limit min(T_R, t_c(v)/20), with a warning giving
+  /// the steps per contact at v and the restitution error bound (0.6 ln²ε + 0.1)/N;
+  /// above the stability limit it is refused.
   int samples_per_period = 1000;
   /// Particle snapshots kept, evenly spaced over the analysed periods, in
   /// [0, min(samples_per_period × analysed_periods, 10000)].
@@ -129,7 +139,7 @@ struct EnergyBalance {
 struct DamperResult {
   Summary summary;
   double eta_star = 0.0;               ///< reduced loss factor from complex power (PHYSICS.md §1)
-  double eta_star_stderr = 0.0;        ///< standard error of the mean of the per-period values
+  double eta_star_stderr = 0.0;        ///< standard error of the mean of the per-period values (sample sd/√n)
   /// η* from the energy balance instead: (D + ΔE)/(n·π·m_bed·V²) (independent check).
   double eta_star_energy_balance = 0.0;
   double e_diss_j = 0.0;               ///< Re(P)/Ω, J
@@ -146,6 +156,7 @@ struct DamperResult {
   double intensity = 0.0;              ///< Γ = XΩ²/g
   double time_step_s = 0.0;
   int steps_per_period = 0;
+  /// η* of each analysed period, from that period's drive bin (not from the blocks).
   std::vector<double> eta_star_per_period;
   EnergyBalance energy;
   TimeSeries series;
@@ -172,6 +183,10 @@ using ProgressCallback = std::function<void(const Progress&)>;
 struct RunEstimate {
   int particles = 0;
   double time_step_s = 0.0;            ///< exactly as run_harmonic chooses it, s
+  double impact_speed_m_s = 0.0;       ///< the speed the bound is taken at: max(max_impact_speed_m_s, 2XΩ + √(2|g|H_free)), m/s
+  double steps_per_contact = 0.0;      ///< Hertz contact time at that speed / time_step_s
+  double stability_limit_s = 0.0;      ///< largest user time step accepted: min(T_R, t_c/20), s
+  std::vector<std::string> warnings;   ///< as run_harmonic will add them (a user step above the automatic bound)
   std::int64_t steps_per_period = 0;
   std::int64_t settling_steps = 0;
   std::int64_t transient_steps = 0;
@@ -199,7 +214,8 @@ struct RunEstimate {
 };
 
 /// The estimate of run_harmonic(options). Throws std::invalid_argument as run_harmonic
-/// does for invalid options (all violations, one per line) or a time step above the bound.
+/// does for invalid options (all violations, one per line) or a time step above the
+/// stability limit.
 RunEstimate estimate_run(const DamperSimulationOptions& options);
 
 /// Places the particles as run_harmonic would (lattice or random, inner structures and

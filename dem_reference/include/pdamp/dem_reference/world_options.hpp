@@ -166,7 +166,7 @@ struct IntegrationOptions {
   int steps_per_contact = 50;      ///< in [40, 10000]
   double rayleigh_fraction = 0.25; ///< fraction of the Rayleigh time, in (0, 1]
   /// Largest normal impact speed expected, m/s, in (0, 1000] (run_harmonic raises it
-  /// to at least 2XΩ + √(2|g|L) of the drive, which must stay <= 1000 m/s as well).
+  /// to at least 2XΩ + √(2|g|(H − 2r)) of the drive, which must stay <= 1000 m/s as well).
   double max_impact_speed_m_s = 1.0;
   /// Verlet skin as a fraction of the largest radius, in [0.01, 2]: pairs closer than
   /// r_i + r_j + skin are listed; the list is rebuilt when a particle has moved more

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <complex>
+#include <cstdint>
 #include <span>
 
 namespace pdamp::formulas {
@@ -48,5 +49,56 @@ struct ComplexPower {
 /// execution not; per-thread workspaces): safe to call from several threads.
 ComplexPower complex_power(std::span<const double> force_n, std::span<const double> velocity_m_s, double dt_s,
                            double frequency_hz);
+
+/// How a sampled force is held over its time step (docs/complex_power.md "Step by step").
+enum class StepForce {
+  /// F_k acts constant over [t_k − dt/2, t_k + dt/2]: the leapfrog impulse F_k·dt of
+  /// the DEM step. ∫ e^{−iΩt} over the step is dt·sinc(Ωdt/2)·e^{−iΩt_k}.
+  kConstant,
+  /// F linear between the samples (trapezoidal): the weight is dt·sinc²(Ωdt/2)·e^{−iΩt_k}.
+  kLinear,
+};
+
+/// The Fourier coefficient at Ω of a force and a velocity, accumulated one time step
+/// at a time (no record kept): exact for a force held over each step as `force_model`
+/// says, whatever its harmonics, and exact for a velocity whose content lies below
+/// M/2 harmonics (a sampled pure harmonic: the container's). The record must be whole
+/// periods of M = steps_per_period steps, dt = T/M; sample k is at t_k = k·dt (k the
+/// step index passed to add(), any origin: only whole periods matter).
+///
+///   F* = (2/N)·w·Σ_k F_k e^{−2πi k/M},  V* = (2/N)·Σ_k v_k e^{−2πi k/M},
+///   w = sinc(π/M) (kConstant) or sinc²(π/M) (kLinear), N the number of samples.
+///
+/// Unlike complex_power() on block averages, harmonics at (jM' ± 1)Ω of a coarser
+/// record of M' blocks do not fold into the bin: only (jM ± 1)Ω would, and M is the
+/// number of steps per period. The phase e^{−2πi k/M} is rotated step by step and
+/// recomputed from k every 64 steps (round-off < 1e-13).
+class DriveBinAccumulator {
+ public:
+  /// steps_per_period >= 3; throws std::invalid_argument otherwise.
+  explicit DriveBinAccumulator(std::int64_t steps_per_period, StepForce force_model = StepForce::kConstant);
+  /// Adds the samples of step k (N, m/s).
+  void add(std::int64_t step, double force_n, double velocity_m_s);
+  /// Adds another accumulator's sums (same steps_per_period and force model).
+  void merge(const DriveBinAccumulator& other);
+  void clear();
+  std::int64_t samples() const { return samples_; }
+  /// The measures at frequency_hz from the sums so far. Throws std::invalid_argument
+  /// unless the samples are a positive whole number of periods, are finite, and the
+  /// velocity has a component at Ω (the rules of complex_power()).
+  ComplexPower result(double frequency_hz) const;
+
+ private:
+  std::int64_t steps_per_period_;
+  double weight_;                      ///< sinc(π/M) or sinc²(π/M)
+  std::complex<double> rotor_;         ///< e^{−2πi/M}
+  std::complex<double> phase_{1.0, 0.0};
+  std::int64_t next_step_ = 0;
+  bool started_ = false;
+  std::complex<double> force_sum_{0.0, 0.0};
+  std::complex<double> velocity_sum_{0.0, 0.0};
+  double max_abs_velocity_ = 0.0;
+  std::int64_t samples_ = 0;
+};
 
 }  // namespace pdamp::formulas
