@@ -524,6 +524,12 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, double amplitu
   return options;
 }
 
+formulas::BufferModel buffer_model(const std::string& name, const std::string& where, const std::string& key) {
+  if (name == "layered") return formulas::BufferModel::kLayered;
+  if (name == "half_space") return formulas::BufferModel::kHalfSpace;
+  throw InputError(where, key, "'" + name + "': must be layered or half_space");
+}
+
 InputError dem_input_error(const Case& c, const std::string& problem) {
   // "<path> = <value>: <rule>" (dem_reference's validate(); "dem." before the path in
   // the time-step bound's message) or "<path> size = <n>: <rule>".
@@ -678,6 +684,8 @@ Case load_case(const std::string& path) {
     in.intensity = intensity.value_or(0.0);
     in.particles_per_contact = b.number("particles_per_contact", 1.0, {1.0, 1e9});
     in.impact_velocity_m_s = b.optional_number("impact_velocity_m_s", limits::kImpactSpeed, " m/s").value_or(0.0);
+    in.model = buffer_model(b.text("model", std::string("layered"), {"layered", "half_space"}), b.file(),
+                            b.pointer() + "/model");
     in.particle_radius_m = c.damper.particle_radius_m;
     in.particle = c.materials.at(c.damper.particle_material);
     in.layer = c.materials.at(spec.layer_material);

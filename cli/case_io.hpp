@@ -88,6 +88,10 @@ Case load_case(const std::string& path);
 
 std::string_view to_string(Task task);
 
+/// "layered" or "half_space" (the contact law of the buffer sizing); InputError naming
+/// `where` (a file or a flag) and `key` otherwise.
+formulas::BufferModel buffer_model(const std::string& name, const std::string& where, const std::string& key);
+
 /// A line of dem_reference's validate() ("integration.time_step_s = 0.001: ...") as
 /// the case's error: the internal option name becomes the JSON pointer of the case key
 /// it comes from (/dem/time_step_s, /dem/inner_structures/pins/0, ...).

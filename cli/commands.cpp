@@ -208,11 +208,16 @@ int run_loss(const ParsedArgs& args) {
 }
 
 json buffer_json(const fm::BufferDesign& b) {
-  return {{"layer_thickness_m", b.layer_thickness_m},   {"impact_velocity_m_s", b.impact_velocity_m_s},
+  return {{"model", b.model == fm::BufferModel::kLayered ? "layered" : "half_space"},
+          {"layer_thickness_m", b.layer_thickness_m},   {"impact_velocity_m_s", b.impact_velocity_m_s},
           {"max_penetration_m", b.max_penetration_m},   {"contact_time_s", b.contact_time_s},
           {"contact_time_over_period", b.contact_time_over_period},
           {"effective_mass_kg", b.effective_mass_kg},   {"max_force_n", b.max_force_n},
-          {"contact_radius_m", b.contact_radius_m},     {"assumptions", b.assumptions},
+          {"contact_radius_m", b.contact_radius_m},
+          {"contact_radius_over_thickness", b.contact_radius_over_thickness},
+          {"half_space_thickness_m", b.half_space_thickness_m},
+          {"layered_compression_of_half_space_design", b.layered_compression_of_half_space_design},
+          {"assumptions", b.assumptions},
           {"warnings", b.warnings}};
 }
 
@@ -230,7 +235,9 @@ int run_buffer(const ParsedArgs& args) {
   in.particle.youngs_modulus_pa = args.optional_number("--particle-modulus", limits::kModulus).value_or(in.particle.youngs_modulus_pa);
   in.particle.poisson_ratio = args.optional_number("--particle-poisson", limits::kPoisson).value_or(in.particle.poisson_ratio);
   in.layer.youngs_modulus_pa = args.number("--layer-modulus", limits::kModulus);
-  in.layer.poisson_ratio = args.optional_number("--layer-poisson", limits::kPoisson).value_or(0.45);
+  in.layer.poisson_ratio =
+      args.optional_number("--layer-poisson", limits::kPoisson).value_or(fm::kDefaultLayerPoissonRatio);
+  in.model = buffer_model(args.optional_text("--layer-model").value_or("layered"), "--layer-model", "");
   in.particles_per_contact = args.optional_number("--particles-per-contact", Range{1.0, 1e9}).value_or(1.0);
   in.impact_velocity_m_s = args.optional_number("--impact-velocity", limits::kImpactSpeed).value_or(0.0);
   const auto problems = in.validate();
@@ -238,7 +245,12 @@ int run_buffer(const ParsedArgs& args) {
   const auto design = fm::size_buffer_layer(in);
   print_warnings(design.warnings);
   return emit(args, buffer_json(design),
-              {{"layer_thickness_m", format_number(design.layer_thickness_m)},
+              {{"model", std::string(design.model == fm::BufferModel::kLayered ? "layered" : "half_space")},
+               {"layer_thickness_m", format_number(design.layer_thickness_m)},
+               {"contact_radius/thickness", format_number(design.contact_radius_over_thickness, 3)},
+               {"half-space thickness", format_number(design.half_space_thickness_m) + "  (compressed to " +
+                                            format_number(design.layered_compression_of_half_space_design, 3) +
+                                            " of it by the design impact)"},
                {"impact_velocity_m_s", format_number(design.impact_velocity_m_s)},
                {"max_penetration_m", format_number(design.max_penetration_m)},
                {"contact_time_s", format_number(design.contact_time_s)},
@@ -780,7 +792,9 @@ const std::vector<Command>& commands() {
          {"--particle-modulus", "PA", "particle Young's modulus, Pa (default 210e9, steel)"},
          {"--particle-poisson", "NU", "particle Poisson ratio (default 0.3)"},
          {"--layer-modulus", "PA", "layer Young's modulus at the design frequency and temperature, Pa"},
-         {"--layer-poisson", "NU", "layer Poisson ratio (default 0.45)"},
+         {"--layer-poisson", "NU", "layer Poisson ratio, [0, 0.5] (default 0.48, polyurethane; 0.5 incompressible)"},
+         {"--layer-model", "LAW", "layered (default: sphere on a layer bonded to the wall, exact for any\n"
+                                  "                          contact radius/thickness) or half_space (the source study's Hertz rule)"},
          {"--particles-per-contact", "N", "particles whose momentum drives one contact (default 1)"},
          {"--impact-velocity", "M_S", "impact speed, m/s (default 2*X*Omega, the bouncing optimum)"},
          kJsonFlag}},

@@ -49,8 +49,9 @@ inline constexpr Range kIntensity{1e-4, 1e5};
 inline constexpr Range kDensity{1.0, 1e5};
 /// Young's modulus: 1 kPa (gels) to 2 TPa (above diamond's 1.2 TPa).
 inline constexpr Range kModulus{1e3, 2e12};
-/// Poisson ratio of a material the contact laws take (0.5 makes E* singular).
-inline constexpr Range kPoisson{0.0, 0.4999};
+/// Poisson ratio: [0, 0.5] (0.5: incompressible rubbers and polyurethanes; the thin
+/// bonded layer law takes that limit, formulas/layered_contact.hpp).
+inline constexpr Range kPoisson{0.0, 0.5};
 /// Impact speed: (0, 1000] m/s; above it impacts are ballistic and the Hertz laws (and
 /// the DEM's time step) mean nothing.
 inline constexpr Range kImpactSpeed{0.0, dem_reference::limits::kMaxImpactSpeed_m_s, true};

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "pdamp/formulas/collect_and_collide.hpp"  // kPi, kStandardGravity
+#include "pdamp/formulas/layered_contact.hpp"
 
 namespace pdamp::formulas {
 namespace {
@@ -15,6 +16,9 @@ namespace {
 constexpr double kMaxContactTimeOverPeriod = 0.1;    // impact short against the period
 constexpr double kMaxContactRadiusOverRadius = 0.2;  // Hertz small-strain: a ≪ r
 constexpr double kIntensityMismatch = 1e-6;          // relative X-Γ disagreement warned about
+// Half-space sizing warned about above this a/t: at a/t = 0.3 the exact bonded-layer
+// solution is already 1.3-1.45x stiffer than Hertz for nu = 0.3-0.5 (docs).
+constexpr double kMaxHalfSpaceContactOverThickness = 0.3;
 
 std::string number(double value, int digits = 12) {
   std::ostringstream out;
@@ -31,7 +35,7 @@ bool positive_finite(double value) { return value > 0.0 && std::isfinite(value);
 
 bool valid(const Material& m) {
   return positive_finite(m.density_kg_m3) && positive_finite(m.youngs_modulus_pa) && m.poisson_ratio >= 0.0 &&
-         m.poisson_ratio < 0.5;
+         m.poisson_ratio <= 0.5;
 }
 
 std::string joined(const std::vector<std::string>& lines) {
@@ -81,9 +85,13 @@ std::vector<std::string> Material::validate(const std::string& prefix) const {
     problems.push_back(field(prefix, "youngs_modulus_pa") + " = " + number(youngs_modulus_pa) +
                        ": must be > 0 and finite");
   }
-  if (!(poisson_ratio >= 0.0 && poisson_ratio < 0.5)) {
+  // ν = 0.5 (incompressible: rubbers, polyurethane) is allowed. Hertz (E* = E/(1−ν²)),
+  // Mindlin's G* and the Rayleigh time stay finite there; only the constrained modulus
+  // of a thin bonded layer diverges, and the layered law (layered_contact.hpp) takes
+  // that limit.
+  if (!(poisson_ratio >= 0.0 && poisson_ratio <= 0.5)) {
     problems.push_back(field(prefix, "poisson_ratio") + " = " + number(poisson_ratio) +
-                       ": must be in [0, 0.5)");
+                       ": must be in [0, 0.5]");
   }
   return problems;
 }
@@ -180,6 +188,9 @@ std::vector<std::string> BufferDesignInput::validate() const {
   }
   for (auto& line : particle.validate("particle")) problems.push_back(std::move(line));
   for (auto& line : layer.validate("layer")) problems.push_back(std::move(line));
+  if (model != BufferModel::kLayered && model != BufferModel::kHalfSpace) {
+    problems.push_back("model = " + std::to_string(static_cast<int>(model)) + ": must be layered or half_space");
+  }
   return problems;
 }
 
@@ -199,14 +210,48 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
       input.impact_velocity_m_s > 0.0 ? input.impact_velocity_m_s : 2.0 * stroke * omega;
   const double particle_mass = input.particle.density_kg_m3 * 4.0 / 3.0 * kPi * r * r * r;
   design.effective_mass_kg = input.particles_per_contact * particle_mass;
-  const HertzContact contact = sphere_wall_contact(r, design.effective_mass_kg, input.particle, input.layer);
+  // E* from both materials (the layer may be incompressible: E*, not Material::validate).
+  const double layer_compliance =
+      (1.0 - input.layer.poisson_ratio * input.layer.poisson_ratio) / input.layer.youngs_modulus_pa;
+  const HertzContact contact{1.0 / (compliance(input.particle) + layer_compliance), r, design.effective_mass_kg};
   const double v = design.impact_velocity_m_s;
-  design.max_penetration_m = max_penetration(contact, v);
-  design.layer_thickness_m = design.max_penetration_m;
-  design.contact_time_s = contact_time(contact, v);
+  const double half_space_thickness = max_penetration(contact, v);
+  design.half_space_thickness_m = half_space_thickness;
+  const auto layered = [&](double thickness_m) {
+    return LayeredContact(r, input.layer.youngs_modulus_pa, input.layer.poisson_ratio,
+                          input.particle.youngs_modulus_pa, input.particle.poisson_ratio, thickness_m);
+  };
+  const LayeredContact half_space_design = layered(half_space_thickness);
+  design.layered_compression_of_half_space_design =
+      layered_impact(half_space_design, design.effective_mass_kg, v).max_overlap_m / half_space_thickness;
+  design.model = input.model;
+  if (input.model == BufferModel::kHalfSpace) {
+    design.max_penetration_m = half_space_thickness;
+    design.layer_thickness_m = half_space_thickness;
+    design.contact_time_s = contact_time(contact, v);
+    design.max_force_n = contact.force(design.max_penetration_m);
+    design.contact_radius_m = std::sqrt(r * design.max_penetration_m);
+  } else {
+    // ½m*v² = U(t; t): U at bottoming out grows with t (∝ t^{5/2} for a/t → 0, ∝ t² for
+    // the compressible and ∝ t for the incompressible thin layer), so bisection on ln t
+    // between the half-space value (an upper bound: the layer is stiffer) and 1e-6 of it.
+    const double kinetic = 0.5 * design.effective_mass_kg * v * v;
+    double hi = half_space_thickness, lo = 1e-6 * half_space_thickness;
+    for (int i = 0; i < 200 && hi / lo - 1.0 > 1e-13; ++i) {
+      const double mid = std::sqrt(lo * hi);
+      (layered(mid).energy(mid) > kinetic ? hi : lo) = mid;
+    }
+    const double thickness = std::sqrt(lo * hi);
+    const LayeredContact law = layered(thickness);
+    const LayeredImpact impact = layered_impact(law, design.effective_mass_kg, v);
+    design.layer_thickness_m = thickness;
+    design.max_penetration_m = impact.max_overlap_m;  // = t to the bisection's 1e-13
+    design.contact_time_s = impact.contact_time_s;
+    design.max_force_n = impact.max_force_n;
+    design.contact_radius_m = law.contact_radius(impact.max_overlap_m);
+  }
   design.contact_time_over_period = design.contact_time_s * f;
-  design.max_force_n = contact.force(design.max_penetration_m);
-  design.contact_radius_m = std::sqrt(r * design.max_penetration_m);
+  design.contact_radius_over_thickness = design.contact_radius_m / design.layer_thickness_m;
   const double thickness = design.layer_thickness_m;
   const double a = design.contact_radius_m;
 
@@ -233,24 +278,42 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
                    " spheres, m* = " + number(design.effective_mass_kg, 4) +
                    " kg, as a rigid column (no wave travel or rebound inside the bed).");
   }
+  const bool half_space = input.model == BufferModel::kHalfSpace;
   said.push_back(
-      "The wall behind the layer is rigid and driven (no wall mass in m*); the contact is a sphere on "
-      "an elastic half-space of the layer material, E* = " +
+      "The wall behind the layer is rigid and driven (no wall mass in m*); the layer is bonded to the wall "
+      "and the sphere's contact with the layer is frictionless; E* = " +
       number(contact.effective_modulus_pa, 4) + " Pa from both materials.");
   said.push_back(
       "Layer modulus E = " + number(input.layer.youngs_modulus_pa, 4) +
       " Pa (nu = " + number(input.layer.poisson_ratio, 3) +
       ") is taken at the design frequency and temperature: polymers are rate- and temperature-dependent "
-      "(viscoelastic), and Hertz is elastic, so the layer's own loss is not in this sizing.");
-  said.push_back(
-      "Hertz treats the layer as a half-space, valid while the contact radius a = sqrt(r*delta) is "
-      "small against the thickness; here a = " +
-      number(a, 4) + " m is " + number(a / thickness, 3) + " times the thickness " + number(thickness, 4) +
-      " m.");
-  said.push_back(
-      "The thickness equals delta_max so the design impact just compresses the layer fully (strain 1 "
-      "under the sphere's tip): a first sizing beyond linear elasticity, to be checked in the DEM.");
-
+      "(viscoelastic), and the contact law is elastic, so the layer's own loss is not in this sizing.");
+  if (half_space) {
+    said.push_back(
+        "Model half_space (the source study's sizing): Hertz treats the layer as a half-space, valid while "
+        "the contact radius a = sqrt(r*delta) is small against the thickness; here a = " +
+        number(a, 4) + " m is " + number(a / thickness, 3) + " times the thickness " + number(thickness, 4) +
+        " m. Under the layered law (bonded layer) the design impact compresses this layer to only " +
+        number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
+    said.push_back(
+        "The thickness equals the Hertz delta_max so the design impact just compresses the layer fully "
+        "(strain 1 under the sphere's tip): a first sizing beyond linear elasticity, to be checked in the "
+        "DEM.");
+  } else {
+    said.push_back(
+        "Model layered: sphere on an elastic layer of thickness t bonded to the rigid wall (exact linear "
+        "elasticity for any a/t, Hertz for a/t -> 0, thin-layer limits for a/t >> 1; "
+        "docs/hertz_and_buffer.md). The thickness t = " +
+        number(thickness, 4) + " m is the one whose full compression (delta_max = t, nominal strain 1 "
+        "under the sphere's tip) the design impact just reaches: 1/2 m* v^2 = integral_0^t F(delta; t) "
+        "ddelta. The half-space sizing would give " +
+        number(half_space_thickness, 4) + " m, which this impact compresses to only " +
+        number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
+    said.push_back(
+        "At full compression the contact radius is a = " + number(a, 4) + " m, a/t = " + number(a / thickness, 3) +
+        "; the strain of 1 at the tip is far beyond linear elasticity (and the paraboloid needs a << r): a "
+        "sizing estimate, to be checked in the DEM with the layered law.");
+  }
   auto& warn = design.warnings;
   if (design.contact_time_over_period > kMaxContactTimeOverPeriod) {
     warn.push_back(
@@ -259,18 +322,23 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
         " of the period (> 0.1): the impact is not short against the period, so it is not an impact "
         "and the collect-and-collide timing does not hold");
   }
-  if (a > thickness) {
+  if (half_space && a > kMaxHalfSpaceContactOverThickness * thickness) {
     warn.push_back(
-        "contact radius a = " + number(a, 4) + " m is " + number(a / thickness, 3) +
+        "half-space sizing: contact radius a = " + number(a, 4) + " m is " + number(a / thickness, 3) +
         " times the layer thickness " + number(thickness, 4) +
-        " m: the layer is thin, not the half-space Hertz assumes; a thin layer on the rigid wall is "
-        "stiffer, so the design impact compresses it less than fully and bottoms out only at a higher "
-        "speed");
+        " m (> 0.3): the layer is thin, not the half-space Hertz assumes; bonded to the rigid wall it is "
+        "stiffer, and the design impact compresses it to only " +
+        number(design.layered_compression_of_half_space_design, 3) + " of its thickness (model layered)");
+  }
+  if (!half_space && std::sqrt(r / thickness) > LayeredContact::kMaxTabulatedOverlapParameter) {
+    warn.push_back("layered law: sqrt(r/t) = " + number(std::sqrt(r / thickness), 3) + " exceeds the tabulated " +
+                   "exact solution (" + number(LayeredContact::kMaxTabulatedOverlapParameter, 3) +
+                   "): the force continues as the table's end power law (thin-layer regime)");
   }
   if (a > kMaxContactRadiusOverRadius * r) {
     warn.push_back("contact radius a = " + number(a, 4) + " m is " + number(a / r, 3) +
                    " of the particle radius " + number(r, 4) +
-                   " m (> 0.2): Hertz needs a << r (small strain)");
+                   " m (> 0.2): the contact law needs a << r (small strain, paraboloidal sphere)");
   }
   if (input.impact_velocity_m_s == 0.0 && intensity < 1.0) {
     warn.push_back("design intensity Gamma = " + number(intensity, 3) +

@@ -290,3 +290,27 @@ TEST_CASE("a partial scattered-state fit in a case stays provisional", "[cli]") 
           c["damper"]["model_options"] = {{"scattered", {{"jump_fraction", 0.3}, {"exponent", 1.5}}}};
         }) == "case file");
 }
+
+TEST_CASE("buffer sizes a bonded layer by default and keeps the half-space rule on request", "[cli]") {
+  const std::string base = "buffer --frequency 60 --intensity 20 --radius 0.0025 --layer-modulus 60e6 "
+                           "--particles-per-contact 20 --layer-poisson 0.45 --json";
+  const auto layered = run_pdamp(base);
+  REQUIRE(layered.exit_code == 0);
+  const json l = json::parse(layered.out);
+  CHECK(l["model"] == "layered");
+  // The half-space rule's 0.378 mm (the old design) is reported beside it; a layer bonded
+  // to steel is stiffer, so the layer the design impact bottoms out is thinner, and the
+  // half-space design is compressed only partly (0.4 t in the elastic foundation limit).
+  CHECK(l["half_space_thickness_m"].get<double>() == Approx(0.000378).epsilon(0.01));
+  CHECK(l["layer_thickness_m"].get<double>() < 0.5 * l["half_space_thickness_m"].get<double>());
+  CHECK(l["layered_compression_of_half_space_design"].get<double>() < 0.6);
+  const auto half_space = run_pdamp(base + " --layer-model half_space");
+  REQUIRE(half_space.exit_code == 0);
+  const json h = json::parse(half_space.out);
+  CHECK(h["layer_thickness_m"].get<double>() == Approx(h["half_space_thickness_m"].get<double>()).epsilon(1e-12));
+  CHECK_THAT(half_space.err, Catch::Contains("times the layer thickness"));
+  require_one_line_error(run_pdamp(base + " --layer-model winkler"), "--layer-model: 'winkler': must be layered or half_space");
+  // Incompressible polyurethane is a valid layer.
+  CHECK(run_pdamp("buffer --frequency 60 --intensity 20 --radius 0.0025 --layer-modulus 60e6 --layer-poisson 0.5 --json")
+            .exit_code == 0);
+}

@@ -168,6 +168,9 @@ TEST_CASE("the buffered-wall sizing is just fully compressed by the design impac
   input.particle = fm::Material{kSteelRho, kSteelE, kSteelNu};
   input.layer = fm::Material{kLayerRho, kLayerE, kLayerNu};
   input.particles_per_contact = 4.0;
+  // The DEM's layer contact is still the Hertz half-space (issue 9: the bonded-layer law
+  // is in formulas/layered_contact.hpp, not yet in the DEM), so it checks that sizing.
+  input.model = fm::BufferModel::kHalfSpace;
   const fm::BufferDesign design = fm::size_buffer_layer(input);
   const double v = design.impact_velocity_m_s;
   REQUIRE(v == Approx(2.0 * 0.001 * 2.0 * kPi * 60.0).epsilon(1e-12));

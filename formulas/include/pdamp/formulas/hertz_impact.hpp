@@ -12,7 +12,7 @@ namespace pdamp::formulas {
 struct Material {
   double density_kg_m3 = 7850.0;     ///< ρ, kg/m^3, > 0
   double youngs_modulus_pa = 210e9;  ///< E, Pa, > 0
-  double poisson_ratio = 0.3;        ///< ν, in [0, 0.5)
+  double poisson_ratio = 0.3;        ///< ν, in [0, 0.5] (0.5: incompressible)
   /// One line per violation, "<prefix>.youngs_modulus_pa = -1: must be > 0 and finite"
   /// (no prefix and dot when prefix is empty); empty when valid.
   std::vector<std::string> validate(const std::string& prefix) const;
@@ -53,11 +53,25 @@ double contact_time(const HertzContact& contact, double impact_speed_m_s);
 /// dimensionless, exact to double precision (from std::tgamma).
 double contact_time_coefficient();
 
+/// Contact law used to size the buffer layer.
+enum class BufferModel {
+  /// Sphere on a layer of thickness t bonded to the rigid wall, frictionless at the
+  /// sphere (LayeredContact, layered_contact.hpp): exact linear elasticity for any a/t.
+  kLayered,
+  /// The source study's rule: Hertz half-space of the layer material, t = δ_max(v).
+  /// Ignores the wall under the layer (a/t = √(r/t) > 1 always): kept for comparison.
+  kHalfSpace,
+};
+
 /// Design of a polymer layer on a container wall that the design impact just
-/// compresses fully ("compression collect-and-collide", PHYSICS.md §5).
-/// The impact is one sphere of the bed's front row (radius r, particle material) on an
-/// elastic half-space of the layer material, carrying the momentum of
-/// particles_per_contact spheres; the wall behind the layer is rigid and driven.
+/// compresses fully ("compression collect-and-collide", PHYSICS.md §5): δ_max = t,
+/// "bottoms out" = a nominal strain of 1 under the sphere's tip; beyond it the hard
+/// wall's contact acts in parallel (the DEM's business).
+/// The impact is one sphere of the bed's front row (radius r, particle material) on the
+/// layer, carrying the momentum of particles_per_contact spheres; the wall behind the
+/// layer is rigid and driven.
+/// Layer Poisson ratio for polyurethane-like buffers (0.48–0.5 measured; 0.5 = incompressible).
+inline constexpr double kDefaultLayerPoissonRatio = 0.48;
 struct BufferDesignInput {
   double frequency_hz = 60.0;  ///< design frequency f, Hz, > 0
   double amplitude_m = 0.0;    ///< design stroke X, m, >= 0; 0 = derive from intensity
@@ -66,31 +80,46 @@ struct BufferDesignInput {
   double intensity = 0.0;
   double particle_radius_m = 0.0;  ///< sphere radius r, m, > 0
   Material particle;               ///< sphere material (density gives the particle mass)
-  Material layer;                  ///< modulus at the design frequency and temperature (density unused)
+  /// Modulus at the design frequency and temperature (density unused); ν in [0, 0.5]
+  /// (0.5 = incompressible). Callers should default polyurethane-like layers to
+  /// kDefaultLayerPoissonRatio.
+  Material layer{1200.0, 60e6, kDefaultLayerPoissonRatio};
   /// Particles whose momentum drives one contact with the layer (the collected bed
   /// hits the layer with its front row: bed_particles / front_row_particles), >= 1.
   double particles_per_contact = 1.0;
   /// Impact speed, m/s, >= 0; 0 = bouncing optimum 2XΩ (impact against the wall moving at −V).
   double impact_velocity_m_s = 0.0;
+  BufferModel model = BufferModel::kLayered;  ///< contact law of the sizing
   /// One line per violation ("particle_radius_m = -0.005: must be > 0 and finite");
   /// X or Γ (or an impact speed) must be given: amplitude_m = intensity = 0 is a
   /// violation unless impact_velocity_m_s > 0.
   std::vector<std::string> validate() const;
 };
 struct BufferDesign {
-  double layer_thickness_m = 0.0;         ///< = max_penetration_m: the design impact just bottoms out, m
+  BufferModel model = BufferModel::kLayered;  ///< contact law used
+  /// Layered: the t whose full compression (δ_max = t) the design impact just reaches,
+  /// ½m*v² = ∫₀^t F(δ; t) dδ. Half-space: t = Hertz δ_max. m
+  double layer_thickness_m = 0.0;
   double impact_velocity_m_s = 0.0;       ///< design impact speed v, m/s
-  double max_penetration_m = 0.0;         ///< Hertz δ_max at v, m
-  double contact_time_s = 0.0;            ///< Hertz t_c at v, s
+  double max_penetration_m = 0.0;         ///< δ_max at v under the model's law (= layer_thickness_m), m
+  double contact_time_s = 0.0;            ///< elastic contact time at v under the model's law, s
   double contact_time_over_period = 0.0;  ///< t_c·f; the impact picture needs it small (warning above 0.1)
   double effective_mass_kg = 0.0;         ///< m* = particles_per_contact·(4/3)πr³ρ, kg
-  double max_force_n = 0.0;               ///< (4/3) E* √r δ_max^{3/2}, N
-  double contact_radius_m = 0.0;          ///< a = √(r δ_max), m; half-space valid while a ≲ thickness
+  double max_force_n = 0.0;               ///< F(δ_max) under the model's law, N
+  /// Contact radius at δ_max, m: layered from the exact solution; half-space √(r δ_max).
+  double contact_radius_m = 0.0;
+  double contact_radius_over_thickness = 0.0;  ///< a/t at δ_max
+  /// Both models' comparison numbers, whichever sizes: the half-space thickness
+  /// t_H = Hertz δ_max(v), m, and δ_max/t_H under the layered law for a layer of
+  /// thickness t_H (how far the design impact really compresses the half-space design).
+  double half_space_thickness_m = 0.0;
+  double layered_compression_of_half_space_design = 0.0;
   std::vector<std::string> assumptions;   ///< readable sentences with the numbers used
   std::vector<std::string> warnings;      ///< validity-range violations (INTERFACE.md)
 };
 /// Sizes the layer: X from Γ if needed, v = 2XΩ unless given, m* from the bed's sharing,
-/// E* from particle and layer, thickness = δ_max(v). Throws std::invalid_argument with
+/// E* from particle and layer; kLayered: t from ½m*v² = U(t; t) with the layered law
+/// (bisection in ln t), t_c from the one-degree-of-freedom impact; kHalfSpace: t = δ_max(v). Throws std::invalid_argument with
 /// all of input.validate()'s lines (newline-separated) for invalid input.
 BufferDesign size_buffer_layer(const BufferDesignInput& input);
 
