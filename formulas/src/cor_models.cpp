@@ -1,5 +1,6 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
+#include "root_finding.hpp"
 #include "pdamp/formulas/csv_text.hpp"
 #include "pdamp/formulas/input_file.hpp"
 
@@ -828,24 +829,7 @@ double damping_for_restitution(double restitution) {
   }
   // |Δ ln ε| < 1e-10 gives |Δε| < 1e-10: inside the 1e-9 promise with the
   // integrator's own ~1e-11 error.
-  int side = 0;
-  double u = hi;
-  for (int iteration = 0; iteration < 200; ++iteration) {
-    u = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-    const double f = residual(u);
-    if (std::abs(f) < 1e-10 || hi - lo < 1e-15) break;
-    if (f > 0.0) {
-      lo = u;
-      f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = u;
-      f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    }
-  }
+  const double u = detail::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-10, 1e-15, 200);
   return std::expm1(u);
 }
 

@@ -1,5 +1,6 @@
 // Sphere on an elastic layer bonded to a rigid wall: kernel, thin-layer limits, exact Nyström solution, table.
 #include "pdamp/formulas/layered_contact.hpp"
+#include "root_finding.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -632,24 +633,7 @@ double layered_damping_for_restitution(const LayeredContact& contact, double mas
   };
   double lo = 0.0, f_lo = -target, hi = std::log1p(100.0), f_hi = residual(hi);
   if (f_hi > 0.0) throw std::runtime_error("layered_damping_for_restitution: not reached at damping 100");
-  int side = 0;
-  double u = hi;
-  for (int iteration = 0; iteration < 100; ++iteration) {
-    u = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-    const double f = residual(u);
-    if (std::abs(f) < 1e-7 || hi - lo < 1e-12) break;
-    if (f > 0.0) {
-      lo = u;
-      f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = u;
-      f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    }
-  }
+  const double u = detail::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
   return std::min(std::expm1(u), 100.0);
 }
 
