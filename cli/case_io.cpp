@@ -268,6 +268,17 @@ void read_damper(ObjectReader& r, Case& c) {
     d.particle_radius_m = p.number("radius_m", std::nullopt, limits::kParticleRadius, " m");
     d.particle_material = p.text("material", std::string("steel"));
     d.packing.collect_side = p.text("collect_side", std::string("negative"), {"negative", "positive"}) == "negative" ? -1 : 1;
+    // Gap between neighbouring lanes across the drive: a number, or "auto" (the width
+    // the lanes leave, shared out equally: each lane owns L/n).
+    if (p.is_string("lane_gap_m")) {
+      p.text("lane_gap_m", std::nullopt, {"auto"});
+      d.packing.lane_gap_auto = true;
+    } else {
+      d.packing.lane_gap_m = p.number("lane_gap_m", 0.0, {0.0, limits::kContainerSize.max}, " m (or \"auto\")");
+    }
+    d.lot_diameter_variation_m = p.number("lot_diameter_variation_m",
+                                          dem_reference::ParticleGroupOptions{}.lot_diameter_variation_m,
+                                          {0.0, dem_reference::limits::kMaxLotDiameterVariation_m}, " m");
     if (p.has("lattice") && !p.is_string("lattice")) {
       const auto counts = p.vector3("lattice", std::nullopt, {1.0, 1e6}, "");
       std::array<int, 3> n{};
@@ -382,6 +393,7 @@ void read_dem(ObjectReader& r, Case& c) {
   group.radius_m = d.particle_radius_m;
   group.material = material_index(r, "", d.particle_material, world.materials);
   group.radius_spread = r.number("radius_spread", 0.0, {0.0, 0.4999});
+  group.lot_diameter_variation_m = d.lot_diameter_variation_m;
   compartment.particles = {group};
   const std::string placement =
       r.text("placement", std::string("collected_lattice"), {"collected_lattice", "centred_lattice", "random"});
@@ -390,6 +402,8 @@ void read_dem(ObjectReader& r, Case& c) {
                                                            : dr::InitialPlacement::kRandom;
   compartment.collect_axis = d.drive_axis;
   compartment.collect_side = d.packing.collect_side;
+  compartment.lane_gap_m = d.packing.lane_gap_m;
+  compartment.lane_gap_auto = d.packing.lane_gap_auto;
   if (d.packing.lattice_counts) compartment.lattice_counts.assign(d.packing.lattice_counts->begin(), d.packing.lattice_counts->end());
 
   r.object("contact", false, [&](ObjectReader& p) { read_contact_pair(p, world.default_pair); });

@@ -28,6 +28,8 @@ struct DamperSpec {
   int particle_count = 0;
   double particle_radius_m = 0.0;
   std::string particle_material = "steel";
+  /// ISO 3290 lot variation of the ball diameter (dem_reference::ParticleGroupOptions).
+  double lot_diameter_variation_m = dem_reference::ParticleGroupOptions{}.lot_diameter_variation_m;
   formulas::LatticePacking packing;
   formulas::ModelOptions model_options;
   // Derived on load:

@@ -1,5 +1,6 @@
 // Initial placement: lattice collected against a wall (formulas::collected_lattice),
-// the same lattice centred, or seeded random non-overlapping positions.
+// the same lattice centred, or seeded random non-overlapping positions; radii with the
+// group's spread or ball-lot tolerance (seeded), lanes spaced by the compartment's lane gap.
 #include "initial_state.hpp"
 
 #include <algorithm>
@@ -45,7 +46,25 @@ formulas::LatticePacking packing_of(const CompartmentOptions& c, const Vec3& gra
   if (c.lattice_counts.size() == 3) {
     packing.lattice_counts = std::array<int, 3>{c.lattice_counts[0], c.lattice_counts[1], c.lattice_counts[2]};
   }
+  packing.lane_gap_m = c.lane_gap_m;
+  packing.lane_gap_auto = c.lane_gap_auto;
   return packing;
+}
+
+/// Fraction of the radius the ball-lot tolerance may take at most: the time-step bound
+/// (world.cpp, from radius_m·(1 − radius_spread)) then errs by under 1%.
+constexpr double kMaxToleranceFraction = 0.01;
+
+/// Radius of one sphere of the group from one uniform draw u in [0, 1) (exactly one
+/// draw per sphere whatever the options, so that the random placement's sequence does
+/// not depend on them). A spread gives the bits of r(1 + s(2u − 1)); otherwise the
+/// ball-lot tolerance gives r − Δu, Δ = min(V_DwL/2, r/100); both zero: r exactly.
+double draw_radius(const ParticleGroupOptions& group, double u) {
+  if (group.radius_spread > 0.0 || group.lot_diameter_variation_m == 0.0) {
+    return group.radius_m * (1.0 + group.radius_spread * (2.0 * u - 1.0));
+  }
+  const double range = std::min(0.5 * group.lot_diameter_variation_m, kMaxToleranceFraction * group.radius_m);
+  return group.radius_m - range * u;
 }
 
 /// Largest distance a centre may have from the compartment centre along each axis, and
@@ -93,7 +112,7 @@ InitialBed place_particles(const WorldOptions& options, const std::vector<WallFe
     int count = 0;
     for (const auto& group : c.particles) {
       for (int k = 0; k < group.count; ++k) {
-        const double r = group.radius_m * (1.0 + group.radius_spread * (2.0 * uniform(rng) - 1.0));
+        const double r = draw_radius(group, uniform(rng));
         bed.radii_m.push_back(r);
         bed.materials.push_back(group.material);
         bed.compartments.push_back(id);

@@ -255,6 +255,9 @@ void validate_compartment(Violations& v, const CompartmentOptions& c, const std:
     v.check(std::isfinite(p.radius_spread) && p.radius_spread >= 0.0 && p.radius_spread < 0.5,
             pg + ".radius_spread", p.radius_spread, "must be in [0, 0.5)");
     v.check(material_ok(p.material, materials), pg + ".material", p.material, range);
+    v.check(within(p.lot_diameter_variation_m, 0.0, limits::kMaxLotDiameterVariation_m),
+            pg + ".lot_diameter_variation_m", p.lot_diameter_variation_m,
+            "must be in " + interval(0.0, limits::kMaxLotDiameterVariation_m) + " m");
   }
   v.check(c.collect_axis >= 0 && c.collect_axis <= 2, at + ".collect_axis", c.collect_axis, "must be 0, 1 or 2");
   v.check(c.collect_side == -1 || c.collect_side == 1, at + ".collect_side", c.collect_side, "must be -1 or +1");
@@ -262,6 +265,12 @@ void validate_compartment(Violations& v, const CompartmentOptions& c, const std:
           c.lattice_counts.size(), "must be 0 (automatic) or 3");
   for (std::size_t a = 0; a < c.lattice_counts.size(); ++a) {
     v.check(c.lattice_counts[a] >= 1, index(at + ".lattice_counts", a), c.lattice_counts[a], "must be >= 1");
+  }
+  v.check(finite_at_least(c.lane_gap_m, 0.0), at + ".lane_gap_m", c.lane_gap_m, "must be >= 0 m");
+  if (c.container.shape != formulas::ContainerShape::kBox) {
+    v.check(c.lane_gap_m == 0.0 || !std::isfinite(c.lane_gap_m), at + ".lane_gap_m", c.lane_gap_m,
+            "must be 0 in a cylinder (lane gaps are for box containers)");
+    v.check(!c.lane_gap_auto, at + ".lane_gap_auto", "true", "must be false in a cylinder (lane gaps are for box containers)");
   }
   for (std::size_t k = 0; k < c.plates.size(); ++k) {
     const auto& p = c.plates[k];

@@ -45,6 +45,13 @@ int sites_along(double length_m, double radius_m) {
   return static_cast<int>(std::floor(length_m / (2.0 * radius_m) * (1.0 + kFitTolerance)));
 }
 
+/// Whole lanes of width 2r with gaps g between neighbours along an inner length L:
+/// n·2r + (n − 1)·g <= L.
+int lanes_along(double length_m, double radius_m, double gap_m) {
+  if (gap_m == 0.0) return sites_along(length_m, radius_m);
+  return static_cast<int>(std::floor((length_m + gap_m) / (2.0 * radius_m + gap_m) * (1.0 + kFitTolerance)));
+}
+
 /// Where the packing puts a slab's sites: the two transverse axes (ascending) and,
 /// when gravity lies along one of them, which one and its sign.
 struct CrossSection {
@@ -77,10 +84,32 @@ Vec3 site(const CrossSection& cs, double along_a, double along_b) {
   return p;
 }
 
-std::vector<Vec3> box_sites(const Container& c, double r, const CrossSection& cs, int n_a, int n_b) {
-  const auto sign_of = [&](int axis) { return axis == cs.gravity_axis ? cs.gravity_sign : 0; };
-  const auto pa = box_positions(n_a, c.box_inner_size_m[cs.axis_a], r, sign_of(cs.axis_a));
-  const auto pb = box_positions(n_b, c.box_inner_size_m[cs.axis_b], r, sign_of(cs.axis_b));
+/// Gap between the lanes along a transverse box axis of inner length L holding n lanes:
+/// none along gravity (rows rest on each other), else the given or the shared gap.
+double lane_gap(const LatticePacking& packing, const CrossSection& cs, int axis, double length_m, int n,
+                double radius_m) {
+  if (axis == cs.gravity_axis) return 0.0;
+  if (packing.lane_gap_auto) return std::max(0.0, (length_m - n * 2.0 * radius_m) / n);
+  return packing.lane_gap_m;
+}
+
+/// Positions of n lanes of pitch 2r + g centred on 0 (g = 0: centred_positions).
+std::vector<double> spaced_positions(int n, double radius_m, double gap_m) {
+  if (gap_m == 0.0) return centred_positions(n, radius_m);
+  std::vector<double> positions(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) positions[i] = (i - 0.5 * (n - 1)) * (2.0 * radius_m + gap_m);
+  return positions;
+}
+
+std::vector<Vec3> box_sites(const Container& c, double r, const CrossSection& cs, int n_a, int n_b,
+                            const LatticePacking& packing) {
+  const auto positions = [&](int axis, int n) {
+    const double length = c.box_inner_size_m[axis];
+    if (axis == cs.gravity_axis) return box_positions(n, length, r, cs.gravity_sign);
+    return spaced_positions(n, r, lane_gap(packing, cs, axis, length, n, r));
+  };
+  const auto pa = positions(cs.axis_a, n_a);
+  const auto pb = positions(cs.axis_b, n_b);
   std::vector<Vec3> sites;
   sites.reserve(pa.size() * pb.size());
   for (const double a : pa) {
@@ -169,6 +198,13 @@ std::vector<std::string> packing_problems(const Container& container, int count,
       problems.push_back("packing.gravity axis = " + std::to_string(axis) + ": must be 0, 1 or 2");
     if (sign != -1 && sign != 1)
       problems.push_back("packing.gravity sign = " + std::to_string(sign) + ": must be -1 or +1");
+  }
+  if (!std::isfinite(packing.lane_gap_m) || packing.lane_gap_m < 0.0) {
+    problems.push_back("packing.lane_gap_m = " + number(packing.lane_gap_m) + ": must be >= 0 and finite");
+  }
+  if ((packing.lane_gap_m != 0.0 || packing.lane_gap_auto) && container.shape != ContainerShape::kBox) {
+    problems.push_back("packing.lane_gap_m = " + (packing.lane_gap_auto ? std::string("auto") : number(packing.lane_gap_m)) +
+                       ": lane gaps are supported in a box only (must be 0 for a cylinder)");
   }
   if (packing.lattice_counts) {
     for (int i = 0; i < 3; ++i) {
@@ -264,13 +300,28 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
     } else {
       check_fit(cs.axis_a);
       check_fit(cs.axis_b);
-      sites = box_sites(container, r, cs, n[cs.axis_a], n[cs.axis_b]);
+      for (const int axis : {cs.axis_a, cs.axis_b}) {
+        const double inner = container.inner_length(axis);
+        const double gap = lane_gap(packing, cs, axis, inner, n[axis], r);
+        const double width = n[axis] * 2.0 * r + (n[axis] - 1) * gap;
+        if (width > inner * (1.0 + kFitTolerance)) {
+          reject("lattice_counts " + counts_text(n) + " with radius_m = " + number(r) + " and lane_gap_m = " +
+                 number(gap) + ": " + std::to_string(n[axis]) + " lanes need " + number(width) +
+                 " m along axis " + std::to_string(axis) + ", the inner length is " + number(inner) + " m");
+        }
+      }
+      sites = box_sites(container, r, cs, n[cs.axis_a], n[cs.axis_b], packing);
     }
   } else if (cylinder) {
     sites = cylinder_sites_auto(r, container.cylinder_inner_radius_m, cs);
   } else {
-    sites = box_sites(container, r, cs, sites_along(container.box_inner_size_m[cs.axis_a], r),
-                      sites_along(container.box_inner_size_m[cs.axis_b], r));
+    const auto lanes = [&](int axis) {
+      const double inner = container.box_inner_size_m[axis];
+      // Along gravity rows stack at pitch 2r; "auto" shares what floor(L/2r) lanes leave.
+      const bool spaced = axis != cs.gravity_axis && !packing.lane_gap_auto;
+      return lanes_along(inner, r, spaced ? packing.lane_gap_m : 0.0);
+    };
+    sites = box_sites(container, r, cs, lanes(cs.axis_a), lanes(cs.axis_b), packing);
   }
   if (sites.empty()) {
     reject("no sphere of radius_m = " + number(r) + " fits in the cross-section normal to axis " +

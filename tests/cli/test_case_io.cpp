@@ -314,3 +314,31 @@ TEST_CASE("buffer sizes a bonded layer by default and keeps the half-space rule 
   CHECK(run_pdamp("buffer --frequency 60 --intensity 20 --radius 0.0025 --layer-modulus 60e6 --layer-poisson 0.5 --json")
             .exit_code == 0);
 }
+
+TEST_CASE("the gap between lanes and the ball-lot tolerance are case keys", "[cli]") {
+  const auto clearance_of = [](const std::function<void(json&)>& edit) {
+    const auto r = run_pdamp("validate " + edited_case("pdamp_lanes.json", edit));
+    REQUIRE(r.exit_code == 0);
+    return json::parse(r.out)["damper"]["derived"]["clearance_m"].get<double>();
+  };
+  // 61 mm across the drive: 6 lanes of 10 mm touch (1 mm left over); "auto" shares the
+  // millimetre out and keeps 6 lanes, so the 36 spheres still make 6 slabs: h = 160 − 60 mm.
+  CHECK(clearance_of([](json& c) { c["damper"]["particles"]["lane_gap_m"] = "auto"; }) == Approx(0.100).margin(1e-12));
+  // A 2 mm gap: 6 lanes need 6 x 10 + 5 x 2 = 70 mm > 61 mm, so the case's 6 x 6 lattice
+  // is refused with the numbers; 5 lanes (58 mm) fit, and validate builds that DEM bed.
+  require_one_line_error(
+      run_pdamp("validate " + edited_case("pdamp_lanes_6.json", [](json& c) { c["damper"]["particles"]["lane_gap_m"] = 0.002; })),
+      "6 lanes need 0.07 m along axis 1");
+  CHECK(clearance_of([](json& c) {
+          c["damper"]["particles"]["lane_gap_m"] = 0.002;
+          c["damper"]["particles"]["count"] = 30;
+          c["damper"]["particles"]["lattice"] = {6, 5, 1};
+        }) == Approx(0.100).margin(1e-12));
+  require_one_line_error(
+      run_pdamp("validate " + edited_case("pdamp_lanes_bad.json", [](json& c) { c["damper"]["particles"]["lane_gap_m"] = "wide"; })),
+      "/damper/particles/lane_gap_m: 'wide' is not allowed");
+  require_one_line_error(run_pdamp("validate " + edited_case("pdamp_lot_bad.json", [](json& c) {
+                           c["damper"]["particles"]["lot_diameter_variation_m"] = 0.01;
+                         })),
+                         "/damper/particles/lot_diameter_variation_m: = 0.01: must be a finite number >= 0 and <= 0.001");
+}

@@ -9,7 +9,8 @@ namespace dr = pdamp::dem_reference;
 
 inline constexpr double kPi = 3.14159265358979323846;
 
-/// `count` steel spheres of radius r in a static 0.2 m cubic box, no gravity.
+/// `count` identical steel spheres of radius r (no ball-lot tolerance) in a static 0.2 m
+/// cubic box, no gravity.
 inline dr::WorldOptions box_world(int count, double radius_m, double restitution, double friction) {
   dr::WorldOptions o;
   o.gravity_m_s2 = {0.0, 0.0, 0.0};
@@ -17,6 +18,8 @@ inline dr::WorldOptions box_world(int count, double radius_m, double restitution
   c.container.shape = pdamp::formulas::ContainerShape::kBox;
   c.container.box_inner_size_m = {0.2, 0.2, 0.2};
   c.particles = {dr::ParticleGroupOptions{count, radius_m, 0.0, 0}};
+  // Identical spheres: the tests compare with closed forms at the nominal radius.
+  c.particles.front().lot_diameter_variation_m = 0.0;
   c.lattice_counts.clear();
   o.default_pair.restitution.constant = restitution;
   o.default_pair.friction = friction;

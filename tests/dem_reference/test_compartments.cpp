@@ -26,6 +26,9 @@ dr::CompartmentOptions compartment_a() {
   c.container.box_inner_size_m = {0.06, 0.03, 0.03};
   c.offset_m = {0.0, 0.0, 0.0};
   c.particles = {dr::ParticleGroupOptions{8, 0.005, 0.0, 0}};
+  // Identical spheres: with the ball-lot tolerance a compartment's radii would depend on
+  // the draws of the compartments before it, and superposition would not be exact.
+  c.particles.front().lot_diameter_variation_m = 0.0;
   c.lattice_counts = {2, 2, 2};
   return c;
 }
@@ -41,6 +44,9 @@ dr::CompartmentOptions compartment_b() {
   c.container.cylinder_inner_length_m = 0.08;
   c.offset_m = {0.01, 0.004, 0.006};
   c.particles = {dr::ParticleGroupOptions{6, 0.004, 0.0, 0}};
+  // Identical spheres: with the ball-lot tolerance a compartment's radii would depend on
+  // the draws of the compartments before it, and superposition would not be exact.
+  c.particles.front().lot_diameter_variation_m = 0.0;
   c.lattice_counts = {3, 2, 1};
   return c;
 }

@@ -165,6 +165,7 @@ TEST_CASE("a settled bed in a static turned container loads it with its weight",
   c.container.box_inner_size_m = {0.06, 0.04, 0.05};
   c.offset_m = {0.03, 0.01, -0.02};
   c.particles = {dr::ParticleGroupOptions{18, kRadius, 0.0, 0}};
+  c.particles.front().lot_diameter_variation_m = 0.0;  // identical spheres (perfect lattice)
   o.default_pair.restitution.constant = 0.5;
   o.default_pair.friction = 0.4;
   o.default_pair.rolling_friction = 0.1;

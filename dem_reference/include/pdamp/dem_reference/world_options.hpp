@@ -56,6 +56,9 @@ inline constexpr int kMaxStepsPerContact = 10'000;
 /// step; above 2 they hold most of the bed.
 inline constexpr double kMinSkinFraction = 0.01;
 inline constexpr double kMaxSkinFraction = 2.0;
+/// Ball lot diameter variation, m: ISO 3290-1 grade G2000 allows 100 µm; 1 mm is
+/// beyond any graded ball (a unit mistake, e.g. µm given as mm).
+inline constexpr double kMaxLotDiameterVariation_m = 1e-3;
 /// OpenMP threads: more than the largest machines have is a mistake.
 inline constexpr int kMaxThreads = 1024;
 }  // namespace limits
@@ -100,6 +103,17 @@ struct ParticleGroupOptions {
   /// s dimensionless in [0, 0.5). 0 = monodisperse.
   double radius_spread = 0.0;
   int material = 0;                   ///< index into WorldOptions::materials
+  /// Manufacturing tolerance of the balls when radius_spread = 0: the variation of ball
+  /// lot diameter V_DwL of ISO 3290-1 (the largest minus the smallest mean diameter in
+  /// a lot), m, in [0, 1e-3]. Radii are drawn uniform in [r − Δ, r] with WorldOptions::seed,
+  /// Δ = min(V_DwL/2, r/100) (r = radius_m is the lot's largest ball, the one the
+  /// container and the lattice pitch are sized for; the cap keeps tiny spheres, which are
+  /// no graded balls, within 1% of the time-step bound). It breaks the exact symmetry
+  /// of a collected lattice, whose lanes would otherwise move as clones (docs/dem.md
+  /// "Initial state"). Default 5 µm: grade G100, the usual grade of steel balls sold
+  /// for dampers and general use. 0 = identical spheres (the perfect lattice). Ignored
+  /// when radius_spread > 0 (the spread is then the whole size distribution).
+  double lot_diameter_variation_m = 5e-6;
 };
 
 enum class InitialPlacement {
@@ -151,6 +165,16 @@ struct CompartmentOptions {
   /// Explicit lattice counts along x, y, z (product >= particle count); empty = fill
   /// each slab with every site that fits, lowest first.
   std::vector<int> lattice_counts;
+  /// Gap between neighbouring lanes of the lattice (rows of spheres along collect_axis,
+  /// side by side across it; not along gravity, where rows rest on each other), m,
+  /// finite, >= 0, box containers only: lane pitch 2r + lane_gap_m, block centred
+  /// (formulas::LatticePacking::lane_gap_m). 0 = touching lanes (pitch 2r, the closed
+  /// form's bed). With automatic counts fewer lanes may fit: floor((L + g)/(2r + g)).
+  double lane_gap_m = 0.0;
+  /// true ("auto"): lane_gap_m is ignored and the width the n lanes leave is shared
+  /// equally, g = (L − n·2r)/n: each lane owns L/n, the side walls keep g/2 (shipped
+  /// 61 mm box, 6 lanes of 10 mm: g = 0.167 mm). Box containers only.
+  bool lane_gap_auto = false;
   std::vector<PlateOptions> plates;
   std::vector<PinOptions> pins;
   WallLayerOptions layer;

@@ -43,6 +43,17 @@ struct LatticePacking {
   /// product, and the lattice must fit); nullopt = fill each slab (the plane normal
   /// to the drive) with every site that fits, lowest first.
   std::optional<std::array<int, 3>> lattice_counts;
+  /// Gap between neighbouring lanes, m, finite and >= 0 (box only). A lane is a row of
+  /// spheres along the drive; lanes sit side by side along the transverse axes that are
+  /// not along gravity (rows along gravity rest on each other and keep pitch 2r). The
+  /// lanes' pitch is 2r + lane_gap_m and the block stays centred, so each side wall
+  /// keeps half of what is left. 0 = touching lanes (pitch 2r). With automatic counts
+  /// the lanes that fit are floor((L + g)/(2r + g)).
+  double lane_gap_m = 0.0;
+  /// true: lane_gap_m is ignored and the width left over by the lanes (n of them, from
+  /// the counts, or floor(L/2r)) is shared equally: g = (L − n·2r)/n, so every lane owns
+  /// the width L/n and the side walls keep g/2 each (box only).
+  bool lane_gap_auto = false;
 };
 
 /// A collected simple-cubic lattice of touching spheres (pitch 2r).
@@ -60,7 +71,9 @@ struct LatticeBed {
 /// Cross-section sites of a slab:
 /// - box: n = floor(L/2r) sites along each transverse axis (or the explicit counts),
 ///   centred, except along gravity, where the lowest row rests on the wall gravity
-///   points to (centre r from it);
+///   points to (centre r from it); across gravity the lanes are spaced by
+///   packing.lane_gap_m (or the shared leftover width, lane_gap_auto), which leaves
+///   the drive direction and so the clearance unchanged for given counts;
 /// - cylinder driven along its axis: the square lattice sites with |offset| + r <= R,
 ///   registered on the axis or offset by r along either transverse axis, whichever
 ///   holds the most sites (the first of (0,0), (r,0), (0,r), (r,r) on ties); explicit
