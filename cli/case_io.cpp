@@ -9,6 +9,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 #include "errors.hpp"
@@ -31,6 +32,14 @@ constexpr Range kRestitution{dem_reference::limits::kMinRestitution, 1.0};
 
 std::string type_name(const json& value) { return value.type_name(); }
 
+/// A number for messages, with enough digits to tell 0.1000001 from 0.1.
+std::string number_text(double value) {
+  std::ostringstream out;
+  out.precision(10);
+  out << value;
+  return out.str();
+}
+
 /// Reads one JSON object: every read key is recorded with its resolved value, and
 /// finish() rejects the keys nobody read, naming the allowed ones.
 class ObjectReader {
@@ -41,8 +50,15 @@ class ObjectReader {
     resolved_ = json::object();
   }
 
+  /// `key` may be a path below this object ("lattice/0"): each token is escaped as a
+  /// JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1") except the separators given.
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw InputError(file_, pointer_ + (key.empty() ? "" : "/" + key), what);
+  }
+  [[noreturn]] void fail_at_key(const std::string& key, const std::string& what) const {
+    std::string token;
+    for (char ch : key) token += ch == '~' ? std::string("~0") : ch == '/' ? std::string("~1") : std::string(1, ch);
+    fail(token, what);
   }
   bool has(const std::string& key) const { return object_.contains(key); }
   bool is_string(const std::string& key) const { return has(key) && object_.at(key).is_string(); }
@@ -94,6 +110,7 @@ class ObjectReader {
     }
     if (!range.contains(value)) {
       std::ostringstream out;
+      out.precision(10);  // 0.1000001 is not 0.1
       out << "= " << value << ": " << range.text() << unit;
       fail(key, out.str());
     }
@@ -118,10 +135,18 @@ class ObjectReader {
       value = *fallback;
     } else {
       const json& item = object_.at(key);
-      if (!item.is_number_integer()) fail(key, "must be an integer, got " + type_name(item));
-      const auto wide = item.get<long long>();
+      // A whole number written 36.0 or 1e3 is an integer too (as lattice counts and
+      // --periods take it); the comparison is done in double, so 2^64 - 1 (an unsigned
+      // JSON integer) is not read as -1.
+      const bool whole = item.is_number_integer() ||
+                         (item.is_number_float() && std::isfinite(item.get<double>()) &&
+                          item.get<double>() == std::floor(item.get<double>()));
+      if (!whole) fail(key, "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "], got " +
+                                (item.is_number() ? number_text(item.get<double>()) : type_name(item)));
+      const double wide = item.is_number_unsigned() ? static_cast<double>(item.get<unsigned long long>())
+                                                    : item.get<double>();
       if (wide < min || wide > max)
-        fail(key, "= " + std::to_string(wide) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+        fail(key, "= " + number_text(wide) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
       value = static_cast<int>(wide);
     }
     resolved_[key] = value;
@@ -159,6 +184,7 @@ class ObjectReader {
         value[i] = item[i].get<double>();
         if (!range.contains(value[i])) {
           std::ostringstream out;
+          out.precision(10);  // 0.1000001 is not 0.1
           out << "= " << value[i] << ": " << range.text() << unit;
           fail(key + "/" + std::to_string(i), out.str());
         }
@@ -185,7 +211,7 @@ class ObjectReader {
       if (!known_.count(key)) {
         std::string allowed;
         for (const auto& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
-        fail(key, "unknown key (allowed here: " + allowed + ")");
+        fail_at_key(key, "unknown key (allowed here: " + allowed + ")");
       }
     }
   }
@@ -318,11 +344,21 @@ void read_damper(ObjectReader& r, Case& c) {
   }
   const auto explicit_clearance = r.optional_number("clearance_m", limits::kClearance, " m");
   d.clearance_m = explicit_clearance.value_or(d.bed.clearance_m);
+  // A bed that leaves (nearly) no room is no damper: the derived clearance takes the
+  // range of an explicit one.
+  if (!explicit_clearance && !limits::kClearance.contains(d.bed.clearance_m)) {
+    std::ostringstream out;
+    out.precision(10);
+    out << "the collected bed leaves a clearance of " << d.bed.clearance_m << " m (" << d.bed.slabs
+        << " slabs of 2r in " << d.container.inner_length(d.drive_axis) << " m): " << limits::kClearance.text() << " m";
+    r.fail("particles", out.str());
+  }
   // The bed cannot travel farther than the container is long: an override beyond the
   // free length (inner length along the drive minus the bed) is a typo, not a design.
   const double inner_length = d.container.inner_length(d.drive_axis);
   if (explicit_clearance && *explicit_clearance > inner_length - d.bed.bed_extent_m + 1e-12) {
     std::ostringstream out;
+    out.precision(10);  // 0.1000001 is not 0.1
     out << "= " << *explicit_clearance << ": must be <= the free length along the drive, " << inner_length - d.bed.bed_extent_m
         << " m (inner length " << inner_length << " m minus the bed's " << d.bed.bed_extent_m << " m)";
     r.fail("clearance_m", out.str());
@@ -428,6 +464,17 @@ void read_dem(ObjectReader& r, Case& c) {
     }
     world.pairs.push_back(pair);
   });
+  // The closed forms' base friction (where auto leaves rolling) is the DEM's
+  // sphere-wall friction: one number for both models.
+  {
+    double mu = world.default_pair.friction;
+    for (const auto& pair : world.pairs)
+      if ((pair.material_a == group.material && pair.material_b == compartment.wall_material) ||
+          (pair.material_b == group.material && pair.material_a == compartment.wall_material))
+        mu = pair.friction;
+    c.damper.model_options.base_friction = mu;
+    c.resolved["damper"]["derived"]["base_friction"] = mu;
+  }
   r.object("inner_structures", false, [&](ObjectReader& s) {
     s.array("plates", [&](ObjectReader& p) {
       dr::PlateOptions plate;
@@ -499,7 +546,10 @@ void read_field(ObjectReader& r, Case& c) {
   const double h = c.damper.clearance_m;
   const double f = c.excitation.frequency_hz;
   surrogate::AxisRange default0{f, f, 1, surrogate::AxisSpacing::kLinear};
-  surrogate::AxisRange default1{0.1 * h, 1.0 * h, 10, surrogate::AxisSpacing::kLinear};
+  // Strokes from 0.1 h to 1.0 h, within the range of a stroke (a 50 m clearance would
+  // ask for 50 m strokes, a key the case never wrote).
+  surrogate::AxisRange default1{std::min(0.1 * h, 0.5 * limits::kStroke.max), std::min(1.0 * h, limits::kStroke.max), 10,
+                                surrogate::AxisSpacing::kLinear};
   std::string unit0 = " Hz", unit1 = " m";
   if (axes == "intensity_stroke_over_clearance") {
     field.axes = surrogate::GridAxes::kIntensityStrokeOverClearance;
@@ -522,10 +572,28 @@ void read_field(ObjectReader& r, Case& c) {
     read1(fallback);
   }
   field.threads = r.integer("threads", 2, 1, 256);
+  surrogate::Grid grid;
   try {
-    (void)surrogate::Grid::from_ranges(field.axes, field.axis0, field.axis1);  // the node limit, spacing rules
+    grid = surrogate::Grid::from_ranges(field.axes, field.axis0, field.axis1);  // the node limit, spacing rules
   } catch (const std::invalid_argument& e) {
     r.fail("", e.what());
+  }
+  // The sweep's own rules (nodes strictly increasing: min and max a rounding apart with
+  // count 3 give equal nodes), as pdamp field checks them.
+  if (const auto problems = grid.validate(); !problems.empty()) r.fail("", problems.front());
+  // Every node must be a drive pdamp can evaluate: on intensity axes Γ and X/h give
+  // f = √(Γg/X)/2π, which leaves the frequency range for tiny X/h.
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    const auto drive = surrogate::drive_point(grid, k, h);
+    for (const auto& [name, value, range] :
+         {std::tuple{"frequency_hz", drive.frequency_hz, limits::kFrequency}, std::tuple{"amplitude_m", drive.amplitude_m, limits::kStroke}}) {
+      if (range.contains(value)) continue;
+      std::ostringstream out;
+      out.precision(10);
+      out << "node " << k << " (axis0 = " << grid.coordinate0(k) << ", axis1 = " << grid.coordinate1(k) << ") drives at "
+          << name << " = " << value << ": " << range.text() << " (narrow the axes)";
+      r.fail("", out.str());
+    }
   }
 }
 

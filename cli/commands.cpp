@@ -53,6 +53,7 @@ fm::DamperModel model_flag(const ParsedArgs& args, const std::vector<std::string
 fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
   fm::ModelOptions options;
   if (const auto kappa = args.optional_number("--inertia-factor", Range{0.0, 1.0, true})) options.rolling_inertia_factor = *kappa;
+  if (const auto mu = args.optional_number("--friction", Range{0.0, 10.0})) options.base_friction = *mu;
   if (const auto c = args.optional_number("--calibration", Range{0.0, 2.0, true})) {
     if (model == fm::DamperModel::kBouncing) options.bouncing_calibration = *c;
     else options.rolling_calibration = *c;
@@ -138,6 +139,7 @@ json loss_json(const fm::LossResult& loss, double bed_mass_kg, double frequency_
           {"energy_per_cycle_j", fm::energy_per_cycle(e_diss)},
           {"equivalent_damping_n_s_m", loss.eta_star * bed_mass_kg * 2.0 * fm::kPi * frequency_hz},
           {"regime", fm::to_string(loss.regime)},
+          {"inertia_factor", loss.inertia_factor},
           {"intensity", loss.intensity},
           {"stroke_over_onset", loss.stroke_over_onset},
           {"velocity_amplitude_m_s", loss.velocity_amplitude_m_s},
@@ -259,13 +261,16 @@ int run_buffer(const ParsedArgs& args) {
 }
 
 
-/// `auto` in a design: rolling when its design stroke at the case frequency is below
-/// 1 g (PHYSICS.md §3: low intensity), else bouncing.
+/// `auto` in a design: rolling when the base friction keeps the spheres rolling at its
+/// design stroke (Γ <= Γ_slip, formulas::slip_intensity), else bouncing.
 fm::DamperModel design_family(const Case& c) {
   if (c.damper.model != fm::DamperModel::kAuto) return c.damper.model;
-  const auto rolling = fm::optimum_stroke(fm::DamperModel::kRolling, c.damper.clearance_m, c.damper.model_options);
+  const auto& options = c.damper.model_options;
+  if (!options.gravity_across_drive) return fm::DamperModel::kBouncing;
+  const auto rolling = fm::optimum_stroke(fm::DamperModel::kRolling, c.damper.clearance_m, options);
   const double omega = 2.0 * fm::kPi * c.excitation.frequency_hz;
-  return rolling.x_opt_m * omega * omega < fm::kStandardGravity ? fm::DamperModel::kRolling : fm::DamperModel::kBouncing;
+  return rolling.x_opt_m * omega * omega / fm::kStandardGravity <= fm::slip_intensity(options) ? fm::DamperModel::kRolling
+                                                                                                : fm::DamperModel::kBouncing;
 }
 
 /// The damper_design task's numbers (no files): what `pdamp run` prints and writes.
@@ -423,7 +428,10 @@ json dem_json(const dem_reference::DamperResult& r) {
            {{"relative_stroke_over_clearance", m.relative_stroke_over_clearance},
             {"period_correlation", m.period_correlation}, {"eta_star_variation", m.eta_star_variation},
             {"apparent_mass_fraction", m.apparent_mass_fraction}, {"base_contact_fraction", m.base_contact_fraction},
-            {"airborne_fraction", m.airborne_fraction}, {"spread_over_packed", m.spread_over_packed}}},
+            {"airborne_fraction", m.airborne_fraction}, {"spread_over_packed", m.spread_over_packed},
+            {"phase_locked_stroke", m.phase_locked_stroke}, {"phase_coherence", m.phase_coherence},
+            {"phase_lag_deg", m.phase_lag_deg}, {"crossing_fraction", m.crossing_fraction},
+            {"settled_base_contact_fraction", m.settled_base_contact_fraction}, {"mobile_fraction", m.mobile_fraction}}},
           {"run",
            {{"outcome", dem_reference::to_string(r.summary.outcome)}, {"steps", r.summary.steps},
             {"particles", r.summary.particles}, {"wall_time_s", r.summary.wall_time_s},
@@ -603,18 +611,34 @@ int import_measured_field(const ParsedArgs& args, const Case& c, OutputDir& file
 std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const surrogate::SweepOptions* sweep) {
   auto options = dem_options(c, 1.0, 1.0);
   options.world.threads = 1;  // as the sweep runs each point
+  // Up to 8 nodes per axis, evenly spread with both ends: the options are monotone in
+  // the stroke and the frequency (the impact speed grows with both), so the corners
+  // hold the extremes, and the work sums scale with the nodes (an estimate of a
+  // million-node grid node by node took minutes).
+  const auto sampled = [](std::size_t n) {
+    std::vector<std::size_t> picks;
+    const std::size_t m = std::min<std::size_t>(n, 8);
+    for (std::size_t j = 0; j < m; ++j) picks.push_back(m == 1 ? 0 : j * (n - 1) / (m - 1));
+    return picks;
+  };
   double wall_time_s = 0.0, particle_steps = 0.0;
+  std::size_t evaluated = 0;
   dem_reference::RunEstimate largest;
-  for (std::size_t k = 0; k < grid.size(); ++k) {
-    const auto drive = surrogate::drive_point(grid, k, c.damper.clearance_m);
-    options.amplitude_m = drive.amplitude_m;
-    options.frequency_hz = drive.frequency_hz;
-    const auto e = check_dem_run(c, options);
-    if (k == 0) check_dem_placement(c, options);  // the same bed at every node
-    wall_time_s += e.wall_time_s;
-    particle_steps += e.particle_steps;
-    if (e.memory_bytes > largest.memory_bytes) largest = e;
+  for (const std::size_t i0 : sampled(grid.axis0.size())) {
+    for (const std::size_t i1 : sampled(grid.axis1.size())) {
+      const auto drive = surrogate::drive_point(grid, i0 * grid.axis1.size() + i1, c.damper.clearance_m);
+      options.amplitude_m = drive.amplitude_m;
+      options.frequency_hz = drive.frequency_hz;
+      const auto e = check_dem_run(c, options);
+      if (evaluated++ == 0) check_dem_placement(c, options);  // the same bed at every node
+      wall_time_s += e.wall_time_s;
+      particle_steps += e.particle_steps;
+      if (e.memory_bytes > largest.memory_bytes) largest = e;
+    }
   }
+  const double per_node = static_cast<double>(grid.size()) / static_cast<double>(evaluated);
+  wall_time_s *= per_node;
+  particle_steps *= per_node;
   const double at_once = std::min<double>(c.field.threads, static_cast<double>(grid.size()));
   const double available = available_memory_bytes();
   if (at_once * static_cast<double>(largest.memory_bytes) > available) refuse_memory(c, largest, at_once, available);
@@ -746,7 +770,8 @@ int run_validate(const ParsedArgs& args) {
 
 const FlagSpec kModelOverrides[] = {
     {"--calibration", "C", "design factor c in x_opt = c*x_opt_ideal (default 0.8976 rolling, 1.0 bouncing)"},
-    {"--inertia-factor", "K", "rolling spheres' I/(m r^2) (default 0.4, solid spheres)"}};
+    {"--inertia-factor", "K", "rolling spheres' I/(m r^2) (default 0.4, solid spheres)"},
+    {"--friction", "MU", "sphere-base friction: auto rolls up to Gamma = MU(1+K)/K (default 0.3)"}};
 
 }  // namespace
 
@@ -760,13 +785,13 @@ const std::vector<Command>& commands() {
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",
         {{"--model", "MODEL", "rolling (low intensity, A < g) or bouncing (high intensity)"},
-         {"--clearance", "M", "free travel h of the collected bed, m (> 0)"}, kModelOverrides[0], kModelOverrides[1],
+         {"--clearance", "M", "free travel h of the collected bed, m (> 0)"}, kModelOverrides[0], kModelOverrides[1], kModelOverrides[2],
          kJsonFlag}},
        run_optimum},
       {{"size", "pdamp size --model rolling|bouncing --stroke M [--json]",
         "clearance h whose design stroke equals the target stroke (inverse of optimum)",
         {{"--model", "MODEL", "rolling or bouncing"}, {"--stroke", "M", "target container stroke X, m (> 0)"},
-         kModelOverrides[0], kModelOverrides[1], kJsonFlag}},
+         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kJsonFlag}},
        run_size},
       {{"loss", "pdamp loss --model M --clearance M --amplitude M --frequency HZ [--bed-mass KG] [-o DIR] [--json]",
         "closed-form reduced loss factor eta* at one operating point (with -o: eta* over stroke)",
@@ -778,7 +803,7 @@ const std::vector<Command>& commands() {
          {"--bed-mass", "KG", "bed mass for e_diss_j and energy_per_cycle_j, kg (default 1)"},
          {"--scattered-fit", "FILE", "fitted scattered-state coefficients (scattered_fit.json of\n"
                                      "                          pdamp field --source dem); default: provisional"},
-         kModelOverrides[0], kModelOverrides[1], kOutFlag, kJsonFlag}},
+         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kOutFlag, kJsonFlag}},
        run_loss},
       {{"buffer",
         "pdamp buffer --frequency HZ (--amplitude M | --intensity G) --radius M --layer-modulus PA [options] [--json]",

@@ -4,16 +4,20 @@
 #include <stdexcept>
 #include <string>
 
+#include "pdamp/formulas/input_file.hpp"
+
 namespace pdamp::cli {
 
 /// Bad input: exit code 2, one line `pdamp: error: <where>: <key>: <what>`.
 class InputError : public std::runtime_error {
  public:
   /// where: a file name or a flag; key: a JSON pointer or key (may be empty).
+  /// The message is made printable here (formulas::printable): a NUL in a user's key
+  /// would cut what() short, a newline would break the one line.
   InputError(const std::string& where, const std::string& key, const std::string& what)
-      : std::runtime_error(where + (key.empty() ? "" : ": " + key) + ": " + what) {}
+      : std::runtime_error(formulas::printable(where + (key.empty() ? "" : ": " + key) + ": " + what)) {}
   /// A message that already reads "<where>: <key>: <what>" (a library's error).
-  explicit InputError(const std::string& formatted) : std::runtime_error(formatted) {}
+  explicit InputError(const std::string& formatted) : std::runtime_error(formulas::printable(formatted)) {}
 };
 
 /// A numerical failure detected at run time (e.g. DEM instability): exit code 3.

@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +18,13 @@
 namespace pdamp::cli {
 
 namespace fs = std::filesystem;
+
+namespace {
+// Signal state: written by the handler, read by the writers (sig_atomic_t / atomic).
+std::atomic<int> g_output_phase{0};
+volatile sig_atomic_t g_pending_signal = 0;
+volatile sig_atomic_t g_child = 0;  // the running external program, 0 if none
+}  // namespace
 
 std::optional<fs::path> find_executable(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -44,6 +52,7 @@ int run_program(const fs::path& program, const std::vector<std::string>& argumen
   argv.push_back(nullptr);
   const std::string dir = directory.string(), log = log_file.string();
 
+  const pid_t parent = ::getpid();
   const pid_t child = ::fork();
   if (child < 0) return -1;
   if (child == 0) {
@@ -51,6 +60,10 @@ int run_program(const fs::path& program, const std::vector<std::string>& argumen
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
     ::signal(SIGHUP, SIG_DFL);
+    // It dies with pdamp (a SIGKILLed pdamp must not leave gnuplot drawing in a
+    // staging folder for minutes); the check closes the race with an early death.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
     const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
     const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (in < 0 || out < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0) ::_exit(127);
@@ -58,21 +71,27 @@ int run_program(const fs::path& program, const std::vector<std::string>& argumen
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
+  g_child = child;
   int status = 0;
   while (::waitpid(child, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
+    if (errno != EINTR) {
+      g_child = 0;
+      return -1;
+    }
   }
+  g_child = 0;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 namespace {
 
-std::atomic<int> g_output_phase{0};
-volatile sig_atomic_t g_pending_signal = 0;
 
 extern "C" void on_interrupt(int signal_number) {
   if (g_output_phase.load() > 0) {
     g_pending_signal = signal_number;
+    // A signal to pdamp alone (kill PID, not the group) must not wait for the drawing:
+    // its pictures are discarded anyway.
+    if (const pid_t child = g_child; child > 0) ::kill(child, SIGTERM);
     return;
   }
   // Outside the output phase: end as the default action would (the signal is blocked

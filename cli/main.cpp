@@ -41,10 +41,16 @@ int report(const char* what, int exit_code) {
   std::_Exit(128 + signal_number);  // not reached: the default action ends the process
 }
 
-/// The command's exit code, unless a signal arrived while it wrote its results (they
-/// are complete then): the signal's default action is taken now.
+/// The command's exit code, unless stdout could not take the result (a full disk, a
+/// closed pipe: exit 1, not a silent 0) or a signal arrived while it wrote its results
+/// (they are complete then: said on stderr, then the signal's default action).
 int finished(int exit_code) {
-  if (const int s = pdamp::cli::pending_interrupt(); s != 0) die_by(s);
+  std::cout.flush();
+  if (!std::cout) return report("cannot write the result to standard output", pdamp::cli::kExitOther);
+  if (const int s = pdamp::cli::pending_interrupt(); s != 0) {
+    std::cerr << "pdamp: error: interrupted after the results were written (they are complete)" << std::endl;
+    die_by(s);
+  }
   return exit_code;
 }
 
@@ -65,7 +71,7 @@ int main(int argc, char** argv) {
       const ParsedArgs parsed(command.spec, std::vector<std::string>(args.begin() + 1, args.end()));
       if (parsed.help_requested()) {
         std::cout << help_text(command.spec);
-        return kExitOk;
+        return finished(kExitOk);
       }
       return finished(command.run(parsed));
     }

@@ -83,7 +83,12 @@ void write_file_atomically(const fs::path& path, const std::string& content) {
     out.flush();
     if (!out) throw std::runtime_error("cannot write " + tmp.string());
   }
-  fs::rename(tmp, path);
+  std::error_code error;
+  fs::rename(tmp, path, error);
+  if (error) {
+    fs::remove(tmp, error);
+    throw std::runtime_error("cannot write " + path.string());
+  }
 }
 
 OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
@@ -179,7 +184,9 @@ std::vector<std::string> OutputDir::commit() {
   // A result name taken by a folder (or a device) would stop the renames half-way:
   // refused before the first one, so the set is moved whole or not at all.
   std::error_code error;
-  for (const auto& name : names_) {
+  std::vector<std::string> targets = names_;
+  targets.push_back(kManifest);
+  for (const auto& name : targets) {
     const auto status = fs::symlink_status(dir_ / name, error);
     if (fs::exists(status) && !fs::is_regular_file(status))
       throw InputError("-o", "", "'" + formulas::printable((dir_ / name).string()) +

@@ -35,6 +35,10 @@ std::string mode_code(const std::string& mode) {
   return "?";
 }
 
+/// Most axis-0 nodes drawn as cuts, and most nodes labelled with their motion mode.
+constexpr std::size_t kMaxCuts = 12;
+constexpr std::size_t kMaxLabelledNodes = 400;
+
 /// An axis end widened by 4% of the axis span, so edge labels of the heat map show.
 double padded(const std::vector<double>& values, int side) {
   const double span = values.back() - values.front();
@@ -117,12 +121,25 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
   out.add("field_table.csv", table.str());
   out.add("field_map.dat", map.str());
 
-  // Closed-form eta* along axis 1 at every axis-0 node, finely sampled, for the cuts.
-  std::ostringstream formula;
+  // The cuts: eta* along axis 1 at up to kMaxCuts axis-0 nodes (evenly spread, ends
+  // included): more curves are unreadable, and gnuplot reads the data once per curve
+  // (10,000 nodes took minutes). Their field points and the closed form, finely sampled.
+  std::vector<std::size_t> cut_nodes;
+  const std::size_t n0 = g.axis0.size();
+  const std::size_t cuts_count = std::min(n0, kMaxCuts);
+  for (std::size_t j = 0; j < cuts_count; ++j) cut_nodes.push_back(cuts_count == 1 ? 0 : j * (n0 - 1) / (cuts_count - 1));
+  std::ostringstream formula, points;
   formula.precision(10);
+  points.precision(10);
   formula << "axis0,axis1,eta_star_formula\n";
+  points << "axis0,axis1,eta_star,eta_star_stderr\n";
   const double a1 = g.axis1.values.front(), b1 = g.axis1.values.back();
-  for (std::size_t i0 = 0; i0 < g.axis0.size(); ++i0) {
+  for (const std::size_t i0 : cut_nodes) {
+    for (std::size_t i1 = 0; i1 < g.axis1.size(); ++i1) {
+      const auto& p = field.points[i0 * g.axis1.size() + i1];
+      points << g.axis0.values[i0] << ',' << g.axis1.values[i1] << ',' << p.eta_star << ',' << p.eta_star_stderr << '\n';
+    }
+    points << "\n\n";
     for (int j = 0; j <= 200; ++j) {
       const double v1 = a1 + (b1 - a1) * j / 200.0;
       surrogate::Grid one{{g.axis0.quantity, g.axis0.spacing, {g.axis0.values[i0]}}, {g.axis1.quantity, g.axis1.spacing, {v1}}};
@@ -134,6 +151,9 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
     formula << "\n\n";
   }
   out.add("field_cuts_formula.csv", formula.str());
+  out.add("field_cuts_points.csv", points.str());
+  std::string cut_values;
+  for (const std::size_t i0 : cut_nodes) cut_values += format_number(g.axis0.values[i0], 10) + " ";
 
   const std::string source(surrogate::to_string(field.provenance.source));
   std::vector<std::string> warnings;
@@ -146,15 +166,11 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
        << "do for [t in 'pngcairo svg'] {\n"
        << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
        << "  set output (t eq 'svg') ? 'field_cuts.svg' : 'field_cuts.png'\n"
-       << "  plot for [i=0:" << g.axis0.size() - 1 << "] 'field_cuts_formula.csv' index i using 2:3 with lines dt 2 lw 1.5 lc i+1 "
-       << "title sprintf('closed form, " << axis_symbol(g.axis0.quantity) << "', word('";
-  for (double v : g.axis0.values) cuts << v << ' ';
-  cuts << "', i+1)+0), \\\n"
-       << "       for [i=0:" << g.axis0.size() - 1 << "] 'field_table.csv' every ::(i*" << g.axis1.size() << "+1)::((i+1)*"
-       << g.axis1.size() << ") using 2:5:6 with yerrorlines pt 7 lw 2 lc i+1 title sprintf('" << source
-       << ", " << axis_symbol(g.axis0.quantity) << "', word('";
-  for (double v : g.axis0.values) cuts << v << ' ';
-  cuts << "', i+1)+0)\n}\n";
+       << "  plot for [i=0:" << cut_nodes.size() - 1 << "] 'field_cuts_formula.csv' index i using 2:3 with lines dt 2 lw 1.5 lc i+1 "
+       << "title sprintf('closed form, " << axis_symbol(g.axis0.quantity) << "', word('" << cut_values << "', i+1)+0), \\\n"
+       << "       for [i=0:" << cut_nodes.size() - 1 << "] 'field_cuts_points.csv' index i using 2:3:4 with yerrorlines pt 7 lw 2 "
+       << "lc i+1 title sprintf('" << source << ", " << axis_symbol(g.axis0.quantity) << "', word('" << cut_values
+       << "', i+1)+0)\n}\n";
   for (auto& w : out.add_plot("field_cuts.gp", cuts.str(), {"field_cuts.png", "field_cuts.svg"})) warnings.push_back(w);
 
   if (g.axis0.size() >= 2 && g.axis1.size() >= 2) {
@@ -172,7 +188,9 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
          << "do for [t in 'pngcairo svg'] {\n"
          << "  set terminal t size 1000,700 enhanced font 'Sans,11'\n"
          << "  set output (t eq 'svg') ? 'field_map.svg' : 'field_map.png'\n"
-         << "  splot 'field_map.dat' using 1:2:3 with pm3d notitle, '' using 1:2:3:4 with labels tc rgb 'black' font ',10' notitle\n"
+         << "  splot 'field_map.dat' using 1:2:3 with pm3d notitle"
+         // Mode labels on every node only while they can be read (and drawn quickly).
+         << (g.size() <= kMaxLabelledNodes ? ", '' using 1:2:3:4 with labels tc rgb 'black' font ',10' notitle" : "") << "\n"
          << "}\n";
     for (auto& w : out.add_plot("field_map.gp", heat.str(), {"field_map.png", "field_map.svg"})) warnings.push_back(w);
   }

@@ -27,7 +27,7 @@ std::vector<std::string> write_eta_curve(OutputDir& out, const std::vector<Curve
 /// container force on the bed and the container velocity over the analysed periods.
 std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::string& title);
 
-/// field_table.csv, field_map.dat, field_cuts_formula.csv, the eta* cuts along axis 1
+/// field_table.csv, field_map.dat, field_cuts_formula.csv, field_cuts_points.csv, the eta* cuts along axis 1 (at most 12)
 /// with the closed form, and the heat map with motion modes (when both axes have >= 2
 /// nodes).
 std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field, const Case& c);

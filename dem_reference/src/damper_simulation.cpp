@@ -96,18 +96,103 @@ double period_correlation(const std::vector<double>& signal, int samples, int pe
   return sum / (periods - 1);
 }
 
-/// The labels of PHYSICS.md from the indicators (docs/dem.md "Motion modes").
-/// rolling_family: gravity across the drive exceeds the drive acceleration, so the bed
-/// stays on its base between impacts (low intensity).
-MotionMode classify(const MotionIndicators& m, double eta_star, double intensity, bool rolling_family) {
-  if (m.relative_stroke_over_clearance < 0.1 && m.apparent_mass_fraction > 0.8) return MotionMode::kSolidLike;
-  if (std::abs(m.apparent_mass_fraction) < 0.1 && eta_star < 0.1) return MotionMode::kDecoupled;
-  if (m.relative_stroke_over_clearance > 0.5 && m.period_correlation > 0.8 && m.eta_star_variation < 0.25) {
-    return rolling_family ? MotionMode::kRollingCollectAndCollide : MotionMode::kBouncingCollectAndCollide;
+/// Thresholds of the motion-mode labels (docs/dem.md "Motion modes" derives them from
+/// the mode definitions of PHYSICS.md and the ideal orbits of §2-3).
+struct ModeThresholds {
+  /// solid_like: the bed uses under a tenth of its clearance and carries over 80% of the
+  /// rigidly attached bed's inertial force (m_f = 1).
+  static constexpr double kSolidStroke = 0.1;
+  static constexpr double kSolidMass = 0.8;
+  /// decoupled: under 10% of the rigid inertial force and under 10% of the plastic
+  /// block's η* (the container moves around a bed at rest: m_f = η* = 0).
+  static constexpr double kDecoupledMass = 0.1;
+  static constexpr double kDecoupledEta = 0.1;
+  /// collect-and-collide: the ideal orbits (plastic block, bouncing or rolling, from the
+  /// onset to X = 10h) cross the clearance once per half period (crossing fraction 1),
+  /// with a phase-locked stroke of 0.98-1.26, a lag behind the container from 149° (the
+  /// onset orbit, the latest impact that still repeats) down to 37°, and m_f in
+  /// [−0.56, 1.12]. Accepted: at least every other half period crosses, at least half
+  /// the ideal locked stroke, a lag in [0°, 150°] (a bed left behind lags 180°; an
+  /// elastic bed's rebound makes it lead), and m_f <= 1.5 (a collected bed never moves
+  /// faster than the walls; a bed rebounding elastically off walls at ±V leaves at up
+  /// to (1 + 2ε)V, m_f ≈ 2.5-3).
+  static constexpr double kCrossing = 0.5;
+  static constexpr double kLockedStroke = 0.5;
+  static constexpr double kMinLag_deg = 0.0;
+  static constexpr double kMaxLag_deg = 150.0;
+  static constexpr double kMaxMass = 1.5;
+  /// rolling: the bed keeps at least half of its settled base contacts, on average over
+  /// the analysed periods (most of it rolls on its base, PHYSICS.md §3); otherwise
+  /// bouncing (airborne: spheres hopping after the wall impacts, or no gravity).
+  static constexpr double kRollingBase = 0.5;
+  /// A sphere is mobile when its rms speed relative to the bed's mean velocity exceeds
+  /// V/2: walls moving at ±V drive a granular gas at fluctuations of order V, a
+  /// collected block only by its internal rearrangement.
+  static constexpr double kMobileSpeed = 0.5;
+  /// Fluidisation (high intensity, Γ > 1): all of the bed mobile (>= 90%, a few spheres
+  /// may stay wedged) is global, a part (>= 10%) local.
+  static constexpr double kGlobalMobile = 0.9;
+  static constexpr double kLocalMobile = 0.1;
+};
+
+/// The labels of PHYSICS.md from the indicators (docs/dem.md "Motion modes"); the first
+/// that applies.
+MotionMode classify(const MotionIndicators& m, double eta_star, double intensity) {
+  using T = ModeThresholds;
+  if (m.relative_stroke_over_clearance < T::kSolidStroke && m.apparent_mass_fraction > T::kSolidMass) {
+    return MotionMode::kSolidLike;
   }
-  if (m.spread_over_packed >= 2.0) return MotionMode::kGlobalFluidisation;
-  if (m.spread_over_packed >= 1.2 && intensity > 1.0) return MotionMode::kLocalFluidisation;
+  if (std::abs(m.apparent_mass_fraction) < T::kDecoupledMass && eta_star < T::kDecoupledEta) {
+    return MotionMode::kDecoupled;
+  }
+  if (m.crossing_fraction >= T::kCrossing && m.phase_locked_stroke >= T::kLockedStroke &&
+      m.phase_lag_deg >= T::kMinLag_deg && m.phase_lag_deg <= T::kMaxLag_deg &&
+      m.apparent_mass_fraction <= T::kMaxMass) {
+    const bool rolling = m.settled_base_contact_fraction > 0.0 &&
+                         m.base_contact_fraction >= T::kRollingBase * m.settled_base_contact_fraction;
+    return rolling ? MotionMode::kRollingCollectAndCollide : MotionMode::kBouncingCollectAndCollide;
+  }
+  if (intensity > 1.0 && m.mobile_fraction >= T::kGlobalMobile) return MotionMode::kGlobalFluidisation;
+  if (intensity > 1.0 && m.mobile_fraction >= T::kLocalMobile) return MotionMode::kLocalFluidisation;
   return MotionMode::kScattering;
+}
+
+/// Fills the phase-locked indicators from x_r (relative to the container centre) sampled
+/// at times t (`samples` per period, `periods` periods) of the drive X sin Ωt, clearance h.
+void phase_indicators(const std::vector<double>& rel, const std::vector<double>& time_s, int samples, int periods,
+                      double omega, double h, MotionIndicators& m) {
+  if (!(h > 0.0) || rel.empty()) {
+    m.phase_locked_stroke = m.phase_coherence = m.phase_lag_deg = m.crossing_fraction = kNaN;
+    return;
+  }
+  double re_all = 0.0, im_all = 0.0, abs_sum = 0.0;
+  for (int p = 0; p < periods; ++p) {
+    double re = 0.0, im = 0.0;
+    for (int k = p * samples; k < (p + 1) * samples; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      re += rel[i] * std::cos(omega * time_s[i]);
+      im -= rel[i] * std::sin(omega * time_s[i]);
+    }
+    re *= 2.0 / samples;  // x_r ≈ Re(c e^{iΩt}), c = re + i·im
+    im *= 2.0 / samples;
+    re_all += re / periods;
+    im_all += im / periods;
+    abs_sum += std::hypot(re, im) / periods;
+  }
+  const double c_abs = std::hypot(re_all, im_all);
+  m.phase_locked_stroke = 2.0 * c_abs / h;
+  m.phase_coherence = abs_sum > 0.0 ? c_abs / abs_sum : 0.0;
+  // The container position X sin Ωt has the coefficient −iX: lag = arg(−i / c).
+  m.phase_lag_deg = c_abs > 0.0 ? std::atan2(-re_all, -im_all) * 180.0 / kPi : 0.0;
+  if (m.phase_lag_deg <= -180.0) m.phase_lag_deg += 360.0;
+  // Crossings: transits between the outer quarters at either wall (x_r < −h/4, x_r > h/4).
+  int side = 0, crossings = 0;
+  for (const double x : rel) {
+    const int now = x < -0.25 * h ? -1 : (x > 0.25 * h ? 1 : 0);
+    if (now != 0 && side != 0 && now != side) ++crossings;
+    if (now != 0) side = now;
+  }
+  m.crossing_fraction = static_cast<double>(crossings) / (2.0 * periods);
 }
 
 /// Reports progress about twice a second. The clock is read every `stride` steps, a
@@ -246,7 +331,9 @@ RunPlan plan_run(const DamperSimulationOptions& options) {
         << integ.steps_per_contact << " steps per contact or " << integ.rayleigh_fraction << " of the Rayleigh time)";
     throw std::invalid_argument(msg.str());
   }
-  const double target_step = user_step > 0.0 ? user_step : bound.max_time_step_s;
+  // The automatic bound of metre-sized soft spheres can exceed the largest step the
+  // integration takes (limits::kMaxTimeStep_s): the run then steps at that limit.
+  const double target_step = user_step > 0.0 ? user_step : std::min(bound.max_time_step_s, limits::kMaxTimeStep_s);
   const double period = 1.0 / options.frequency_hz;
   const int samples = options.samples_per_period;
   plan.steps_per_block = static_cast<std::int64_t>(std::ceil(period / (samples * target_step) - 1e-9));
@@ -550,6 +637,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     reporter.maybe_report("settling", k, total_steps, (k - settle_steps) * dt);
   }
 
+  const double settled_base = static_cast<double>(world.contact_census(g).touching_base) / n;
   // The drive starts with the bed at rest relative to the container: collected against
   // its wall and riding with it, as on the collect-and-collide orbit at detachment.
   world.add_velocity(start.velocity_m_s);
@@ -577,8 +665,11 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
                   &series.bed_relative_position_m, &series.bed_momentum_kg_m_s, &series.kinetic_energy_j}) {
     v->reserve(static_cast<std::size_t>(blocks));
   }
+  std::vector<double> rel_time_s;  // block ends, where the bed's x_r is sampled
+  rel_time_s.reserve(static_cast<std::size_t>(blocks));
   const EnergyAccount e_start = world.energy();
   double base_sum = 0.0, airborne_sum = 0.0, spread_sum = 0.0;
+  std::vector<double> fluctuation_sum(static_cast<std::size_t>(n), 0.0);  // Σ over blocks of |v_i − v_bed|², m²/s²
   const double packed_extent =
       world_options.compartments.front().container.inner_length(world_options.compartments.front().collect_axis) -
       result.clearance_m;
@@ -618,6 +709,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     series.force_n.push_back(force_blocks.back());
     const Vec3 com = world.bed_centre_of_mass();
     series.bed_relative_position_m.push_back(dot(com, axis) - dot(now.position_m, axis));
+    rel_time_s.push_back(static_cast<double>(step) * dt);
     series.bed_momentum_kg_m_s.push_back(dot(world.bed_momentum(), axis));
     const EnergyAccount e = world.energy();
     series.kinetic_energy_j.push_back(e.kinetic_j);
@@ -632,6 +724,14 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
       hi = std::max(hi, along + world.radius(i));
     }
     spread_sum += packed_extent > 0.0 ? (hi - lo) / packed_extent : kNaN;
+    // Velocity of each sphere relative to the bed's mean velocity (the fluctuation).
+    const Vec3 p_bed = world.bed_momentum();
+    for (int i = 0; i < n; ++i) {
+      const Vec3 v = world.velocity(i);
+      double d2 = 0.0;
+      for (std::size_t a = 0; a < 3; ++a) d2 += (v[a] - p_bed[a] / m_bed) * (v[a] - p_bed[a] / m_bed);
+      fluctuation_sum[static_cast<std::size_t>(i)] += d2;
+    }
     if (std::find(snapshot_blocks.begin(), snapshot_blocks.end(), b) != snapshot_blocks.end()) {
       result.snapshots.push_back(snapshot_of(world, static_cast<double>(step) * dt));
     }
@@ -683,10 +783,19 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   mi.base_contact_fraction = base_sum / static_cast<double>(blocks);
   mi.airborne_fraction = airborne_sum / static_cast<double>(blocks);
   mi.spread_over_packed = spread_sum / static_cast<double>(blocks);
-  const double g_along = dot(g, axis);
-  const double g_across = std::sqrt(std::max(g_norm * g_norm - g_along * g_along, 0.0));
-  const double drive_acceleration = options.amplitude_m * motion.angular_frequency_rad_s() * motion.angular_frequency_rad_s();
-  result.motion_mode = classify(mi, result.eta_star, result.intensity, g_across > drive_acceleration);
+  mi.settled_base_contact_fraction = settled_base;
+  // x_r about the container centre (compartment 0's offset along the drive).
+  const double middle = dot(world_options.compartments.front().offset_m, axis);
+  std::vector<double> rel_mid(rel.size());
+  for (std::size_t k = 0; k < rel.size(); ++k) rel_mid[k] = rel[k] - middle;
+  // Mobile spheres: rms speed relative to the bed's mean velocity above V/2.
+  int mobile = 0;
+  for (const double sum : fluctuation_sum) {
+    mobile += std::sqrt(sum / static_cast<double>(blocks)) > ModeThresholds::kMobileSpeed * v_amp ? 1 : 0;
+  }
+  mi.mobile_fraction = static_cast<double>(mobile) / n;
+  phase_indicators(rel_mid, rel_time_s, samples, periods, motion.angular_frequency_rad_s(), result.clearance_m, mi);
+  result.motion_mode = classify(mi, result.eta_star, result.intensity);
 
   // Validity remarks.
   auto& warn = result.warnings;

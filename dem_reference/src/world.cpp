@@ -11,8 +11,8 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
-#include <emmintrin.h>
 #include <omp.h>
 
 #include "broad_phase.hpp"
@@ -153,17 +153,15 @@ struct PairGeometry {
   std::size_t i, j;   ///< particles
 };
 
-/// A touching pair waiting for a second one to be evaluated with.
+/// A touching pair waiting for the others of its lanes to be evaluated with.
 struct WaitingPair {
-  bool active = false;
   PairGeometry g{};
   int contact = -1;  ///< pool index, or −1: staged at `fresh`
   int fresh = -1;
 };
 
-/// A touching wall contact whose kinematics are ready, waiting for a second one.
+/// A touching wall contact whose kinematics are ready, waiting for the others of its lanes.
 struct WaitingWall {
-  bool active = false;
   ContactKinematics k{};
   int contact = -1;  ///< pool index, or −1: staged at `fresh`
   int fresh = -1;
@@ -320,9 +318,8 @@ struct World::Impl {
   std::size_t place(int id) const { return static_cast<std::size_t>(index_of.at(static_cast<std::size_t>(id))); }
   void to_body(double px, double py, double pz, double* out) const;
   Contact particle_pair_contact(std::size_t a, std::size_t b) const;
-  [[gnu::always_inline]] void pair_kinematics(const PairGeometry& g, ContactKinematics& k) const;
-  [[gnu::always_inline]] void pair_kinematics_2(const PairGeometry& a, const PairGeometry& b, ContactKinematics& ka,
-                                                ContactKinematics& kb) const;
+  template <class W>
+  [[gnu::always_inline]] detail::KinematicsLanes<W> pair_kinematics(const PairGeometry* const* g) const;
   Contact particle_wall_contact(std::size_t a, int wall) const;
 
   WorldOptions options;
@@ -554,60 +551,30 @@ Contact World::Impl::particle_wall_contact(std::size_t a, int wall) const {
   return c;
 }
 
-// Normal, overlap and relative motion of a touching pair: contact-point velocity of i
-// relative to j, v_i − v_j + (r_i ω_i + r_j ω_j) × n, and ω_i − ω_j.
-inline void World::Impl::pair_kinematics(const PairGeometry& g, ContactKinematics& k) const {
-  const std::size_t i = g.i, j = g.j;
-  const double dist = std::sqrt(g.d2);
-  const double inv = 1.0 / dist;
-  k.n[0] = g.dx * inv;
-  k.n[1] = g.dy * inv;
-  k.n[2] = g.dz * inv;
-  k.delta = g.sum - dist;
-  const double ax = g.ri * wx[i] + g.rj * wx[j], ay = g.ri * wy[i] + g.rj * wy[j], az = g.ri * wz[i] + g.rj * wz[j];
-  k.v[0] = vx[i] - vx[j] + ay * k.n[2] - az * k.n[1];
-  k.v[1] = vy[i] - vy[j] + az * k.n[0] - ax * k.n[2];
-  k.v[2] = vz[i] - vz[j] + ax * k.n[1] - ay * k.n[0];
-  k.w[0] = wx[i] - wx[j];
-  k.w[1] = wy[i] - wy[j];
-  k.w[2] = wz[i] - wz[j];
-}
-
-// pair_kinematics of two pairs in the lanes of an SSE2 register: the same operations in
-// the same order, so the same bits (see detail::contact_force_2).
-inline void World::Impl::pair_kinematics_2(const PairGeometry& a, const PairGeometry& b, ContactKinematics& ka,
-                                           ContactKinematics& kb) const {
-  using V = __m128d;
-  const auto pack = [](double lane_a, double lane_b) { return _mm_set_pd(lane_b, lane_a); };
-  const auto put = [](V v, double& lane_a, double& lane_b) {
-    _mm_storel_pd(&lane_a, v);
-    _mm_storeh_pd(&lane_b, v);
+// Normal, overlap and relative motion of W::kWidth touching pairs (lane l: g[l]):
+// contact-point velocity of i relative to j, v_i − v_j + (r_i ω_i + r_j ω_j) × n, and
+// ω_i − ω_j. One IEEE operation order for every width (see detail::contact_force_lanes).
+template <class W>
+inline detail::KinematicsLanes<W> World::Impl::pair_kinematics(const PairGeometry* const* g) const {
+  const auto at = [&](const std::vector<double>& a, bool of_i) {
+    return W::gather([&](int l) { return a[of_i ? g[l]->i : g[l]->j]; });
   };
-  const std::size_t ia = a.i, ja = a.j, ib = b.i, jb = b.j;
-  const V dist = _mm_sqrt_pd(pack(a.d2, b.d2));
-  const V inv = _mm_div_pd(_mm_set1_pd(1.0), dist);
-  const V n0 = _mm_mul_pd(pack(a.dx, b.dx), inv);
-  const V n1 = _mm_mul_pd(pack(a.dy, b.dy), inv);
-  const V n2 = _mm_mul_pd(pack(a.dz, b.dz), inv);
-  const V ri = pack(a.ri, b.ri), rj = pack(a.rj, b.rj);
-  const V wi0 = pack(wx[ia], wx[ib]), wi1 = pack(wy[ia], wy[ib]), wi2 = pack(wz[ia], wz[ib]);
-  const V wj0 = pack(wx[ja], wx[jb]), wj1 = pack(wy[ja], wy[jb]), wj2 = pack(wz[ja], wz[jb]);
-  const V ax = _mm_add_pd(_mm_mul_pd(ri, wi0), _mm_mul_pd(rj, wj0));
-  const V ay = _mm_add_pd(_mm_mul_pd(ri, wi1), _mm_mul_pd(rj, wj1));
-  const V az = _mm_add_pd(_mm_mul_pd(ri, wi2), _mm_mul_pd(rj, wj2));
-  const V dv0 = _mm_sub_pd(pack(vx[ia], vx[ib]), pack(vx[ja], vx[jb]));
-  const V dv1 = _mm_sub_pd(pack(vy[ia], vy[ib]), pack(vy[ja], vy[jb]));
-  const V dv2 = _mm_sub_pd(pack(vz[ia], vz[ib]), pack(vz[ja], vz[jb]));
-  put(n0, ka.n[0], kb.n[0]);
-  put(n1, ka.n[1], kb.n[1]);
-  put(n2, ka.n[2], kb.n[2]);
-  put(_mm_sub_pd(pack(a.sum, b.sum), dist), ka.delta, kb.delta);
-  put(_mm_sub_pd(_mm_add_pd(dv0, _mm_mul_pd(ay, n2)), _mm_mul_pd(az, n1)), ka.v[0], kb.v[0]);
-  put(_mm_sub_pd(_mm_add_pd(dv1, _mm_mul_pd(az, n0)), _mm_mul_pd(ax, n2)), ka.v[1], kb.v[1]);
-  put(_mm_sub_pd(_mm_add_pd(dv2, _mm_mul_pd(ax, n1)), _mm_mul_pd(ay, n0)), ka.v[2], kb.v[2]);
-  put(_mm_sub_pd(wi0, wj0), ka.w[0], kb.w[0]);
-  put(_mm_sub_pd(wi1, wj1), ka.w[1], kb.w[1]);
-  put(_mm_sub_pd(wi2, wj2), ka.w[2], kb.w[2]);
+  const W dist = sqrt(W::gather([&](int l) { return g[l]->d2; }));
+  const W inv = W::splat(1.0) / dist;
+  detail::KinematicsLanes<W> k;
+  k.n[0] = W::gather([&](int l) { return g[l]->dx; }) * inv;
+  k.n[1] = W::gather([&](int l) { return g[l]->dy; }) * inv;
+  k.n[2] = W::gather([&](int l) { return g[l]->dz; }) * inv;
+  k.delta = W::gather([&](int l) { return g[l]->sum; }) - dist;
+  const W ri = W::gather([&](int l) { return g[l]->ri; }), rj = W::gather([&](int l) { return g[l]->rj; });
+  const W wi[3] = {at(wx, true), at(wy, true), at(wz, true)};
+  const W wj[3] = {at(wx, false), at(wy, false), at(wz, false)};
+  const W ax = ri * wi[0] + rj * wj[0], ay = ri * wi[1] + rj * wj[1], az = ri * wi[2] + rj * wj[2];
+  k.v[0] = at(vx, true) - at(vx, false) + ay * k.n[2] - az * k.n[1];
+  k.v[1] = at(vy, true) - at(vy, false) + az * k.n[0] - ax * k.n[2];
+  k.v[2] = at(vz, true) - at(vz, false) + ax * k.n[1] - ay * k.n[0];
+  for (int c = 0; c < 3; ++c) k.w[c] = wi[c] - wj[c];
+  return k;
 }
 
 // A step in one OpenMP region: the rebuild check (before: a rebuild has parallel loops
@@ -911,12 +878,15 @@ void World::Impl::plan_partitions() {
 // its walls (flat loops over many slots: rows are short, and a loop per row would pay
 // a mispredicted exit per particle). A particle's walls thus follow all its pair forces
 // (from its own row and from earlier rows naming it), so its sums run in the same
-// order as with all walls after all pairs. Touching contacts are evaluated two at a
-// time (contact_force_2) and their forces added one after the other, in slot order.
+// order as with all walls after all pairs. Touching contacts are evaluated
+// SweepLanes::kWidth at a time (contact_force_lanes; the rest of a block with fewer
+// lanes) and their forces added one after the other, in slot order.
 // With integrate_ahead, the particles a slot needs are integrated just before it (a
 // particle's data then come from memory once per step).
 template <bool kPrefetch>
 void World::Impl::sweep(Partition& part, bool integrate_ahead) {
+  using Lanes = detail::simd::SweepLanes;
+  constexpr int kLanes = Lanes::kWidth;
   const double h = dt;
   const double limit = overlap_limit;
   const auto& R = container.orientation;
@@ -947,7 +917,6 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
   StepDissipation diss;
   LoadSums sums;
   ContactKinematics k;
-  ContactResult out;
   // The history of a contact of `rows`: pooled, or staged in this step in `staged` (by
   // index: staging may move the staged ones).
   struct Located {
@@ -962,19 +931,18 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
     StagedContact& s = staged[static_cast<std::size_t>(fresh)];
     return Located{&s.contact, s.torque};
   };
-  // Forces of two contacts of `rows` (contact_force_2), or of one (contact_force).
-  const auto force_2 = [&](RowList& rows, std::vector<StagedContact>& staged, int contact_a, int fresh_a,
-                           const ContactKinematics& ka, int contact_b, int fresh_b, const ContactKinematics& kb,
-                           ContactResult& out_a, ContactResult& out_b) {
-    const Located a = locate(rows, staged, contact_a, fresh_a);
-    const Located b = locate(rows, staged, contact_b, fresh_b);
-    detail::contact_force_2(a.state->params, a.state->history, a.torque, ka, b.state->params, b.state->history,
-                            b.torque, kb, h, law, out_a, out_b, diss);
-  };
-  const auto force_1 = [&](RowList& rows, std::vector<StagedContact>& staged, int contact, int fresh,
-                           const ContactKinematics& kin, ContactResult& result) {
-    const Located c = locate(rows, staged, contact, fresh);
-    detail::contact_force(c.state->params, c.state->history, c.torque, kin, h, law, result, diss);
+  // The contacts of `rows` waiting in w[0..kWidth) as the lanes of one kernel call.
+  const auto lanes_of = [&]<int kN>(RowList& rows, std::vector<StagedContact>& staged, const auto* w,
+                                    ContactResult* out) {
+    detail::ContactLanes<kN> c;
+    for (int l = 0; l < kN; ++l) {
+      const Located at = locate(rows, staged, w[l].contact, w[l].fresh);
+      c.params[l] = &at.state->params;
+      c.history[l] = &at.state->history;
+      c.rolling_torque[l] = at.torque;
+      c.out[l] = &out[l];
+    }
+    return c;
   };
   // Adds a pair's force and torques: on i, and on j directly or through the halo.
   const auto apply = [&](const ContactResult& r, const PairGeometry& g) {
@@ -1023,8 +991,41 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
     sums.moment[1] += rc[2] * r.f[0] - rc[0] * r.f[2] + r.m[1];
     sums.moment[2] += rc[0] * r.f[1] - rc[1] * r.f[0] + r.m[2];
   };
-  WaitingPair waiting;
-  WaitingWall waiting_wall;
+  // Evaluates kWidth waiting pairs (walls) in the lanes of a W.
+  const auto pair_forces = [&](auto lanes, const WaitingPair* w) {
+    using W = typename decltype(lanes)::type;
+    constexpr int kN = W::kWidth;
+    const PairGeometry* g[kN];
+    for (int l = 0; l < kN; ++l) g[l] = &w[l].g;
+    const detail::KinematicsLanes<W> kin = pair_kinematics<W>(g);
+    for (int l = 0; l < kN; ++l) overlap(lane(kin.delta, l), w[l].g);
+    ContactResult out[kN];
+    detail::contact_force_lanes<W>(lanes_of.template operator()<kN>(pairs, part.fresh_pairs, w, out), kin, h, law,
+                                   diss);
+    for (int l = 0; l < kN; ++l) apply(out[l], w[l].g);
+  };
+  const auto wall_forces = [&](auto lanes, const WaitingWall* w) {
+    using W = typename decltype(lanes)::type;
+    constexpr int kN = W::kWidth;
+    const ContactKinematics* kin[kN];
+    for (int l = 0; l < kN; ++l) kin[l] = &w[l].k;
+    ContactResult out[kN];
+    detail::contact_force_lanes<W>(lanes_of.template operator()<kN>(wall_rows, part.fresh_walls, w, out),
+                                   detail::load_kinematics<W>(kin), h, law, diss);
+    for (int l = 0; l < kN; ++l) apply_wall(out[l], w[l].i, w[l].ri, w[l].rc);
+  };
+  // The count < kLanes contacts left waiting at the end of a block: two lanes, then one.
+  const auto flush = [&](const auto* w, int& count, const auto& forces) {
+    int done = 0;
+    if constexpr (kLanes > 2) {
+      for (; count - done >= 2; done += 2) forces(std::type_identity<detail::simd::Lanes2>{}, w + done);
+    }
+    for (; done < count; ++done) forces(std::type_identity<detail::simd::Lanes1>{}, w + done);
+    count = 0;
+  };
+  WaitingPair waiting[kLanes];
+  WaitingWall waiting_walls[kLanes];
+  int waiting_count = 0, wall_count = 0;
   for (int block = part.begin; block < end; block += kRowBlock) {
     const int block_end = std::min(end, block + kRowBlock);
     if (block_end > ahead) integrate_to(block_end);
@@ -1051,8 +1052,8 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
         }
         continue;
       }
-      // Two touching pairs are evaluated together (kinematics and contact_force_2):
-      // this one waits for the next unless one is already waiting.
+      // Touching pairs wait until SweepLanes::kWidth of them are evaluated together
+      // (pair_kinematics and contact_force_lanes).
       int fresh = -1;
       if (slot.contact < 0) {
         StagedContact& staged = part.fresh_pairs.emplace_back();
@@ -1061,28 +1062,13 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
         staged.contact = particle_pair_contact(i, j);
         fresh = static_cast<int>(part.fresh_pairs.size()) - 1;
       }
-      const PairGeometry g{dx, dy, dz, d2, sum, ri, rj, i, j};
-      if (!waiting.active) {
-        waiting = WaitingPair{true, g, slot.contact, fresh};
-        continue;
+      waiting[waiting_count++] = WaitingPair{PairGeometry{dx, dy, dz, d2, sum, ri, rj, i, j}, slot.contact, fresh};
+      if (waiting_count == kLanes) {
+        pair_forces(std::type_identity<Lanes>{}, waiting);
+        waiting_count = 0;
       }
-      ContactKinematics ka, kb;
-      pair_kinematics_2(waiting.g, g, ka, kb);
-      overlap(ka.delta, waiting.g);
-      overlap(kb.delta, g);
-      ContactResult out_b;
-      force_2(pairs, part.fresh_pairs, waiting.contact, waiting.fresh, ka, slot.contact, fresh, kb, out, out_b);
-      apply(out, waiting.g);
-      apply(out_b, g);
-      waiting.active = false;
     }
-    if (waiting.active) {
-      pair_kinematics(waiting.g, k);
-      overlap(k.delta, waiting.g);
-      force_1(pairs, part.fresh_pairs, waiting.contact, waiting.fresh, k, out);
-      apply(out, waiting.g);
-      waiting.active = false;
-    }
+    flush(waiting, waiting_count, pair_forces);
     const int wall_last = wall_rows.offsets[static_cast<std::size_t>(block_end)];
     for (int s = wall_rows.offsets[static_cast<std::size_t>(block)]; s < wall_last; ++s) {
       const Slot& slot = wall_rows.slots[static_cast<std::size_t>(s)];
@@ -1128,22 +1114,13 @@ void World::Impl::sweep(Partition& part, bool integrate_ahead) {
         staged.contact = particle_wall_contact(i, slot.j);
         fresh = static_cast<int>(part.fresh_walls.size()) - 1;
       }
-      if (!waiting_wall.active) {
-        waiting_wall = WaitingWall{true, k, slot.contact, fresh, i, ri, {rc[0], rc[1], rc[2]}};
-        continue;
+      waiting_walls[wall_count++] = WaitingWall{k, slot.contact, fresh, i, ri, {rc[0], rc[1], rc[2]}};
+      if (wall_count == kLanes) {
+        wall_forces(std::type_identity<Lanes>{}, waiting_walls);
+        wall_count = 0;
       }
-      ContactResult out_b;
-      force_2(wall_rows, part.fresh_walls, waiting_wall.contact, waiting_wall.fresh, waiting_wall.k, slot.contact,
-              fresh, k, out, out_b);
-      apply_wall(out, waiting_wall.i, waiting_wall.ri, waiting_wall.rc);
-      apply_wall(out_b, i, ri, rc);
-      waiting_wall.active = false;
     }
-    if (waiting_wall.active) {
-      force_1(wall_rows, part.fresh_walls, waiting_wall.contact, waiting_wall.fresh, waiting_wall.k, out);
-      apply_wall(out, waiting_wall.i, waiting_wall.ri, waiting_wall.rc);
-      waiting_wall.active = false;
-    }
+    flush(waiting_walls, wall_count, wall_forces);
     // The block's forces are complete (but for what earlier partitions add: reduce_halo).
     for (int row = std::max(block, part.head_end); row < block_end; ++row) {
       u2_max = std::max(u2_max, drift2(static_cast<std::size_t>(row)));

@@ -13,6 +13,11 @@
 namespace pdamp::formulas {
 namespace {
 
+/// Most lattice sites of one slab that collected_lattice builds (the largest bed's
+/// sphere count).
+constexpr double kMaxSlabSites = 1e7;
+
+
 /// Relative round-off allowance in "fits" tests: L = n·2r computed in floating point
 /// may land a few ulps below n·2r and must still hold n sites.
 constexpr double kFitTolerance = 1e-9;
@@ -278,9 +283,20 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
   }
   const double length = container.inner_length(drive);
 
+  // A slab's sites are built and sorted: a cross-section of 1e9 sites (a 100 m box of
+  // 5 mm spheres, or 10 µm spheres in a real container) would take minutes and
+  // gigabytes for a bed that may hold 36 spheres. Beyond the largest bed (1e7 spheres)
+  // the caller must give the counts.
+  const auto refuse_huge = [&](double per_slab) {
+    if (per_slab > kMaxSlabSites)
+      reject("the cross-section normal to axis " + std::to_string(drive) + " holds about " + number(per_slab) +
+             " lattice sites of radius_m = " + number(r) + " (more than " + number(kMaxSlabSites) +
+             "): give lattice_counts (the lanes the bed really has)");
+  };
   std::vector<Vec3> sites;
   if (packing.lattice_counts) {
     const auto& n = *packing.lattice_counts;
+    refuse_huge(static_cast<double>(n[cs.axis_a]) * n[cs.axis_b]);
     const long long capacity = static_cast<long long>(n[0]) * n[1] * n[2];
     if (count > capacity) {
       reject("count = " + std::to_string(count) + " spheres > " + std::to_string(capacity) +
@@ -313,6 +329,7 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
       sites = box_sites(container, r, cs, n[cs.axis_a], n[cs.axis_b], packing);
     }
   } else if (cylinder) {
+    refuse_huge(3.14159265358979323846 * std::pow(container.cylinder_inner_radius_m / (2.0 * r), 2));
     sites = cylinder_sites_auto(r, container.cylinder_inner_radius_m, cs);
   } else {
     const auto lanes = [&](int axis) {
@@ -321,6 +338,7 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
       const bool spaced = axis != cs.gravity_axis && !packing.lane_gap_auto;
       return lanes_along(inner, r, spaced ? packing.lane_gap_m : 0.0);
     };
+    refuse_huge(static_cast<double>(lanes(cs.axis_a)) * lanes(cs.axis_b));
     sites = box_sites(container, r, cs, lanes(cs.axis_a), lanes(cs.axis_b), packing);
   }
   if (sites.empty()) {

@@ -12,6 +12,11 @@
 namespace pdamp::formulas {
 namespace {
 
+/// Above this multiple of μ the friction takes less than 5% of the drive's acceleration
+/// and the sliding bed is a free-flying block within the models' accuracy (no warning).
+constexpr double kFreeFlightFrictionRatio = 20.0;
+
+
 /// R = √(π²+4): π cos ψ + 2 sin ψ = R cos(ψ − α), so the sub-peak orbit exists for
 /// h_eff/X <= R and the onset stroke is h_eff/R.
 constexpr double kOnsetRadius = 3.724191778237173;
@@ -207,6 +212,8 @@ std::vector<std::string> ModelOptions::validate() const {
                     rolling_calibration > 0.0 && rolling_calibration <= 2.0, "in (0, 2]");
   append_range_rule(problems, "bouncing_calibration", bouncing_calibration,
                     bouncing_calibration > 0.0 && bouncing_calibration <= 2.0, "in (0, 2]");
+  append_range_rule(problems, "base_friction", base_friction, base_friction >= 0.0 && base_friction <= 10.0,
+                    "in [0, 10]");
   for (const std::string& line : scattered.validate()) problems.push_back("scattered." + line);
   return problems;
 }
@@ -304,6 +311,23 @@ double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptio
          (1.0 + inertia_factor_of(model, options));
 }
 
+double slip_intensity(const ModelOptions& options) {
+  const double kappa = options.rolling_inertia_factor;
+  return options.base_friction * (1.0 + kappa) / kappa;
+}
+
+double auto_inertia_factor(double intensity, const ModelOptions& options) {
+  if (!options.gravity_across_drive) return 0.0;
+  if (intensity <= slip_intensity(options)) return options.rolling_inertia_factor;
+  const double mu = options.base_friction;
+  return mu / (intensity - mu);  // intensity > Γ_slip >= μ(1+κ)/κ > μ
+}
+
+double onset_stroke_m(double inertia_factor, double clearance_m) {
+  return onset_stroke((1.0 + inertia_factor) * clearance_m);
+}
+double onset_reduced_loss_factor(double inertia_factor) { return onset_eta_star(inertia_factor); }
+
 LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
                                double frequency_hz, const ModelOptions& options) {
   require_positive("clearance_m", clearance_m);
@@ -316,13 +340,17 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
   result.model_requested = model;
   result.velocity_amplitude_m_s = stroke_m * omega;
   result.intensity = result.velocity_amplitude_m_s * omega / kStandardGravity;
-  const bool low_intensity = result.intensity < 1.0;
+  const double slip = slip_intensity(options);
+  const bool rolls = options.gravity_across_drive && result.intensity <= slip;
   const bool explicit_family = model == DamperModel::kRolling || model == DamperModel::kBouncing;
+  const double inertia_factor = explicit_family ? inertia_factor_of(model, options)
+                                                : auto_inertia_factor(result.intensity, options);
+  result.inertia_factor = inertia_factor;
+  // The nearer family names the answer (in the slip band κ_eff lies between κ and 0).
   result.model_used = explicit_family ? model
-                      : low_intensity ? DamperModel::kRolling
-                                      : DamperModel::kBouncing;
+                      : 2.0 * inertia_factor >= options.rolling_inertia_factor ? DamperModel::kRolling
+                                                                                : DamperModel::kBouncing;
   const bool rolling = result.model_used == DamperModel::kRolling;
-  const double inertia_factor = inertia_factor_of(result.model_used, options);
   const double onset_m = onset_stroke((1.0 + inertia_factor) * clearance_m);
   const double s = stroke_m / onset_m;
   result.stroke_over_onset = s;
@@ -366,19 +394,30 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
     }
   }
 
-  if (model == DamperModel::kRolling && !low_intensity) {
+  if (model == DamperModel::kRolling && !options.gravity_across_drive) {
+    result.warnings.push_back("rolling model without gravity across the drive: no base carries the spheres, so they "
+                              "fly rather than roll (the bouncing model describes that)");
+  } else if (model == DamperModel::kRolling && !rolls) {
     result.warnings.push_back(
-        "rolling model at intensity Gamma = " + format(result.intensity) +
-        " >= 1: the container acceleration exceeds g, so spheres lift off and slide, "
-        "while the rolling model assumes A < g (rolling without slip would need a base "
-        "friction mu >= " + format(rolling_no_slip_friction(inertia_factor, result.intensity)) +
-        ")");
+        "rolling model at intensity Gamma = " + format(result.intensity) + ": rolling without slip needs a base "
+        "friction mu >= kappa Gamma/(1+kappa) = " + format(rolling_no_slip_friction(inertia_factor, result.intensity)) +
+        ", more than mu = " + format(options.base_friction) + ", so the spheres slide (auto then moves toward "
+        "free flight)");
   }
-  if (model == DamperModel::kBouncing && low_intensity) {
+  if (model == DamperModel::kBouncing && rolls) {
     result.warnings.push_back(
-        "bouncing model at intensity Gamma = " + format(result.intensity) +
-        " < 1: gravity is comparable to the drive and the bed does not fly; the rolling "
-        "model describes a horizontal drive at A < g");
+        "bouncing model at intensity Gamma = " + format(result.intensity) + " <= " + format(slip) +
+        ": the base friction mu = " + format(options.base_friction) + " keeps the spheres rolling there, and "
+        "the rolling model describes a bed rolling on its base");
+  }
+  if (!explicit_family && options.gravity_across_drive && !rolls &&
+      result.intensity < kFreeFlightFrictionRatio * options.base_friction) {
+    result.warnings.push_back(
+        "auto at intensity Gamma = " + format(result.intensity) + ": the spheres slide on the base (rolling holds up "
+        "to Gamma = " + format(slip) + " with mu = " + format(options.base_friction) + "), and friction still takes " +
+        format(100.0 * options.base_friction / result.intensity) + "% of the drive's acceleration: eta* = " +
+        format(result.eta_star) + " uses the relative acceleration 1 - mu/Gamma (kappa_eff = " + format(inertia_factor) +
+        "), between rolling and free flight, an approximation: check with pdamp dem");
   }
   if (result.model_used == DamperModel::kBouncing && options.gravity_across_drive && stroke_m < clearance_m &&
       model != DamperModel::kScattered) {

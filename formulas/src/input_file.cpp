@@ -166,6 +166,11 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
     }
     return true;
   };
+  // The parser stops at a NUL byte as at the end of the text, so "{...}\0garbage" would
+  // pass: a NUL has no place in JSON text (RFC 8259: control characters only escaped).
+  if (const auto nul = text.find('\0'); nul != std::string::npos)
+    throw std::invalid_argument(printable(path) + ": malformed JSON: a NUL byte at offset " + std::to_string(nul) +
+                                " (a binary file, or text with a NUL)");
   try {
     return json::parse(text, track);
   } catch (const DuplicateKey& duplicate) {

@@ -128,8 +128,6 @@ std::vector<ScatteredSample> scattered_samples(const EffectiveField& field, form
   detail::throw_if_any(field.validate(), "effective field");
   detail::throw_if_any(options.validate(), "model options");
   const bool fixed = model == formulas::DamperModel::kRolling || model == formulas::DamperModel::kBouncing;
-  const auto rolling = formulas::optimum_stroke(formulas::DamperModel::kRolling, field.clearance_m, options);
-  const auto bouncing = formulas::optimum_stroke(formulas::DamperModel::kBouncing, field.clearance_m, options);
   std::vector<ScatteredSample> samples;
   for (std::size_t k = 0; k < field.points.size(); ++k) {
     const FieldPoint& p = field.points[k];
@@ -137,10 +135,13 @@ std::vector<ScatteredSample> scattered_samples(const EffectiveField& field, form
     const DrivePoint drive = drive_point(field.grid, k, field.clearance_m);
     const double omega = 2.0 * formulas::kPi * drive.frequency_hz;
     const double intensity = drive.amplitude_m * omega * omega / formulas::kStandardGravity;
-    const bool use_rolling = fixed ? model == formulas::DamperModel::kRolling : intensity < 1.0;
-    const auto& family = use_rolling ? rolling : bouncing;
-    const double s = drive.amplitude_m / family.x_onset_m;
-    if (s < 1.0) samples.push_back({s, p.eta_star, p.eta_star_stderr, family.eta_star_onset});
+    // The block the closed forms use at this point (auto: formulas::auto_inertia_factor),
+    // so that s and η*_onset are those reduced_loss_factor evaluates the fit with.
+    const double kappa = !fixed ? formulas::auto_inertia_factor(intensity, options)
+                         : model == formulas::DamperModel::kRolling ? options.rolling_inertia_factor
+                                                                     : 0.0;
+    const double s = drive.amplitude_m / formulas::onset_stroke_m(kappa, field.clearance_m);
+    if (s < 1.0) samples.push_back({s, p.eta_star, p.eta_star_stderr, formulas::onset_reduced_loss_factor(kappa)});
   }
   return samples;
 }

@@ -1,13 +1,16 @@
 // Hostile and nonsensical input (issue 8, docs/bad_inputs.md): no command runs from a
 // case file or a path, nothing hangs, every refusal is exit 2 with one line naming the
 // file or flag and the key, and an interrupted run leaves no partial result.
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -388,4 +391,92 @@ TEST_CASE("duplicate keys and binary bytes in a case file are refused on one lin
   const auto r = run_pdamp({"validate", binary.string()});
   require_one_line_error(r, "binary.json: malformed JSON");
   CHECK(r.err.find('\x1b') == std::string::npos);  // no terminal escape reaches the screen
+}
+
+TEST_CASE("round two of the hostile inputs: bytes after the JSON, huge lattices, grids validate must see", "[cli]") {
+  TempDir tmp("round_two");
+  // Text after a NUL byte was ignored by the parser: "{valid case}\0garbage" passed.
+  std::ifstream in(case_path("low_intensity_36_spheres.json"));
+  const std::string valid{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const fs::path trailing = tmp.path / "trailing.json";
+  std::ofstream(trailing, std::ios::binary) << valid << std::string("\0garbage {{{", 12);
+  require_one_line_error(run_pdamp({"validate", trailing.string()}), "trailing.json: malformed JSON: a NUL byte at offset");
+  // A key with a NUL is named whole (the message is not cut at it) and escaped.
+  const fs::path nul_key = tmp.path / "nul_key.json";
+  std::ofstream(nul_key, std::ios::binary) << std::string("{\"task\\u0000x\": 1, \"a/b~c\": 2}");
+  const auto r = run_pdamp({"validate", nul_key.string()});
+  CHECK(r.exit_code == 2);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  // The automatic lattice of a 100 m box of 5 mm spheres (4e8 sites a slab) took 50 s
+  // and 2.3 GB; now it is refused at once, naming the fix.
+  RunOptions quick;
+  quick.time_limit_s = 20.0;
+  const auto huge = edited_case("pdamp_huge_box.json", [](json& c) {
+    c["damper"]["container"]["inner_size_m"] = {100.0, 100.0, 100.0};
+    c["damper"]["particles"].erase("lattice");
+  });
+  require_one_line_error(run_pdamp({"validate", huge}, quick), "give lattice_counts");
+  // Nodes a rounding apart (count 3 between 2 and 2 + 4e-16) are refused by validate
+  // as by field; a stroke-over-clearance node far below the drive range as well.
+  require_one_line_error(run_pdamp({"validate", edited_case("pdamp_equal_nodes.json", [](json& c) {
+                                      c["field"] = {{"axis0", {{"min", 2.0}, {"max", 2.0000000000000004}, {"count", 3}}}};
+                                    })}),
+                         "/field: ");
+  require_one_line_error(run_pdamp({"validate", edited_case("pdamp_tiny_node.json", [](json& c) {
+                                      c["field"] = {{"axes", "intensity_stroke_over_clearance"},
+                                                    {"axis1", {{"min", 1e-300}, {"max", 0.5}, {"count", 2}}}};
+                                    })}),
+                         "drives at frequency_hz = ");
+  // A bed that leaves no room (1e-12 m) is no damper.
+  require_one_line_error(run_pdamp({"validate", edited_case("pdamp_no_room.json", [](json& c) {
+                                      c["damper"]["container"]["inner_size_m"] = {0.120000000001, 0.061, 0.04};
+                                      c["damper"]["particles"]["lattice"] = {12, 6, 1};
+                                      c["damper"]["particles"]["count"] = 72;
+                                    })}),
+                         "/damper/particles: the collected bed leaves a clearance of");
+  // Whole numbers written 36.0 are integers; 2^64 - 1 is not read as -1.
+  CHECK(run_pdamp({"validate", edited_case("pdamp_float_count.json", [](json& c) { c["damper"]["particles"]["count"] = 36.0; })})
+            .exit_code == 0);
+  const fs::path seed = tmp.path / "seed.json";
+  {
+    json c = json::parse(valid);
+    c["dem"]["seed"] = 18446744073709551615ULL;
+    std::ofstream(seed) << c.dump();
+  }
+  require_one_line_error(run_pdamp({"validate", seed.string()}), "/dem/seed: = 1.844674407e+19: must be in [0, 2147483647]");
+}
+
+TEST_CASE("round two: the manifest name, a full stdout, many cuts", "[cli]") {
+  TempDir tmp("round_two_out");
+  fs::create_directories(tmp.path / "o" / ".pdamp-outputs.json");
+  const std::string low = case_path("low_intensity_36_spheres.json");
+  require_one_line_error(run_pdamp({"run", low, "-o", (tmp.path / "o").string()}), ".pdamp-outputs.json' exists and is not a file");
+  for (const auto& entry : fs::directory_iterator(tmp.path / "o")) CHECK(!entry.is_regular_file());
+  // stdout that cannot take the result is a failure, not a silent 0.
+  if (fs::exists("/dev/full")) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      const int out = ::open("/dev/full", O_WRONLY);
+      const int err = ::open("/dev/null", O_WRONLY);
+      ::dup2(out, 1);
+      ::dup2(err, 2);
+      ::execl(PDAMP_BINARY, PDAMP_BINARY, "validate", low.c_str(), "--json", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 1);
+  }
+  // 2000 frequency nodes: the cuts plot draws at most 12 of them (before: one gnuplot
+  // curve per node, which ran for minutes); the field is still complete.
+  const auto many = edited_case("pdamp_many_cuts.json", [](json& c) {
+    c["field"] = {{"axis0", {{"min", 1.0}, {"max", 3.0}, {"count", 2000}}}, {"axis1", {{"min", 0.01}, {"max", 0.08}, {"count", 2}}}};
+  });
+  RunOptions bounded;
+  bounded.time_limit_s = 60.0;  // a hang guard, not a timing: a few seconds are expected
+  const auto r = run_pdamp({"field", many, "--source", "formulas", "-o", (tmp.path / "cuts").string(), "--json"}, bounded);
+  REQUIRE(r.exit_code == 0);
+  CHECK(json::parse(r.out)["points"] == 4000);
+  require_plot(tmp.path / "cuts", "field_cuts.png");
 }

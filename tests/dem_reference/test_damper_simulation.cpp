@@ -199,6 +199,12 @@ TEST_CASE("low-intensity sweep shows the jump to rolling collect-and-collide nea
 // (PHYSICS.md §2: "may sit above 4/π with partial rebound"; measured +15-22%, independent
 // of μ and of ε in 0.2-0.8) — there only the lower bound applies. E/100: docs/dem.md
 // records η* at h/π for E, E/10, E/100 (equal within the per-period scatter).
+//
+// The ideal model is one coherent block, which the perfect lattice of identical spheres
+// is (its lanes move as one): the sweep runs it (lot_diameter_variation_m = 0). The
+// default bed with the G100 ball-lot tolerance, whose lanes drift apart, jumps a little
+// later, between 0.28 and 0.30 h (4-12% above the ideal onset; docs/dem.md records
+// its sweep), and follows the same curve above.
 TEST_CASE("high-intensity sweep without gravity follows the bouncing collect-and-collide model",
           "[dem_reference][long]") {
   const std::vector<double> strokes{0.2, 0.22, 0.24, 0.26, 0.28, 0.3, 0.318, 0.34, 0.36, 0.38, 0.4, 0.414, 0.45, 0.5};
@@ -207,7 +213,9 @@ TEST_CASE("high-intensity sweep without gravity follows the bouncing collect-and
   std::fprintf(out, "x_over_h,eta_star,eta_star_stderr,ideal_eta_star,apparent_mass_fraction,motion_mode,energy_balance_error\n");
   std::vector<dr::DamperResult> results;
   for (const double x : strokes) {
-    results.push_back(dr::run_harmonic(high_intensity(x, 100.0)));
+    auto options = high_intensity(x, 100.0);
+    options.world.compartments.front().particles.front().lot_diameter_variation_m = 0.0;
+    results.push_back(dr::run_harmonic(options));
     const auto& r = results.back();
     REQUIRE(r.summary.outcome == dr::Outcome::kCompleted);
     const double ideal = x >= 1.0 / kPi ? ideal_bouncing(x) : std::nan("");

@@ -161,10 +161,13 @@ TEST_CASE("a seeded run reproduces its final-state hash", "[dem_reference]") {
 // Two threads: partitions, halo forces and their fixed summation order. The hash pins
 // the parallel path as the one above pins the serial one (the partition plan counts
 // work, it does not time it, so it is the same on every machine).
-// Without rolling resistance touching contacts are evaluated two at a time in SSE2 lanes
-// (detail::contact_force_2), with it one at a time (detail::contact_force). The lanes
-// repeat the scalar kernel's operations in its order, so they must give its bits: the
-// expected hash is that of the scalar kernel alone (commit f3e8b96, before the lanes).
+// Touching contacts are evaluated two (four with AVX2) at a time in the lanes of one
+// kernel written over the lane type (detail::contact_force_lanes; with rolling
+// resistance too; the rest of a block in fewer lanes). The lanes repeat the scalar
+// kernel's operations in its order, so they must give its bits: the expected hashes
+// here are those of the scalar kernel alone (commit f3e8b96, before the lanes), and the
+// two tests around, with rolling resistance, were pinned when those contacts took the
+// scalar kernel.
 TEST_CASE("the two-lane contact kernel gives the bits of the scalar kernel", "[dem_reference]") {
   CHECK(colliding_gas_hash(1, 60, 0.003, dr::Vec3{0.04, 0.04, 0.04}, 40000, 0.0) == 0xd50b6ff37544ee46ULL);
   CHECK(colliding_gas_hash(2, 1600, 0.0015, dr::Vec3{0.05, 0.05, 0.06}, 1500, 0.0) == 0xc7dac9fe27563c19ULL);

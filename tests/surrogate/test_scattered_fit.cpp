@@ -134,17 +134,26 @@ TEST_CASE("samples are the ok field points below the onset of the family in use"
   // Reference onsets (PHYSICS.md §2-3): X_onset = (1+κ)h/√(π²+4), κ = 0.4 rolling, 0 bouncing.
   const double rolling_onset = 1.4 * h / std::sqrt(kPi * kPi + 4), bouncing_onset = h / std::sqrt(kPi * kPi + 4);
   const auto automatic = scattered_samples(field);
-  // Γ = 0.5 (rolling): X/h = 0.1, 0.2, 0.3 below 0.376; Γ = 2 (bouncing): 0.1, 0.2 below 0.268.
-  REQUIRE(automatic.size() == 5);
+  // Γ = 0.5 (rolling): X/h = 0.1, 0.2, 0.3 below 0.376; Γ = 2 > Γ_slip = 1.05 (spheres
+  // sliding, κ_eff = μ/(Γ − μ) = 0.3/1.7): 0.1, 0.2, 0.3 below (1 + κ_eff)/√(π²+4) = 0.316.
+  const double sliding = 0.3 / 1.7, sliding_onset = (1.0 + sliding) * h / std::sqrt(kPi * kPi + 4);
+  REQUIRE(automatic.size() == 6);
   CHECK(automatic[0].s == Approx(0.1 * h / rolling_onset).epsilon(1e-12));
   CHECK(automatic[0].eta_star_onset == Approx(4 * kPi / ((kPi * kPi + 4) * 1.4)).epsilon(1e-12));
-  CHECK(automatic[4].s == Approx(0.2 * h / bouncing_onset).epsilon(1e-12));
-  CHECK(automatic[4].eta_star_onset == Approx(kBouncingOnset).epsilon(1e-12));
+  CHECK(automatic[4].s == Approx(0.2 * h / sliding_onset).epsilon(1e-12));
+  CHECK(automatic[4].eta_star_onset == Approx(4 * kPi / ((kPi * kPi + 4) * (1.0 + sliding))).epsilon(1e-12));
+  // Without a base both intensities are the free-flight block: 0.1 and 0.2 below 0.268.
+  fm::ModelOptions weightless;
+  weightless.gravity_across_drive = false;
+  const auto floating = scattered_samples(field, fm::DamperModel::kAuto, weightless);
+  REQUIRE(floating.size() == 4);
+  CHECK(floating[3].s == Approx(0.2 * h / bouncing_onset).epsilon(1e-12));
+  CHECK(floating[3].eta_star_onset == Approx(kBouncingOnset).epsilon(1e-12));
   CHECK(scattered_samples(field, fm::DamperModel::kBouncing).size() == 4);
   field.points[0].status = PointStatus::kFailed;
   field.points[0].eta_star = FieldPoint::kUnknown;
   field.points[0].e_diss_j = FieldPoint::kUnknown;
-  CHECK(scattered_samples(field).size() == 4);
+  CHECK(scattered_samples(field).size() == 5);  // the failed point is left out
 }
 
 TEST_CASE("the coefficient file round-trips and is read strictly", "[surrogate]") {

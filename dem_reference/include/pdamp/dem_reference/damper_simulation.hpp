@@ -82,23 +82,49 @@ enum class MotionMode {
 /// "scattering", "local_fluidisation", "global_fluidisation", "decoupled".
 std::string_view to_string(MotionMode mode);
 
-/// The numbers the motion-mode label is decided from (averages over the analysed periods).
+/// The numbers the motion-mode label is decided from (over the analysed periods; x_r is
+/// the bed's centre of mass relative to the container centre along the drive, sampled at
+/// the block ends; h the clearance of compartment 0). Derivations and thresholds:
+/// docs/dem.md "Motion modes".
 struct MotionIndicators {
-  /// Peak-to-peak travel of the bed's centre of mass relative to the container along
-  /// the drive, over the clearance h (≈ 1 when the bed crosses the clearance).
+  /// Peak-to-peak travel of x_r over h (≈ 1 when the bed crosses the clearance).
   double relative_stroke_over_clearance = 0.0;
-  /// Correlation of that relative motion between consecutive periods, in [−1, 1]
-  /// (≈ 1: synchronous with the drive).
+  /// Phase-locked stroke 2|x̂_r(Ω)|/h: peak-to-peak of the component of x_r at the drive
+  /// frequency over all analysed periods together (a motion whose phase drifts from
+  /// period to period averages out). Ideal collect-and-collide orbits: 0.98 (onset) to
+  /// 1.23 (X = 3h); a bed at rest in the inertial frame: 2X/h.
+  double phase_locked_stroke = 0.0;
+  /// |Σ_p x̂_r,p| / Σ_p |x̂_r,p| over the periods p, in [0, 1]: 1 when every period's
+  /// relative motion at Ω has the same phase (≈ 1/√n for a random phase).
+  double phase_coherence = 0.0;
+  /// Lag of the component of x_r at Ω behind the container position X sin Ωt, degrees in
+  /// (−180, 180]: ideal collect-and-collide orbits 149° (onset) to 82° (X = h), 55°
+  /// (X = 3h) and 37° (X = 10h); a bed left behind by the container (rolling freely,
+  /// decoupled) 180°.
+  double phase_lag_deg = 0.0;
+  /// Crossings of the clearance per half period: transits of x_r from the outer quarter
+  /// of the clearance at one wall (within h/4 of the collected position) to that at the
+  /// other, over 2 × analysed periods (1 on a collect-and-collide orbit).
+  double crossing_fraction = 0.0;
+  /// Correlation of x_r between consecutive periods, in [−1, 1] (informative only: the
+  /// chaotic scatter of a many-sphere bed lowers it on a collect-and-collide orbit).
   double period_correlation = 0.0;
-  /// Coefficient of variation of the per-period η* (0: every period alike).
+  /// Coefficient of variation of the per-period η* (informative only, as above).
   double eta_star_variation = 0.0;
   double apparent_mass_fraction = 0.0;  ///< m_app/m_bed
-  /// Particles touching the wall that gravity presses them on (mean fraction, 0 without gravity).
+  /// Particles touching the wall that gravity presses them on (mean fraction, 0 without
+  /// gravity): rolling collect-and-collide when >= half the settled fraction.
   double base_contact_fraction = 0.0;
+  /// The same fraction of the settled bed before the drive starts (0 without gravity).
+  double settled_base_contact_fraction = 0.0;
   /// Particles touching nothing (mean fraction).
   double airborne_fraction = 0.0;
-  /// Mean extent of the bed along the drive over its packed extent (1 = packed).
+  /// Mean extent of the bed along the drive over its packed extent (1 = packed;
+  /// informative only: a container barely longer than the bed caps it).
   double spread_over_packed = 0.0;
+  /// Spheres whose rms speed relative to the bed's mean velocity (over the analysed
+  /// periods) exceeds V/2, fraction (0: the bed moves as a block; 1: a granular gas).
+  double mobile_fraction = 0.0;
 };
 
 /// Signals over the analysed periods, one sample per block (block averages).

@@ -14,7 +14,9 @@ namespace pdamp::dem_reference {
 
 /// Version of the DEM physics (contact laws, integration, measures). Bumped whenever
 /// results change for the same input; the effective fields hash it.
-inline constexpr int kPhysicsModelVersion = 1;
+/// 2: the ISO 3290 ball-lot tolerance by default, the drive-bin measure accumulated
+/// every step, the impact speed from the free-fall height (issue 9).
+inline constexpr int kPhysicsModelVersion = 2;
 
 /// The automatic time-step bound (docs/dem.md "Time step").
 struct TimeStepBound {

@@ -80,6 +80,10 @@ struct ModelOptions {
   /// decoupled state, docs/dem.md), in place of the bouncing orbit: true makes the
   /// bouncing model warn for X < h. false: no gravity, or gravity along the drive only.
   bool gravity_across_drive = true;
+  /// Sliding friction μ between the spheres and the base, dimensionless, in [0, 10]
+  /// (default 0.3, dry steel on steel; a case takes its DEM contact's). It sets where
+  /// `auto` leaves rolling: spheres roll without slip while μ >= κΓ/(1+κ).
+  double base_friction = 0.3;
   /// One line per violated rule ("rolling_inertia_factor = 1.5: must be in (0, 1]"),
   /// the fit's lines prefixed "scattered."; empty if valid.
   std::vector<std::string> validate() const;
@@ -139,7 +143,10 @@ double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptio
 /// Closed-form reduced loss factor at one operating point.
 struct LossResult {
   DamperModel model_requested = DamperModel::kAuto;
-  DamperModel model_used = DamperModel::kRolling;  ///< rolling or bouncing family
+  DamperModel model_used = DamperModel::kRolling;  ///< rolling or bouncing family (the nearer, in auto's slip band)
+  /// κ of the block that answered: rolling_inertia_factor (rolling), 0 (bouncing), or
+  /// auto's friction-limited value in between (auto_inertia_factor).
+  double inertia_factor = 0.0;
   MotionRegime regime = MotionRegime::kScattered;
   double eta_star = 0.0;          ///< reduced loss factor η*, dimensionless
   double intensity = 0.0;         ///< Γ = XΩ²/g
@@ -148,12 +155,29 @@ struct LossResult {
   double stroke_over_onset = 0.0; ///< s = X/X_onset of the family used
   std::vector<std::string> warnings;  ///< validity-range violations (INTERFACE.md)
 };
+/// The inertia factor auto gives a bed at intensity Γ (docs/collect_and_collide.md §6):
+/// with gravity across the drive the spheres roll without slip while the base friction
+/// can hold them, Γ <= Γ_slip = μ(1+κ)/κ, and the block is the rolling one (κ); above,
+/// they slide, friction μg cuts the relative acceleration A to A − μg, and the block
+/// moves relative to the container as one with 1/(1+κ_eff) = 1 − μ/Γ, κ_eff = μ/(Γ − μ):
+/// continuous at Γ_slip (1 − κ/(1+κ) = 1/(1+κ)) and tending to free flight (0) as Γ
+/// grows. Without gravity across the drive (no base): 0.
+double auto_inertia_factor(double intensity, const ModelOptions& options);
+/// Γ_slip = μ(1+κ)/κ: the intensity up to which the base friction keeps spheres rolling.
+double slip_intensity(const ModelOptions& options);
+/// Onset stroke (1+κ)h/√(π²+4) and η* there, 4π/((π²+4)(1+κ)), of the block of inertia
+/// factor κ (PHYSICS.md §2-3).
+double onset_stroke_m(double inertia_factor, double clearance_m);
+double onset_reduced_loss_factor(double inertia_factor);
+
 /// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0), all finite
 /// (std::invalid_argument naming the quantity otherwise, and for invalid options).
-/// kAuto: Γ = XΩ²/g < 1 rolling, else bouncing; below the onset every model gives the
+/// kAuto: the block of auto_inertia_factor (rolling up to Γ_slip, friction-limited
+/// sliding above, free flight without gravity across the drive); below the onset every model gives the
 /// scattered fit (kRolling and kBouncing with a warning, since their orbit does not
 /// exist there). kScattered: the fit regardless of s (family chosen by Γ as in kAuto).
-/// Warnings (one sentence each, with numbers): rolling at Γ >= 1, bouncing at Γ < 1,
+/// Warnings (one sentence each, with numbers): rolling above Γ_slip or without a base,
+/// bouncing below Γ_slip on a base, auto in its slip band (Γ_slip < Γ < 20μ),
 /// gravity along the drive, the orbit missing below its onset, the scattered fit
 /// provisional or outside [s_min, 1), X/h > 10. No allocation when there is no warning.
 LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
