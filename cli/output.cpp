@@ -114,7 +114,9 @@ OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
 OutputDir::~OutputDir() {
   std::error_code error;
   fs::remove_all(staging_, error);
-  if (writing_) end_output_phase();
+  // After a commit signals stay deferred until pdamp exits: one that arrives now finds
+  // the results complete, and main says so (finished()).
+  if (writing_ && !committed_) end_output_phase();
 }
 
 void OutputDir::start_writing() {
@@ -201,6 +203,7 @@ std::vector<std::string> OutputDir::commit() {
   write_file_atomically(dir_ / kManifest,
                         nlohmann::json{{"format", "pdamp.outputs"}, {"files", current}}.dump(2) + "\n");
   for (const auto& name : current) paths.push_back((dir_ / name).string());
+  committed_ = true;
   return paths;
 }
 

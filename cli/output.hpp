@@ -54,6 +54,7 @@ class OutputDir {
   std::vector<std::string> names_;     // staged, moved by commit()
   std::vector<std::string> in_place_;  // already in DIR
   bool writing_ = false;
+  bool committed_ = false;
 };
 
 /// Writes `content` to `path` through a temporary file and rename().
