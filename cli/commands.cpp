@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <regex>
 #include <mutex>
 #include <sstream>
 
@@ -501,6 +502,13 @@ void check_dem_placement(const Case& c, const dem_reference::DamperSimulationOpt
   }
 }
 
+/// The DEM's advice names its options ("lower integration.time_step_s"): the user edits
+/// the case keys they come from (/dem/time_step_s).
+std::string case_key_names(const std::string& advice) {
+  static const std::regex kOption(R"(\bintegration\.(\w+))");
+  return std::regex_replace(advice, kOption, "/dem/$1");
+}
+
 /// The estimate of a DEM run, for stderr before it starts.
 std::string estimate_line(const std::string& label, const dem_reference::RunEstimate& e) {
   return label + ": " + std::to_string(e.particles) + " particles, " + std::to_string(e.total_steps) + " steps of " +
@@ -533,9 +541,9 @@ int run_dem(const ParsedArgs& args) {
     throw InputError(path, "/dem", e.what());
   }
   if (result.summary.outcome == dem_reference::Outcome::kUnstable)
-    throw NumericalError("DEM unstable: " + result.summary.message);
+    throw NumericalError("DEM unstable: " + case_key_names(result.summary.message));
   if (result.summary.outcome != dem_reference::Outcome::kCompleted)  // a step threw (on any thread)
-    throw NumericalError("DEM failed: " + result.summary.message);
+    throw NumericalError("DEM failed: " + case_key_names(result.summary.message));
 
   json out = dem_json(result);
   out.update({{"case", c.name}, {"amplitude_m", x}, {"frequency_hz", f}});

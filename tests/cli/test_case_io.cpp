@@ -257,6 +257,8 @@ TEST_CASE("a DEM instability exits with code 3 and advice and a refused time ste
   CHECK(r.exit_code == 3);
   CHECK(r.out.empty());
   CHECK_THAT(r.err, Catch::Contains("pdamp: error: DEM unstable"));
+  // The advice names the case's keys, not the library's options.
+  CHECK_THAT(r.err, Catch::Contains("lower /dem/time_step_s"));
   CHECK(!fs::exists(fs::temp_directory_path() / "pdamp_unstable_out" / "summary.json"));
 
   const auto big_step = edited_case("pdamp_dem_step.json", [](json& c) { c["dem"] = {{"time_step_s", 1e-3}}; });
