@@ -35,17 +35,20 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return text;
 }
 
+/// Inner extent of a compartment along gravity (g_norm = |g| > 0), m.
+double extent_along_gravity(const CompartmentOptions& c, const Vec3& gravity, double g_norm) {
+  double h = 0.0;
+  for (int a = 0; a < 3; ++a) h += std::abs(gravity[static_cast<std::size_t>(a)]) / g_norm * c.container.inner_length(a);
+  return h;
+}
+
 /// The inner extent of the tallest compartment along gravity, m (the settling time of a
 /// random placement).
 double fall_height(const WorldOptions& w) {
   const double g = norm(w.gravity_m_s2);
   if (g == 0.0) return 0.0;
   double height = 0.0;
-  for (const auto& c : w.compartments) {
-    double h = 0.0;
-    for (int a = 0; a < 3; ++a) h += std::abs(w.gravity_m_s2[static_cast<std::size_t>(a)]) / g * c.container.inner_length(a);
-    height = std::max(height, h);
-  }
+  for (const auto& c : w.compartments) height = std::max(height, extent_along_gravity(c, w.gravity_m_s2, g));
   return height;
 }
 
@@ -60,8 +63,7 @@ double free_fall_height(const WorldOptions& w) {
   if (g == 0.0) return 0.0;
   double height = 0.0;
   for (const auto& c : w.compartments) {
-    double h = 0.0;
-    for (int a = 0; a < 3; ++a) h += std::abs(w.gravity_m_s2[static_cast<std::size_t>(a)]) / g * c.container.inner_length(a);
+    const double h = extent_along_gravity(c, w.gravity_m_s2, g);
     double r_min = std::numeric_limits<double>::infinity();
     for (const auto& p : c.particles) r_min = std::min(r_min, p.radius_m * (1.0 - p.radius_spread));
     if (!std::isfinite(r_min)) r_min = 0.0;
