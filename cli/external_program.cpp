@@ -109,7 +109,9 @@ void install_interrupt_handlers() {
   struct sigaction action {};
   action.sa_handler = on_interrupt;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // no SA_RESTART: a blocked read or wait returns with EINTR
+  // SA_RESTART: a deferred signal must not make a write of the output phase fail with
+  // EINTR (that would report a write error instead of the interruption).
+  action.sa_flags = SA_RESTART;
   for (int s : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(s, &action, nullptr);
 }
 
