@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "dem_test_support.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
 
@@ -24,16 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 /// spheres r = 5 mm, 6 × 6 × 1 lattice collected against −x in a 160 × 61 × 40 mm box
 /// (h_roll = 0.1 m), 2 Hz along x, gravity −z. Young's modulus divided by `softening`.
 dr::DamperSimulationOptions low_intensity(double stroke_over_clearance, double softening) {
-  dr::DamperSimulationOptions o;
-  auto& c = o.world.compartments.front();
-  c.container.box_inner_size_m = {0.160, 0.061, 0.040};
-  c.particles = {dr::ParticleGroupOptions{36, 0.005, 0.0, 0}};
-  c.lattice_counts = {6, 6, 1};
-  o.world.materials.front().material.youngs_modulus_pa = 210e9 / softening;
-  o.world.default_pair.restitution.constant = 0.8;
-  o.world.default_pair.friction = 0.3;
-  o.frequency_hz = 2.0;
-  o.amplitude_m = stroke_over_clearance * 0.1;
+  auto o = dem_test::shipped_layer(stroke_over_clearance, 0.8, 0.3, 0.0, softening);
   o.transient_periods = 3;
   o.analysed_periods = 4;
   return o;

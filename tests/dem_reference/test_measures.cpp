@@ -24,15 +24,7 @@ constexpr double kG = 9.80665;
 /// cases/low_intensity_36_spheres.json as the CLI builds it: 36 steel spheres r = 5 mm
 /// (default material), 6 × 6 × 1 lattice in a 160 × 61 × 40 mm box, 2 Hz along x, X = 0.04 m.
 dr::DamperSimulationOptions shipped_low_intensity() {
-  dr::DamperSimulationOptions o;
-  auto& c = o.world.compartments.front();
-  c.container.box_inner_size_m = {0.160, 0.061, 0.040};
-  c.particles = {dr::ParticleGroupOptions{36, 0.005, 0.0, 0}};
-  c.lattice_counts = {6, 6, 1};
-  o.world.default_pair.restitution.constant = 0.8;
-  o.world.default_pair.friction = 0.3;
-  o.world.default_pair.rolling_friction = 0.0;
-  o.frequency_hz = 2.0;
+  auto o = dem_test::shipped_layer(0.4, 0.8, 0.3, 0.0, 1.0);
   o.amplitude_m = 0.04;
   o.transient_periods = 3;
   o.analysed_periods = 8;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "dem_test_support.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 
 namespace {
@@ -20,17 +21,7 @@ namespace dr = pdamp::dem_reference;
 /// (h_roll = 0.1 m), 2 Hz along x, gravity −z; ε, μ, μ_r as given, E = 210 GPa / softening.
 dr::DamperSimulationOptions layer(double x_over_h, double restitution, double friction, double rolling,
                                   double softening) {
-  dr::DamperSimulationOptions o;
-  auto& c = o.world.compartments.front();
-  c.container.box_inner_size_m = {0.160, 0.061, 0.040};
-  c.particles = {dr::ParticleGroupOptions{36, 0.005, 0.0, 0}};
-  c.lattice_counts = {6, 6, 1};
-  o.world.materials.front().material.youngs_modulus_pa = 210e9 / softening;
-  o.world.default_pair.restitution.constant = restitution;
-  o.world.default_pair.friction = friction;
-  o.world.default_pair.rolling_friction = rolling;
-  o.frequency_hz = 2.0;
-  o.amplitude_m = x_over_h * 0.1;
+  auto o = dem_test::shipped_layer(x_over_h, restitution, friction, rolling, softening);
   o.samples_per_period = 200;
   return o;
 }
