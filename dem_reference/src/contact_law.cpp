@@ -64,6 +64,25 @@ ContactLaw::ContactLaw(const WorldOptions& options)
                                     : std::numeric_limits<double>::quiet_NaN();
     }
   }
+  // One layered law per (particle material, layer) of the compartments. The sphere's
+  // radius does not enter the dimensionless law (R* = 1 m stands in).
+  for (const auto& c : options.compartments) {
+    if (!(c.layer.thickness_m > 0.0)) continue;
+    const auto& layer = options.materials[static_cast<std::size_t>(c.layer.material)].material;
+    for (const auto& group : c.particles) {
+      const int type = pair_type(group.material, c.layer.material);
+      const bool known = std::any_of(layers_.begin(), layers_.end(), [&](const WallLayerLaw& l) {
+        return l.pair_type == type && l.thickness_m == c.layer.thickness_m;
+      });
+      if (known) continue;
+      const auto& sphere = options.materials[static_cast<std::size_t>(group.material)].material;
+      formulas::LayeredContact contact(1.0, layer.youngs_modulus_pa, layer.poisson_ratio, sphere.youngs_modulus_pa,
+                                       sphere.poisson_ratio, c.layer.thickness_m);
+      formulas::LayeredDampingTable damping(contact);
+      layers_.push_back(WallLayerLaw{type, c.layer.thickness_m, 1.0 / c.layer.thickness_m, std::move(contact),
+                                     std::move(damping)});
+    }
+  }
 }
 
 ContactParams ContactLaw::particle_pair(double radius_i, double mass_i, int material_i,
@@ -80,7 +99,7 @@ ContactParams ContactLaw::particle_pair(double radius_i, double mass_i, int mate
 }
 
 ContactParams ContactLaw::particle_wall(double radius_i, double mass_i, int material_i,
-                                        int wall_material, double wall_radius_m) const {
+                                        int wall_material, double wall_radius_m, double layer_thickness_m) const {
   const int type = pair_type(material_i, wall_material);
   const auto t = static_cast<std::size_t>(type);
   // Curved walls: Hertz's equivalent radius √(R'R'') of the two principal relative
@@ -96,29 +115,43 @@ ContactParams ContactLaw::particle_wall(double radius_i, double mass_i, int mate
   p.stiffness = 4.0 / 3.0 * e_star_[t] * std::sqrt(r_eff);
   p.damping_scale = std::sqrt(mass_i * p.stiffness);
   p.pair_type = type;
+  if (layer_thickness_m > 0.0) {
+    for (std::size_t l = 0; l < layers_.size(); ++l) {
+      if (layers_[l].pair_type == type && layers_[l].thickness_m == layer_thickness_m) p.layer = static_cast<int>(l);
+    }
+    if (p.layer < 0) throw std::logic_error("ContactLaw: no law for this wall layer");
+  }
   return p;
 }
 
-double ContactLaw::damping_coefficient(int pair_type, double impact_speed_m_s) const {
-  const auto t = static_cast<std::size_t>(pair_type);
-  if (!std::isnan(constant_gamma_[t])) return constant_gamma_[t];
+double ContactLaw::damping_coefficient(const ContactParams& params, double impact_speed_m_s) const {
+  const auto t = static_cast<std::size_t>(params.pair_type);
+  if (params.layer < 0 && !std::isnan(constant_gamma_[t])) return constant_gamma_[t];
   // Validation keeps ε(v) in the table's range [0.01, 1] up to max_impact_speed_m_s;
   // a faster first touch gets the nearest value of that range instead of an exception
   // that would end the run (0.01 and less are both practically plastic). Values inside
   // the range are unchanged, so are the results; NaN stays NaN and the table throws.
-  const double restitution = restitution_[t]->restitution(impact_speed_m_s);
-  return damping_table().damping_for_restitution(
-      std::clamp(restitution, formulas::DampingTable::kMinRestitution, 1.0));
+  const double restitution = std::clamp(restitution_[t]->restitution(impact_speed_m_s),
+                                        formulas::DampingTable::kMinRestitution, 1.0);
+  if (params.layer < 0) return damping_table().damping_for_restitution(restitution);
+  // On a layer ε(γ_n) depends on the impact's overlap parameter ξ = √(R*δ_H)/t, with the
+  // Hertz maximum overlap δ_H = (5m*v²/4K)^{2/5} (formulas::LayeredDampingTable).
+  const WallLayerLaw& l = layers_[static_cast<std::size_t>(params.layer)];
+  const double root_r = params.stiffness * types_[t].inv_hertz_modulus;
+  const double mass = params.damping_scale * params.damping_scale / params.stiffness;
+  const double hertz_overlap = std::pow(1.25 * mass * impact_speed_m_s * impact_speed_m_s / params.stiffness, 0.4);
+  return l.damping.damping_for_restitution(root_r * std::sqrt(hertz_overlap) * l.inv_thickness, restitution);
 }
 
 bool ContactLaw::any_rolling_friction() const {
   return std::any_of(types_.begin(), types_.end(), [](const PairType& t) { return t.rolling_friction > 0.0; });
 }
 
-double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, const double* mr,
+double stored_energy(const ContactParams& p, const ContactLaw& law, const ContactHistory& h, const double* mr,
                      double delta) {
   if (delta <= 0.0 || h.inv_kt_prev <= 0.0) return 0.0;
-  const double hertz = 0.4 * p.stiffness * delta * delta * std::sqrt(delta);
+  const PairType& type = law.type(p.pair_type);
+  const double hertz = 0.4 * p.stiffness * delta * delta * std::sqrt(delta) * law.hertz_ratios(p, std::sqrt(delta)).energy;
   const double ft2 = h.ft[0] * h.ft[0] + h.ft[1] * h.ft[1] + h.ft[2] * h.ft[2];
   double springs = 0.5 * ft2 * h.inv_kt_prev;
   if (type.rolling_friction > 0.0) {

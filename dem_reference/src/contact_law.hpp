@@ -8,6 +8,7 @@
 
 #include "pdamp/dem_reference/world_options.hpp"
 #include "pdamp/formulas/cor_models.hpp"
+#include "pdamp/formulas/layered_contact.hpp"
 #include "simd_lanes.hpp"
 
 namespace pdamp::dem_reference::detail {
@@ -25,6 +26,7 @@ struct ContactParams {
   double stiffness = 0.0;      ///< K = (4/3)E*√R*, N/m^{3/2}
   double damping_scale = 0.0;  ///< √(m*K), kg^{1/2} N^{1/2} m^{-3/4}
   int pair_type = 0;           ///< index of the material pair
+  int layer = -1;              ///< index of the wall-layer law (ContactLaw::layer_law); −1: Hertz
 };
 
 /// History of one contact. inv_kt_prev = 0 marks "not in contact at the last step".
@@ -61,6 +63,17 @@ struct StepDissipation {
   int contacts = 0;
 };
 
+/// The contact law of a sphere material on a bonded wall layer of one thickness: the
+/// layered force, damping and energy relative to Hertz's at χ = √(R*δ)/t, and the
+/// damping γ_n that realises the pair's ε on it (docs/dem.md "Buffered walls").
+struct WallLayerLaw {
+  int pair_type = 0;
+  double thickness_m = 0.0;
+  double inv_thickness = 0.0;  ///< 1/t, 1/m
+  formulas::LayeredContact contact;
+  formulas::LayeredDampingTable damping;
+};
+
 /// Material-pair table: E*, G*, μ, μ_r and the restitution model of every pair.
 class ContactLaw {
  public:
@@ -71,11 +84,21 @@ class ContactLaw {
   ContactParams particle_pair(double radius_i, double mass_i, int material_i, double radius_j,
                               double mass_j, int material_j) const;
   /// Parameters of a sphere–wall contact; wall_radius_m: 0 flat, > 0 convex (pin),
-  /// < 0 concave (cylinder mantle) curvature radius across the contact.
+  /// < 0 concave (cylinder mantle) curvature radius across the contact; layer_thickness_m
+  /// > 0: the wall is the surface of a bonded layer of that thickness (WallLayerLaw).
   ContactParams particle_wall(double radius_i, double mass_i, int material_i, int wall_material,
-                              double wall_radius_m) const;
-  /// γ_n realising ε(v) of the pair (PHYSICS.md §6, via formulas::DampingTable).
-  double damping_coefficient(int pair_type, double impact_speed_m_s) const;
+                              double wall_radius_m, double layer_thickness_m = 0.0) const;
+  /// γ_n realising ε(v) of the contact's pair (PHYSICS.md §6): Hertz's via
+  /// formulas::DampingTable, a layer's via its formulas::LayeredDampingTable.
+  double damping_coefficient(const ContactParams& params, double impact_speed_m_s) const;
+  const WallLayerLaw& layer_law(int index) const { return layers_[static_cast<std::size_t>(index)]; }
+  /// The layered law of a contact relative to Hertz's at overlap δ (√δ given); all ones for Hertz.
+  formulas::LayeredContact::HertzRatios hertz_ratios(const ContactParams& params, double root_delta) const {
+    if (params.layer < 0) return {};
+    const WallLayerLaw& l = layers_[static_cast<std::size_t>(params.layer)];
+    const double root_r = params.stiffness * types_[static_cast<std::size_t>(params.pair_type)].inv_hertz_modulus;
+    return l.contact.hertz_ratios(root_r * root_delta * l.inv_thickness);
+  }
   double effective_modulus(int material_a, int material_b) const {
     return e_star_[static_cast<std::size_t>(pair_type(material_a, material_b))];
   }
@@ -89,6 +112,7 @@ class ContactLaw {
   std::vector<PairType> types_;
   std::vector<std::shared_ptr<const formulas::RestitutionModel>> restitution_;
   std::vector<double> constant_gamma_;   // γ_n for constant-ε pairs, NaN otherwise
+  std::vector<WallLayerLaw> layers_;     // one per (sphere material, layer) met in the compartments
 };
 
 /// The contacts one evaluation of the kernel serves, one per lane (lane l: params[l], …).
@@ -211,15 +235,27 @@ template <class W>
     ContactHistory& h = *c.history[l];
     if (h.gamma < 0.0) {
       const double speed = lane(vn, l);
-      h.gamma = law.damping_coefficient(c.params[l]->pair_type, speed > 0.0 ? speed : 0.0);
+      h.gamma = law.damping_coefficient(*c.params[l], speed > 0.0 ? speed : 0.0);
     }
   }
   const W stiffness = W::gather([&](int l) { return c.params[l]->stiffness; });
   const W gamma = W::gather([&](int l) { return c.history[l]->gamma; });
   const W damping_scale = W::gather([&](int l) { return c.params[l]->damping_scale; });
   const W root = sqrt(k.delta);
-  const W f_elastic = stiffness * k.delta * root;
-  W f_n = f_elastic + gamma * damping_scale * sqrt(root) * vn;
+  W f_elastic = stiffness * k.delta * root;
+  W damping_rate = gamma * damping_scale * sqrt(root);
+  // Contacts on a bonded wall layer: the layered law, F = Kδ^{3/2}G(χ) and the damping
+  // scaled through its local stiffness (formulas::layered_realised_restitution). Hertz
+  // lanes are multiplied by exactly 1, so their bits do not change.
+  bool any_layer = false;
+  for (int l = 0; l < kN; ++l) any_layer = any_layer || c.params[l]->layer >= 0;
+  if (any_layer) {
+    formulas::LayeredContact::HertzRatios ratios[kN];
+    for (int l = 0; l < kN; ++l) ratios[l] = law.hertz_ratios(*c.params[l], lane(root, l));
+    f_elastic = f_elastic * W::gather([&](int l) { return ratios[l].force; });
+    damping_rate = damping_rate * W::gather([&](int l) { return ratios[l].damping; });
+  }
+  W f_n = f_elastic + damping_rate * vn;
   f_n = select(f_n < zero, zero, f_n);  // no tension: the contact ends when the force returns to zero
   const W f_damp = f_n - f_elastic;
   // Trapezoidal work of the damping force over the step's overlap change vn·dt.
@@ -278,9 +314,9 @@ template <class W>
   diss.contacts += kN;
 }
 
-/// Energy stored in a contact: (2/5)Kδ^{5/2} + |F_t|²/2k_t + |M_r|²/2k_r, J. mr: the
-/// rolling spring torque, as ContactLanes::rolling_torque.
-double stored_energy(const ContactParams& p, const PairType& type, const ContactHistory& h, const double* mr,
+/// Energy stored in a contact: (2/5)Kδ^{5/2} (times W(χ) on a layer) + |F_t|²/2k_t +
+/// |M_r|²/2k_r, J. mr: the rolling spring torque, as ContactLanes::rolling_torque.
+double stored_energy(const ContactParams& p, const ContactLaw& law, const ContactHistory& h, const double* mr,
                      double delta);
 
 }  // namespace pdamp::dem_reference::detail

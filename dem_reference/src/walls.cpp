@@ -51,6 +51,7 @@ std::vector<WallFeature> build_walls(const WorldOptions& options) {
         // once the layer is fully compressed.
         if (layered(c.layer, axis)) {
           walls.push_back(plane(id, c.layer.material, c.offset_m, axis, side, half_length - t));
+          walls.back().layer_thickness_m = t;
         }
       }
     };
@@ -72,6 +73,7 @@ std::vector<WallFeature> build_walls(const WorldOptions& options) {
         mantle.material = c.layer.material;
         mantle.radius -= t;
         mantle.curvature_radius_m = -mantle.radius;
+        mantle.layer_thickness_m = t;
         walls.push_back(mantle);
       }
     }

@@ -22,6 +22,9 @@ struct WallFeature {
   int material = 0;
   /// Curvature radius across the contact for Hertz: 0 flat, > 0 convex, < 0 concave, m.
   double curvature_radius_m = 0.0;
+  /// > 0: the surface of a layer of this thickness bonded to the hard wall behind it
+  /// (the layered contact law, formulas::LayeredContact), m; 0: a solid wall (Hertz).
+  double layer_thickness_m = 0.0;
   double centre[3] = {0.0, 0.0, 0.0};  ///< body frame: plane point / axis point / box or pin centre, m
   double normal[3] = {0.0, 0.0, 0.0};  ///< plane: unit normal into the particle region
   int axis = 0;                        ///< cylinder and pin axis

@@ -547,7 +547,7 @@ Contact World::Impl::particle_wall_contact(std::size_t a, int wall) const {
   const double listed_at[3] = {rx[a], ry[a], rz[a]};
   Contact c;
   c.params = law.particle_wall(radius[a], mass[a], material[a], w.material,
-                               detail::contact_curvature_radius(w, listed_at));
+                               detail::contact_curvature_radius(w, listed_at), w.layer_thickness_m);
   return c;
 }
 
@@ -1305,7 +1305,7 @@ double World::Impl::elastic_energy() const {
       const double dx = x[j] - x[i], dy = y[j] - y[i], dz = z[j] - z[i];
       const double delta = radius[i] + radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
       const auto& params = pairs.pool.state[c].params;
-      e += detail::stored_energy(params, law.type(params.pair_type), pairs.pool.state[c].history,
+      e += detail::stored_energy(params, law, pairs.pool.state[c].history,
                                  pairs.pool.rolling_torque(c), delta);
     }
   }
@@ -1319,7 +1319,7 @@ double World::Impl::elastic_energy() const {
       double nb[3];
       const double gap = detail::wall_gap(walls[static_cast<std::size_t>(slot.j)], p, radius[i], nb);
       const auto& params = wall_rows.pool.state[c].params;
-      e += detail::stored_energy(params, law.type(params.pair_type), wall_rows.pool.state[c].history,
+      e += detail::stored_energy(params, law, wall_rows.pool.state[c].history,
                                  wall_rows.pool.rolling_torque(c), -gap);
     }
   }

@@ -465,7 +465,14 @@ LayeredContact::LayeredContact(double effective_radius_m, double layer_modulus_p
       std::isinf(sphere_modulus_pa) ? 0.0 : (1.0 - sphere_poisson_ratio * sphere_poisson_ratio) / sphere_modulus_pa;
   effective_modulus_ = 1.0 / (layer_compliance + sphere_compliance);
   hertz_stiffness_ = 4.0 / 3.0 * effective_modulus_ * std::sqrt(radius_);
-  table_ = shared_table(layer_poisson_ratio, layer_compliance * effective_modulus_);
+  layer_poisson_ = layer_poisson_ratio;
+  layer_share_ = layer_compliance * effective_modulus_;
+  table_ = shared_table(layer_poisson_, layer_share_);
+}
+
+LayeredContact::LayeredContact(const LayeredContact& materials, double thickness_m) : LayeredContact(materials) {
+  require(positive_finite(thickness_m), "LayeredContact", "thickness_m", thickness_m, "must be > 0 and finite");
+  thickness_ = thickness_m;
 }
 
 double LayeredContact::force_over_hertz(double chi) const {
@@ -482,12 +489,10 @@ double LayeredContact::force(double overlap) const {
   return hertz_stiffness_ * overlap * root * force_over_hertz(std::sqrt(radius_) * root / thickness_);
 }
 
-double LayeredContact::stiffness(double overlap) const {
-  if (!(overlap > 0.0)) return 0.0;
-  const Table& t = *table_;
-  const double root = std::sqrt(overlap);
-  const double chi = std::sqrt(radius_) * root / thickness_;
-  double g, slope;
+namespace {
+
+/// G(χ) and dG/dχ from the table (or its power-law continuation beyond it).
+void force_ratio_and_slope(const LayeredContact::Table& t, double chi, double& g, double& slope) {
   if (chi >= t.end_chi) {
     g = t.end_g * std::pow(chi / t.end_chi, t.end_exponent);
     slope = t.end_exponent * g / chi;
@@ -497,25 +502,50 @@ double LayeredContact::stiffness(double overlap) const {
     g = hermite(t.g, t.dg, i, position - i, t.step);
     slope = hermite_slope(t.g, t.dg, i, position - i, t.step);
   }
-  // F = Kδ^{3/2}G(χ), dχ/dδ = χ/(2δ).
-  return hertz_stiffness_ * root * (1.5 * g + 0.5 * chi * slope);
 }
 
-double LayeredContact::energy(double overlap) const {
-  if (!(overlap > 0.0)) return 0.0;
-  const Table& t = *table_;
-  const double root = std::sqrt(overlap);
-  const double chi = std::sqrt(radius_) * root / thickness_;
-  const double hertz = 0.4 * hertz_stiffness_ * overlap * overlap * root;  // (8/15)E*√R δ^{5/2}
+/// W(χ) = U/U_Hertz = 5Ψ(χ)/χ⁵ (χ > 0).
+double energy_ratio(const LayeredContact::Table& t, double chi) {
   if (chi >= t.end_chi) {
     const double p = t.end_exponent;
     const double psi = t.end_psi + t.end_g * std::pow(t.end_chi, -p) *
                                        (std::pow(chi, p + 5.0) - std::pow(t.end_chi, p + 5.0)) / (p + 5.0);
-    return hertz * 5.0 * psi / std::pow(chi, 5);
+    return 5.0 * psi / std::pow(chi, 5);
   }
   const double position = chi / t.step;
   const int i = static_cast<int>(position);
-  return hertz * hermite(t.w, t.dw, i, position - i, t.step);
+  return hermite(t.w, t.dw, i, position - i, t.step);
+}
+
+}  // namespace
+
+double LayeredContact::stiffness(double overlap) const {
+  if (!(overlap > 0.0)) return 0.0;
+  const double root = std::sqrt(overlap);
+  const double chi = std::sqrt(radius_) * root / thickness_;
+  double g, slope;
+  force_ratio_and_slope(*table_, chi, g, slope);
+  // F = Kδ^{3/2}G(χ), dχ/dδ = χ/(2δ).
+  return hertz_stiffness_ * root * (1.5 * g + 0.5 * chi * slope);
+}
+
+LayeredContact::HertzRatios LayeredContact::hertz_ratios(double chi) const {
+  HertzRatios out;
+  if (!(chi > 0.0)) return out;
+  double slope;
+  force_ratio_and_slope(*table_, chi, out.force, slope);
+  // S/S_Hertz with S_Hertz = (3/2)Kδ^{1/2}: (1.5G + 0.5χG')/1.5.
+  out.damping = std::sqrt(out.force + chi * slope / 3.0);
+  out.energy = energy_ratio(*table_, chi);
+  return out;
+}
+
+double LayeredContact::energy(double overlap) const {
+  if (!(overlap > 0.0)) return 0.0;
+  const double root = std::sqrt(overlap);
+  const double chi = std::sqrt(radius_) * root / thickness_;
+  const double hertz = 0.4 * hertz_stiffness_ * overlap * overlap * root;  // (8/15)E*√R δ^{5/2}
+  return hertz * energy_ratio(*table_, chi);
 }
 
 double LayeredContact::contact_radius(double overlap) const {
@@ -584,21 +614,15 @@ struct OneCollision {
   }
 };
 
-}  // namespace
-
-double layered_realised_restitution(const LayeredContact& contact, double mass, double speed, double damping) {
-  constexpr const char* kFunction = "layered_realised_restitution";
-  require(positive_finite(mass), kFunction, "effective_mass_kg", mass, "must be > 0 and finite");
-  require(positive_finite(speed), kFunction, "impact_speed_m_s", speed, "must be > 0 and finite");
-  require(damping >= 0.0 && damping <= 100.0, kFunction, "damping_coefficient", damping, "must be in [0, 100]");
+/// The one-collision solve of layered_realised_restitution with `steps` RK4 steps per
+/// elastic contact time (arguments valid).
+double realised_restitution(const LayeredContact& contact, double mass, double speed, double damping,
+                            int steps) {
   const OneCollision model{contact, mass, damping};
-  // Step: the elastic contact time over 20000 (RK4, the force's δ^{1/4}-type start costs
-  // an O(h^{5/4}) local error in the first steps only: ε converged to ~1e-6, docs).
-  const double tc = layered_impact(contact, mass, speed).contact_time_s;
-  const double h = tc / 20000.0;
+  const double h = layered_impact(contact, mass, speed).contact_time_s / steps;
   double x = 0.0, v = speed;
   auto accel = [&](double xx, double vv) { return -model.total_force(xx, vv) / mass; };
-  for (int step = 0; step < 4'000'000; ++step) {
+  for (long step = 0; step < 200L * steps; ++step) {
     const double k1x = v, k1v = accel(x, v);
     const double k2x = v + 0.5 * h * k1v, k2v = accel(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
     const double k3x = v + 0.5 * h * k2v, k3v = accel(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
@@ -620,6 +644,18 @@ double layered_realised_restitution(const LayeredContact& contact, double mass, 
   throw std::runtime_error("layered_realised_restitution: contact did not end");
 }
 
+}  // namespace
+
+double layered_realised_restitution(const LayeredContact& contact, double mass, double speed, double damping) {
+  constexpr const char* kFunction = "layered_realised_restitution";
+  require(positive_finite(mass), kFunction, "effective_mass_kg", mass, "must be > 0 and finite");
+  require(positive_finite(speed), kFunction, "impact_speed_m_s", speed, "must be > 0 and finite");
+  require(damping >= 0.0 && damping <= 100.0, kFunction, "damping_coefficient", damping, "must be in [0, 100]");
+  // Step: the elastic contact time over 20000 (RK4, the force's δ^{1/4}-type start costs
+  // an O(h^{5/4}) local error in the first steps only: ε converged to ~1e-6, docs).
+  return realised_restitution(contact, mass, speed, damping, 20000);
+}
+
 double layered_damping_for_restitution(const LayeredContact& contact, double mass, double speed,
                                        double restitution) {
   require(restitution >= 1e-3 && restitution <= 1.0, "layered_damping_for_restitution", "restitution",
@@ -634,6 +670,106 @@ double layered_damping_for_restitution(const LayeredContact& contact, double mas
   double lo = 0.0, f_lo = -target, hi = std::log1p(100.0), f_hi = residual(hi);
   if (f_hi > 0.0) throw std::runtime_error("layered_damping_for_restitution: not reached at damping 100");
   const double u = detail::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
+  return std::min(std::expm1(u), 100.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Damping table of the layered law (LayeredDampingTable).
+
+struct LayeredDampingTable::Table {
+  std::vector<double> log_xi;          // ln ξ nodes, uniform
+  std::vector<double> u;               // ln(1 + γ) nodes, uniform from 0
+  std::vector<double> log_eps;         // ln ε, row per ξ node (decreasing along u)
+};
+
+namespace {
+
+// Grid: 61 ξ nodes (12 per decade over [1e-3, 100]) by 41 γ nodes (u = ln(1 + γ) over
+// [0, ln 101]). RK4 at 4000 steps per contact time: ε to ~1e-5 (the δ^{1/4}-type start,
+// docs), far below the interpolation error. Accuracy of the inversion: test.
+constexpr int kDampingXiNodes = 61;
+constexpr int kDampingGammaNodes = 41;
+constexpr int kDampingSteps = 4000;
+
+std::shared_ptr<const LayeredDampingTable::Table> build_damping_table(const LayeredContact& prototype) {
+  auto table = std::make_shared<LayeredDampingTable::Table>();
+  const double lo = std::log(LayeredDampingTable::kMinOverlapParameter);
+  const double hi = std::log(LayeredDampingTable::kMaxOverlapParameter);
+  const double u_max = std::log1p(100.0);
+  for (int i = 0; i < kDampingXiNodes; ++i) table->log_xi.push_back(lo + (hi - lo) * i / (kDampingXiNodes - 1));
+  for (int j = 0; j < kDampingGammaNodes; ++j) table->u.push_back(u_max * j / (kDampingGammaNodes - 1));
+  table->log_eps.resize(static_cast<std::size_t>(kDampingXiNodes * kDampingGammaNodes));
+  // A unit impact (m* = 1 kg, v = 1 m/s) on the prototype's moduli and radius; the
+  // thickness gives each node its ξ (ε depends on nothing else, class comment).
+  const double mass = 1.0, speed = 1.0;
+  const double k = 4.0 / 3.0 * prototype.effective_modulus_pa() * std::sqrt(prototype.effective_radius_m());
+  const double hertz_overlap = std::pow(1.25 * mass * speed * speed / k, 0.4);
+  for (int i = 0; i < kDampingXiNodes; ++i) {
+    const double thickness = std::sqrt(prototype.effective_radius_m() * hertz_overlap) / std::exp(table->log_xi[i]);
+    const LayeredContact node(prototype, thickness);
+    for (int j = 0; j < kDampingGammaNodes; ++j) {
+      const double gamma = std::min(std::expm1(table->u[static_cast<std::size_t>(j)]), 100.0);
+      table->log_eps[static_cast<std::size_t>(i * kDampingGammaNodes + j)] =
+          j == 0 ? 0.0 : std::log(realised_restitution(node, mass, speed, gamma, kDampingSteps));
+    }
+  }
+  return table;
+}
+
+/// u = ln(1 + γ) with ln ε(u) = target on row i (linear between the nodes; ln ε falls along u).
+double row_inverse(const LayeredDampingTable::Table& t, int i, double target) {
+  const double* row = &t.log_eps[static_cast<std::size_t>(i * kDampingGammaNodes)];
+  if (target >= row[0]) return 0.0;
+  for (int j = 1; j < kDampingGammaNodes; ++j) {
+    if (row[j] <= target) {
+      const double s = (row[j - 1] - target) / (row[j - 1] - row[j]);
+      return t.u[static_cast<std::size_t>(j - 1)] + s * (t.u[static_cast<std::size_t>(j)] - t.u[static_cast<std::size_t>(j - 1)]);
+    }
+  }
+  return t.u.back();
+}
+
+}  // namespace
+
+LayeredDampingTable::LayeredDampingTable(const LayeredContact& contact) {
+  struct Entry {
+    double nu, share;
+    std::shared_ptr<const Table> table;
+  };
+  static std::mutex mutex;
+  static std::vector<Entry> cache;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& e : cache) {
+      if (e.nu == contact.layer_poisson_ && e.share == contact.layer_share_) {
+        table_ = e.table;
+        return;
+      }
+    }
+  }
+  auto table = build_damping_table(contact);  // outside the lock: ~1 s
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (cache.size() >= 32) cache.erase(cache.begin());
+  cache.push_back({contact.layer_poisson_, contact.layer_share_, table});
+  table_ = std::move(table);
+}
+
+double LayeredDampingTable::impact_overlap_parameter(const LayeredContact& contact, double mass, double speed) {
+  const double k = 4.0 / 3.0 * contact.effective_modulus_pa() * std::sqrt(contact.effective_radius_m());
+  const double hertz_overlap = std::pow(1.25 * mass * speed * speed / k, 0.4);
+  return std::sqrt(contact.effective_radius_m() * hertz_overlap) / contact.thickness_m();
+}
+
+double LayeredDampingTable::damping_for_restitution(double xi, double restitution) const {
+  const Table& t = *table_;
+  if (restitution >= 1.0) return 0.0;
+  const double target = std::log(restitution);
+  const double position = std::clamp((std::log(std::max(xi, kMinOverlapParameter)) - t.log_xi.front()) /
+                                         (t.log_xi[1] - t.log_xi[0]),
+                                     0.0, static_cast<double>(kDampingXiNodes - 1));
+  const int i = std::min(static_cast<int>(position), kDampingXiNodes - 2);
+  const double s = position - i;
+  const double u = (1.0 - s) * row_inverse(t, i, target) + s * row_inverse(t, i + 1, target);
   return std::min(std::expm1(u), 100.0);
 }
 

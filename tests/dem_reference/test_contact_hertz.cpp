@@ -160,7 +160,7 @@ std::pair<std::vector<LaneContact>, dd::StepDissipation> random_contacts_in_lane
     one.params = law.particle_pair(0.005, 4e-3, mi, 0.004, 2e-3, mj);
     one.rolling = law.type(one.params.pair_type).rolling_friction > 0.0;
     if (c % 4 != 0) {  // in touch already: a stored spring (and rolling torque), γ known
-      one.history.gamma = law.damping_coefficient(one.params.pair_type, 0.5);
+      one.history.gamma = law.damping_coefficient(one.params, 0.5);
       one.history.inv_kt_prev = uniform(0.5e-6, 2e-6);
       one.history.fn_prev = uniform(0.0, 20.0);
       one.history.fd_prev = uniform(-2.0, 2.0);

@@ -374,6 +374,39 @@ TEST_CASE("the layered damping reduces to the calibrated Hertz damping on a thic
   CHECK(fm::layered_realised_restitution(thin, mass, v, gamma) == Approx(0.6).margin(1e-5));
 }
 
+TEST_CASE("the layered damping table realises the target restitution between its nodes", "[formulas]") {
+  // Reference: the one-collision solve layered_realised_restitution (20000 RK4 steps,
+  // ~1e-6), which the table's inversion must hit at impacts between its ξ nodes and for
+  // restitutions between its γ nodes. 1e-3 relative: the DEM's restitution tolerance is
+  // 2% (issue 3); linear inversion on the (ln ξ, ln(1 + γ)) grid stays well inside.
+  const double radius = 0.005, mass = 4.1e-3;
+  const fm::LayeredContact materials(radius, 100e6, 0.48, 210e9, 0.3, 1.5e-4);
+  const fm::LayeredDampingTable table(materials);
+  // Also the ratios the DEM uses: force and energy at χ against the dimensional law,
+  // and the damping ratio √(S/S_Hertz) against the law's own stiffness.
+  const double delta = 3e-5, chi = std::sqrt(radius * delta) / 1.5e-4;
+  const auto ratios = materials.hertz_ratios(chi);
+  const double k_hertz = 4.0 / 3.0 * materials.effective_modulus_pa() * std::sqrt(radius);
+  CHECK(ratios.force * k_hertz * std::pow(delta, 1.5) == Approx(materials.force(delta)).epsilon(1e-12));
+  CHECK(ratios.energy * 0.4 * k_hertz * std::pow(delta, 2.5) == Approx(materials.energy(delta)).epsilon(1e-12));
+  CHECK(ratios.damping * ratios.damping * 1.5 * k_hertz * std::sqrt(delta) ==
+        Approx(materials.stiffness(delta)).epsilon(1e-12));
+  for (const double thickness : {3e-3, 3.3e-4, 1.1e-4, 4e-5}) {
+    const fm::LayeredContact layer(materials, thickness);
+    for (const double v : {0.37, 2.9}) {
+      const double xi = fm::LayeredDampingTable::impact_overlap_parameter(layer, mass, v);
+      for (const double eps : {0.33, 0.71, 0.93}) {
+        const double gamma = table.damping_for_restitution(xi, eps);
+        const double realised = fm::layered_realised_restitution(layer, mass, v, gamma);
+        INFO("t = " << thickness << " m, v = " << v << " m/s, xi = " << xi << ", target " << eps << ": gamma "
+                    << gamma << ", realised " << realised);
+        CHECK(realised == Approx(eps).epsilon(1e-3));
+      }
+    }
+  }
+  CHECK(table.damping_for_restitution(0.5, 1.0) == 0.0);
+}
+
 TEST_CASE("the layered law rejects invalid parameters", "[formulas]") {
   CHECK_THROWS_WITH(fm::LayeredContact(-1.0, 60e6, 0.45, kInf, 0.3, 1e-4),
                     Catch::StartsWith("LayeredContact: effective_radius_m = -1: must be > 0"));

@@ -16,7 +16,9 @@ namespace pdamp::dem_reference {
 /// results change for the same input; the effective fields hash it.
 /// 2: the ISO 3290 ball-lot tolerance by default, the drive-bin measure accumulated
 /// every step, the impact speed from the free-fall height (issue 9).
-inline constexpr int kPhysicsModelVersion = 2;
+/// 3: wall layers with the bonded-layer contact law (issue 9; worlds without layers
+/// give the same results as in version 2).
+inline constexpr int kPhysicsModelVersion = 3;
 
 /// The automatic time-step bound (docs/dem.md "Time step").
 struct TimeStepBound {

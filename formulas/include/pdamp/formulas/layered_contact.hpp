@@ -112,10 +112,25 @@ class LayeredContact {
   /// Contact radius a at overlap δ (from the table of a/t), m.
   double contact_radius(double overlap_m) const;
 
+  /// The law relative to Hertz's at χ = √(R*δ)/t, the three numbers a DEM step needs
+  /// (they depend on R* and t only through χ, so one object serves every sphere size):
+  struct HertzRatios {
+    double force = 1.0;    ///< G = F/F_Hertz
+    double damping = 1.0;  ///< √(S/S_Hertz) = √(G + χG'/3), S = dF/dδ: the damping scale ratio
+    double energy = 1.0;   ///< W = U/U_Hertz
+  };
+  /// χ >= 0 (0 gives Hertz: all ones).
+  HertzRatios hertz_ratios(double overlap_parameter) const;
+
+  /// The same materials (and table) at another thickness t > 0.
+  LayeredContact(const LayeredContact& materials, double thickness_m);
+
   struct Table;  ///< dimensionless G(χ), W(χ), λ(χ) on a uniform χ grid (internal)
 
  private:
+  friend class LayeredDampingTable;  // keys its cache on the layer's (ν, k)
   double radius_ = 0.0, thickness_ = 0.0, effective_modulus_ = 0.0;
+  double layer_poisson_ = 0.0, layer_share_ = 1.0;  // ν and k = E*/E'_layer of the table
   double hertz_stiffness_ = 0.0;  // K = (4/3) E* √R*
   std::shared_ptr<const Table> table_;
 };
@@ -142,5 +157,37 @@ double layered_realised_restitution(const LayeredContact& contact, double effect
 /// γ_n with layered_realised_restitution(...) = ε (|Δε| < 1e-6), ε in [1e-3, 1].
 double layered_damping_for_restitution(const LayeredContact& contact, double effective_mass_kg,
                                        double impact_speed_m_s, double restitution);
+
+/// γ_n realising ε on the layered law, tabulated for a DEM (one solve per first touch
+/// would cost milliseconds). Dimensional analysis of the one-collision ODE with δ scaled
+/// by the Hertz maximum overlap δ_H = (15m*v²/(16E*√R*))^{2/5} and time by δ_H/v: the
+/// inertia coefficient is m*v²/(Kδ_H^{5/2}) = 5/2 and the damping coefficient γ_n√(5/2),
+/// so ε depends on (γ_n, ν, k) and, through G(χ), only on ξ = √(R*δ_H)/t: the Hertz
+/// overlap parameter of the impact. The table holds ln ε on a grid of (ln ξ, ln(1 + γ_n))
+/// (ln ε is nearly linear in ln(1 + γ_n), cor_models.cpp) and inverts it by linear
+/// interpolation at the two neighbouring ξ nodes, blended linearly in ln ξ: realised ε
+/// within 1e-3 relative of the target (test). Below ξ = kMinOverlapParameter the law is
+/// Hertz's within 0.2% and the first node answers; above kMaxOverlapParameter (δ_H of
+/// 10⁴t²/R*: 100 layer thicknesses at R*/t = 100, far beyond bottoming out, where the
+/// hard wall takes over; the law there is the table's power-law continuation) the last
+/// node answers. Build: ~0.5 s per (ν, k), cached; copies share it.
+class LayeredDampingTable {
+ public:
+  static constexpr double kMinOverlapParameter = 1e-3;
+  static constexpr double kMaxOverlapParameter = 100.0;
+  /// The table of `contact`'s (ν, k); its R* and t do not matter.
+  explicit LayeredDampingTable(const LayeredContact& contact);
+  /// ξ = √(R*δ_H)/t of an impact at speed v >= 0 with effective mass m* > 0 on `contact`'s
+  /// modulus, radius and thickness.
+  static double impact_overlap_parameter(const LayeredContact& contact, double effective_mass_kg,
+                                         double impact_speed_m_s);
+  /// γ_n in [0, 100] for ξ >= 0 and ε in (0, 1] (ε below the table's reach gives 100).
+  double damping_for_restitution(double impact_overlap_parameter, double restitution) const;
+
+  struct Table;  ///< ln ε on the (ln ξ, ln(1 + γ)) grid (internal)
+
+ private:
+  std::shared_ptr<const Table> table_;
+};
 
 }  // namespace pdamp::formulas
