@@ -17,10 +17,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "case_io.hpp"
 #include "errors.hpp"
+#include "limits.hpp"
 #include "output.hpp"
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 #include "plots.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
@@ -37,6 +38,22 @@ namespace {
 
 using nlohmann::json;
 namespace fm = formulas;
+using case_file::Case;
+
+/// The one damper of one layer that the closed-form and DEM commands take (a format-1
+/// case, or a format-2 case with one damper of one layer).
+struct SingleDamper {
+  const case_file::DamperSpec& damper;
+  const case_file::LayerSpec& layer;
+};
+
+SingleDamper single_damper(const Case& c, const std::string& command) {
+  if (c.dampers.size() != 1 || c.dampers.front().layers.size() != 1)
+    throw InputError(c.path, "/dampers",
+                     command + " takes one damper of one layer (the case has " + std::to_string(c.dampers.size()) +
+                         " dampers, the first with " + std::to_string(c.dampers.front().layers.size()) + " layers)");
+  return {c.dampers.front(), c.dampers.front().layers.front()};
+}
 
 const FlagSpec kJsonFlag{"--json", "", "print exactly one JSON object on stdout"};
 const FlagSpec kOutFlag{"-o", "DIR", "write result files (JSON, CSV, plots) into DIR, atomically"};
@@ -240,7 +257,7 @@ int run_buffer(const ParsedArgs& args) {
   in.layer.youngs_modulus_pa = args.number("--layer-modulus", limits::kModulus);
   in.layer.poisson_ratio =
       args.optional_number("--layer-poisson", limits::kPoisson).value_or(fm::kDefaultLayerPoissonRatio);
-  in.model = buffer_model(args.optional_text("--layer-model").value_or("layered"), "--layer-model", "");
+  in.model = case_file::buffer_model(args.optional_text("--layer-model").value_or("layered"), "--layer-model", "");
   in.particles_per_contact = args.optional_number("--particles-per-contact", Range{1.0, 1e9}).value_or(1.0);
   in.impact_velocity_m_s = args.optional_number("--impact-velocity", limits::kImpactSpeed).value_or(0.0);
   const auto problems = in.validate();
@@ -264,11 +281,11 @@ int run_buffer(const ParsedArgs& args) {
 
 /// `auto` in a design: rolling when the base friction keeps the spheres rolling at its
 /// design stroke (Γ <= Γ_slip, formulas::slip_intensity), else bouncing.
-fm::DamperModel design_family(const Case& c) {
-  if (c.damper.model != fm::DamperModel::kAuto) return c.damper.model;
-  const auto& options = c.damper.model_options;
+fm::DamperModel design_family(const SingleDamper& single, const Case& c) {
+  if (single.damper.model != fm::DamperModel::kAuto) return single.damper.model;
+  const auto& options = single.damper.model_options;
   if (!options.gravity_across_drive) return fm::DamperModel::kBouncing;
-  const auto rolling = fm::optimum_stroke(fm::DamperModel::kRolling, c.damper.clearance_m, options);
+  const auto rolling = fm::optimum_stroke(fm::DamperModel::kRolling, single.layer.clearance_m, options);
   const double omega = 2.0 * fm::kPi * c.excitation.frequency_hz;
   return rolling.x_opt_m * omega * omega / fm::kStandardGravity <= fm::slip_intensity(options) ? fm::DamperModel::kRolling
                                                                                                 : fm::DamperModel::kBouncing;
@@ -288,16 +305,18 @@ struct DamperDesign {
 /// is refused as well, so `pdamp validate` catches whatever `pdamp run` would.
 DamperDesign damper_design(const Case& c) {
   DamperDesign out;
+  const SingleDamper single = single_damper(c, "the damper_design task");
   try {
-    const auto& d = c.damper;
-    const auto family = design_family(c);
+    const auto& d = single.damper;
+    const auto& layer = single.layer;
+    const auto family = design_family(single, c);
     const double f = c.excitation.frequency_hz;
-    out.optimum = fm::optimum_stroke(family, d.clearance_m, d.model_options);
+    out.optimum = fm::optimum_stroke(family, layer.clearance_m, d.model_options);
     json& result = out.result;
-    result = {{"task", to_string(c.task)}, {"case", c.name}, {"model", fm::to_string(family)},
-              {"clearance_m", d.clearance_m}, {"bed_mass_kg", d.bed_mass_kg}, {"optimum", optimum_json(out.optimum)}};
+    result = {{"task", case_file::to_string(c.task.kind)}, {"case", c.name}, {"model", fm::to_string(family)},
+              {"clearance_m", layer.clearance_m}, {"bed_mass_kg", layer.bed_mass_kg}, {"optimum", optimum_json(out.optimum)}};
     auto& warnings = out.warnings;
-    const auto design_point = fm::reduced_loss_factor(family, d.clearance_m, out.optimum.x_opt_m, f, d.model_options);
+    const auto design_point = fm::reduced_loss_factor(family, layer.clearance_m, out.optimum.x_opt_m, f, d.model_options);
     out.eta_star_at_design = design_point.eta_star;
     result["optimum"]["eta_star_at_design"] = design_point.eta_star;
     result["optimum"]["intensity_at_design"] = design_point.intensity;
@@ -306,11 +325,11 @@ DamperDesign damper_design(const Case& c) {
       const double h = fm::clearance_for_stroke(family, *c.design.target_stroke_m, d.model_options);
       result["sizing"] = {{"target_stroke_m", *c.design.target_stroke_m},
                           {"clearance_m", h},
-                          {"container_inner_length_along_drive_m", d.bed.bed_extent_m + h}};
+                          {"container_inner_length_along_drive_m", layer.bed.bed_extent_m + h}};
     }
     if (c.excitation.amplitude_m) {
-      const auto op = fm::reduced_loss_factor(d.model, d.clearance_m, *c.excitation.amplitude_m, f, d.model_options);
-      result["operating_point"] = loss_json(op, d.bed_mass_kg, f);
+      const auto op = fm::reduced_loss_factor(d.model, layer.clearance_m, *c.excitation.amplitude_m, f, d.model_options);
+      result["operating_point"] = loss_json(op, layer.bed_mass_kg, f);
       result["operating_point"]["amplitude_m"] = *c.excitation.amplitude_m;
       warnings.insert(warnings.end(), op.warnings.begin(), op.warnings.end());
     }
@@ -320,9 +339,9 @@ DamperDesign damper_design(const Case& c) {
       result["buffer"]["layer_material"] = c.buffer->layer_material;
       warnings.insert(warnings.end(), design.warnings.begin(), design.warnings.end());
     }
-    out.curve = eta_curve(d.model == fm::DamperModel::kAuto ? fm::DamperModel::kAuto : family, d.clearance_m, f,
-                          d.model_options, c.design.sweep_min_over_clearance * d.clearance_m,
-                          c.design.sweep_max_over_clearance * d.clearance_m, c.design.sweep_points);
+    out.curve = eta_curve(d.model == fm::DamperModel::kAuto ? fm::DamperModel::kAuto : family, layer.clearance_m, f,
+                          d.model_options, c.design.sweep_min_over_clearance * layer.clearance_m,
+                          c.design.sweep_max_over_clearance * layer.clearance_m, c.design.sweep_points);
   } catch (const std::invalid_argument& e) {
     throw InputError(c.path, "", std::string("the closed forms refuse this case: ") + e.what());
   }
@@ -364,11 +383,16 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
 }
 
 int run_run(const ParsedArgs& args) {
-  const Case c = load_case(args.positional().at(0));
-  switch (c.task) {
-    case Task::kDamperDesign: return run_damper_design(args, c);
+  const Case c = case_file::load_case(args.positional().at(0));
+  switch (c.task.kind) {
+    case case_file::TaskKind::kDamperDesign: return run_damper_design(args, c);
+    case case_file::TaskKind::kFrf:
+    case case_file::TaskKind::kDecay:
+    case case_file::TaskKind::kModes: break;
   }
-  return kExitOther;
+  // The case is read and checked (pdamp validate); the structure solvers are not wired here yet.
+  throw std::runtime_error("pdamp run: task '" + std::string(case_file::to_string(c.task.kind)) +
+                           "' is not run by pdamp yet (the case is valid: see pdamp validate)");
 }
 
 /// One progress line on stderr: rewritten in place on a terminal, else a line every 10 s.
@@ -462,43 +486,47 @@ std::string megabytes(double bytes) {
 }
 
 /// The DEM would not fit: exit 2 naming the keys that set its memory.
-[[noreturn]] void refuse_memory(const Case& c, const dem_reference::RunEstimate& e, double runs_at_once, double available) {
+[[noreturn]] void refuse_memory(const Case& c, std::size_t damper, const dem_reference::RunEstimate& e, double runs_at_once,
+                                double available) {
+  const std::string counts = c.format_version == 1 ? "/damper/particles/count"
+                                                   : "/dampers/" + std::to_string(damper) + "/layers/*/particles/count";
   throw InputError(c.path, "/dem",
                    "the DEM needs about " + megabytes(runs_at_once * static_cast<double>(e.memory_bytes)) + " (" +
                        std::to_string(e.particles) + " particles, " + std::to_string(e.recorded_samples) +
                        " recorded samples = samples_per_period x analysed_periods, " + std::to_string(e.snapshots) +
                        " snapshots" + (runs_at_once > 1 ? ", " + format_number(runs_at_once, 3) + " runs at once" : "") +
                        "), more than the " + megabytes(available) +
-                       " available: reduce /dem/samples_per_period, /dem/analysed_periods, /dem/snapshots or "
-                       "/damper/particles/count");
+                       " available: reduce /dem/samples_per_period, /dem/analysed_periods, /dem/snapshots or " + counts);
 }
 
 /// A DEM run's options and cost, checked before it starts (issue 8: no job that cannot
 /// finish is started silently): every option in range (the case's JSON pointer named),
-/// the time step below its bound, the memory within what is available.
-dem_reference::RunEstimate check_dem_run(const Case& c, const dem_reference::DamperSimulationOptions& options) {
+/// the time step below its bound, the memory within what is available. `damper` is the
+/// index of the case's damper the options are of.
+dem_reference::RunEstimate check_dem_run(const Case& c, std::size_t damper,
+                                         const dem_reference::DamperSimulationOptions& options) {
   const auto problems = options.validate("");
-  if (!problems.empty()) throw dem_input_error(c, problems.front());
+  if (!problems.empty()) throw case_file::dem_case_error(c, damper, problems.front());
   dem_reference::RunEstimate e;
   try {
     e = dem_reference::estimate_run(options);
   } catch (const std::invalid_argument& error) {  // the time step above its bound
     const std::string what = error.what();
-    throw dem_input_error(c, what.substr(0, what.find('\n')));
+    throw case_file::dem_case_error(c, damper, what.substr(0, what.find('\n')));
   }
   const double available = available_memory_bytes();
-  if (static_cast<double>(e.memory_bytes) > available) refuse_memory(c, e, 1.0, available);
+  if (static_cast<double>(e.memory_bytes) > available) refuse_memory(c, damper, e, 1.0, available);
   return e;
 }
 
 /// The DEM's initial bed built as a run would build it (inner structures, wall layers),
 /// so a bed that does not fit is refused before any output (and by `pdamp validate`).
-void check_dem_placement(const Case& c, const dem_reference::DamperSimulationOptions& options) {
+void check_dem_placement(const Case& c, std::size_t damper, const dem_reference::DamperSimulationOptions& options) {
   try {
     dem_reference::check_initial_placement(options);
   } catch (const std::invalid_argument& error) {
     const std::string what = error.what();
-    throw dem_input_error(c, what.substr(0, what.find('\n')));
+    throw case_file::dem_case_error(c, damper, what.substr(0, what.find('\n')));
   }
 }
 
@@ -519,17 +547,18 @@ std::string estimate_line(const std::string& label, const dem_reference::RunEsti
 
 int run_dem(const ParsedArgs& args) {
   const std::string& path = args.positional().at(0);
-  const Case c = load_case(path);
+  const Case c = case_file::load_case(path);
+  const SingleDamper single = single_damper(c, "pdamp dem");
   const double f = args.optional_number("--frequency", limits::kFrequency).value_or(c.excitation.frequency_hz);
   const auto amplitude = args.optional_number("--amplitude", limits::kStroke);
   if (!amplitude && !c.excitation.amplitude_m)
     throw InputError(path, "/excitation/amplitude_m", "required by pdamp dem (or give --amplitude M)");
   const double x = amplitude.value_or(c.excitation.amplitude_m.value_or(0.0));
-  auto options = dem_options(c, x, f);
+  auto options = case_file::dem_options(c, 0, x, f);
   if (const auto periods = args.optional_integer("--periods", 1, dem_reference::limits::kMaxPeriods)) options.analysed_periods = static_cast<int>(*periods);
   if (const auto threads = args.optional_integer("--threads", 0, dem_reference::limits::kMaxThreads)) options.world.threads = static_cast<int>(*threads);
-  const auto estimate = check_dem_run(c, options);
-  check_dem_placement(c, options);
+  const auto estimate = check_dem_run(c, 0, options);
+  check_dem_placement(c, 0, options);
   auto files = output_dir(args);
   std::cerr << estimate_line("pdamp dem", estimate) << std::endl;
 
@@ -548,7 +577,7 @@ int run_dem(const ParsedArgs& args) {
   json out = dem_json(result);
   out.update({{"case", c.name}, {"amplitude_m", x}, {"frequency_hz", f}});
   // The closed form at the same point, for comparison (same model family as the case).
-  const auto closed = fm::reduced_loss_factor(c.damper.model, result.clearance_m, x, f, c.damper.model_options);
+  const auto closed = fm::reduced_loss_factor(single.damper.model, result.clearance_m, x, f, single.damper.model_options);
   out["closed_form"] = {{"eta_star", closed.eta_star}, {"model_used", fm::to_string(closed.model_used)},
                         {"regime", fm::to_string(closed.regime)}};
   std::vector<std::string> warnings = result.warnings;
@@ -585,24 +614,18 @@ int run_dem(const ParsedArgs& args) {
 
 // ---------------------------------------------------------------- effective fields
 
-/// The physics a field depends on: damper, materials and DEM settings (not names).
-std::string physics_hash(const Case& c, const std::string& source) {
-  json identity = {{"damper", c.resolved["damper"]}, {"materials", c.resolved["materials"]}, {"source", source}};
-  if (source == "dem") identity["dem"] = c.resolved["dem"];
-  return surrogate::case_hash(identity);
-}
-
 int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
                         OutputDir& files, json out);
 
 /// A test-rig field from CSV (docs/effective_fields.md) for the case's damper.
 int import_measured_field(const ParsedArgs& args, const Case& c, OutputDir& files) {
+  const SingleDamper single = single_damper(c, "pdamp field");
   surrogate::MeasuredImportOptions options;
-  options.clearance_m = c.damper.clearance_m;
-  options.bed_mass_kg = c.damper.bed_mass_kg;
+  options.clearance_m = single.layer.clearance_m;
+  options.bed_mass_kg = single.layer.bed_mass_kg;
   options.frequency_spacing = c.field.axis0.spacing;
   options.amplitude_spacing = c.field.axis1.spacing;
-  options.case_hash = physics_hash(c, "measured");
+  options.case_hash = case_file::physics_hash(c, "measured");
   const std::string csv = args.text("--measured");
   surrogate::EffectiveField field;
   try {
@@ -616,8 +639,10 @@ int import_measured_field(const ParsedArgs& args, const Case& c, OutputDir& file
 /// A DEM field's sweep checked before it starts: every point's run as check_dem_run,
 /// the memory of field.threads runs at once. Returns the estimate of the work still
 /// to do (the points already in the results file of `sweep` excluded), for stderr.
-std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const surrogate::SweepOptions* sweep) {
-  auto options = dem_options(c, 1.0, 1.0);
+std::string check_dem_field(const Case& c, std::size_t damper, const surrogate::Grid& grid,
+                            const surrogate::SweepOptions* sweep) {
+  auto options = case_file::dem_options(c, damper, 1.0, 1.0);
+  const double clearance_m = c.dampers.at(damper).layers.front().clearance_m;
   options.world.threads = 1;  // as the sweep runs each point
   // Up to 8 nodes per axis, evenly spread with both ends: the options are monotone in
   // the stroke and the frequency (the impact speed grows with both), so the corners
@@ -634,11 +659,11 @@ std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const su
   dem_reference::RunEstimate largest;
   for (const std::size_t i0 : sampled(grid.axis0.size())) {
     for (const std::size_t i1 : sampled(grid.axis1.size())) {
-      const auto drive = surrogate::drive_point(grid, i0 * grid.axis1.size() + i1, c.damper.clearance_m);
+      const auto drive = surrogate::drive_point(grid, i0 * grid.axis1.size() + i1, clearance_m);
       options.amplitude_m = drive.amplitude_m;
       options.frequency_hz = drive.frequency_hz;
-      const auto e = check_dem_run(c, options);
-      if (evaluated++ == 0) check_dem_placement(c, options);  // the same bed at every node
+      const auto e = check_dem_run(c, damper, options);
+      if (evaluated++ == 0) check_dem_placement(c, damper, options);  // the same bed at every node
       wall_time_s += e.wall_time_s;
       particle_steps += e.particle_steps;
       if (e.memory_bytes > largest.memory_bytes) largest = e;
@@ -649,7 +674,7 @@ std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const su
   particle_steps *= per_node;
   const double at_once = std::min<double>(c.field.threads, static_cast<double>(grid.size()));
   const double available = available_memory_bytes();
-  if (at_once * static_cast<double>(largest.memory_bytes) > available) refuse_memory(c, largest, at_once, available);
+  if (at_once * static_cast<double>(largest.memory_bytes) > available) refuse_memory(c, damper, largest, at_once, available);
   std::size_t pending = grid.size();
   try {
     if (sweep != nullptr) pending = surrogate::pending_sweep_points(grid, *sweep);
@@ -667,7 +692,8 @@ std::string check_dem_field(const Case& c, const surrogate::Grid& grid, const su
 constexpr const char* kSweepLog = "field_sweep.jsonl";
 
 int run_field(const ParsedArgs& args) {
-  const Case c = load_case(args.positional().at(0));
+  const Case c = case_file::load_case(args.positional().at(0));
+  const SingleDamper single = single_damper(c, "pdamp field");
   const std::string source = args.text("--source");
   if (source != "formulas" && source != "dem" && source != "measured")
     throw InputError("--source", "", "'" + source + "': must be formulas, dem or measured");
@@ -681,7 +707,7 @@ int run_field(const ParsedArgs& args) {
     // elsewhere ("../x", "/etc/x"): one safe path component under out/.
     const std::string safe = safe_file_name(c.name);
     if (safe != c.name)
-      print_warnings({"case name '" + formulas::printable(c.name) + "' is not a safe folder name: writing to out/" +
+      print_warnings({"case name '" + strict_json::printable(c.name) + "' is not a safe folder name: writing to out/" +
                       safe + "_field_" + source});
     dir = "out/" + safe + "_field_" + source;
   }
@@ -693,17 +719,17 @@ int run_field(const ParsedArgs& args) {
 
   surrogate::SweepOptions sweep;
   sweep.source = dem ? surrogate::FieldSource::kDem : surrogate::FieldSource::kFormulas;
-  sweep.case_hash = physics_hash(c, source);
+  sweep.case_hash = case_file::physics_hash(c, source);
   sweep.model_version = dem ? surrogate::dem_model_version() : 0;
-  sweep.clearance_m = c.damper.clearance_m;
-  sweep.bed_mass_kg = c.damper.bed_mass_kg;
+  sweep.clearance_m = single.layer.clearance_m;
+  sweep.bed_mass_kg = single.layer.bed_mass_kg;
   sweep.threads = dem ? c.field.threads : 1;
   std::mutex progress_mutex;
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   std::string estimate;
   if (dem) {
     sweep.results_path = std::filesystem::path(dir) / kSweepLog;
-    estimate = check_dem_field(c, grid, &sweep);
+    estimate = check_dem_field(c, 0, grid, &sweep);
   }
   OutputDir files(dir);
   if (dem) {
@@ -718,12 +744,12 @@ int run_field(const ParsedArgs& args) {
   }
   surrogate::PointEvaluator evaluator;
   if (dem) {
-    auto options = dem_options(c, 1.0, 1.0);
+    auto options = case_file::dem_options(c, 0, 1.0, 1.0);
     options.world.threads = 1;  // the sweep runs points in parallel instead
     evaluator = surrogate::dem_evaluator(options);
   } else {
-    evaluator = surrogate::formula_evaluator(c.damper.model, c.damper.clearance_m, c.damper.bed_mass_kg,
-                                             c.damper.model_options);
+    evaluator = surrogate::formula_evaluator(single.damper.model, single.layer.clearance_m, single.layer.bed_mass_kg,
+                                             single.damper.model_options);
   }
   const auto result = surrogate::run_sweep(grid, evaluator, sweep);
   if (dem && tty) std::cerr << "\n";
@@ -735,6 +761,7 @@ int run_field(const ParsedArgs& args) {
 /// field.json, the scattered-state fit (DEM and measured fields), tables and pictures.
 int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::EffectiveField& field,
                         OutputDir& files, json out) {
+  const auto& damper = single_damper(c, "pdamp field").damper;
   const std::string source(surrogate::to_string(field.provenance.source));
   std::vector<std::string> warnings = out.value("warnings", std::vector<std::string>{});
   out.update({{"source", source}, {"points", field.grid.size()}});
@@ -742,7 +769,7 @@ int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::
   out["file"] = (files.dir() / "field.json").string();
   if (field.provenance.source != surrogate::FieldSource::kFormulas) {
     try {
-      const auto samples = surrogate::scattered_samples(field, c.damper.model, c.damper.model_options);
+      const auto samples = surrogate::scattered_samples(field, damper.model, damper.model_options);
       const auto fit = surrogate::fit_scattered_law(samples, "pdamp field --source " + source + ", case " + c.name);
       surrogate::write_scattered_fit(fit, files.staged_path("scattered_fit.json"));
       out["scattered_fit"] = {{"jump_fraction", fit.fit.jump_fraction}, {"exponent", fit.fit.exponent},
@@ -752,7 +779,7 @@ int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::
       warnings.push_back(std::string("scattered-state fit not made: ") + e.what());
     }
   }
-  for (auto& w : write_field_pictures(files, field, c)) warnings.push_back(w);
+  for (auto& w : write_field_pictures(files, field, c.name, damper)) warnings.push_back(w);
   out["files"] = files.commit();
   out["warnings"] = warnings;
   print_warnings(warnings);
@@ -767,11 +794,15 @@ int write_field_outputs(const ParsedArgs& args, const Case& c, const surrogate::
 
 /// Every check that run, dem and field make on a case, without the work.
 int run_validate(const ParsedArgs& args) {
-  const Case c = load_case(args.positional().at(0));
-  (void)damper_design(c);
-  if (c.excitation.amplitude_m) (void)check_dem_run(c, dem_options(c, *c.excitation.amplitude_m, c.excitation.frequency_hz));
-  // check_dem_field places the bed as every DEM run of the case would.
-  (void)check_dem_field(c, surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1), nullptr);
+  const Case c = case_file::load_case(args.positional().at(0));
+  if (c.task.kind == case_file::TaskKind::kDamperDesign) (void)damper_design(c);
+  const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
+  for (std::size_t i = 0; i < c.dampers.size(); ++i) {
+    if (c.excitation.amplitude_m)
+      (void)check_dem_run(c, i, case_file::dem_options(c, i, *c.excitation.amplitude_m, c.excitation.frequency_hz));
+    // check_dem_field places the bed as every DEM run of the case would.
+    (void)check_dem_field(c, i, grid, nullptr);
+  }
   std::cout << c.resolved.dump(2) << "\n";
   return kExitOk;
 }

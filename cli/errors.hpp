@@ -4,20 +4,21 @@
 #include <stdexcept>
 #include <string>
 
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::cli {
 
-/// Bad input: exit code 2, one line `pdamp: error: <where>: <key>: <what>`.
+/// Bad input: exit code 2, one line `pdamp: error: <where>: <key>: <what>`. A case
+/// file's errors (case_file::CaseError) exit 2 the same way.
 class InputError : public std::runtime_error {
  public:
   /// where: a file name or a flag; key: a JSON pointer or key (may be empty).
-  /// The message is made printable here (formulas::printable): a NUL in a user's key
+  /// The message is made printable here (strict_json::printable): a NUL in a user's key
   /// would cut what() short, a newline would break the one line.
   InputError(const std::string& where, const std::string& key, const std::string& what)
-      : std::runtime_error(formulas::printable(where + (key.empty() ? "" : ": " + key) + ": " + what)) {}
+      : std::runtime_error(strict_json::printable(where + (key.empty() ? "" : ": " + key) + ": " + what)) {}
   /// A message that already reads "<where>: <key>: <what>" (a library's error).
-  explicit InputError(const std::string& formatted) : std::runtime_error(formulas::printable(formatted)) {}
+  explicit InputError(const std::string& formatted) : std::runtime_error(strict_json::printable(formatted)) {}
 };
 
 /// A numerical failure detected at run time (e.g. DEM instability): exit code 3.

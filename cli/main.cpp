@@ -9,7 +9,8 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "external_program.hpp"
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/case_file/case_error.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace {
 
@@ -28,7 +29,7 @@ void print_overview() {
 /// One error line on stderr (INTERFACE.md); the message is made printable so that a
 /// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
 int report(const char* what, int exit_code) {
-  std::cerr << "pdamp: error: " << pdamp::formulas::printable(what) << "\n";
+  std::cerr << "pdamp: error: " << pdamp::strict_json::printable(what) << "\n";
   return exit_code;
 }
 
@@ -77,6 +78,8 @@ int main(int argc, char** argv) {
     }
     throw InputError(args[0], "", "unknown command (see pdamp --help)");
   } catch (const InputError& e) {
+    return report(e.what(), kExitBadInput);
+  } catch (const pdamp::case_file::CaseError& e) {  // "<case file>: <pointer>: <rule>"
     return report(e.what(), kExitBadInput);
   } catch (const std::invalid_argument& e) {
     return report(("pdamp " + args[0] + ": " + e.what()).c_str(), kExitBadInput);

@@ -14,7 +14,7 @@
 
 #include "errors.hpp"
 #include "external_program.hpp"
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::cli {
 
@@ -44,7 +44,7 @@ void remove_stale_staging(const fs::path& dir) {
 std::vector<std::string> previous_outputs(const fs::path& dir) {
   std::vector<std::string> names;
   try {
-    const auto doc = formulas::parse_json_document(formulas::read_input_file((dir / kManifest).string()), kManifest);
+    const auto doc = strict_json::parse_json_document(strict_json::read_input_file((dir / kManifest).string()), kManifest);
     for (const auto& item : doc.at("files")) {
       const std::string name = item.get<std::string>();
       if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name[0] == '.') continue;
@@ -92,7 +92,7 @@ void write_file_atomically(const fs::path& path, const std::string& content) {
 }
 
 OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
-  const std::string shown = formulas::printable(dir_.string());
+  const std::string shown = strict_json::printable(dir_.string());
   if (dir_.empty()) throw InputError(flag, "", "'': an empty path is not an output directory");
   std::error_code error;
   const auto status = fs::status(dir_, error);
@@ -191,7 +191,7 @@ std::vector<std::string> OutputDir::commit() {
   for (const auto& name : targets) {
     const auto status = fs::symlink_status(dir_ / name, error);
     if (fs::exists(status) && !fs::is_regular_file(status))
-      throw InputError("-o", "", "'" + formulas::printable((dir_ / name).string()) +
+      throw InputError("-o", "", "'" + strict_json::printable((dir_ / name).string()) +
                                      "' exists and is not a file: move it away (pdamp writes " + name + " there)");
   }
   const SignalBlock whole;

@@ -102,7 +102,8 @@ std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::st
   return out.add_plot("force_velocity.gp", gp.str(), {"force_velocity.png", "force_velocity.svg"});
 }
 
-std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field, const Case& c) {
+std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field,
+                                              const std::string& case_name, const case_file::DamperSpec& damper) {
   const auto& g = field.grid;
   std::ostringstream table, map;
   table.precision(10);
@@ -144,8 +145,8 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
       const double v1 = a1 + (b1 - a1) * j / 200.0;
       surrogate::Grid one{{g.axis0.quantity, g.axis0.spacing, {g.axis0.values[i0]}}, {g.axis1.quantity, g.axis1.spacing, {v1}}};
       const auto drive = surrogate::drive_point(one, 0, field.clearance_m);
-      const auto loss = fm::reduced_loss_factor(c.damper.model, field.clearance_m, drive.amplitude_m, drive.frequency_hz,
-                                                c.damper.model_options);
+      const auto loss = fm::reduced_loss_factor(damper.model, field.clearance_m, drive.amplitude_m, drive.frequency_hz,
+                                                damper.model_options);
       formula << g.axis0.values[i0] << ',' << v1 << ',' << loss.eta_star << '\n';
     }
     formula << "\n\n";
@@ -161,7 +162,7 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
   cuts << "# eta* along axis 1 at each axis-0 node: field points (" << source << ") and the closed form\n"
        << "set datafile separator ','\nset grid\nset key outside right\n"
        << "set xlabel '" << axis_label(g.axis1.quantity) << "'\nset ylabel 'reduced loss factor {/Symbol h}*'\n"
-       << "set title " << gnuplot_string(c.name + ": effective field (" + source + ") and closed form") << " noenhanced\n"
+       << "set title " << gnuplot_string(case_name + ": effective field (" + source + ") and closed form") << " noenhanced\n"
        << "set yrange [0:*]\n"
        << "do for [t in 'pngcairo svg'] {\n"
        << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
@@ -179,7 +180,7 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
          << "set view map\nset pm3d map interpolate 0,0\nset palette rgb 33,13,10\n"
          << "set xlabel '" << axis_label(g.axis0.quantity) << "'\nset ylabel '" << axis_label(g.axis1.quantity) << "'\n"
          << "set cblabel 'reduced loss factor {/Symbol h}*'\n"
-         << "set title " << gnuplot_string(c.name + ": effective field (" + source + ")") << " noenhanced\n"
+         << "set title " << gnuplot_string(case_name + ": effective field (" + source + ")") << " noenhanced\n"
          << "set label 1 'RC/BC rolling/bouncing collect-and-collide, SP sub-peak orbit, SC scattered, SL solid-like, "
             "LF/GF local/global fluidisation, DC decoupled' at screen 0.5, 0.02 center font ',9'\n"
          << "set bmargin 5\n"

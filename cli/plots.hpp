@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "case_io.hpp"
+#include "pdamp/case_file/case.hpp"
 #include "output.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
@@ -29,7 +29,8 @@ std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::st
 
 /// field_table.csv, field_map.dat, field_cuts_formula.csv, field_cuts_points.csv, the eta* cuts along axis 1 (at most 12)
 /// with the closed form, and the heat map with motion modes (when both axes have >= 2
-/// nodes).
-std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field, const Case& c);
+/// nodes); the closed form is that of `damper`, the titles name `case_name`.
+std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field,
+                                                  const std::string& case_name, const case_file::DamperSpec& damper);
 
 }  // namespace pdamp::cli

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::surrogate::detail {
 
@@ -18,12 +18,12 @@ std::string errno_text() { return std::strerror(errno); }
 
 }  // namespace
 
-std::string file_label(const std::filesystem::path& path) { return formulas::printable(path.string()); }
+std::string file_label(const std::filesystem::path& path) { return strict_json::printable(path.string()); }
 
-std::string read_text_file(const std::filesystem::path& path) { return formulas::read_input_file(path.string()); }
+std::string read_text_file(const std::filesystem::path& path) { return strict_json::read_input_file(path.string()); }
 
 nlohmann::json read_json_file(const std::filesystem::path& path) {
-  return formulas::parse_json_document(read_text_file(path), path.string());
+  return strict_json::parse_json_document(read_text_file(path), path.string());
 }
 
 void write_all_synced(int fd, std::string_view data, const std::filesystem::path& path) {

@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "file_io.hpp"
-#include "pdamp/formulas/input_file.hpp"
-#include "strict_json.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/strict_object.hpp"
 #include "text_util.hpp"
 
 namespace pdamp::surrogate {
@@ -203,7 +203,7 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   const std::string file = detail::file_label(path);
   // read_json_file refuses directories, FIFOs and duplicate keys ("<path>: ...").
   const json doc = detail::read_json_file(path);
-  detail::StrictObject root(doc, "", file);
+  strict_json::StrictObject root(doc, "", file);
   if (root.optional("format") != nullptr) root.expect_string("format", kFormat);
   if (root.optional("format_version") != nullptr) root.integer("format_version", kFormatVersion, kFormatVersion);
   ScatteredFitResult result;
@@ -213,7 +213,7 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   result.fit.s_max = root.number("s_max", false);
   result.fit.source = root.string("source");
   if (detail::has_control_byte(result.fit.source)) {
-    root.fail("source", "\"" + formulas::printable(result.fit.source) +
+    root.fail("source", "\"" + strict_json::printable(result.fit.source) +
                             "\" holds control characters (must be printable text: it is printed in reports)");
   }
   result.fit.provisional = false;

@@ -22,8 +22,8 @@
 
 #include "field_format.hpp"
 #include "file_io.hpp"
-#include "pdamp/formulas/input_file.hpp"
-#include "strict_json.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/strict_object.hpp"
 #include "text_util.hpp"
 
 namespace pdamp::surrogate {
@@ -197,7 +197,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
     json value;
     try {
       // parse_json_document also refuses a repeated key, which no writer of ours produces.
-      value = formulas::parse_json_document(line, context);
+      value = strict_json::parse_json_document(line, context);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(e.what() + damaged);
     }
@@ -210,12 +210,12 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       continue;
     }
     try {
-      detail::StrictObject object(value, "", context);
+      strict_json::StrictObject object(value, "", context);
       const long long index = object.integer("index", 0, static_cast<long long>(grid.size()) - 1);
       const auto k = static_cast<std::size_t>(index);
       if (done[k]) object.fail("index", std::to_string(index) + " appears twice");
       const DrivePoint node = drive_point(grid, k, options.clearance_m);
-      detail::StrictObject drive(object.required("drive"), "/drive", context);
+      strict_json::StrictObject drive(object.required("drive"), "/drive", context);
       const double f = drive.number("frequency_hz", true, "Hz");
       const double x = drive.number("amplitude_m", true, "m");
       drive.finish();
@@ -263,7 +263,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
 /// returns how many were resumed and adds a warning for a dropped partial last line.
 std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Grid& grid, const SweepOptions& options,
                    std::vector<FieldPoint>& points, std::vector<bool>& done, std::vector<std::string>& warnings) {
-  // read_text_file (formulas::read_input_file) again refuses anything but a regular file.
+  // read_text_file (strict_json::read_input_file) again refuses anything but a regular file.
   const std::string text = detail::read_text_file(path);
   const SavedPoints saved = read_saved_points(text, detail::file_label(path), grid, options, points, done);
   if (!saved.warning.empty()) warnings.push_back(saved.warning);

@@ -1,34 +1,15 @@
-// Reading a user's input file (case, field, CSV, fit) safely: only a regular file is
-// opened, so a FIFO, a device or a directory is refused at once instead of hanging or
-// failing deep inside a parser (issue 8, docs/bad_inputs.md).
+// formulas' names for the strict input reader (pdamp/strict_json/input_file.hpp), which
+// the COR-table reader (cor_models.cpp) and structure/ use: reading a user's file
+// safely, JSON without duplicate keys, one-line printable messages. New code includes
+// pdamp/strict_json/input_file.hpp directly.
 #pragma once
 
-#include <cstddef>
-#include <string>
-
-#include <nlohmann/json.hpp>
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::formulas {
 
-/// Largest input file read (256 MiB): far above any case, field or measured CSV, and
-/// small enough that a mistaken path (a disk image, /dev/zero) cannot exhaust memory.
-inline constexpr std::size_t kMaxInputFileBytes = std::size_t{256} << 20;
-
-/// The whole file as bytes. std::invalid_argument "<path>: <reason>" when the path
-/// does not exist, is not a regular file (directory, FIFO, socket, device), cannot be
-/// read or is larger than kMaxInputFileBytes. The file is opened without blocking, so
-/// a FIFO swapped in after the check cannot hang the caller either.
-std::string read_input_file(const std::string& path);
-
-/// Parses `text` (read from `path`) as one JSON document, refusing what
-/// nlohmann::json would accept silently: a key repeated in one object (the parser keeps
-/// the last one, so an edit that seems to change a value may not). std::invalid_argument
-/// "<path>: malformed JSON: <where and what>" or "<path>: <pointer>: duplicate key".
-nlohmann::json parse_json_document(const std::string& text, const std::string& path);
-
-/// `text` made printable on one line: control bytes (newline, NUL, ESC, ...) and bytes
-/// of invalid UTF-8 become \n, \0, \x1b ... escapes, so a message quoting a user's
-/// input stays one line and is not cut at a NUL byte.
-std::string printable(const std::string& text);
+using strict_json::parse_json_document;
+using strict_json::printable;
+using strict_json::read_input_file;
 
 }  // namespace pdamp::formulas

@@ -1,5 +1,5 @@
-// Safe reading of users' input files (see input_file.hpp).
-#include "pdamp/formulas/input_file.hpp"
+// Safe reading of users' input files and their errors (input_file.hpp, input_error.hpp).
+#include "pdamp/strict_json/input_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -9,15 +9,17 @@
 #include <cstdio>
 #include <cstring>
 #include <set>
+#include <string_view>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
-namespace pdamp::formulas {
+namespace pdamp::strict_json {
 
 namespace {
 
 [[noreturn]] void refuse(const std::string& path, const std::string& reason) {
-  throw std::invalid_argument(printable(path) + ": " + reason);
+  throw InputError(path, "", reason);
 }
 
 const char* kind_of(mode_t mode) {
@@ -40,6 +42,18 @@ std::size_t utf8_length(const std::string& s, std::size_t i) {
 }
 
 }  // namespace
+
+InputError::InputError(std::string file, std::string pointer, std::string rule)
+    : std::invalid_argument(printable(file + (pointer.empty() ? "" : ": " + pointer) + ": " + rule)),
+      file_(std::move(file)),
+      pointer_(std::move(pointer)),
+      rule_(std::move(rule)) {}
+
+std::string pointer_token(std::string_view key) {
+  std::string token;
+  for (char c : key) token += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+  return token;
+}
 
 std::string printable(const std::string& text) {
   std::string out;
@@ -111,13 +125,6 @@ std::string read_input_file(const std::string& path) {
 
 namespace {
 
-/// RFC 6901 reference token of an object key ("~" -> "~0", "/" -> "~1").
-std::string pointer_token(const std::string& key) {
-  std::string token;
-  for (char c : key) token += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
-  return token;
-}
-
 /// The parser's position: one frame per open object or array, for duplicate-key
 /// detection and for naming where a duplicate sits.
 struct Frame {
@@ -169,21 +176,19 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
   // The parser stops at a NUL byte as at the end of the text, so "{...}\0garbage" would
   // pass: a NUL has no place in JSON text (RFC 8259: control characters only escaped).
   if (const auto nul = text.find('\0'); nul != std::string::npos)
-    throw std::invalid_argument(printable(path) + ": malformed JSON: a NUL byte at offset " + std::to_string(nul) +
-                                " (a binary file, or text with a NUL)");
+    throw InputError(path, "", "malformed JSON: a NUL byte at offset " + std::to_string(nul) +
+                                   " (a binary file, or text with a NUL)");
   try {
     return json::parse(text, track);
   } catch (const DuplicateKey& duplicate) {
-    throw std::invalid_argument(printable(path) + ": " + printable(duplicate.pointer) +
-                                ": duplicate key (each key may appear once in an object)");
+    throw InputError(path, duplicate.pointer, "duplicate key (each key may appear once in an object)");
   } catch (const json::exception& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 9: ..."
     // or "[json.exception.out_of_range.406] number overflow parsing '1e400'".
     std::string what = e.what();
     const auto start = what.find("] ");
-    throw std::invalid_argument(printable(path) + ": malformed JSON: " +
-                                printable(start == std::string::npos ? what : what.substr(start + 2)));
+    throw InputError(path, "", "malformed JSON: " + (start == std::string::npos ? what : what.substr(start + 2)));
   }
 }
 
-}  // namespace pdamp::formulas
+}  // namespace pdamp::strict_json

@@ -1,0 +1,3 @@
+// placeholder: filled by the structure issue
+#include <benchmark/benchmark.h>
+BENCHMARK_MAIN();

@@ -1,0 +1,201 @@
+// The case file format (docs/cases.md), formats 1 and 2: JSON -> the modules' option
+// structs, checked against their own validate(), and the resolved case with every
+// default filled in (`pdamp validate`).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case_error.hpp"
+#include "pdamp/dem_reference/damper_simulation.hpp"
+#include "pdamp/formulas/bed_packing.hpp"
+#include "pdamp/formulas/collect_and_collide.hpp"
+#include "pdamp/formulas/hertz_impact.hpp"
+#include "pdamp/structure/beam.hpp"
+#include "pdamp/structure/modal_model.hpp"
+#include "pdamp/surrogate/grid.hpp"
+
+namespace pdamp::case_file {
+
+/// A direction in the structure's plane (x, y), a unit vector.
+using PlaneVector = std::array<double, 2>;
+
+/// One compartment of a damper: its container, its particles, their lattice and the
+/// clearance (format 1: the whole damper; format 2: `dampers[i].layers[k]`).
+struct LayerSpec {
+  formulas::Container container;
+  int particle_count = 0;
+  double particle_radius_m = 0.0;
+  std::string particle_material = "steel";
+  /// ISO 3290 lot variation of the ball diameter (dem_reference::ParticleGroupOptions), m.
+  double lot_diameter_variation_m = dem_reference::ParticleGroupOptions{}.lot_diameter_variation_m;
+  formulas::LatticePacking packing;
+  /// The compartment as the DEM builds it: wall material, placement, inner structures,
+  /// wall layer and offset (format 1: from `/dem`), particles and lattice from above.
+  dem_reference::CompartmentOptions compartment;
+  // Derived on load:
+  formulas::LatticeBed bed;  ///< the collected lattice and its clearance
+  double clearance_m = 0.0;  ///< the bed's h, or the explicit `clearance_m` override, m
+  double bed_mass_kg = 0.0;  ///< particle mass of the layer, kg
+};
+
+/// A particle damper: its drive, gravity and closed-form constants, and its layers.
+struct DamperSpec {
+  /// Format 2: the named point of the structure the container sits at ("" in format 1).
+  std::string site;
+  /// Format 2: the structure-plane direction the container's drive axis moves along
+  /// (normalised on load); format 1: (1, 0).
+  PlaneVector drive_direction{1.0, 0.0};
+  /// Format 2: mass of the empty container, kg (0 in format 1, which has no structure).
+  double container_mass_kg = 0.0;
+  formulas::DamperModel model = formulas::DamperModel::kAuto;
+  int drive_axis = 0;  ///< the container-frame axis of the drive, 0..2 (x, y, z)
+  formulas::Vec3 gravity_m_s2{0.0, 0.0, -formulas::kStandardGravity};  ///< container frame
+  formulas::ModelOptions model_options;
+  std::vector<LayerSpec> layers;  ///< at least one
+};
+
+struct ExcitationSpec {
+  double frequency_hz = 0.0;
+  std::optional<double> amplitude_m;  ///< the operating stroke, if the case has one
+};
+
+struct DesignSpec {
+  std::optional<double> target_stroke_m;
+  double sweep_min_over_clearance = 0.05;
+  double sweep_max_over_clearance = 1.5;
+  int sweep_points = 301;
+};
+
+struct BufferSpec {
+  std::string layer_material;
+  formulas::BufferDesignInput input;  ///< particle data filled from the (first) damper layer
+};
+
+/// The DEM numerics shared by every damper (docs/cases.md, `dem`). The options of one
+/// run come from dem_options().
+struct DemSpec {
+  /// Materials, contact pairs, integration and run control; compartments, gravity,
+  /// drive, amplitude and frequency are filled per damper and run by dem_options().
+  dem_reference::DamperSimulationOptions simulation;
+  double stiffness_softening = 1.0;  ///< factor on every Young's modulus in the DEM only
+  double radius_spread = 0.0;        ///< polydispersity of every particle group, [0, 0.4999]
+};
+
+/// The effective-field grid of `pdamp field` (docs/cases.md, `field`).
+struct FieldSpec {
+  surrogate::GridAxes axes = surrogate::GridAxes::kFrequencyAmplitude;
+  surrogate::AxisRange axis0;  ///< frequency_hz or intensity
+  surrogate::AxisRange axis1;  ///< amplitude_m or stroke_over_clearance
+  int threads = 2;             ///< DEM points run at once
+};
+
+/// Format 2 `structure`: a beam of finite elements or imported modal data.
+struct StructureSpec {
+  enum class Kind { kBeam, kModalData };
+  Kind kind = Kind::kBeam;
+  structure::BeamModel beam;        ///< kBeam
+  int mode_count = 4;               ///< kBeam: modes kept, [1, 100]
+  structure::ModalDamping damping;  ///< kBeam
+  /// kModalData: the modal file, as a path (relative ones resolved against the case file).
+  std::string modal_data_file;
+  /// kModalData: the imported model (read on load once structure/ can parse it).
+  std::optional<structure::ModalModel> modal_data;
+  /// Every name a damper site or a task point may take (points and point masses).
+  std::vector<std::string> point_names;
+};
+
+enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes };
+
+/// `task` kind frf: the frequency response over a band.
+struct FrfTask {
+  double min_frequency_hz = 0.0;
+  double max_frequency_hz = 0.0;
+  int points = 400;  ///< frequencies, [2, 100000]
+  surrogate::AxisSpacing spacing = surrogate::AxisSpacing::kLinear;
+  enum class Excitation { kBase, kForce };
+  Excitation excitation = Excitation::kBase;
+  double base_amplitude_m = 0.0;       ///< kBase: amplitude of the support motion, m
+  std::string force_point;             ///< kForce: the named point the force acts at
+  double force_amplitude_n = 0.0;      ///< kForce, N
+  PlaneVector direction{0.0, 1.0};     ///< of the base motion or the force, unit (normalised)
+};
+
+/// `task` kind decay: a free decay from an initial state.
+struct DecayTask {
+  enum class InitialState { kStaticLoad, kModalAmplitudes };
+  InitialState initial_state = InitialState::kStaticLoad;
+  std::string load_point;                 ///< kStaticLoad: where the force is released
+  PlaneVector load_force_n{0.0, 0.0};     ///< kStaticLoad: (x, y) force, N
+  std::vector<double> modal_amplitudes;   ///< kModalAmplitudes: q_j(0), one per mode at most
+  double duration_s = 0.0;                ///< simulated time, s
+  double settling_threshold = 0.05;       ///< settled below this fraction of the initial amplitude, (0, 1)
+};
+
+/// `task` kind modes: natural frequencies, shapes and backbones.
+struct ModesTask {
+  int mode_count = 0;                       ///< modes reported, [1, the structure's mode_count]
+  double backbone_min_amplitude_m = 0.0;    ///< lowest amplitude at the damper site, m
+  double backbone_max_amplitude_m = 0.0;    ///< highest, m (> min)
+  int backbone_points = 50;                 ///< [2, 10000]
+};
+
+/// What `pdamp run` does; the settings of the kind given (format 1: damper_design only).
+struct TaskSpec {
+  TaskKind kind = TaskKind::kDamperDesign;
+  std::optional<FrfTask> frf;
+  std::optional<DecayTask> decay;
+  std::optional<ModesTask> modes;
+};
+
+struct Case {
+  std::string path;
+  int format_version = 1;
+  std::string name;
+  std::string description;
+  TaskSpec task;
+  std::map<std::string, formulas::Material> materials;
+  std::vector<DamperSpec> dampers;       ///< format 1: exactly one, with one layer
+  std::optional<StructureSpec> structure;  ///< format 2 only
+  ExcitationSpec excitation;
+  DesignSpec design;
+  std::optional<BufferSpec> buffer;
+  DemSpec dem;
+  FieldSpec field;
+  nlohmann::json resolved;  ///< the case with every default resolved and derived values added
+};
+
+/// Reads and validates a case file (format 1 or 2). CaseError names the file, the JSON
+/// pointer and the rule broken (for a modal data file: that file and its pointer).
+Case load_case(const std::string& path);
+
+std::string_view to_string(TaskKind kind);
+
+/// "layered" or "half_space" (the contact law of the buffer sizing); CaseError naming
+/// `where` (a file or a flag) and `key` otherwise.
+formulas::BufferModel buffer_model(const std::string& name, const std::string& where, const std::string& key);
+
+/// The DEM options of damper `damper_index` of the case at one operating point
+/// (stroke X, m; frequency f, Hz): one compartment per layer.
+dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t damper_index, double amplitude_m,
+                                                   double frequency_hz);
+
+/// A line of dem_reference's validate() or placement check ("integration.time_step_s =
+/// 0.001: ...") for damper `damper_index` as the case's error: the internal option name
+/// becomes the JSON pointer of the case key it comes from (/dem/time_step_s,
+/// /dem/inner_structures/pins/0, /dampers/0/layers/1/particles, ...).
+CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::string& problem);
+
+/// The identity of the physics a field of `source` (formulas, dem, measured) depends
+/// on: dampers, materials and, for dem, the DEM settings; not names or descriptions.
+/// A format-1 case keeps the hash it always had, so shipped fields stay valid.
+std::string physics_hash(const Case& c, const std::string& source);
+
+}  // namespace pdamp::case_file

@@ -1,0 +1,232 @@
+// Dampers and their layers: drive, gravity, model constants, container, particles, bed.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "readers.hpp"
+
+namespace pdamp::case_file::detail {
+
+namespace fm = formulas;
+
+int axis_index(const std::string& name) { return name == "x" ? 0 : name == "y" ? 1 : 2; }
+
+namespace {
+
+/// ModelOptions::validate() owns the constants' ranges: its line "rolling_calibration =
+/// 3: must be in (0, 2]" (or "scattered.s_max = ...") becomes the case's error at
+/// model_options/rolling_calibration. base_friction is no key of model_options: it is
+/// the DEM's friction (checked there).
+void check_model_options(const ObjectReader& r, const fm::ModelOptions& options) {
+  for (const auto& line : options.validate()) {
+    const auto cut = line.find(" = ");
+    std::string field = line.substr(0, cut);
+    if (field == "base_friction") continue;
+    for (auto& ch : field)
+      if (ch == '.') ch = '/';
+    r.fail("model_options/" + field, line.substr(cut + 1));
+  }
+}
+
+void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
+  const fm::ModelOptions defaults;
+  options.rolling_inertia_factor = r.number("rolling_inertia_factor", defaults.rolling_inertia_factor, Range{});
+  options.rolling_calibration = r.number("rolling_calibration", defaults.rolling_calibration, Range{});
+  options.bouncing_calibration = r.number("bouncing_calibration", defaults.bouncing_calibration, Range{});
+  r.object("scattered", false, [&](ObjectReader& s) {
+    options.scattered.jump_fraction = s.number("jump_fraction", defaults.scattered.jump_fraction, Range{});
+    options.scattered.exponent = s.number("exponent", defaults.scattered.exponent, Range{});
+    options.scattered.s_min = s.number("s_min", defaults.scattered.s_min, Range{});
+    options.scattered.s_max = s.number("s_max", defaults.scattered.s_max, Range{});
+    // Fitted only when both coefficients are given: a partial object keeps a default
+    // coefficient, which stays provisional (and says so in the warnings).
+    options.scattered.provisional = !(s.has("jump_fraction") && s.has("exponent"));
+    options.scattered.source =
+        s.text("source", options.scattered.provisional ? defaults.scattered.source : std::string("case file"));
+  });
+  if (!r.has("scattered")) {
+    auto& s = r.resolved()["scattered"];
+    s["jump_fraction"] = defaults.scattered.jump_fraction;
+    s["exponent"] = defaults.scattered.exponent;
+    s["s_min"] = defaults.scattered.s_min;
+    s["s_max"] = defaults.scattered.s_max;
+    s["source"] = defaults.scattered.source;
+  }
+}
+
+}  // namespace
+
+void read_damper_drive(ObjectReader& r, DamperSpec& d) {
+  const std::string model = r.text("model", std::string("auto"), {"rolling", "bouncing", "auto"});
+  d.model = *fm::damper_model_from_string(model);
+  d.drive_axis = axis_index(r.text("drive_axis", std::string("x"), {"x", "y", "z"}));
+  d.gravity_m_s2 = r.vector3("gravity_m_s2", fm::Vec3{0.0, 0.0, -fm::kStandardGravity}, limits::kGravity, " m/s^2");
+  r.object("model_options", false, [&](ObjectReader& m) { read_model_options(m, d.model_options); });
+  if (!r.has("model_options")) {
+    ObjectReader defaults(r.file(), empty_object(), r.pointer() + "/model_options", r.resolved()["model_options"]);
+    read_model_options(defaults, d.model_options);
+  }
+  check_model_options(r, d.model_options);
+  // Gravity along the drive breaks the closed forms' assumption (PHYSICS.md §2).
+  const double g_norm = std::hypot(d.gravity_m_s2[0], d.gravity_m_s2[1], d.gravity_m_s2[2]);
+  d.model_options.gravity_along_drive = g_norm > 0.0 && std::abs(d.gravity_m_s2[d.drive_axis]) > 0.01 * g_norm;
+  const double g_across = std::sqrt(std::max(0.0, g_norm * g_norm - d.gravity_m_s2[d.drive_axis] * d.gravity_m_s2[d.drive_axis]));
+  d.model_options.gravity_across_drive = g_across > 0.01 * std::max(g_norm, 1e-300);
+}
+
+void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSpec& layer) {
+  r.object("container", true, [&](ObjectReader& k) {
+    const std::string shape = k.text("shape", std::nullopt, {"box", "cylinder"});
+    if (shape == "box") {
+      layer.container.shape = fm::ContainerShape::kBox;
+      layer.container.box_inner_size_m = k.vector3("inner_size_m", std::nullopt, limits::kContainerSize, " m");
+    } else {
+      layer.container.shape = fm::ContainerShape::kCylinder;
+      layer.container.cylinder_inner_radius_m = k.number("inner_radius_m", std::nullopt, limits::kContainerSize, " m");
+      layer.container.cylinder_inner_length_m = k.number("inner_length_m", std::nullopt, limits::kContainerSize, " m");
+      layer.container.cylinder_axis = axis_index(k.text("axis", std::string("x"), {"x", "y", "z"}));
+    }
+  });
+  auto& packing = layer.packing;
+  r.object("particles", true, [&](ObjectReader& p) {
+    layer.particle_count = p.integer("count", std::nullopt, 1, 10'000'000);
+    layer.particle_radius_m = p.number("radius_m", std::nullopt, limits::kParticleRadius, " m");
+    layer.particle_material = p.text("material", std::string("steel"));
+    packing.collect_side = p.text("collect_side", std::string("negative"), {"negative", "positive"}) == "negative" ? -1 : 1;
+    // Gap between neighbouring lanes across the drive: a number, or "auto" (the width
+    // the lanes leave, shared out equally: each lane owns L/n).
+    if (p.is_string("lane_gap_m")) {
+      p.text("lane_gap_m", std::nullopt, {"auto"});
+      packing.lane_gap_auto = true;
+    } else {
+      packing.lane_gap_m = p.number("lane_gap_m", 0.0, {0.0, limits::kContainerSize.max}, " m (or \"auto\")");
+    }
+    layer.lot_diameter_variation_m = p.number("lot_diameter_variation_m",
+                                              dem_reference::ParticleGroupOptions{}.lot_diameter_variation_m,
+                                              {0.0, dem_reference::limits::kMaxLotDiameterVariation_m}, " m");
+    if (p.has("lattice") && !p.is_string("lattice")) {
+      const auto counts = p.vector3("lattice", std::nullopt, {1.0, 1e6}, "");
+      std::array<int, 3> n{};
+      for (int i = 0; i < 3; ++i) {
+        if (counts[i] != std::floor(counts[i])) p.fail("lattice/" + std::to_string(i), "must be a whole number >= 1");
+        n[i] = static_cast<int>(counts[i]);
+      }
+      packing.lattice_counts = n;
+    } else {
+      p.text("lattice", std::string("auto"), {"auto"});
+    }
+  });
+  packing.drive_axis = d.drive_axis;
+  // The bed rests on the wall gravity points to (the dominant component).
+  int g_axis = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(d.gravity_m_s2[i]) > std::abs(d.gravity_m_s2[g_axis])) g_axis = i;
+  const double g_norm = std::hypot(d.gravity_m_s2[0], d.gravity_m_s2[1], d.gravity_m_s2[2]);
+  if (g_norm > 0.0) packing.gravity_axis_sign = std::make_pair(g_axis, d.gravity_m_s2[g_axis] < 0.0 ? -1 : 1);
+
+  for (const auto& line : layer.container.validate("damper/container")) r.fail("container", line);
+  if (!c.materials.count(layer.particle_material))
+    r.fail("particles/material", "'" + layer.particle_material + "' is not defined in /materials (nor built in)");
+  try {
+    layer.bed = fm::collected_lattice(layer.container, layer.particle_count, layer.particle_radius_m, packing);
+  } catch (const std::invalid_argument& e) {
+    r.fail("particles", e.what());
+  }
+  const auto explicit_clearance = r.optional_number("clearance_m", limits::kClearance, " m");
+  layer.clearance_m = explicit_clearance.value_or(layer.bed.clearance_m);
+  // A bed that leaves (nearly) no room is no damper: the derived clearance takes the
+  // range of an explicit one.
+  if (!explicit_clearance && !limits::kClearance.contains(layer.bed.clearance_m)) {
+    std::ostringstream out;
+    out.precision(10);
+    out << "the collected bed leaves a clearance of " << layer.bed.clearance_m << " m (" << layer.bed.slabs
+        << " slabs of 2r in " << layer.container.inner_length(d.drive_axis) << " m): " << limits::kClearance.text() << " m";
+    r.fail("particles", out.str());
+  }
+  // The bed cannot travel farther than the container is long: an override beyond the
+  // free length (inner length along the drive minus the bed) is a typo, not a design.
+  const double inner_length = layer.container.inner_length(d.drive_axis);
+  if (explicit_clearance && *explicit_clearance > inner_length - layer.bed.bed_extent_m + 1e-12) {
+    std::ostringstream out;
+    out.precision(10);  // 0.1000001 is not 0.1
+    out << "= " << *explicit_clearance << ": must be <= the free length along the drive, " << inner_length - layer.bed.bed_extent_m
+        << " m (inner length " << inner_length << " m minus the bed's " << layer.bed.bed_extent_m << " m)";
+    r.fail("clearance_m", out.str());
+  }
+  const double volume = 4.0 / 3.0 * fm::kPi * std::pow(layer.particle_radius_m, 3);
+  layer.bed_mass_kg = layer.particle_count * volume * c.materials.at(layer.particle_material).density_kg_m3;
+  auto& derived = r.resolved()["derived"];
+  derived["bed_clearance_m"] = layer.bed.clearance_m;
+  derived["bed_extent_m"] = layer.bed.bed_extent_m;
+  derived["bed_slabs"] = layer.bed.slabs;
+  derived["clearance_m"] = layer.clearance_m;
+  derived["bed_mass_kg"] = layer.bed_mass_kg;
+
+  // The DEM's compartment takes the bed as the closed forms see it.
+  auto& compartment = layer.compartment;
+  compartment.container = layer.container;
+  compartment.collect_axis = d.drive_axis;
+  compartment.collect_side = packing.collect_side;
+  compartment.lane_gap_m = packing.lane_gap_m;
+  compartment.lane_gap_auto = packing.lane_gap_auto;
+  if (packing.lattice_counts) compartment.lattice_counts.assign(packing.lattice_counts->begin(), packing.lattice_counts->end());
+  dem_reference::ParticleGroupOptions group;
+  group.count = layer.particle_count;
+  group.radius_m = layer.particle_radius_m;
+  group.material = material_index(r, "particles/material", layer.particle_material, c);
+  group.lot_diameter_variation_m = layer.lot_diameter_variation_m;
+  compartment.particles = {group};
+}
+
+/// A structure-plane direction, normalised; CaseError for a zero or non-finite one.
+PlaneVector read_plane_direction(ObjectReader& r, const std::string& key, std::optional<PlaneVector> fallback) {
+  PlaneVector v{};
+  if (r.has(key) || !fallback) {
+    const auto values = r.number_array(key, Range{-1e6, 1e6}, "", 2);
+    if (values.size() != 2) r.fail(key, "has " + std::to_string(values.size()) + " entries: must be [x, y]");
+    v = {values[0], values[1]};
+  } else {
+    v = *fallback;
+  }
+  const double norm = std::hypot(v[0], v[1]);
+  if (!(norm > 1e-9)) r.fail(key, "= [" + number_text(v[0]) + ", " + number_text(v[1]) + "]: must be a non-zero direction");
+  v = {v[0] / norm, v[1] / norm};
+  r.resolved()[key] = v;
+  return v;
+}
+
+std::string read_point_name(ObjectReader& r, const std::string& key, const Case& c) {
+  const std::string name = r.text(key, std::nullopt);
+  const auto& names = c.structure->point_names;
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    std::string known;
+    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    r.fail(key, "'" + name + "' is no named point of the structure (known: " + known + ")");
+  }
+  return name;
+}
+
+void read_dampers(ObjectReader& root, Case& c) {
+  if (!root.has("dampers")) root.fail("dampers", "required (an array of at least one damper)");
+  root.array("dampers", [&](ObjectReader& r) {
+    DamperSpec d;
+    d.site = read_point_name(r, "site", c);
+    d.drive_direction = read_plane_direction(r, "drive_direction", std::nullopt);
+    d.container_mass_kg = r.number("container_mass_kg", std::nullopt, limits::kMass, " kg");
+    read_damper_drive(r, d);
+    if (!r.has("layers")) r.fail("layers", "required (an array of at least one layer)");
+    r.array("layers", [&](ObjectReader& l) {
+      LayerSpec layer;
+      read_layer_bed(l, c, d, layer);
+      read_layer_geometry(l, c, layer);
+      layer.compartment.offset_m = l.vector3("offset_m", fm::Vec3{0.0, 0.0, 0.0}, limits::kPosition, " m");
+      d.layers.push_back(std::move(layer));
+    });
+    if (d.layers.empty()) r.fail("layers", "is empty: a damper needs at least one layer");
+    c.dampers.push_back(std::move(d));
+  });
+  if (c.dampers.empty()) root.fail("dampers", "is empty: give at least one damper");
+}
+
+}  // namespace pdamp::case_file::detail

@@ -1,0 +1,140 @@
+// Format-2 cases (case_file/src/read_structure.cpp, read_damper.cpp, read_task.cpp): the
+// example structures and dampers of tests/case_file/data/, and their error paths.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/structure/beam.hpp"
+#include "case_file/case_error_check.hpp"
+#include "support/temp_dir.hpp"
+
+using nlohmann::json;
+using pdamp::case_file::Case;
+using pdamp::case_file::CaseError;
+using pdamp::case_file::load_case;
+using pdamp::test::require_case_error;
+using pdamp::case_file::StructureSpec;
+using pdamp::case_file::TaskKind;
+
+namespace {
+
+std::string data(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/tests/case_file/data/" + name; }
+
+/// The cantilever example with one edit, written into `dir` (with the modal file beside it).
+std::string edited(const pdamp::test::TempDir& dir, const std::string& example, const std::function<void(json&)>& edit) {
+  std::ifstream in(data(example));
+  json c = json::parse(in);
+  edit(c);
+  const std::string path = (dir.path / example).string();
+  std::ofstream(path) << c.dump(2);
+  return path;
+}
+
+constexpr const char* kCantilever = "vertical_cantilever_tip_damper.json";
+constexpr const char* kModalData = "modal_data_tip_damper.json";
+
+}  // namespace
+
+TEST_CASE("the format-2 cantilever example reads its beam, damper and frf task", "[case_file]") {
+  const Case c = load_case(data(kCantilever));
+  CHECK(c.format_version == 2);
+  REQUIRE(c.structure.has_value());
+  const StructureSpec& s = *c.structure;
+  CHECK(s.kind == StructureSpec::Kind::kBeam);
+  REQUIRE(s.beam.segments.size() == 1);
+  CHECK(s.beam.segments[0].section.shape == pdamp::structure::SectionShape::kSolidRectangle);
+  CHECK(s.beam.segments[0].material.youngs_modulus_pa == 206e9);  // from the named material
+  CHECK(s.beam.geometric_stiffness);
+  CHECK(s.beam.axial_gravity_m_s2 == -9.80665);
+  CHECK(s.mode_count == 3);
+  CHECK(s.damping.ratios == std::vector<double>{0.002});
+  REQUIRE(c.dampers.size() == 1);
+  const auto& d = c.dampers[0];
+  CHECK(d.site == "tip");
+  CHECK(d.container_mass_kg == 0.3);
+  REQUIRE(d.layers.size() == 1);
+  CHECK(d.layers[0].clearance_m == Approx(0.1).margin(1e-12));  // the 36-sphere bed of the shipped low-intensity case
+  CHECK(c.resolved["dampers"][0]["layers"][0]["wall_material"] == "steel");  // DEM geometry moved to the layer
+  CHECK_FALSE(c.resolved["dem"].contains("wall_material"));
+  CHECK(c.task.kind == TaskKind::kFrf);
+  REQUIRE(c.task.frf.has_value());
+  CHECK(c.task.frf->points == 301);
+  CHECK(c.task.frf->excitation == pdamp::case_file::FrfTask::Excitation::kBase);
+  CHECK(pdamp::case_file::dem_options(c, 0, 0.04, 2.0).validate("").empty());
+}
+
+TEST_CASE("the cantilever example's bare beam has the Euler-Bernoulli first mode, 2 Hz coming from its tip damper", "[case_file]") {
+  // Euler-Bernoulli estimate: k = 3EI/L^3 = 98.9 N/m with EI = 206e9 * 0.03 * 0.002^3 / 12,
+  // tip mass 0.3 kg container + 0.148 kg bed + 0.236 of the 0.236 kg beam: 2.2 Hz, gravity's
+  // compression lowers it by ~5% (P/P_cr ~ 0.1). The example is built for 2 Hz; the beam
+  // model here carries only the beam (the damper's masses are the coupling's), so its
+  // first mode is that of the bare beam: 1.875^2/(2 pi L^2) sqrt(EI/(rho A)) = 6.7 Hz.
+  const Case c = load_case(data(kCantilever));
+  const auto result = pdamp::structure::beam_modal_model(c.structure->beam, c.structure->mode_count, c.structure->damping);
+  // 10%: the gravity softening of the bare beam (its own weight, 0.02 of buckling) and the mesh.
+  CHECK(result.modal.natural_frequencies_hz[0] == Approx(6.7).epsilon(0.1));
+}
+
+TEST_CASE("a modal-data structure reads its file relative to the case and normalises the drive direction",
+          "[case_file]") {
+  const Case c = load_case(data(kModalData));
+  REQUIRE(c.structure.has_value());
+  CHECK(c.structure->kind == StructureSpec::Kind::kModalData);
+  CHECK(c.structure->modal_data_file == data("one_mode_tip.json"));
+  REQUIRE(c.structure->modal_data.has_value());
+  CHECK(c.structure->modal_data->natural_frequencies_hz[0] == 2.0);
+  CHECK(c.dampers[0].drive_direction[0] == 0.0);
+  CHECK(c.dampers[0].drive_direction[1] == 1.0);  // [0, 2] normalised
+  CHECK(c.resolved["dampers"][0]["drive_direction"][1] == 1.0);
+  REQUIRE(c.task.decay.has_value());
+  CHECK(c.task.decay->load_point == "tip");
+  CHECK(c.task.decay->settling_threshold == 0.05);  // the default
+}
+
+TEST_CASE("format-2 errors name the file, the pointer and the rule", "[case_file]") {
+  const pdamp::test::TempDir dir("case_file_v2_errors");
+  const auto cantilever = [&](const std::function<void(json&)>& edit) { return edited(dir, kCantilever, edit); };
+  const std::string file = (dir.path / kCantilever).string();
+  // structure::BeamModel::validate() owns the beam's ranges.
+  require_case_error(cantilever([](json& c) { c["structure"]["segments"][0]["length_m"] = -0.5; }), file,
+                     "/structure/segments/0/length_m", "must be > 0 m");
+  require_case_error(cantilever([](json& c) { c["structure"]["points"][0]["position_m"] = 2.0; }), file,
+                     "/structure/points/0/position_m", "on the beam");
+  require_case_error(cantilever([](json& c) { c["structure"]["damping"] = {{"ratios", {-0.1}}}; }), file,
+                     "/structure/damping/ratios/0", "must be >= 0");
+  require_case_error(cantilever([](json& c) { c["structure"]["segments"][0]["section"]["diameter_m"] = 0.01; }), file,
+                     "/structure/segments/0/section/diameter_m", "unknown key");
+  require_case_error(cantilever([](json& c) { c["structure"]["kind"] = "plate"; }), file, "/structure/kind",
+                     "'plate' is not allowed");
+  require_case_error(cantilever([](json& c) { c["dampers"][0]["site"] = "root"; }), file, "/dampers/0/site",
+                     "'root' is no named point of the structure (known: tip, middle)");
+  require_case_error(cantilever([](json& c) { c["dampers"][0]["drive_direction"] = {0.0, 0.0}; }), file,
+                     "/dampers/0/drive_direction", "must be a non-zero direction");
+  require_case_error(cantilever([](json& c) { c["dampers"][0]["layers"] = json::array(); }), file, "/dampers/0/layers",
+                     "is empty");
+  require_case_error(cantilever([](json& c) { c["dampers"][0]["layers"][0]["particles"]["count"] = 500; }), file,
+                     "/dampers/0/layers/0/particles", "");
+  require_case_error(cantilever([](json& c) { c["dem"]["wall_material"] = "steel"; }), file, "/dem/wall_material",
+                     "unknown key");  // format 2 keeps the geometry in the layers
+  require_case_error(cantilever([](json& c) { c["task"]["excitation"]["kind"] = "shaker"; }), file,
+                     "/task/excitation/kind", "is not allowed");
+  require_case_error(cantilever([](json& c) { c["task"]["max_frequency_hz"] = 0.5; }), file, "/task/max_frequency_hz",
+                     "must be > min_frequency_hz");
+  require_case_error(cantilever([](json& c) { c["task"] = {{"kind", "modes"}, {"mode_count", 5}, {"backbone_min_amplitude_m", 1e-3}, {"backbone_max_amplitude_m", 1e-2}}; }),
+                     file, "/task/mode_count", "must be in [1, 3]");
+  require_case_error(cantilever([](json& c) { c["damper"] = json::object(); }), file, "/damper", "unknown key");
+}
+
+TEST_CASE("an invalid modal data file is named with its own pointer", "[case_file]") {
+  const pdamp::test::TempDir dir("case_file_modal_errors");
+  const std::string modal = (dir.path / "one_mode_tip.json").string();
+  std::ofstream(modal) << R"({"frequencies_hz": [-2.0], "damping_ratios": 0.0, "points": {"tip": {"translation_y": [1.0]}}})";
+  const std::string path = edited(dir, kModalData, [](json&) {});
+  require_case_error(path, modal, "/frequencies_hz/0", "");
+  std::filesystem::remove(modal);
+  require_case_error(path, modal, "", "no such file");
+}
