@@ -92,7 +92,9 @@ Case read_case(const std::string& path) {
     // One damper of one layer; its DEM geometry is read with /dem.
     r.object("damper", true, [&](ObjectReader& d) {
       DamperSpec damper;
+      damper.name = "damper_1";
       LayerSpec layer;
+      layer.name = "layer_1";
       detail::read_damper_drive(d, damper);
       detail::read_layer_bed(d, c, damper, layer);
       damper.layers.push_back(std::move(layer));

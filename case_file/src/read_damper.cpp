@@ -1,6 +1,7 @@
 // Dampers and their layers: drive, gravity, model constants, container, particles, bed.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 
@@ -207,10 +208,20 @@ std::string read_point_name(ObjectReader& r, const std::string& key, const Case&
   return name;
 }
 
+std::string resolve_case_relative(const ObjectReader& r, const std::string& path) {
+  if (path.empty()) return path;
+  const std::filesystem::path given(path);
+  return (given.is_absolute() ? given : std::filesystem::path(r.file()).parent_path() / given).lexically_normal().string();
+}
+
 void read_dampers(ObjectReader& root, Case& c) {
   if (!root.has("dampers")) root.fail("dampers", "required (an array of at least one damper)");
   root.array("dampers", [&](ObjectReader& r) {
     DamperSpec d;
+    d.name = r.text("name", "damper_" + std::to_string(c.dampers.size() + 1));
+    for (const auto& other : c.dampers) {
+      if (other.name == d.name) r.fail("name", "'" + d.name + "' names another damper already: names must be unique");
+    }
     d.site = read_point_name(r, "site", c);
     d.drive_direction = read_plane_direction(r, "drive_direction", std::nullopt);
     d.container_mass_kg = r.number("container_mass_kg", std::nullopt, limits::kMass, " kg");
@@ -218,6 +229,11 @@ void read_dampers(ObjectReader& root, Case& c) {
     if (!r.has("layers")) r.fail("layers", "required (an array of at least one layer)");
     r.array("layers", [&](ObjectReader& l) {
       LayerSpec layer;
+      layer.name = l.text("name", "layer_" + std::to_string(d.layers.size() + 1));
+      for (const auto& other : d.layers) {
+        if (other.name == layer.name) l.fail("name", "'" + layer.name + "' names another layer of this damper already");
+      }
+      layer.field_file = resolve_case_relative(l, l.text("field_file", std::string()));
       read_layer_bed(l, c, d, layer);
       read_layer_geometry(l, c, layer);
       layer.compartment.offset_m = l.vector3("offset_m", fm::Vec3{0.0, 0.0, 0.0}, limits::kPosition, " m");

@@ -131,9 +131,7 @@ void read_beam(ObjectReader& r, const Case& c, StructureSpec& s) {
 void read_modal_data(ObjectReader& r, StructureSpec& s) {
   const std::string file = r.text("file", std::nullopt);
   if (file.empty()) r.fail("file", "must not be empty (the path of the modal data file)");
-  const std::filesystem::path given(file);
-  s.modal_data_file =
-      (given.is_absolute() ? given : std::filesystem::path(r.file()).parent_path() / given).lexically_normal().string();
+  s.modal_data_file = resolve_case_relative(r, file);
   const nlohmann::json document = strict_json::parse_json_document(strict_json::read_input_file(s.modal_data_file),
                                                                     s.modal_data_file);
   try {

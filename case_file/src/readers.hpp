@@ -28,6 +28,9 @@ PlaneVector read_plane_direction(ObjectReader& r, const std::string& key, std::o
 /// The name at `key`, which must be a named point of the structure (format 2), or a
 /// CaseError listing the known ones.
 std::string read_point_name(ObjectReader& r, const std::string& key, const Case& c);
+/// A path given in the case file at r's position, relative to the case file's folder
+/// unless absolute ("" stays "").
+std::string resolve_case_relative(const ObjectReader& r, const std::string& path);
 /// Format 2 `dampers`, checked against the structure's point names.
 void read_dampers(ObjectReader& root, Case& c);
 /// `dem`: materials and contacts, numerics; format 1 also the layer geometry.

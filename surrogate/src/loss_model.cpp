@@ -1,20 +1,171 @@
-// Closed-form implementation of the LossModel lookup interface.
+// Closed-form implementation of the LossModel lookup interface: η* from formulas/, the
+// apparent mass and the stroke derivatives from the same ideal orbits.
 #include "pdamp/surrogate/loss_model.hpp"
 
+#include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 namespace pdamp::surrogate {
 
+namespace {
+
+constexpr double kPi = formulas::kPi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Scan range of the closed forms relative to the clearance: above 10 h they warn (X/h > 10).
+constexpr double kMinStrokeOverClearance = 1e-3;
+constexpr double kMaxStrokeOverClearance = 10.0;
+
+bool uses_auto_block(formulas::DamperModel model) {
+  return model == formulas::DamperModel::kAuto || model == formulas::DamperModel::kScattered;
+}
+
+/// dκ/dX of the block that answers: nonzero only for auto's friction-limited sliding,
+/// κ_eff = μ/(Γ − μ) above Γ_slip, with Γ = XΩ²/g so dΓ/dX = Γ/X.
+double d_inertia_factor_d_stroke(formulas::DamperModel model, const formulas::ModelOptions& options,
+                                 double intensity, double stroke_m) {
+  if (!uses_auto_block(model) || !options.gravity_across_drive) return 0.0;
+  if (intensity <= formulas::slip_intensity(options)) return 0.0;
+  const double mu = options.base_friction;
+  return -mu / ((intensity - mu) * (intensity - mu)) * intensity / stroke_m;
+}
+
+/// The free block's η*, m_app/m and their derivatives with respect to r = h_eff/X on one
+/// orbit branch (docs/collect_and_collide.md §2-3, docs/structure_coupling.md §2).
+struct BlockSlopes {
+  double apparent_mass_fraction;
+  double d_eta_d_r;       ///< of the block's η*, before the 1/(1+κ) factor
+  double d_apparent_d_r;  ///< of the block's m_app/m
+};
+
+BlockSlopes block_slopes(formulas::MotionRegime regime, double impact_phase_rad) {
+  if (regime == formulas::MotionRegime::kCollectAndCollide) {
+    // φ* − sin φ* = r ⇒ dφ*/dr = 1/(1 − cos φ*); η_b = (1 − cos φ*)²/π ⇒ dη_b/dr = 2 sin φ*/π;
+    // m_b = (π − φ* + 2 sin φ* − sin φ* cos φ*)/π ⇒ dm_b/dφ* = 2 cos φ*(1 − cos φ*)/π.
+    const double phi = impact_phase_rad;
+    const double s = std::sin(phi), c = std::cos(phi);
+    return {(kPi - phi + 2.0 * s - s * c) / kPi, 2.0 * s / kPi, 2.0 * c / kPi};
+  }
+  // Sub-peak: π cos ψ + 2 sin ψ = r ⇒ dψ/dr = 1/(2 cos ψ − π sin ψ) (infinite at the onset);
+  // η_b = 4 cos²ψ/π ⇒ dη_b/dψ = −4 sin 2ψ/π;  m_b = −2 sin 2ψ/π ⇒ dm_b/dψ = −4 cos 2ψ/π.
+  const double psi = impact_phase_rad - kPi;
+  const double d_psi_d_r = 1.0 / (2.0 * std::cos(psi) - kPi * std::sin(psi));
+  return {-2.0 * std::sin(2.0 * psi) / kPi, -4.0 * std::sin(2.0 * psi) / kPi * d_psi_d_r,
+          -4.0 * std::cos(2.0 * psi) / kPi * d_psi_d_r};
+}
+
+}  // namespace
+
+std::vector<double> LossModel::discontinuities_stroke_m(double /*frequency_hz*/) const { return {}; }
+
+std::vector<std::string> LossModel::warning_messages(double frequency_hz, double stroke_m) const {
+  return describe_loss_warnings(evaluate(frequency_hz, stroke_m).warnings);
+}
+
+std::vector<std::string> describe_loss_warnings(std::uint32_t warnings) {
+  static constexpr std::pair<LossWarning, const char*> kSentences[] = {
+      {kLossOutsideFieldGrid, "effective field queried outside its grid: the edge value is used, its slope is 0"},
+      {kLossRescaledClearance, "effective field made for another clearance, reused at equal intensity and X/h"},
+      {kLossOutsideClosedForm, "a validity rule of the closed-form model is violated (see its warning)"},
+      {kLossScatteredState, "below the collect-and-collide onset: eta* from the empirical scattered-state fit"},
+      {kLossApparentMassMissing, "the loss model gives no apparent mass"},
+      {kLossApparentMassAssumed, "apparent mass from an assumption (no-impact limit below the onset)"},
+  };
+  std::vector<std::string> sentences;
+  for (const auto& [bit, sentence] : kSentences)
+    if (warnings & bit) sentences.emplace_back(sentence);
+  return sentences;
+}
+
 ClosedFormLossModel::ClosedFormLossModel(formulas::DamperModel model, double clearance_m,
                                          formulas::ModelOptions options)
-    : model_(model), clearance_m_(clearance_m), options_(std::move(options)) {}
+    : model_(model), clearance_m_(clearance_m), options_(std::move(options)) {
+  if (!(clearance_m > 0.0 && std::isfinite(clearance_m)))
+    throw std::invalid_argument("ClosedFormLossModel: clearance_m = " + std::to_string(clearance_m) +
+                                ": must be > 0 and finite");
+  if (const auto problems = options_.validate(); !problems.empty())
+    throw std::invalid_argument("ClosedFormLossModel: " + problems.front());
+}
 
 DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_m) const {
   const auto loss = formulas::reduced_loss_factor(model_, clearance_m_, stroke_m, frequency_hz, options_);
-  // The closed forms describe dissipation only; the bed's inertia is not modelled.
-  return {loss.eta_star, std::numeric_limits<double>::quiet_NaN(), std::string(formulas::to_string(loss.regime))};
+  DamperResponse response;
+  response.eta_star = loss.eta_star;
+  response.regime = formulas::to_string(loss.regime);
+  const double kappa = loss.inertia_factor;
+  const double scale = 1.0 + kappa;
+  const double d_kappa = d_inertia_factor_d_stroke(model_, options_, loss.intensity, stroke_m);
+  const bool scattered = loss.regime == formulas::MotionRegime::kScattered;
+  if (scattered) {
+    // η* = j·η*_onset(κ)·(X/X_onset(κ))^p with η*_onset, X_onset ∝ 1/(1+κ), (1+κ):
+    // d ln η* = p dX/X − (1+p) dκ/(1+κ). Apparent mass: the no-impact limit κ/(1+κ).
+    const double p = options_.scattered.exponent;
+    response.d_eta_star_d_stroke_1_m = loss.eta_star * (p / stroke_m - (1.0 + p) * d_kappa / scale);
+    response.apparent_mass_fraction = kappa / scale;
+    response.d_apparent_mass_fraction_d_stroke_1_m = d_kappa / (scale * scale);
+    response.warnings |= kLossScatteredState | kLossApparentMassAssumed;
+    // The scattered state's own warnings (provisional or extrapolated fit) are expected
+    // there; only the others mean the closed form is outside its validity.
+    const bool explicit_family =
+        model_ == formulas::DamperModel::kRolling || model_ == formulas::DamperModel::kBouncing;
+    std::size_t expected = (explicit_family ? 1u : 0u) + (options_.scattered.provisional ? 1u : 0u);
+    const double s = loss.stroke_over_onset;
+    if (s < options_.scattered.s_min || s > options_.scattered.s_max || s >= 1.0) ++expected;
+    if (loss.warnings.size() > expected) response.warnings |= kLossOutsideClosedForm;
+    return response;
+  }
+  // On an orbit: η* = η_b(r)/(1+κ), m_app/m = (κ + m_b(r))/(1+κ), r = (1+κ)h/X, so
+  // dr/dX = −r/X + (h/X)·dκ/dX and ∂/∂κ at fixed r of the two are −η*/(1+κ) and
+  // (1 − m_b)/(1+κ)².
+  const BlockSlopes block = block_slopes(loss.regime, loss.impact_phase_rad);
+  const double r = scale * clearance_m_ / stroke_m;
+  const double dr = -r / stroke_m + clearance_m_ / stroke_m * d_kappa;
+  response.apparent_mass_fraction = (kappa + block.apparent_mass_fraction) / scale;
+  response.d_eta_star_d_stroke_1_m = block.d_eta_d_r * dr / scale - loss.eta_star * d_kappa / scale;
+  response.d_apparent_mass_fraction_d_stroke_1_m =
+      block.d_apparent_d_r * dr / scale + (1.0 - block.apparent_mass_fraction) * d_kappa / (scale * scale);
+  if (!loss.warnings.empty()) response.warnings |= kLossOutsideClosedForm;
+  return response;
+}
+
+std::vector<double> ClosedFormLossModel::discontinuities_stroke_m(double frequency_hz) const {
+  if (model_ == formulas::DamperModel::kScattered) return {};
+  const auto& options = options_;
+  if (model_ != formulas::DamperModel::kAuto) {
+    const double kappa = model_ == formulas::DamperModel::kRolling ? options.rolling_inertia_factor : 0.0;
+    return {formulas::onset_stroke_m(kappa, clearance_m_)};
+  }
+  // auto: κ_eff(Γ(X)) does not increase with X, so X − X_onset(κ_eff(Γ(X))) increases
+  // monotonically between the free block's onset (κ = 0) and the rolling one: bisection.
+  const double omega = 2.0 * kPi * frequency_hz;
+  const auto excess = [&](double x) {
+    const double kappa = formulas::auto_inertia_factor(x * omega * omega / formulas::kStandardGravity, options);
+    return x - formulas::onset_stroke_m(kappa, clearance_m_);
+  };
+  double lo = formulas::onset_stroke_m(0.0, clearance_m_);
+  double hi = formulas::onset_stroke_m(options.gravity_across_drive ? options.rolling_inertia_factor : 0.0,
+                                       clearance_m_);
+  if (excess(lo) >= 0.0) return {lo};
+  for (int iteration = 0; iteration < 200 && hi - lo > 1e-15 * hi; ++iteration) {
+    const double mid = 0.5 * (lo + hi);
+    (excess(mid) >= 0.0 ? hi : lo) = mid;
+  }
+  return {hi};  // the lowest stroke classified as on the orbit
+}
+
+StrokeRange ClosedFormLossModel::stroke_range_m(double /*frequency_hz*/) const {
+  return {kMinStrokeOverClearance * clearance_m_, kMaxStrokeOverClearance * clearance_m_};
+}
+
+std::vector<std::string> ClosedFormLossModel::warning_messages(double frequency_hz, double stroke_m) const {
+  auto sentences = formulas::reduced_loss_factor(model_, clearance_m_, stroke_m, frequency_hz, options_).warnings;
+  const DamperResponse response = evaluate(frequency_hz, stroke_m);
+  if (response.warnings & kLossApparentMassAssumed)
+    sentences.push_back("apparent mass below the onset assumed to be the no-impact limit kappa/(1+kappa) = " +
+                        std::to_string(response.apparent_mass_fraction) + " of the bed mass (no closed form there)");
+  return sentences;
 }
 
 }  // namespace pdamp::surrogate

@@ -30,6 +30,10 @@ using PlaneVector = std::array<double, 2>;
 /// One compartment of a damper: its container, its particles, their lattice and the
 /// clearance (format 1: the whole damper; format 2: `dampers[i].layers[k]`).
 struct LayerSpec {
+  std::string name;  ///< format 2: `name` (default layer_<k>); format 1: layer_1
+  /// Format 2: `field_file`, the layer's effective field (`pdamp field` output) for
+  /// `--method field`, resolved against the case file's folder; empty: none.
+  std::string field_file;
   formulas::Container container;
   int particle_count = 0;
   double particle_radius_m = 0.0;
@@ -48,6 +52,7 @@ struct LayerSpec {
 
 /// A particle damper: its drive, gravity and closed-form constants, and its layers.
 struct DamperSpec {
+  std::string name;  ///< format 2: `name` (default damper_<i>); format 1: damper_1
   /// Format 2: the named point of the structure the container sits at ("" in format 1).
   std::string site;
   /// Format 2: the structure-plane direction the container's drive axis moves along

@@ -1,0 +1,33 @@
+// The runtime models of a format-2 case (docs/cases.md "Format 2"): the structure's modal
+// model and its dampers, each layer with the loss model a structure solver asks.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+#include "pdamp/structure/modal_model.hpp"
+
+namespace pdamp::case_file {
+
+/// Where the layers' η*(f, X) and apparent mass come from (`--method`).
+enum class LossMethod {
+  kFormulas,  ///< the closed forms of each layer (its model, clearance and constants)
+  kField,     ///< each layer's effective field (`field_file`), looked up at its own clearance
+};
+std::string_view to_string(LossMethod method);
+
+struct StructureSetup {
+  structure::ModalModel modal;               ///< beam: its finite-element modes; modal data: as read
+  int rigid_modes_dropped = 0;               ///< beam: rigid-body modes at 0 Hz not kept
+  std::vector<structure::Damper> dampers;    ///< in case order, layers in case order
+  std::vector<std::string> warnings;         ///< one sentence each (a field reused at another clearance)
+};
+
+/// Builds the structure and its dampers; CaseError (exit 2) for a case without a
+/// structure, a layer without `field_file` under kField, or an unreadable field file.
+StructureSetup structure_setup(const Case& c, LossMethod method);
+
+}  // namespace pdamp::case_file

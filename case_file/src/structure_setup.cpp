@@ -1,0 +1,102 @@
+// Runtime models of a format-2 case: modal model and dampers with their loss models.
+#include "pdamp/case_file/structure_setup.hpp"
+
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "pdamp/structure/beam.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
+
+namespace pdamp::case_file {
+
+namespace {
+
+namespace st = pdamp::structure;
+namespace sg = pdamp::surrogate;
+
+std::string layer_pointer(std::size_t damper, std::size_t layer) {
+  return "/dampers/" + std::to_string(damper) + "/layers/" + std::to_string(layer);
+}
+
+/// The layer's effective field, looked up at the layer's own clearance (a field of
+/// another clearance is reused at equal Γ and X/h, and said so).
+std::shared_ptr<const sg::LossModel> field_loss_model(const Case& c, std::size_t d, std::size_t l,
+                                                      std::vector<std::string>& warnings) {
+  const LayerSpec& layer = c.dampers[d].layers[l];
+  if (layer.field_file.empty()) {
+    throw CaseError(c.path, layer_pointer(d, l) + "/field_file",
+                    "required with --method field (the layer's effective field, made by pdamp field)");
+  }
+  sg::EffectiveField field;
+  try {
+    field = sg::read_effective_field(layer.field_file);
+  } catch (const strict_json::InputError&) {
+    throw;  // names the field file and the pointer in it
+  } catch (const std::exception& e) {
+    throw CaseError(c.path, layer_pointer(d, l) + "/field_file", e.what());
+  }
+  sg::LookupOptions lookup;
+  lookup.clearance_m = layer.clearance_m;
+  if (std::abs(field.clearance_m - layer.clearance_m) > 1e-9 * layer.clearance_m) {
+    std::ostringstream out;
+    out << c.dampers[d].name << "/" << layer.name << ": the field " << layer.field_file << " was made for h = "
+        << field.clearance_m << " m, the layer has h = " << layer.clearance_m
+        << " m: it is reused at equal intensity and X/h (docs/effective_fields.md says when that holds)";
+    warnings.push_back(out.str());
+  }
+  try {
+    return std::make_shared<sg::EffectiveFieldLossModel>(field, lookup);
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(layer.field_file, "", e.what());
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(LossMethod method) {
+  return method == LossMethod::kFormulas ? "formulas" : "field";
+}
+
+StructureSetup structure_setup(const Case& c, LossMethod method) {
+  if (!c.structure) throw CaseError(c.path, "/structure", "required: pdamp modes, frf and decay need a format-2 case");
+  StructureSetup out;
+  const StructureSpec& s = *c.structure;
+  if (s.kind == StructureSpec::Kind::kBeam) {
+    st::BeamModalResult beam;
+    try {
+      beam = st::beam_modal_model(s.beam, s.mode_count, s.damping);
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(c.path, "/structure", e.what());
+    }
+    out.modal = std::move(beam.modal);
+    out.rigid_modes_dropped = beam.rigid_modes_dropped;
+  } else {
+    out.modal = *s.modal_data;
+  }
+  for (std::size_t d = 0; d < c.dampers.size(); ++d) {
+    const DamperSpec& spec = c.dampers[d];
+    st::Damper damper;
+    damper.name = spec.name;
+    damper.point = spec.site;
+    damper.drive_direction = {spec.drive_direction[0], spec.drive_direction[1]};
+    damper.container_mass_kg = spec.container_mass_kg;
+    for (std::size_t l = 0; l < spec.layers.size(); ++l) {
+      const LayerSpec& layer = spec.layers[l];
+      st::DamperLayer coupled;
+      coupled.name = layer.name;
+      coupled.bed_mass_kg = layer.bed_mass_kg;
+      coupled.loss_model = method == LossMethod::kFormulas
+                               ? std::make_shared<sg::ClosedFormLossModel>(spec.model, layer.clearance_m,
+                                                                           spec.model_options)
+                               : field_loss_model(c, d, l, out.warnings);
+      damper.layers.push_back(std::move(coupled));
+    }
+    out.dampers.push_back(std::move(damper));
+  }
+  return out;
+}
+
+}  // namespace pdamp::case_file
