@@ -1,20 +1,20 @@
 // Harmonic DEM run of one damper: settling, transient, analysed periods, and the
-// measures (complex power, energy balance, motion mode).
+// measures (complex power, energy balance, motion mode), assembled from the run
+// machinery that other drivers share (docs/dem.md "Run machinery").
 #include "pdamp/dem_reference/damper_simulation.hpp"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <limits>
-#include <numeric>
 #include <sstream>
 #include <stdexcept>
 
 #include "pdamp/dem_reference/container_motion.hpp"
+#include "pdamp/dem_reference/drive_time_step.hpp"
 #include "pdamp/dem_reference/world.hpp"
-#include "pdamp/formulas/complex_power.hpp"
 #include "initial_state.hpp"
+#include "vec3_ops.hpp"
 #include "walls.hpp"
 #include "world_data.hpp"
 
@@ -22,179 +22,15 @@ namespace pdamp::dem_reference {
 
 namespace {
 
+using detail::dot;
+using detail::norm;
 using Clock = std::chrono::steady_clock;
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
 
 std::string join_lines(const std::vector<std::string>& lines) {
   std::string text;
   for (const auto& line : lines) text += (text.empty() ? "" : "\n") + line;
   return text;
-}
-
-/// Inner extent of a compartment along gravity (g_norm = |g| > 0), m.
-double extent_along_gravity(const CompartmentOptions& c, const Vec3& gravity, double g_norm) {
-  double h = 0.0;
-  for (int a = 0; a < 3; ++a) h += std::abs(gravity[static_cast<std::size_t>(a)]) / g_norm * c.container.inner_length(a);
-  return h;
-}
-
-/// The inner extent of the tallest compartment along gravity, m (the settling time of a
-/// random placement).
-double fall_height(const WorldOptions& w) {
-  const double g = norm(w.gravity_m_s2);
-  if (g == 0.0) return 0.0;
-  double height = 0.0;
-  for (const auto& c : w.compartments) height = std::max(height, extent_along_gravity(c, w.gravity_m_s2, g));
-  return height;
-}
-
-/// Largest free fall of a sphere, m: per compartment, its inner extent H along gravity
-/// less the smallest sphere diameter 2r_min, the largest of these (0 without gravity).
-/// A sphere's centre moves between r from the floor and r from the ceiling, so it falls
-/// at most H − 2r (from rest at the ceiling onto the floor). Not H − h_bed: a sphere
-/// thrown up from a multi-layer bed can land beside it, in the clearance of a collected
-/// bed; for one layer (h_bed = 2r) the two agree. The drive's own speed is in 2XΩ.
-double free_fall_height(const WorldOptions& w) {
-  const double g = norm(w.gravity_m_s2);
-  if (g == 0.0) return 0.0;
-  double height = 0.0;
-  for (const auto& c : w.compartments) {
-    const double h = extent_along_gravity(c, w.gravity_m_s2, g);
-    double r_min = std::numeric_limits<double>::infinity();
-    for (const auto& p : c.particles) r_min = std::min(r_min, p.radius_m * (1.0 - p.radius_spread));
-    if (!std::isfinite(r_min)) r_min = 0.0;
-    height = std::max(height, std::max(0.0, h - 2.0 * r_min));
-  }
-  return height;
-}
-
-/// Mean Pearson correlation of consecutive periods of a periodically sampled signal.
-double period_correlation(const std::vector<double>& signal, int samples, int periods) {
-  if (periods < 2) return 1.0;
-  double sum = 0.0;
-  for (int p = 1; p < periods; ++p) {
-    const double* a = signal.data() + static_cast<std::ptrdiff_t>((p - 1) * samples);
-    const double* b = signal.data() + static_cast<std::ptrdiff_t>(p * samples);
-    double ma = 0.0, mb = 0.0;
-    for (int k = 0; k < samples; ++k) {
-      ma += a[k];
-      mb += b[k];
-    }
-    ma /= samples;
-    mb /= samples;
-    double sab = 0.0, saa = 0.0, sbb = 0.0;
-    for (int k = 0; k < samples; ++k) {
-      sab += (a[k] - ma) * (b[k] - mb);
-      saa += (a[k] - ma) * (a[k] - ma);
-      sbb += (b[k] - mb) * (b[k] - mb);
-    }
-    // A bed at rest in the container repeats itself exactly: count it as synchronous.
-    sum += (saa > 0.0 && sbb > 0.0) ? sab / std::sqrt(saa * sbb) : 1.0;
-  }
-  return sum / (periods - 1);
-}
-
-/// Thresholds of the motion-mode labels (docs/dem.md "Motion modes" derives them from
-/// the mode definitions of PHYSICS.md and the ideal orbits of §2-3).
-struct ModeThresholds {
-  /// solid_like: the bed uses under a tenth of its clearance and carries over 80% of the
-  /// rigidly attached bed's inertial force (m_f = 1).
-  static constexpr double kSolidStroke = 0.1;
-  static constexpr double kSolidMass = 0.8;
-  /// decoupled: under 10% of the rigid inertial force and under 10% of the plastic
-  /// block's η* (the container moves around a bed at rest: m_f = η* = 0).
-  static constexpr double kDecoupledMass = 0.1;
-  static constexpr double kDecoupledEta = 0.1;
-  /// collect-and-collide: the ideal orbits (plastic block, bouncing or rolling, from the
-  /// onset to X = 10h) cross the clearance once per half period (crossing fraction 1),
-  /// with a phase-locked stroke of 0.98-1.26, a lag behind the container from 149° (the
-  /// onset orbit, the latest impact that still repeats) down to 37°, and m_f in
-  /// [−0.56, 1.12]. Accepted: at least every other half period crosses, at least half
-  /// the ideal locked stroke, a lag in [0°, 150°] (a bed left behind lags 180°; an
-  /// elastic bed's rebound makes it lead), and m_f <= 1.5 (a collected bed never moves
-  /// faster than the walls; a bed rebounding elastically off walls at ±V leaves at up
-  /// to (1 + 2ε)V, m_f ≈ 2.5-3).
-  static constexpr double kCrossing = 0.5;
-  static constexpr double kLockedStroke = 0.5;
-  static constexpr double kMinLag_deg = 0.0;
-  static constexpr double kMaxLag_deg = 150.0;
-  static constexpr double kMaxMass = 1.5;
-  /// rolling: the bed keeps at least half of its settled base contacts, on average over
-  /// the analysed periods (most of it rolls on its base, PHYSICS.md §3); otherwise
-  /// bouncing (airborne: spheres hopping after the wall impacts, or no gravity).
-  static constexpr double kRollingBase = 0.5;
-  /// A sphere is mobile when its rms speed relative to the bed's mean velocity exceeds
-  /// V/2: walls moving at ±V drive a granular gas at fluctuations of order V, a
-  /// collected block only by its internal rearrangement.
-  static constexpr double kMobileSpeed = 0.5;
-  /// Fluidisation (high intensity, Γ > 1): all of the bed mobile (>= 90%, a few spheres
-  /// may stay wedged) is global, a part (>= 10%) local.
-  static constexpr double kGlobalMobile = 0.9;
-  static constexpr double kLocalMobile = 0.1;
-};
-
-/// The labels of PHYSICS.md from the indicators (docs/dem.md "Motion modes"); the first
-/// that applies.
-MotionMode classify(const MotionIndicators& m, double eta_star, double intensity) {
-  using T = ModeThresholds;
-  if (m.relative_stroke_over_clearance < T::kSolidStroke && m.apparent_mass_fraction > T::kSolidMass) {
-    return MotionMode::kSolidLike;
-  }
-  if (std::abs(m.apparent_mass_fraction) < T::kDecoupledMass && eta_star < T::kDecoupledEta) {
-    return MotionMode::kDecoupled;
-  }
-  if (m.crossing_fraction >= T::kCrossing && m.phase_locked_stroke >= T::kLockedStroke &&
-      m.phase_lag_deg >= T::kMinLag_deg && m.phase_lag_deg <= T::kMaxLag_deg &&
-      m.apparent_mass_fraction <= T::kMaxMass) {
-    const bool rolling = m.settled_base_contact_fraction > 0.0 &&
-                         m.base_contact_fraction >= T::kRollingBase * m.settled_base_contact_fraction;
-    return rolling ? MotionMode::kRollingCollectAndCollide : MotionMode::kBouncingCollectAndCollide;
-  }
-  if (intensity > 1.0 && m.mobile_fraction >= T::kGlobalMobile) return MotionMode::kGlobalFluidisation;
-  if (intensity > 1.0 && m.mobile_fraction >= T::kLocalMobile) return MotionMode::kLocalFluidisation;
-  return MotionMode::kScattering;
-}
-
-/// Fills the phase-locked indicators from x_r (relative to the container centre) sampled
-/// at times t (`samples` per period, `periods` periods) of the drive X sin Ωt, clearance h.
-void phase_indicators(const std::vector<double>& rel, const std::vector<double>& time_s, int samples, int periods,
-                      double omega, double h, MotionIndicators& m) {
-  if (!(h > 0.0) || rel.empty()) {
-    m.phase_locked_stroke = m.phase_coherence = m.phase_lag_deg = m.crossing_fraction = kNaN;
-    return;
-  }
-  double re_all = 0.0, im_all = 0.0, abs_sum = 0.0;
-  for (int p = 0; p < periods; ++p) {
-    double re = 0.0, im = 0.0;
-    for (int k = p * samples; k < (p + 1) * samples; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      re += rel[i] * std::cos(omega * time_s[i]);
-      im -= rel[i] * std::sin(omega * time_s[i]);
-    }
-    re *= 2.0 / samples;  // x_r ≈ Re(c e^{iΩt}), c = re + i·im
-    im *= 2.0 / samples;
-    re_all += re / periods;
-    im_all += im / periods;
-    abs_sum += std::hypot(re, im) / periods;
-  }
-  const double c_abs = std::hypot(re_all, im_all);
-  m.phase_locked_stroke = 2.0 * c_abs / h;
-  m.phase_coherence = abs_sum > 0.0 ? c_abs / abs_sum : 0.0;
-  // The container position X sin Ωt has the coefficient −iX: lag = arg(−i / c).
-  m.phase_lag_deg = c_abs > 0.0 ? std::atan2(-re_all, -im_all) * 180.0 / kPi : 0.0;
-  if (m.phase_lag_deg <= -180.0) m.phase_lag_deg += 360.0;
-  // Crossings: transits between the outer quarters at either wall (x_r < −h/4, x_r > h/4).
-  int side = 0, crossings = 0;
-  for (const double x : rel) {
-    const int now = x < -0.25 * h ? -1 : (x > 0.25 * h ? 1 : 0);
-    if (now != 0 && side != 0 && now != side) ++crossings;
-    if (now != 0) side = now;
-  }
-  m.crossing_fraction = static_cast<double>(crossings) / (2.0 * periods);
 }
 
 /// Reports progress about twice a second. The clock is read every `stride` steps, a
@@ -247,185 +83,44 @@ class ProgressReporter {
   std::int64_t mask_ = 0;
 };
 
-/// The drive's largest impact speed: a collected bed leaving one wall at the drive's
-/// peak velocity V meets the other wall coming at V (2V), plus the largest free fall of
-/// a sphere, √(2|g|H_free) with H_free = H − 2r_min (free_fall_height), m/s.
-double drive_impact_speed(const DamperSimulationOptions& o) {
-  const double v_amp = o.amplitude_m * 2.0 * kPi * o.frequency_hz;
-  return 2.0 * v_amp + std::sqrt(2.0 * norm(o.world.gravity_m_s2) * free_fall_height(o.world));
-}
-
-/// Fewest steps per contact at the impact speed that a user time step may give
-/// (docs/dem.md "Integration and time step"): the single-impact restitution error of
-/// the leapfrog with the half-step damping velocity follows −(0.6 ln²ε + 0.1)/N from
-/// here on for every ε >= 0.05; below it heavily damped contacts overshoot (ε = 0.05
-/// realises up to 0.11 at 10 steps, ε = 0.01 up to 1.0 at 20).
-constexpr double kMinStepsPerContact = 20.0;
-
-/// The largest relative restitution error of one impact at N steps per contact, for
-/// the target ε: (0.6 ln²ε + 0.1)/N (measured bound, tests/dem_reference/test_measures.cpp).
-double restitution_error_bound(double restitution, double steps_per_contact) {
-  const double l = std::log(restitution);
-  return (0.6 * l * l + 0.1) / steps_per_contact;
-}
-
-/// The smallest restitution the pairs can give (constant or table nodes); NaN when a
-/// pair uses a model.
-double smallest_restitution(const WorldOptions& w) {
-  double e = 1.0;
-  bool model = false;
-  const auto consider = [&](const ContactPairOptions& p) {
-    const auto& r = p.restitution;
-    if (r.model) {
-      model = true;
-    } else if (!r.table_values.empty()) {
-      e = std::min(e, *std::min_element(r.table_values.begin(), r.table_values.end()));
-    } else {
-      e = std::min(e, r.constant);
-    }
-  };
-  consider(w.default_pair);
-  for (const auto& p : w.pairs) consider(p);
-  return model ? kNaN : e;
-}
+/// The harmonic drive's peak container speed V = X·2πf, m/s (in this order of operations:
+/// the impact speed, and so the time step, depend on its last bit).
+double harmonic_peak_speed(const DamperSimulationOptions& o) { return o.amplitude_m * 2.0 * kPi * o.frequency_hz; }
 
 /// What run_harmonic and estimate_run derive from the options before building a world.
 struct RunPlan {
-  WorldOptions world;  ///< with the raised max_impact_speed_m_s and the chosen time step
-  TimeStepBound bound;
-  double dt = 0.0;
-  std::int64_t steps_per_block = 0;
-  std::int64_t steps_per_period = 0;
+  DriveTimeStep step;  ///< time step, step counts per block and period, the world options to build
   std::int64_t settle_steps = 0;
   std::int64_t transient_steps = 0;
   std::int64_t analysed_steps = 0;
   std::int64_t total_steps = 0;
   int particles = 0;
-  double impact_speed_m_s = 0.0;   ///< the speed the bound is taken at (before any lowering below)
-  double stability_limit_s = 0.0;  ///< min(T_R, t_c/kMinStepsPerContact): the largest user step accepted
-  double steps_per_contact = 0.0;  ///< t_c(impact speed)/dt
-  std::vector<std::string> warnings;
 };
 
-/// Validates (std::invalid_argument: all violations) and plans: the automatic bound at
-/// the drive's largest impact speed, the time step reduced so that a period is a whole
-/// number of blocks of whole steps, the settling time, the step counts.
+/// Validates (std::invalid_argument: all violations) and plans: the drive's time step
+/// (drive_time_step: the bound at the drive's largest impact speed, a period of whole
+/// blocks of whole steps), the settling time, the step counts.
 RunPlan plan_run(const DamperSimulationOptions& options) {
   if (const auto errors = options.validate(); !errors.empty()) throw std::invalid_argument(join_lines(errors));
   RunPlan plan;
-  plan.world = options.world;
-  auto& integ = plan.world.integration;
-  integ.max_impact_speed_m_s = std::max(integ.max_impact_speed_m_s, drive_impact_speed(options));
-  const double user_step = integ.time_step_s;
-  integ.time_step_s = 0.0;
-  plan.bound = time_step_bound(plan.world);
-  const TimeStepBound& bound = plan.bound;
-  plan.impact_speed_m_s = integ.max_impact_speed_m_s;
-  // Stability limit: the Rayleigh time (the explicit critical step of the wave through a
-  // sphere, Li, Xu & Thornton 2005) and kMinStepsPerContact at the impact speed.
-  plan.stability_limit_s = std::min(bound.rayleigh_time_s, bound.contact_time_s / kMinStepsPerContact);
-  if (user_step > plan.stability_limit_s) {
-    std::ostringstream msg;
-    msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << plan.stability_limit_s
-        << " s, the stability limit: the Rayleigh time " << bound.rayleigh_time_s << " s or "
-        << kMinStepsPerContact << " steps of the contact time " << bound.contact_time_s << " s at "
-        << integ.max_impact_speed_m_s << " m/s (the automatic step is " << bound.max_time_step_s << " s: "
-        << integ.steps_per_contact << " steps per contact or " << integ.rayleigh_fraction << " of the Rayleigh time)";
-    throw std::invalid_argument(msg.str());
-  }
-  // The automatic bound of metre-sized soft spheres can exceed the largest step the
-  // integration takes (limits::kMaxTimeStep_s): the run then steps at that limit.
-  const double target_step = user_step > 0.0 ? user_step : std::min(bound.max_time_step_s, limits::kMaxTimeStep_s);
-  const double period = 1.0 / options.frequency_hz;
-  const int samples = options.samples_per_period;
-  plan.steps_per_block = static_cast<std::int64_t>(std::ceil(period / (samples * target_step) - 1e-9));
-  plan.steps_per_period = plan.steps_per_block * samples;
-  plan.dt = period / static_cast<double>(plan.steps_per_period);
-  integ.time_step_s = plan.dt;
-  plan.steps_per_contact = bound.contact_time_s / plan.dt;
-  if (plan.dt > bound.max_time_step_s) {
-    // A user step between the automatic bound and the stability limit: accepted, with
-    // what it costs. The world checks its step against its own bound at
-    // max_impact_speed_m_s, so it is built at the (lower) speed whose bound this step
-    // is: t_c ∝ v^{−1/5}, v_w = v·(t_c(v)/(N_c·dt))^5. That speed only sets the world's
-    // bound and its energy-growth threshold (½m_bed v_w²); restitution laws were
-    // validated up to v above.
-    std::ostringstream w;
-    w << "dem.integration.time_step_s = " << user_step << " s is above the automatic bound "
-      << bound.max_time_step_s << " s: " << plan.steps_per_contact << " steps per contact at the impact speed "
-      << plan.impact_speed_m_s << " m/s (automatic: " << integ.steps_per_contact << ")";
-    const double e_min = smallest_restitution(plan.world);
-    if (std::isfinite(e_min)) {
-      w << "; one impact then realises a restitution low by up to (0.6 ln^2(e) + 0.1)/N = "
-        << 100.0 * restitution_error_bound(e_min, plan.steps_per_contact) << "% at e = " << e_min;
-    } else {
-      w << "; one impact then realises a restitution low by up to (0.6 ln^2(e) + 0.1)/N of e";
-    }
-    w << " (docs/dem.md)";
-    plan.warnings.push_back(w.str());
-    const double ratio = bound.contact_time_s / (integ.steps_per_contact * plan.dt);
-    integ.max_impact_speed_m_s = plan.impact_speed_m_s * std::pow(ratio, 5.0);
-    integ.rayleigh_fraction = std::min(1.0, std::max(integ.rayleigh_fraction, plan.dt / bound.rayleigh_time_s));
-    for (int k = 0; k < 8 && time_step_bound(plan.world).max_time_step_s < plan.dt; ++k) {
-      integ.max_impact_speed_m_s *= 1.0 - 1e-9 * (1 << (2 * k));
-      if (integ.rayleigh_fraction < 1.0) integ.rayleigh_fraction = std::min(1.0, integ.rayleigh_fraction * (1.0 + 1e-12));
-    }
-  }
-
-  // Settling: automatic = long enough for the bed to come to rest under gravity.
-  double settling = options.settling_time_s;
-  if (settling < 0.0) {
-    bool random = false;
-    for (const auto& c : plan.world.compartments) random = random || c.placement == InitialPlacement::kRandom;
-    const double g_norm = norm(plan.world.gravity_m_s2);
-    settling = g_norm == 0.0 ? 0.0
-                             : (random ? 2.0 * std::sqrt(2.0 * fall_height(plan.world) / g_norm) + 0.02 : 0.01);
-  }
-  plan.settle_steps = static_cast<std::int64_t>(std::ceil(settling / plan.dt));
-  plan.transient_steps = plan.steps_per_period * options.transient_periods;
-  plan.analysed_steps = plan.steps_per_period * options.analysed_periods;
+  DriveTiming timing;
+  timing.period_s = 1.0 / options.frequency_hz;
+  timing.blocks_per_period = options.samples_per_period;
+  timing.impact_speed_m_s = drive_impact_speed(options.world, harmonic_peak_speed(options));
+  plan.step = drive_time_step(options.world, timing);
+  const double settling =
+      options.settling_time_s < 0.0 ? automatic_settling_time_s(plan.step.world) : options.settling_time_s;
+  plan.settle_steps = static_cast<std::int64_t>(std::ceil(settling / plan.step.time_step_s));
+  plan.transient_steps = plan.step.steps_per_period * options.transient_periods;
+  plan.analysed_steps = plan.step.steps_per_period * options.analysed_periods;
   plan.total_steps = plan.settle_steps + plan.transient_steps + plan.analysed_steps;
-  for (const auto& c : plan.world.compartments) {
+  for (const auto& c : plan.step.world.compartments) {
     for (const auto& g : c.particles) plan.particles += g.count;
   }
   return plan;
 }
 
-ParticleSnapshot snapshot_of(const World& world, double time_s) {
-  ParticleSnapshot s;
-  s.time_s = time_s;
-  const int n = world.particle_count();
-  for (int i = 0; i < n; ++i) {
-    s.positions_m.push_back(world.position(i));
-    s.velocities_m_s.push_back(world.velocity(i));
-    s.angular_velocities_rad_s.push_back(world.angular_velocity(i));
-    s.radii_m.push_back(world.radius(i));
-    s.compartments.push_back(world.compartment(i));
-  }
-  return s;
-}
-
 }  // namespace
-
-std::string_view to_string(MotionMode mode) {
-  switch (mode) {
-    case MotionMode::kSolidLike:
-      return "solid_like";
-    case MotionMode::kRollingCollectAndCollide:
-      return "rolling_collect_and_collide";
-    case MotionMode::kBouncingCollectAndCollide:
-      return "bouncing_collect_and_collide";
-    case MotionMode::kScattering:
-      return "scattering";
-    case MotionMode::kLocalFluidisation:
-      return "local_fluidisation";
-    case MotionMode::kGlobalFluidisation:
-      return "global_fluidisation";
-    case MotionMode::kDecoupled:
-      return "decoupled";
-  }
-  return "scattering";
-}
 
 std::vector<std::string> DamperSimulationOptions::validate(const std::string& prefix) const {
   std::vector<std::string> errors = world.validate(prefix);
@@ -476,7 +171,7 @@ std::vector<std::string> DamperSimulationOptions::validate(const std::string& pr
   // The run raises integration.max_impact_speed_m_s to the drive's impact speed: that
   // speed must be in range too, and the restitution laws are checked up to it.
   if (errors.empty() && amplitude_ok && frequency_ok) {
-    const double drive = drive_impact_speed(*this);
+    const double drive = drive_impact_speed(world, harmonic_peak_speed(*this));
     std::ostringstream rule;
     rule << "the drive's impact speed 2XΩ + √(2|g|(H − 2r_min)) = " << drive << " m/s (frequency_hz = " << frequency_hz
          << ") must be <= " << limits::kMaxImpactSpeed_m_s << " m/s";
@@ -505,7 +200,7 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
   // The cell grid: at most max(64, 8n) cells (CellGrid::configure), 3 ints per particle.
   double r_max = 0.0;
   std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (const auto& c : plan.world.compartments) {
+  for (const auto& c : plan.step.world.compartments) {
     for (const auto& g : c.particles) r_max = std::max(r_max, g.radius_m * (1.0 + g.radius_spread));
     for (int a = 0; a < 3; ++a) {
       const auto k = static_cast<std::size_t>(a);
@@ -513,7 +208,7 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
       hi[k] = std::max(hi[k], c.offset_m[k] + 0.5 * c.container.inner_length(a));
     }
   }
-  const double cell = (2.0 + plan.world.integration.skin_fraction) * r_max;
+  const double cell = (2.0 + plan.step.world.integration.skin_fraction) * r_max;
   double cells = 1.0;
   for (std::size_t a = 0; a < 3; ++a) cells *= std::max(1.0, std::ceil((hi[a] - lo[a]) / cell));
   cells = std::min(cells, std::max(64.0, 8.0 * static_cast<double>(n)));
@@ -521,8 +216,8 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
   e.neighbour_bytes = offsets + slots + grid;
   // Contact pools as reserved: 2 pair contacts and n/2 + 16 wall contacts per particle,
   // each a Contact and a key (and a rolling torque with rolling resistance).
-  bool rolling = plan.world.default_pair.rolling_friction > 0.0;
-  for (const auto& p : plan.world.pairs) rolling = rolling || p.rolling_friction > 0.0;
+  bool rolling = plan.step.world.default_pair.rolling_friction > 0.0;
+  for (const auto& p : plan.step.world.pairs) rolling = rolling || p.rolling_friction > 0.0;
   const std::size_t entry = sizeof(detail::Contact) + sizeof(detail::ContactKey) + (rolling ? 3 * sizeof(double) : 0);
   e.contact_bytes = (2 * n + n / 2 + 16) * entry;
 }
@@ -540,12 +235,12 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   const RunPlan plan = plan_run(options);
   RunEstimate e;
   e.particles = plan.particles;
-  e.time_step_s = plan.dt;
-  e.impact_speed_m_s = plan.impact_speed_m_s;
-  e.steps_per_contact = plan.steps_per_contact;
-  e.stability_limit_s = plan.stability_limit_s;
-  e.warnings = plan.warnings;
-  e.steps_per_period = plan.steps_per_period;
+  e.time_step_s = plan.step.time_step_s;
+  e.impact_speed_m_s = plan.step.impact_speed_m_s;
+  e.steps_per_contact = plan.step.steps_per_contact;
+  e.stability_limit_s = plan.step.stability_limit_s;
+  e.warnings = plan.step.warnings;
+  e.steps_per_period = plan.step.steps_per_period;
   e.settling_steps = plan.settle_steps;
   e.transient_steps = plan.transient_steps;
   e.analysed_steps = plan.analysed_steps;
@@ -554,7 +249,8 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   e.recorded_samples = static_cast<std::int64_t>(options.analysed_periods) * options.samples_per_period;
   e.snapshots = options.snapshots;
   estimate_world_bytes(plan, e);
-  // 7 TimeSeries columns and the 2 block-average signals per sample; η* per period.
+  // Per sample: the 7 TimeSeries columns and the block-end times of BlockRecorder, and
+  // the centred copy of x_r the motion indicators take at the end; η* per period.
   e.signal_bytes = static_cast<std::size_t>(e.recorded_samples) * 9 * sizeof(double) +
                    static_cast<std::size_t>(options.analysed_periods) * sizeof(double);
   // Per particle and snapshot: 3 Vec3, a radius, a compartment.
@@ -581,15 +277,13 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   const double v_amp = motion.velocity_amplitude_m_s();
   const Vec3& g = options.world.gravity_m_s2;
   const double g_norm = norm(g);
-  const WorldOptions& world_options = plan.world;
-  const double dt = plan.dt;
-  const int samples = options.samples_per_period;
-  const std::int64_t steps_per_block = plan.steps_per_block;
-  const std::int64_t steps_per_period = plan.steps_per_period;
+  const double dt = plan.step.time_step_s;
+  const std::int64_t steps_per_period = plan.step.steps_per_period;
   const std::int64_t settle_steps = plan.settle_steps;
-  const std::int64_t drive_steps = plan.transient_steps + plan.analysed_steps;
+  const std::int64_t transient_steps = plan.transient_steps;
   const std::int64_t total_steps = plan.total_steps;
-  ProgressReporter reporter(progress, static_cast<double>(drive_steps) * dt, plan.particles);
+  const int periods = options.analysed_periods;
+  ProgressReporter reporter(progress, static_cast<double>(transient_steps + plan.analysed_steps) * dt, plan.particles);
   // Before the world is built (placement, lists and first forces take seconds for a
   // million spheres) and after: the estimate's wall time is the best ETA there is.
   const double eta_s = static_cast<double>(plan.particles) * static_cast<double>(total_steps) /
@@ -599,7 +293,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   const ContainerState start = motion.state(0.0);
   ContainerState rest = start;
   rest.velocity_m_s = {0.0, 0.0, 0.0};
-  World world(world_options, rest);
+  World world(plan.step.world, rest);
   reporter.report_now("setup", -static_cast<double>(settle_steps) * dt, eta_s);
   reporter.start_stepping();
 
@@ -612,6 +306,23 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   for (int c = 0; c < world.compartment_count(); ++c) result.compartment_clearances_m.push_back(world.clearance_m(c));
   result.clearance_m = result.compartment_clearances_m.front();
   const int n = world.particle_count();
+  const double m_bed = result.bed_mass_kg;
+
+  // The analysed periods' parts: the series (block averages of the force and the
+  // container velocity along the drive, the bed at block ends, snapshots) and the drive
+  // bin accumulated every step and per period (the measures; no aliasing, whatever
+  // samples_per_period).
+  BlockRecorderOptions recording;
+  recording.drive_axis = axis;
+  recording.time_step_s = dt;
+  recording.steps_per_block = plan.step.steps_per_block;
+  recording.blocks_per_period = options.samples_per_period;
+  recording.periods = periods;
+  recording.start_step = transient_steps;
+  recording.snapshots = options.snapshots;
+  recording.prescribed_motion = &motion;
+  BlockRecorder recorder(recording);
+  DriveBinMeasure drive_bin(steps_per_period, options.frequency_hz, m_bed);
 
   const auto finish = [&](Outcome outcome, const std::string& message) {
     auto& s = result.summary;
@@ -627,181 +338,63 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     s.stage_times = world.stage_times();
     result.particle_steps_per_s = s.wall_time_s > 0.0 ? static_cast<double>(s.particle_steps) / s.wall_time_s : 0.0;
   };
-  // The world stops on an instability (kUnstable) or a failed step (kFailed).
-  const auto unstable = [&]() { return world.status().outcome != Outcome::kCompleted; };
+  // The world halts on an instability (kUnstable) or a failed step (kFailed): the result
+  // keeps what was recorded so far, the measures stay unset.
+  const auto halted = [&]() {
+    if (world.status().outcome == Outcome::kCompleted) return false;
+    result.eta_star_per_period = drive_bin.eta_star_per_period();
+    result.series = recorder.take_series();
+    result.snapshots = recorder.take_snapshots();
+    finish(world.status().outcome, world.status().message);
+    return true;
+  };
 
-  for (std::int64_t k = 0; k < settle_steps; ++k) {
-    world.step(rest);
-    if (unstable()) {
-      finish(world.status().outcome, world.status().message);
-      return result;
-    }
-    reporter.maybe_report("settling", k, total_steps, (k - settle_steps) * dt);
-  }
-
-  const double settled_base = static_cast<double>(world.contact_census(g).touching_base) / n;
-  // The drive starts with the bed at rest relative to the container: collected against
-  // its wall and riding with it, as on the collect-and-collide orbit at detachment.
-  world.add_velocity(start.velocity_m_s);
-  const std::int64_t transient_steps = steps_per_period * options.transient_periods;
+  const auto report_settling = [&](std::int64_t k) {
+    reporter.maybe_report("settling", k, total_steps, static_cast<double>(k - settle_steps) * dt);
+  };
+  // settle() returns false exactly when the world halted.
+  if (!settle(world, start, settle_steps, report_settling) && halted()) return result;
+  // Built on the settled bed: its base contacts are the rolling criterion's reference.
+  MotionModeAccumulator motion_modes(world, plan.step.world, axis);
   for (std::int64_t k = 1; k <= transient_steps; ++k) {
     world.step(motion.state(static_cast<double>(k) * dt));
-    if (unstable()) {
-      finish(world.status().outcome, world.status().message);
-      return result;
-    }
+    if (halted()) return result;
     reporter.maybe_report("transient", settle_steps + k, total_steps, static_cast<double>(k) * dt);
   }
 
-  // Analysis: the drive bin (Fourier coefficient at Ω) of the force and the container
-  // velocity along the drive, accumulated every step and per period (the measures; no
-  // aliasing, whatever samples_per_period), block averages of both (the recorded series,
-  // for plots), and instantaneous samples of the bed at block ends.
-  const int periods = options.analysed_periods;
-  const std::int64_t blocks = static_cast<std::int64_t>(periods) * samples;
-  TimeSeries& series = result.series;
-  std::vector<double> force_blocks, velocity_blocks;
-  force_blocks.reserve(static_cast<std::size_t>(blocks));
-  velocity_blocks.reserve(static_cast<std::size_t>(blocks));
-  for (auto* v : {&series.time_s, &series.container_position_m, &series.container_velocity_m_s, &series.force_n,
-                  &series.bed_relative_position_m, &series.bed_momentum_kg_m_s, &series.kinetic_energy_j}) {
-    v->reserve(static_cast<std::size_t>(blocks));
+  const EnergyLedger ledger(world.energy());
+  for (std::int64_t step = transient_steps + 1; step <= transient_steps + plan.analysed_steps; ++step) {
+    const ContainerState state = motion.state(static_cast<double>(step) * dt);
+    const ContainerLoad& load = world.step(state);
+    if (halted()) return result;
+    drive_bin.add(step, dot(load.force_n, axis), dot(state.velocity_m_s, axis));
+    if (recorder.record_step(world)) motion_modes.sample_block(world);
+    reporter.maybe_report("analysis", settle_steps + step, total_steps, static_cast<double>(step) * dt);
   }
-  std::vector<double> rel_time_s;  // block ends, where the bed's x_r is sampled
-  rel_time_s.reserve(static_cast<std::size_t>(blocks));
-  const EnergyAccount e_start = world.energy();
-  double base_sum = 0.0, airborne_sum = 0.0, spread_sum = 0.0;
-  std::vector<double> fluctuation_sum(static_cast<std::size_t>(n), 0.0);  // Σ over blocks of |v_i − v_bed|², m²/s²
-  const double packed_extent =
-      world_options.compartments.front().container.inner_length(world_options.compartments.front().collect_axis) -
-      result.clearance_m;
-  std::vector<std::int64_t> snapshot_blocks;
-  for (int s = 0; s < options.snapshots; ++s) {
-    snapshot_blocks.push_back(static_cast<std::int64_t>((s + 1.0) * static_cast<double>(blocks) / options.snapshots) - 1);
-  }
-  // F_k of a step is the leapfrog impulse F_k·dt over [t_k − dt/2, t_k + dt/2]: held
-  // constant there (formulas::StepForce::kConstant).
-  formulas::DriveBinAccumulator period_bin(steps_per_period), all_bin(steps_per_period);
-  const double m_bed = result.bed_mass_kg;
-  std::int64_t step = transient_steps;
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    double force_sum = 0.0, velocity_sum = 0.0;
-    for (std::int64_t k = 0; k < steps_per_block; ++k) {
-      ++step;
-      const ContainerState state = motion.state(static_cast<double>(step) * dt);
-      const ContainerLoad& load = world.step(state);
-      if (unstable()) {
-        finish(world.status().outcome, world.status().message);
-        return result;
-      }
-      const double force_along = dot(load.force_n, axis);
-      const double velocity_along = dot(state.velocity_m_s, axis);
-      force_sum += force_along;
-      velocity_sum += velocity_along;
-      period_bin.add(step, force_along, velocity_along);
-      reporter.maybe_report("analysis", settle_steps + step, total_steps, static_cast<double>(step) * dt);
-    }
-    const double t_mid = (static_cast<double>(step - steps_per_block) + 0.5 * static_cast<double>(steps_per_block + 1)) * dt;
-    force_blocks.push_back(force_sum / static_cast<double>(steps_per_block));
-    velocity_blocks.push_back(velocity_sum / static_cast<double>(steps_per_block));
-    const ContainerState now = motion.state(static_cast<double>(step) * dt);
-    series.time_s.push_back(t_mid);
-    series.container_position_m.push_back(dot(motion.state(t_mid).position_m, axis));
-    series.container_velocity_m_s.push_back(velocity_blocks.back());
-    series.force_n.push_back(force_blocks.back());
-    const Vec3 com = world.bed_centre_of_mass();
-    series.bed_relative_position_m.push_back(dot(com, axis) - dot(now.position_m, axis));
-    rel_time_s.push_back(static_cast<double>(step) * dt);
-    series.bed_momentum_kg_m_s.push_back(dot(world.bed_momentum(), axis));
-    const EnergyAccount e = world.energy();
-    series.kinetic_energy_j.push_back(e.kinetic_j);
-    const ContactCensus census = world.contact_census(g);
-    base_sum += static_cast<double>(census.touching_base) / n;
-    airborne_sum += static_cast<double>(census.airborne) / n;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (int i = 0; i < n; ++i) {
-      if (world.compartment(i) != 0) continue;
-      const double along = dot(world.position(i), axis);
-      lo = std::min(lo, along - world.radius(i));
-      hi = std::max(hi, along + world.radius(i));
-    }
-    spread_sum += packed_extent > 0.0 ? (hi - lo) / packed_extent : kNaN;
-    // Velocity of each sphere relative to the bed's mean velocity (the fluctuation).
-    const Vec3 p_bed = world.bed_momentum();
-    for (int i = 0; i < n; ++i) {
-      const Vec3 v = world.velocity(i);
-      double d2 = 0.0;
-      for (std::size_t a = 0; a < 3; ++a) d2 += (v[a] - p_bed[a] / m_bed) * (v[a] - p_bed[a] / m_bed);
-      fluctuation_sum[static_cast<std::size_t>(i)] += d2;
-    }
-    if (std::find(snapshot_blocks.begin(), snapshot_blocks.end(), b) != snapshot_blocks.end()) {
-      result.snapshots.push_back(snapshot_of(world, static_cast<double>(step) * dt));
-    }
-    if ((b + 1) % samples == 0) {
-      result.eta_star_per_period.push_back(period_bin.result(options.frequency_hz).reduced_loss_factor(m_bed));
-      all_bin.merge(period_bin);
-      period_bin.clear();
-    }
-  }
-  const EnergyAccount e_end = world.energy();
 
-  // Complex power over all analysed periods (PHYSICS.md §1): the sum of the periods' bins.
-  const auto cp = all_bin.result(options.frequency_hz);
-  result.eta_star = cp.reduced_loss_factor(m_bed);
-  result.e_diss_j = cp.e_diss_j;
-  result.energy_per_cycle_j = cp.energy_per_cycle_j;
-  result.apparent_mass_kg = cp.apparent_mass_kg;
-  const auto& per = result.eta_star_per_period;
-  const double mean = std::accumulate(per.begin(), per.end(), 0.0) / periods;
-  double var = 0.0;
-  for (const double e : per) var += (e - mean) * (e - mean);
-  var = periods > 1 ? var / (periods - 1) : 0.0;
-  result.eta_star_stderr = periods > 1 ? std::sqrt(var / periods) : kNaN;
-
-  // Energy balance over the analysed periods.
-  EnergyBalance& eb = result.energy;
-  eb.container_work_j = e_end.container_work_j - e_start.container_work_j;
-  eb.normal_damping_j = e_end.normal_damping_j - e_start.normal_damping_j;
-  eb.friction_j = e_end.friction_j - e_start.friction_j;
-  eb.rolling_j = e_end.rolling_j - e_start.rolling_j;
-  eb.delta_kinetic_j = e_end.kinetic_j - e_start.kinetic_j;
-  eb.delta_potential_j = e_end.potential_j - e_start.potential_j;
-  eb.delta_elastic_j = e_end.elastic_j - e_start.elastic_j;
-  const double dissipated = eb.normal_damping_j + eb.friction_j + eb.rolling_j;
-  const double delta_e = eb.delta_kinetic_j + eb.delta_potential_j + eb.delta_elastic_j;
-  const double scale = std::max(std::abs(eb.container_work_j), dissipated);
-  eb.relative_error = scale > 0.0 ? std::abs(eb.container_work_j - dissipated - delta_e) / scale : 0.0;
-  result.energy_balance_error = eb.relative_error;
-  result.eta_star_energy_balance = (dissipated + delta_e) / (periods * kPi * m_bed * v_amp * v_amp);
-
-  // Motion mode.
-  MotionIndicators& mi = result.indicators;
-  const auto& rel = series.bed_relative_position_m;
-  const auto [lo_it, hi_it] = std::minmax_element(rel.begin(), rel.end());
-  mi.relative_stroke_over_clearance = result.clearance_m > 0.0 ? (*hi_it - *lo_it) / result.clearance_m : kNaN;
-  mi.period_correlation = period_correlation(rel, samples, periods);
-  mi.eta_star_variation = mean != 0.0 ? std::sqrt(var) / std::abs(mean) : 0.0;
-  mi.apparent_mass_fraction = result.apparent_mass_kg / m_bed;
-  mi.base_contact_fraction = base_sum / static_cast<double>(blocks);
-  mi.airborne_fraction = airborne_sum / static_cast<double>(blocks);
-  mi.spread_over_packed = spread_sum / static_cast<double>(blocks);
-  mi.settled_base_contact_fraction = settled_base;
-  // x_r about the container centre (compartment 0's offset along the drive).
-  const double middle = dot(world_options.compartments.front().offset_m, axis);
-  std::vector<double> rel_mid(rel.size());
-  for (std::size_t k = 0; k < rel.size(); ++k) rel_mid[k] = rel[k] - middle;
-  // Mobile spheres: rms speed relative to the bed's mean velocity above V/2.
-  int mobile = 0;
-  for (const double sum : fluctuation_sum) {
-    mobile += std::sqrt(sum / static_cast<double>(blocks)) > ModeThresholds::kMobileSpeed * v_amp ? 1 : 0;
-  }
-  mi.mobile_fraction = static_cast<double>(mobile) / n;
-  phase_indicators(rel_mid, rel_time_s, samples, periods, motion.angular_frequency_rad_s(), result.clearance_m, mi);
-  result.motion_mode = classify(mi, result.eta_star, result.intensity);
+  DriveBinMeasures measures = drive_bin.result();
+  result.eta_star = measures.eta_star;
+  result.eta_star_stderr = measures.eta_star_stderr;
+  result.e_diss_j = measures.e_diss_j;
+  result.energy_per_cycle_j = measures.energy_per_cycle_j;
+  result.apparent_mass_kg = measures.apparent_mass_kg;
+  result.energy = ledger.balance(world.energy());
+  result.energy_balance_error = result.energy.relative_error;
+  result.eta_star_energy_balance = (result.energy.dissipated_j() + result.energy.delta_energy_j()) /
+                                   (periods * kPi * m_bed * v_amp * v_amp);
+  MotionReference reference;
+  reference.angular_frequency_rad_s = motion.angular_frequency_rad_s();
+  reference.velocity_amplitude_m_s = v_amp;
+  reference.intensity = result.intensity;
+  result.indicators = motion_modes.indicators(recorder, measures, reference);
+  result.motion_mode = classify_motion(result.indicators, result.eta_star, result.intensity);
+  result.eta_star_per_period = std::move(measures.eta_star_per_period);
+  result.series = recorder.take_series();
+  result.snapshots = recorder.take_snapshots();
 
   // Validity remarks.
   auto& warn = result.warnings;
-  warn.insert(warn.end(), plan.warnings.begin(), plan.warnings.end());
+  warn.insert(warn.end(), plan.step.warnings.begin(), plan.step.warnings.end());
   if (g_norm > 0.0 && std::abs(dot(g, axis)) > 1e-6 * g_norm) {
     warn.push_back("gravity has a component along the drive: the ideal collect-and-collide models do not apply");
   }

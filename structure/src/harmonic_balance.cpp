@@ -650,21 +650,34 @@ class BranchEndFinder {
   std::vector<Piece> pieces_;
 };
 
-/// Peaks of a sampled response curve (NaN where none), half-power damping ratio.
+/// Peaks of a sampled response curve (NaN where none), half-power damping ratio. A
+/// plateau (the response held at a loss model's jump: the damper amplitude pinned at the
+/// onset over a band of frequencies) is one peak at the plateau's middle.
 void find_peaks(const std::vector<double>& f, const std::vector<double>& c, std::size_t output,
                 std::vector<ResponsePeak>& peaks) {
   const std::size_t n = c.size();
   for (std::size_t k = 1; k + 1 < n; ++k) {
-    if (!(c[k] > c[k - 1] && c[k] >= c[k + 1])) continue;
+    if (!(c[k] > c[k - 1])) continue;
+    // Samples equal to c[k] up to round-off (1e-9 relative) belong to its plateau.
+    std::size_t end = k;
+    while (end + 1 < n && std::abs(c[end + 1] - c[k]) <= 1e-9 * c[k]) ++end;
+    if (end + 1 >= n || !(c[end] >= c[end + 1])) {
+      k = end;  // a shelf on the way up (or the curve's end), not a peak
+      continue;
+    }
     ResponsePeak peak;
     peak.output = output;
     peak.magnitude = c[k];
-    // Vertex of the parabola through the three samples (non-uniform spacing).
-    const double x0 = f[k - 1], x1 = f[k], x2 = f[k + 1];
-    const double y0 = c[k - 1], y1 = c[k], y2 = c[k + 1];
-    const double num = (x1 - x0) * (x1 - x0) * (y1 - y2) - (x1 - x2) * (x1 - x2) * (y1 - y0);
-    const double den = (x1 - x0) * (y1 - y2) - (x1 - x2) * (y1 - y0);
-    peak.frequency_hz = den != 0.0 ? x1 - 0.5 * num / den : x1;
+    if (end > k) {
+      peak.frequency_hz = 0.5 * (f[k] + f[end]);
+    } else {
+      // Vertex of the parabola through the three samples (non-uniform spacing).
+      const double x0 = f[k - 1], x1 = f[k], x2 = f[k + 1];
+      const double y0 = c[k - 1], y1 = c[k], y2 = c[k + 1];
+      const double num = (x1 - x0) * (x1 - x0) * (y1 - y2) - (x1 - x2) * (x1 - x2) * (y1 - y0);
+      const double den = (x1 - x0) * (y1 - y2) - (x1 - x2) * (y1 - y0);
+      peak.frequency_hz = den != 0.0 ? x1 - 0.5 * num / den : x1;
+    }
     const double half = c[k] / std::sqrt(2.0);
     double f_lo = kNaN, f_hi = kNaN;
     for (std::size_t i = k; i > 0; --i) {
@@ -674,7 +687,7 @@ void find_peaks(const std::vector<double>& f, const std::vector<double>& c, std:
         break;
       }
     }
-    for (std::size_t i = k; i + 1 < n; ++i) {
+    for (std::size_t i = end; i + 1 < n; ++i) {
       if (!std::isfinite(c[i + 1])) break;
       if (c[i + 1] < half) {
         f_hi = f[i] + (c[i] - half) / (c[i] - c[i + 1]) * (f[i + 1] - f[i]);
@@ -683,6 +696,7 @@ void find_peaks(const std::vector<double>& f, const std::vector<double>& c, std:
     }
     peak.damping_ratio = (f_hi - f_lo) / (2.0 * peak.frequency_hz);
     peaks.push_back(peak);
+    k = end;
   }
 }
 

@@ -484,3 +484,30 @@ TEST_CASE("harmonic balance rejects bad inputs naming the field", "[structure]")
   CHECK_THROWS_WITH(harmonic_balance(model, {bad}, e, options), Catch::Contains("dampers[0].point = \"nowhere\""));
   CHECK_THROWS_WITH(harmonic_balance(model, {bad}, e, options), Catch::Contains("dampers[0].layers[0].bed_mass_kg = 0"));
 }
+
+// Reference: the closed-form rolling damper on a 1-DOF held at its onset over a band of
+// frequencies (the damper amplitude pinned at the onset stroke, X = (1+κ)h/√(π²+4) with
+// κ = 2/5: PHYSICS.md §3): the response is flat there, and the flat top is one peak (at
+// its middle), not one peak per sample that round-off makes a local maximum.
+TEST_CASE("a response held at the onset over a band of frequencies is one peak", "[structure]") {
+  const double h = 0.03;
+  const auto loss = std::make_shared<sg::ClosedFormLossModel>(pdamp::formulas::DamperModel::kRolling, h);
+  const ModalModel m = one_dof(0.6, 2.0, 0.002);
+  Excitation e;
+  e.direction = {1.0, 0.0};
+  e.amplitude = 0.00133;
+  HarmonicBalanceOptions o;
+  o.frequencies_hz = linspace(1.5, 2.5, 401);
+  const auto r = harmonic_balance(m, {damper_with(loss, 0.148, 0.3)}, e, o);
+  std::size_t held = 0;
+  for (const auto& p : r.points) held += p.held_at_jump.size();
+  REQUIRE(held > 3);  // the case must exercise the plateau
+  REQUIRE(r.peaks.size() == 1);
+  const double onset = loss->discontinuities_stroke_m(2.0).front();
+  CHECK(onset == Approx(1.4 * h / std::sqrt(kPi * kPi + 4.0)).epsilon(1e-12));
+  // The plateau's height is the onset stroke over U (absolute amplitude of the site); the
+  // roots beside it, on the collect-and-collide piece, sit just above the onset (0.14%
+  // here), so the peak is within 1% above onset/U.
+  CHECK(r.peaks.front().magnitude >= onset / e.amplitude * (1.0 - 1e-9));
+  CHECK(r.peaks.front().magnitude <= 1.01 * onset / e.amplitude);
+}

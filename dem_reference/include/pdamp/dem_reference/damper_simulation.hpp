@@ -1,4 +1,7 @@
 // One damper under harmonic container motion: transient, analysed periods, measures.
+// The run is assembled from the run machinery that other drivers share (docs/dem.md
+// "Run machinery"): drive_time_step.hpp, run_recorder.hpp, run_measures.hpp,
+// motion_modes.hpp.
 #pragma once
 
 #include <cstdint>
@@ -7,6 +10,9 @@
 #include <string_view>
 #include <vector>
 
+#include "pdamp/dem_reference/motion_modes.hpp"
+#include "pdamp/dem_reference/run_measures.hpp"
+#include "pdamp/dem_reference/run_recorder.hpp"
 #include "pdamp/dem_reference/summary.hpp"
 #include "pdamp/dem_reference/world_options.hpp"
 
@@ -66,100 +72,6 @@ struct DamperSimulationOptions {
 
   /// All violations, one line each, prefixed by `prefix` (world fields included).
   std::vector<std::string> validate(const std::string& prefix = "dem.") const;
-};
-
-/// Motion modes of PHYSICS.md (criteria in docs/dem.md "Motion modes").
-enum class MotionMode {
-  kSolidLike,
-  kRollingCollectAndCollide,
-  kBouncingCollectAndCollide,
-  kScattering,
-  kLocalFluidisation,
-  kGlobalFluidisation,
-  kDecoupled,
-};
-/// "solid_like", "rolling_collect_and_collide", "bouncing_collect_and_collide",
-/// "scattering", "local_fluidisation", "global_fluidisation", "decoupled".
-std::string_view to_string(MotionMode mode);
-
-/// The numbers the motion-mode label is decided from (over the analysed periods; x_r is
-/// the bed's centre of mass relative to the container centre along the drive, sampled at
-/// the block ends; h the clearance of compartment 0). Derivations and thresholds:
-/// docs/dem.md "Motion modes".
-struct MotionIndicators {
-  /// Peak-to-peak travel of x_r over h (≈ 1 when the bed crosses the clearance).
-  double relative_stroke_over_clearance = 0.0;
-  /// Phase-locked stroke 2|x̂_r(Ω)|/h: peak-to-peak of the component of x_r at the drive
-  /// frequency over all analysed periods together (a motion whose phase drifts from
-  /// period to period averages out). Ideal collect-and-collide orbits: 0.98 (onset) to
-  /// 1.23 (X = 3h); a bed at rest in the inertial frame: 2X/h.
-  double phase_locked_stroke = 0.0;
-  /// |Σ_p x̂_r,p| / Σ_p |x̂_r,p| over the periods p, in [0, 1]: 1 when every period's
-  /// relative motion at Ω has the same phase (≈ 1/√n for a random phase).
-  double phase_coherence = 0.0;
-  /// Lag of the component of x_r at Ω behind the container position X sin Ωt, degrees in
-  /// (−180, 180]: ideal collect-and-collide orbits 149° (onset) to 82° (X = h), 55°
-  /// (X = 3h) and 37° (X = 10h); a bed left behind by the container (rolling freely,
-  /// decoupled) 180°.
-  double phase_lag_deg = 0.0;
-  /// Crossings of the clearance per half period: transits of x_r from the outer quarter
-  /// of the clearance at one wall (within h/4 of the collected position) to that at the
-  /// other, over 2 × analysed periods (1 on a collect-and-collide orbit).
-  double crossing_fraction = 0.0;
-  /// Correlation of x_r between consecutive periods, in [−1, 1] (informative only: the
-  /// chaotic scatter of a many-sphere bed lowers it on a collect-and-collide orbit).
-  double period_correlation = 0.0;
-  /// Coefficient of variation of the per-period η* (informative only, as above).
-  double eta_star_variation = 0.0;
-  double apparent_mass_fraction = 0.0;  ///< m_app/m_bed
-  /// Particles touching the wall that gravity presses them on (mean fraction, 0 without
-  /// gravity): rolling collect-and-collide when >= half the settled fraction.
-  double base_contact_fraction = 0.0;
-  /// The same fraction of the settled bed before the drive starts (0 without gravity).
-  double settled_base_contact_fraction = 0.0;
-  /// Particles touching nothing (mean fraction).
-  double airborne_fraction = 0.0;
-  /// Mean extent of the bed along the drive over its packed extent (1 = packed;
-  /// informative only: a container barely longer than the bed caps it).
-  double spread_over_packed = 0.0;
-  /// Spheres whose rms speed relative to the bed's mean velocity (over the analysed
-  /// periods) exceeds V/2, fraction (0: the bed moves as a block; 1: a granular gas).
-  double mobile_fraction = 0.0;
-};
-
-/// Signals over the analysed periods, one sample per block (block averages).
-struct TimeSeries {
-  std::vector<double> time_s;
-  std::vector<double> container_position_m;    ///< along the drive, m
-  std::vector<double> container_velocity_m_s;  ///< along the drive, m/s
-  std::vector<double> force_n;                 ///< container → particles along the drive, N
-  std::vector<double> bed_relative_position_m; ///< bed centre of mass − container, along the drive, m
-  std::vector<double> bed_momentum_kg_m_s;     ///< along the drive, kg·m/s
-  std::vector<double> kinetic_energy_j;        ///< particles, J
-};
-
-/// Particle state at one time (ParaView output).
-struct ParticleSnapshot {
-  double time_s = 0.0;
-  std::vector<Vec3> positions_m;
-  std::vector<Vec3> velocities_m_s;
-  std::vector<Vec3> angular_velocities_rad_s;
-  std::vector<double> radii_m;
-  std::vector<int> compartments;
-};
-
-/// Energy balance over the analysed periods: work of the container against the
-/// dissipation in the contacts plus the change of the particles' energy.
-struct EnergyBalance {
-  double container_work_j = 0.0;
-  double normal_damping_j = 0.0;
-  double friction_j = 0.0;
-  double rolling_j = 0.0;
-  double delta_kinetic_j = 0.0;
-  double delta_potential_j = 0.0;
-  double delta_elastic_j = 0.0;
-  /// |W − (D + ΔE)| / max(|W|, D): target < 0.02.
-  double relative_error = 0.0;
 };
 
 struct DamperResult {
