@@ -23,6 +23,7 @@
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 #include "plots.hpp"
+#include "structure_commands.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
@@ -384,15 +385,13 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
 
 int run_run(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
-  switch (c.task.kind) {
-    case case_file::TaskKind::kDamperDesign: return run_damper_design(args, c);
-    case case_file::TaskKind::kFrf:
-    case case_file::TaskKind::kDecay:
-    case case_file::TaskKind::kModes: break;
+  if (c.task.kind == case_file::TaskKind::kDamperDesign) {
+    if (args.has("--method"))
+      throw InputError("--method", "", "applies to the structure tasks (modes, frf, decay); this case's task is damper_design");
+    return run_damper_design(args, c);
   }
-  // The case is read and checked (pdamp validate); the structure solvers are not wired here yet.
-  throw std::runtime_error("pdamp run: task '" + std::string(case_file::to_string(c.task.kind)) +
-                           "' is not run by pdamp yet (the case is valid: see pdamp validate)");
+  // modes, frf, decay: exactly as pdamp modes, frf and decay (structure_commands.cpp).
+  return run_structure_task(args, c);
 }
 
 /// One progress line on stderr: rewritten in place on a terminal, else a line every 10 s.
@@ -815,11 +814,13 @@ const FlagSpec kModelOverrides[] = {
 }  // namespace
 
 const std::vector<Command>& commands() {
-  static const std::vector<Command> all = {
-      {{"run", "pdamp run CASE.json [-o DIR] [--json]",
+  static const std::vector<Command> all = [] {
+    std::vector<Command> list = {
+      {{"run", "pdamp run CASE.json [--method formulas|field] [-o DIR] [--json]",
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
-        "for a target stroke, eta* curve over stroke, buffered-wall sizing)",
-        {kOutFlag, kJsonFlag}, 1},
+        "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
+        "as pdamp modes, frf and decay, --method only for these)",
+        {kMethodFlag, kOutFlag, kJsonFlag}, 1},
        run_run},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",
@@ -892,7 +893,12 @@ const std::vector<Command>& commands() {
         "bed clearance, extent and mass",
         {kJsonFlag}, 1},
        run_validate},
-  };
+    };
+    // Level III after the damper commands, before validate.
+    auto structure = structure_commands();
+    list.insert(list.end() - 1, structure.begin(), structure.end());
+    return list;
+  }();
   return all;
 }
 

@@ -1,6 +1,7 @@
 // Runtime models of a format-2 case: modal model and dampers with their loss models.
 #include "pdamp/case_file/structure_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -65,13 +66,25 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
   StructureSetup out;
   const StructureSpec& s = *c.structure;
   if (s.kind == StructureSpec::Kind::kBeam) {
+    // The dampers' containers and beds hang on the beam: their weight loads its geometric
+    // stiffness (a standing beam with a tip damper), their inertia enters through the coupling.
+    st::BeamModel loaded = s.beam;
+    for (const DamperSpec& d : c.dampers) {
+      double mass = d.container_mass_kg;
+      for (const LayerSpec& layer : d.layers) mass += layer.bed_mass_kg;
+      for (const auto& p : s.beam.points)
+        if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
+      for (const auto& p : s.beam.point_masses)
+        if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
+    }
     st::BeamModalResult beam;
     try {
-      beam = st::beam_modal_model(s.beam, s.mode_count, s.damping);
+      beam = st::beam_modal_model(loaded, s.mode_count, s.damping);
     } catch (const std::invalid_argument& e) {
       throw CaseError(c.path, "/structure", e.what());
     }
     out.modal = std::move(beam.modal);
+    out.beam = std::move(loaded);
     out.rigid_modes_dropped = beam.rigid_modes_dropped;
   } else {
     out.modal = *s.modal_data;
@@ -83,6 +96,9 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
     damper.point = spec.site;
     damper.drive_direction = {spec.drive_direction[0], spec.drive_direction[1]};
     damper.container_mass_kg = spec.container_mass_kg;
+    for (const LayerSpec& layer : spec.layers) {
+      damper.length_along_drive_m = std::max(damper.length_along_drive_m, layer.container.inner_length(spec.drive_axis));
+    }
     for (std::size_t l = 0; l < spec.layers.size(); ++l) {
       const LayerSpec& layer = spec.layers[l];
       st::DamperLayer coupled;

@@ -142,6 +142,7 @@ Mesh build_mesh(const BeamModel& beam) {
   for (const auto& s : beam.supports) add_key(s.position_m);
   for (const auto& m : beam.point_masses) add_key(m.position_m);
   for (const auto& p : beam.points) add_key(p.position_m);
+  for (const auto& w : beam.carried_weights) add_key(w.position_m);
   std::sort(key_positions.begin(), key_positions.end());
   std::vector<double> keys;
   for (double x : key_positions) {
@@ -259,6 +260,10 @@ std::vector<std::pair<double, double>> gravity_tension(const BeamModel& beam, co
   for (const auto& m : beam.point_masses) {
     const Eigen::Index node = mesh.node_at(std::clamp(m.position_m, 0.0, beam.length_m()));
     point_mass_kg[static_cast<std::size_t>(node)] += m.mass_kg;
+  }
+  for (const auto& w : beam.carried_weights) {
+    const Eigen::Index node = mesh.node_at(std::clamp(w.position_m, 0.0, beam.length_m()));
+    point_mass_kg[static_cast<std::size_t>(node)] += w.mass_kg;
   }
   // distributed_before[i]: beam mass on [0, x_i]; point_before[i]: point masses at nodes < i.
   std::vector<double> distributed_before(nodes, 0.0);
@@ -554,6 +559,13 @@ std::vector<std::string> BeamModel::validate() const {
     const std::string at = "points/" + std::to_string(i) + "/";
     check_name(points[i].name, at);
     require(problems, on_beam(points[i].position_m), at + "position_m", points[i].position_m, position_rule);
+  }
+  for (std::size_t i = 0; i < carried_weights.size(); ++i) {
+    const std::string at = "carried_weights/" + std::to_string(i) + "/";
+    require(problems, on_beam(carried_weights[i].position_m), at + "position_m", carried_weights[i].position_m,
+            position_rule);
+    require(problems, non_negative_finite(carried_weights[i].mass_kg), at + "mass_kg", carried_weights[i].mass_kg,
+            "must be >= 0 kg and finite");
   }
   require(problems, std::isfinite(axial_gravity_m_s2), "axial_gravity_m_s2", axial_gravity_m_s2, "must be finite");
   if (geometric_stiffness && axial_gravity_m_s2 != 0.0 && !axial_anchor) {

@@ -78,6 +78,33 @@ std::vector<std::string> Damper::validate(const ModalModel& model) const {
   return problems;
 }
 
+std::vector<std::string> rotation_warnings(const ModalModel& model, const std::vector<Damper>& dampers,
+                                           double fraction) {
+  std::vector<std::string> warnings;
+  for (const Damper& d : dampers) {
+    const PointModeShape* site = find_point(model, d.point);
+    if (!site || !(d.length_along_drive_m > 0.0)) continue;
+    for (Eigen::Index j = 0; j < model.mode_count(); ++j) {
+      const double translation = std::abs(site->translation.col(j).dot(d.drive_direction));
+      const double end_motion = std::abs(site->rotation[j]) * 0.5 * d.length_along_drive_m;
+      if (!(end_motion > fraction * translation)) continue;
+      std::ostringstream out;
+      out.precision(3);
+      out << "damper " << d.name << " at '" << d.point << "': in mode " << j + 1 << " (" << model.natural_frequencies_hz[j]
+          << " Hz) the site rotates, so the container's ends move by ";
+      if (translation > 0.0) {
+        out << 100.0 * end_motion / translation << "%";
+      } else {
+        out << "more than 100%";
+      }
+      out
+          << " of its translation along the drive; the closed forms and the fields assume pure translation";
+      warnings.push_back(out.str());
+    }
+  }
+  return warnings;
+}
+
 std::vector<std::string> CouplingOptions::validate() const {
   if (std::isfinite(apparent_mass_fraction_if_missing)) return {};
   return {"apparent_mass_fraction_if_missing = " + number(apparent_mass_fraction_if_missing) + ": must be finite"};
@@ -169,6 +196,18 @@ CoupledModel couple(const ModalModel& model, const std::vector<Damper>& dampers,
   coupled.dampers = dampers;
   coupled.options = options;
   return coupled;
+}
+
+Eigen::VectorXd natural_frequencies_with_containers_hz(const CoupledModel& coupled) {
+  const Eigen::VectorXd k = coupled.modal_masses_kg.cwiseProduct(coupled.angular_frequencies_rad_s.cwiseAbs2());
+  const Eigen::MatrixXd stiffness = k.asDiagonal();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, coupled.mass_with_containers_kg,
+                                                                         Eigen::EigenvaluesOnly);
+  if (solver.info() != Eigen::Success) {
+    throw std::runtime_error("natural_frequencies_with_containers_hz: the eigenproblem with the containers failed");
+  }
+  constexpr double kTwoPi = 6.283185307179586476925;
+  return solver.eigenvalues().cwiseMax(0.0).cwiseSqrt() / kTwoPi;
 }
 
 void linear_dynamic_stiffness(const CoupledModel& coupled, double angular_frequency_rad_s, Eigen::MatrixXcd& out) {

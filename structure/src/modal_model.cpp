@@ -117,4 +117,16 @@ std::vector<std::string> ModalModel::validate() const {
   return problems;
 }
 
+Eigen::VectorXd modal_static_deflection_amplitudes(const ModalModel& model, const std::string& point,
+                                                   const Eigen::Vector2d& force_n) {
+  const PointModeShape& p = model.point(point);
+  constexpr double kTwoPi = 6.283185307179586476925;
+  Eigen::VectorXd q(model.mode_count());
+  for (Eigen::Index j = 0; j < model.mode_count(); ++j) {
+    const double omega = kTwoPi * model.natural_frequencies_hz[j];
+    q[j] = p.translation.col(j).dot(force_n) / (model.modal_masses_kg[j] * omega * omega);
+  }
+  return q;
+}
+
 }  // namespace pdamp::structure

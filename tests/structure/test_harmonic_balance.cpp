@@ -511,3 +511,21 @@ TEST_CASE("a response held at the onset over a band of frequencies is one peak",
   CHECK(r.peaks.front().magnitude >= onset / e.amplitude * (1.0 - 1e-9));
   CHECK(r.peaks.front().magnitude <= 1.01 * onset / e.amplitude);
 }
+
+// Reference: the geometry of a rotating site. A container of length L centred at a site
+// that rotates by θ per unit q while translating by b along the drive has its ends moving
+// by θL/2 beyond b: 0.2/1 = 20% with θ = 2, L = 0.2 m (warned at the 10% default), 5% with
+// L = 0.05 m (not warned); an unknown length (0) is never warned about.
+TEST_CASE("a damper at a rotating site is warned about with the end motion it sees", "[structure]") {
+  ModalModel m = one_dof(1.0, 5.0, 0.01);
+  m.points[0].rotation = Eigen::RowVectorXd::Constant(1, 2.0);
+  Damper d = damper_with(std::make_shared<ViscousLoss>(1.0, 0.1), 0.1, 0.2);
+  d.length_along_drive_m = 0.2;
+  const auto warned = rotation_warnings(m, {d});
+  REQUIRE(warned.size() == 1);
+  CHECK_THAT(warned.front(), Catch::Contains("mode 1") && Catch::Contains("20%"));
+  d.length_along_drive_m = 0.05;
+  CHECK(rotation_warnings(m, {d}).empty());
+  d.length_along_drive_m = 0.0;
+  CHECK(rotation_warnings(m, {d}).empty());
+}

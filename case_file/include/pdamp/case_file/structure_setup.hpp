@@ -2,11 +2,13 @@
 // model and its dampers, each layer with the loss model a structure solver asks.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/modal_model.hpp"
 
@@ -21,6 +23,9 @@ std::string_view to_string(LossMethod method);
 
 struct StructureSetup {
   structure::ModalModel modal;               ///< beam: its finite-element modes; modal data: as read
+  /// Beam: the beam as analysed, the dampers' weights added as carried weights (their
+  /// geometric stiffness); static deflections must use it. Empty for modal data.
+  std::optional<structure::BeamModel> beam;
   int rigid_modes_dropped = 0;               ///< beam: rigid-body modes at 0 Hz not kept
   std::vector<structure::Damper> dampers;    ///< in case order, layers in case order
   std::vector<std::string> warnings;         ///< one sentence each (a field reused at another clearance)

@@ -58,6 +58,13 @@ struct PointMass {
   double rotary_inertia_kg_m2 = 0.0;
 };
 
+/// A weight the beam carries whose inertia is modelled elsewhere (a damper's container and
+/// beds, coupled through structure::Damper): it loads the geometric stiffness only.
+struct CarriedWeight {
+  double position_m = 0.0;
+  double mass_kg = 0.0;  ///< >= 0
+};
+
 struct NamedPoint {
   std::string name;
   double position_m = 0.0;
@@ -79,6 +86,7 @@ struct BeamModel {
   std::vector<Support> supports;
   std::vector<PointMass> point_masses;
   std::vector<NamedPoint> points;
+  std::vector<CarriedWeight> carried_weights;
   /// Gravity's component along +x (from the first end to the other), m/s². A standing
   /// beam clamped at its first end has −9.81, a hanging one +9.81; 0 for a horizontal beam.
   double axial_gravity_m_s2 = 0.0;

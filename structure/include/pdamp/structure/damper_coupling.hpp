@@ -36,10 +36,21 @@ struct Damper {
   std::string point;                           ///< named point of the ModalModel
   Eigen::Vector2d drive_direction{1.0, 0.0};   ///< unit vector n in the x-y plane (the container's drive axis)
   double container_mass_kg = 0.0;              ///< empty container m_c, kg, >= 0
+  /// Length of the container along its drive, m, >= 0 (0: unknown; rotation_warnings
+  /// then says nothing). Only for the rotation check: the beds act at the site.
+  double length_along_drive_m = 0.0;
   std::vector<DamperLayer> layers;             ///< beds, each at its own clearance; may be empty
   /// One line per violated rule, prefixed "dampers[i]." by the caller's index.
   std::vector<std::string> validate(const ModalModel& model) const;
 };
+
+/// Where the site rotates, the container's ends move beyond its translation: by θ_j·L/2 in
+/// mode j (θ_j the site's rotation per unit q_j, L the container's length along the drive)
+/// against its translation along the drive b_dj. The closed forms and the fields are for a
+/// container in pure translation, so one sentence per damper and mode where θ_j·L/2 exceeds
+/// `fraction` of |b_dj| (0.1 by default: the beds' ends then see 10% more or less stroke).
+std::vector<std::string> rotation_warnings(const ModalModel& model, const std::vector<Damper>& dampers,
+                                           double fraction = 0.1);
 
 /// How the coupling treats answers a loss model cannot give.
 struct CouplingOptions {
@@ -105,6 +116,12 @@ struct CoupledModel {
 /// arrays; throws std::invalid_argument with every violation, one per line.
 CoupledModel couple(const ModalModel& model, const std::vector<Damper>& dampers,
                     const CouplingOptions& options = {});
+
+/// Natural frequencies of the modal model with the empty containers attached (beds
+/// removed), Hz, ascending: the modal stiffness diag(m_j ω_j²) against
+/// mass_with_containers_kg, the linear system of the FRF's "without beds" curve.
+/// std::runtime_error if the eigensolver fails.
+Eigen::VectorXd natural_frequencies_with_containers_hz(const CoupledModel& coupled);
 
 /// The linear modal dynamic stiffness with the containers (layers removed), modes x modes:
 /// diag(m_j(ω_j² − Ω² + 2iζ_jω_jΩ)) − Ω²·Σ m_c Φ_dᵀΦ_d. Writes into `out` (resized once).

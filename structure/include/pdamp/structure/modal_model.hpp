@@ -41,4 +41,11 @@ struct ModalModel {
   std::vector<std::string> validate() const;
 };
 
+/// The static response of the retained modes to a force F (x, y) at a named point:
+/// q0_j = φ_j(p)·F/(m_j ω_j²), the initial state of a release from imported modal data
+/// (truncated to the kept modes; a beam's static_deflection_modal_amplitudes projects the
+/// exact static deflection instead). Throws std::invalid_argument for an unknown point.
+Eigen::VectorXd modal_static_deflection_amplitudes(const ModalModel& model, const std::string& point,
+                                                   const Eigen::Vector2d& force_n);
+
 }  // namespace pdamp::structure

@@ -1,0 +1,683 @@
+// pdamp modes, frf and decay: read a format-2 case, build its structure and dampers
+// (case_file::structure_setup), call the structure solvers, print and write the results
+// (docs/structure_cli.md). The physics lives in structure/; here are flags, calls and output.
+#include "structure_commands.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "errors.hpp"
+#include "output.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/structure/backbone.hpp"
+#include "pdamp/structure/beam.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+#include "pdamp/structure/free_decay.hpp"
+#include "pdamp/structure/harmonic_balance.hpp"
+#include "structure_plots.hpp"
+
+namespace pdamp::cli {
+
+const FlagSpec kMethodFlag{"--method", "M",
+                           "source of each layer's eta*(f, X) and apparent mass: formulas (the closed\n"
+                           "                          forms of its model and clearance; default) or field (the\n"
+                           "                          layer's field_file, made by pdamp field)"};
+
+namespace {
+
+using nlohmann::json;
+namespace st = structure;
+using case_file::Case;
+using case_file::TaskKind;
+
+
+const FlagSpec kJsonFlag{"--json", "", "print exactly one JSON object on stdout"};
+
+/// Default backbone range when the case's task is not `modes`: 40 log-spaced damper
+/// amplitudes from 1 mm to twice the largest clearance of the reference damper's layers.
+constexpr int kDefaultBackbonePoints = 40;
+constexpr double kDefaultBackboneMinM = 1e-3;
+constexpr double kDefaultBackboneMaxOverClearance = 2.0;
+/// A mode in which the reference damper moves less than this fraction of its largest
+/// drive shape gets no backbone (its amplitude there would be meaningless).
+constexpr double kNoMotionFraction = 1e-9;
+/// Free-decay samples: about 50 per period of the first mode, at least 2000, at most 20000.
+constexpr double kDecaySamplesPerPeriod = 50.0;
+constexpr double kDecayMinSamples = 2000.0;
+constexpr double kDecayMaxSamples = 20000.0;
+
+/// Warnings collected once each, in order.
+class Warnings {
+ public:
+  void add(const std::string& w) {
+    if (seen_.insert(w).second) list_.push_back(w);
+  }
+  void add(const std::vector<std::string>& ws, const std::string& prefix = "") {
+    for (const auto& w : ws) add(prefix + w);
+  }
+  const std::vector<std::string>& list() const { return list_; }
+  /// One line each on stderr (made printable: a name with a newline cannot split it).
+  void print() const {
+    for (const auto& w : list_) std::cerr << "pdamp: warning: " << strict_json::printable(w) << "\n";
+  }
+
+ private:
+  std::vector<std::string> list_;
+  std::set<std::string> seen_;
+};
+
+/// A number, or null where the solver defines none (NaN: a half-power point outside the
+/// grid, a decay that did not settle).
+json number_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+case_file::LossMethod loss_method(const ParsedArgs& args) {
+  const std::string name = args.optional_text("--method").value_or("formulas");
+  if (name == "formulas") return case_file::LossMethod::kFormulas;
+  if (name == "field") return case_file::LossMethod::kField;
+  throw InputError("--method", "", "'" + name + "': must be formulas or field");
+}
+
+std::unique_ptr<OutputDir> output_dir(const ParsedArgs& args) {
+  if (const auto dir = args.optional_text("-o")) return std::make_unique<OutputDir>(*dir);
+  return nullptr;
+}
+
+/// The task a command needs, or exit 2 naming /task and what is missing.
+void require_task(const Case& c, TaskKind kind, bool present, const std::string& needed) {
+  if (c.task.kind == kind && present) return;
+  const std::string name(case_file::to_string(kind));
+  throw InputError(c.path, "/task",
+                   "pdamp " + name + " needs a task of kind " + name + " (this case's task is '" +
+                       std::string(case_file::to_string(c.task.kind)) + "'): give \"task\": {\"kind\": \"" + name +
+                       "\", " + needed + "} (docs/cases.md, Format 2)");
+}
+
+/// A structure solver's std::invalid_argument is a property of the case: exit 2 naming it.
+template <class F>
+auto call_solver(const Case& c, const std::string& pointer, F&& f) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path, pointer, e.what());
+  }
+}
+
+/// The case's structure and dampers, built for `method`, with the setup's warnings.
+struct Setup {
+  case_file::LossMethod method;
+  case_file::StructureSetup s;
+  Warnings warnings;
+};
+
+Setup make_setup(const Case& c, case_file::LossMethod method) {
+  Setup out{method, case_file::structure_setup(c, method), {}};
+  out.warnings.add(out.s.warnings);
+  out.warnings.add(st::rotation_warnings(out.s.modal, out.s.dampers));
+  if (out.s.rigid_modes_dropped > 0)
+    out.warnings.add("the structure has " + std::to_string(out.s.rigid_modes_dropped) +
+                     " rigid-body mode(s) at 0 Hz; they are not kept (docs/structures.md)");
+  return out;
+}
+
+std::vector<std::string> damper_names(const Setup& setup) {
+  std::vector<std::string> names;
+  for (const auto& d : setup.s.dampers) names.push_back(d.name);
+  return names;
+}
+
+std::vector<std::string> layer_names(const Setup& setup) {
+  std::vector<std::string> names;
+  for (const auto& d : setup.s.dampers)
+    for (const auto& l : d.layers) names.push_back(d.name + "/" + l.name);
+  return names;
+}
+
+std::vector<double> spaced(double lo, double hi, int n, bool log) {
+  std::vector<double> v(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double s = n == 1 ? 0.0 : static_cast<double>(i) / (n - 1);
+    v[static_cast<std::size_t>(i)] = log ? std::exp(std::log(lo) + s * (std::log(hi) - std::log(lo))) : lo + s * (hi - lo);
+  }
+  v.back() = hi;
+  return v;
+}
+
+/// The common head of every structure result: what ran, on which case, with which method.
+json result_head(const Case& c, const std::string& task, case_file::LossMethod method) {
+  return {{"task", task}, {"case", c.name}, {"method", case_file::to_string(method)}};
+}
+
+/// Commits the files (with the result JSON and the resolved case), prints the warnings
+/// and the result.
+int finish(const ParsedArgs& args, const Case& c, OutputDir* files, const std::string& json_name, json& result,
+           Warnings& warnings, const std::vector<std::pair<std::string, std::string>>& table) {
+  json outputs = json::array();
+  if (files) {
+    result["warnings"] = warnings.list();
+    files->add_json("case_resolved.json", c.resolved);
+    files->add_json(json_name, result);
+    outputs = files->commit();
+  }
+  result["warnings"] = warnings.list();
+  result["outputs"] = outputs;
+  warnings.print();
+  if (args.has("--json")) {
+    std::cout << result.dump(2) << "\n";
+  } else {
+    auto rows = table;
+    rows.insert(rows.begin(), {"case", c.name});
+    for (const auto& path : outputs) rows.push_back({"wrote", path.get<std::string>()});
+    std::cout << key_value_table(rows);
+  }
+  return kExitOk;
+}
+
+std::string file_or_empty(const OutputDir* files, const std::string& name) {
+  return files ? (files->dir() / name).string() : std::string();
+}
+json file_json(const OutputDir* files, const std::string& name) {
+  return files ? json(file_or_empty(files, name)) : json(nullptr);
+}
+
+// ---------------------------------------------------------------- modes
+
+int run_modes_case(const ParsedArgs& args, const Case& c) {
+  const auto method = loss_method(args);
+  auto files = output_dir(args);
+  Setup setup = make_setup(c, method);
+  const st::ModalModel& modal = setup.s.modal;
+  const auto& dampers = setup.s.dampers;
+
+  Eigen::Index mode_count = modal.mode_count();
+  const bool from_task = c.task.kind == TaskKind::kModes && c.task.modes.has_value();
+  if (from_task && c.task.modes->mode_count > 0) mode_count = std::min<Eigen::Index>(mode_count, c.task.modes->mode_count);
+
+  // Backbone amplitudes of the reference damper (the first).
+  double lo = kDefaultBackboneMinM, hi = 0.0;
+  int points = kDefaultBackbonePoints;
+  if (from_task) {
+    lo = c.task.modes->backbone_min_amplitude_m;
+    hi = c.task.modes->backbone_max_amplitude_m;
+    points = c.task.modes->backbone_points;
+  } else {
+    for (const auto& layer : c.dampers.front().layers) hi = std::max(hi, kDefaultBackboneMaxOverClearance * layer.clearance_m);
+    if (!(hi > lo)) lo = hi / 100.0;
+  }
+  const auto amplitudes = spaced(lo, hi, points, true);
+
+  std::vector<st::Damper> containers = dampers;
+  for (auto& d : containers) d.layers.clear();
+  const auto empty = call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
+  const auto coupled = call_solver(c, "/dampers", [&] { return st::couple(modal, dampers); });
+  const Eigen::VectorXd with_containers = st::natural_frequencies_with_containers_hz(empty);
+
+  // μ_dj = b_dj² Σ_l m_bed,l / m_j.
+  Eigen::MatrixXd mass_ratio(mode_count, static_cast<Eigen::Index>(dampers.size()));
+  for (Eigen::Index d = 0; d < mass_ratio.cols(); ++d) {
+    double bed = 0.0;
+    for (const auto& l : dampers[static_cast<std::size_t>(d)].layers) bed += l.bed_mass_kg;
+    for (Eigen::Index j = 0; j < mode_count; ++j)
+      mass_ratio(j, d) = coupled.drive_shapes(j, d) * coupled.drive_shapes(j, d) * bed / coupled.modal_masses_kg[j];
+  }
+
+  std::vector<st::Backbone> backbones;
+  std::map<Eigen::Index, std::size_t> backbone_of_mode;
+  const double largest_drive = coupled.drive_shapes.col(0).cwiseAbs().maxCoeff();
+  bool all_converged = true;
+  std::map<std::string, std::vector<Eigen::Index>> backbone_warnings;  // sentence -> modes (1-based)
+  for (Eigen::Index j = 0; j < mode_count; ++j) {
+    if (!(std::abs(coupled.drive_shapes(j, 0)) > kNoMotionFraction * largest_drive)) {
+      setup.warnings.add("mode " + std::to_string(j + 1) + ": damper " + dampers.front().name +
+                         " does not move along its drive in this mode: no backbone");
+      continue;
+    }
+    st::BackboneOptions options;
+    options.mode = static_cast<int>(j);
+    options.reference_damper = 0;
+    options.damper_amplitudes_m = amplitudes;
+    auto b = call_solver(c, "/task", [&] { return st::backbone(modal, dampers, options); });
+    for (const auto& p : b.points) all_converged = all_converged && p.converged;
+    for (const auto& w : b.warnings) backbone_warnings[w].push_back(j + 1);
+    backbone_of_mode[j] = backbones.size();
+    backbones.push_back(std::move(b));
+  }
+  for (const auto& [sentence, modes] : backbone_warnings) {
+    std::string list;
+    for (const auto m : modes) list += (list.empty() ? "" : ", ") + std::to_string(m);
+    setup.warnings.add("backbone (mode" + std::string(modes.size() > 1 ? "s " : " ") + list + "): " + sentence);
+  }
+  for (Eigen::Index j = 0; j < mode_count; ++j)
+    if (!std::isfinite(with_containers[j]) || !std::isfinite(modal.natural_frequencies_hz[j]))
+      throw NumericalError("pdamp modes: the natural frequency of mode " + std::to_string(j + 1) + " is not finite");
+
+  json modes = json::array();
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (Eigen::Index j = 0; j < mode_count; ++j) {
+    json shapes = json::object();
+    for (const auto& p : modal.points)
+      shapes[p.name] = {{"translation_x", p.translation(0, j)}, {"translation_y", p.translation(1, j)},
+                        {"rotation", p.rotation(j)}};
+    json ratio_per_damper = json::object(), drive = json::object();
+    double ratio_total = 0.0;
+    for (std::size_t d = 0; d < dampers.size(); ++d) {
+      const auto col = static_cast<Eigen::Index>(d);
+      ratio_per_damper[dampers[d].name] = mass_ratio(j, col);
+      drive[dampers[d].name] = coupled.drive_shapes(j, col);
+      ratio_total += mass_ratio(j, col);
+    }
+    json mode = {{"mode", j + 1},
+                 {"frequency_hz", with_containers[j]},
+                 {"bare_frequency_hz", modal.natural_frequencies_hz[j]},
+                 {"damping_ratio", modal.damping_ratios[j]},
+                 {"modal_mass_kg", modal.modal_masses_kg[j]},
+                 {"modal_mass_ratio", ratio_total},
+                 {"modal_mass_ratio_per_damper", ratio_per_damper},
+                 {"drive_shape_per_damper", drive},
+                 {"shapes", shapes},
+                 {"backbone", nullptr}};
+    std::string row = format_number(with_containers[j], 6) + " Hz (bare " + format_number(modal.natural_frequencies_hz[j], 6) +
+                      " Hz), mu = " + format_number(ratio_total, 4);
+    if (const auto it = backbone_of_mode.find(j); it != backbone_of_mode.end()) {
+      const auto& b = backbones[it->second];
+      const auto best = std::max_element(b.points.begin(), b.points.end(), [](const auto& a, const auto& x) {
+        return a.added_damping_ratio < x.added_damping_ratio;
+      });
+      double f_min = b.points.front().damped_frequency_hz, f_max = f_min;
+      for (const auto& p : b.points) f_min = std::min(f_min, p.damped_frequency_hz), f_max = std::max(f_max, p.damped_frequency_hz);
+      mode["backbone"] = {{"file", file_json(files.get(), "backbone_mode" + std::to_string(j + 1) + ".csv")},
+                          {"points", b.points.size()},
+                          {"modal_mass_ratio", b.modal_mass_ratio},
+                          {"max_added_damping_ratio", best->added_damping_ratio},
+                          {"max_added_damping_amplitude_m", best->damper_amplitude_m},
+                          {"min_damped_frequency_hz", f_min},
+                          {"max_damped_frequency_hz", f_max}};
+      row += ", zeta_add max " + format_number(best->added_damping_ratio, 4) + " at X = " +
+             format_number(best->damper_amplitude_m, 4) + " m";
+    }
+    rows.push_back({"mode " + std::to_string(j + 1), row});
+    modes.push_back(std::move(mode));
+  }
+
+  if (files) {
+    ModeTable table;
+    for (Eigen::Index j = 0; j < mode_count; ++j) {
+      table.frequency_hz.push_back(with_containers[j]);
+      table.bare_frequency_hz.push_back(modal.natural_frequencies_hz[j]);
+      table.damping_ratio.push_back(modal.damping_ratios[j]);
+    }
+    table.damper_names = damper_names(setup);
+    table.mass_ratio = mass_ratio;
+    table.points = modal.points;
+    write_modes_table(*files, table);
+    setup.warnings.add(write_backbone_files(*files, backbones, layer_names(setup),
+                                            c.name + ": backbones (" + std::string(case_file::to_string(method)) + ")"));
+  }
+  if (!all_converged) setup.warnings.add("some backbone points did not converge (converged = 0 in backbone_mode<j>.csv)");
+
+  json result = result_head(c, "modes", method);
+  result["file"] = file_json(files.get(), "modes.csv");
+  result["modes"] = modes;
+  result["frequencies"] =
+      "frequency_hz: natural frequencies with the empty containers attached (beds removed); bare_frequency_hz: "
+      "the structure alone; damping_ratio: the structural modal damping ratio";
+  result["rigid_modes_dropped"] = setup.s.rigid_modes_dropped;
+  result["backbone"] = {{"reference_damper", dampers.front().name},
+                        {"amplitude_source", from_task ? "task" : "default"},
+                        {"min_amplitude_m", lo},
+                        {"max_amplitude_m", hi},
+                        {"points", points},
+                        {"spacing", "log"},
+                        {"plot", file_json(files.get(), "backbone.png")}};
+  result["outcome"] = all_converged ? "converged" : "not_converged";
+  rows.insert(rows.begin(), {"method", std::string(case_file::to_string(method))});
+  return finish(args, c, files.get(), "modes.json", result, setup.warnings, rows);
+}
+
+// ---------------------------------------------------------------- frf
+
+std::string_view branch_end_kind(st::BranchEnd::Kind kind) {
+  switch (kind) {
+    case st::BranchEnd::Kind::kFold: return "fold";
+    case st::BranchEnd::Kind::kDiscontinuity: return "discontinuity";
+    case st::BranchEnd::Kind::kStrokeRange: return "stroke_range";
+  }
+  return "";
+}
+
+json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<std::string>& names) {
+  json out = json::array();
+  for (const auto& p : peaks)
+    out.push_back({{"output", p.output < names.size() ? names[p.output] : std::to_string(p.output)},
+                   {"frequency_hz", p.frequency_hz},
+                   {"magnitude", p.magnitude},
+                   {"damping_ratio", number_or_null(p.damping_ratio)}});
+  return out;
+}
+
+int run_frf_case(const ParsedArgs& args, const Case& c) {
+  require_task(c, TaskKind::kFrf, c.task.frf.has_value(),
+               "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\"");
+  const auto method = loss_method(args);
+  auto files = output_dir(args);
+  Setup setup = make_setup(c, method);
+  const auto& task = *c.task.frf;
+
+  st::Excitation excitation;
+  excitation.direction = {task.direction[0], task.direction[1]};
+  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
+    excitation.kind = st::Excitation::Kind::kBaseTranslation;
+    excitation.amplitude = task.base_amplitude_m;
+  } else {
+    excitation.kind = st::Excitation::Kind::kPointForce;
+    excitation.amplitude = task.force_amplitude_n;
+    excitation.point = task.force_point;
+  }
+  if (const auto problems = excitation.validate(setup.s.modal); !problems.empty())
+    throw InputError(c.path, "/task/excitation", problems.front());
+  const bool base = excitation.kind == st::Excitation::Kind::kBaseTranslation;
+
+  st::HarmonicBalanceOptions options;
+  options.frequencies_hz = spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
+                                  task.spacing == surrogate::AxisSpacing::kLog);
+  const auto response =
+      call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+
+  std::size_t with_state = 0, held = 0;
+  for (const auto& p : response.points) {
+    if (!p.roots.empty() || !p.held_at_jump.empty()) ++with_state;
+    if (!p.held_at_jump.empty()) ++held;
+  }
+  if (with_state == 0)
+    throw NumericalError("pdamp frf: no first-harmonic response found at any frequency (" + response.brief_report() +
+                         "); check the excitation amplitude against the layers' stroke range, or try --method formulas");
+  for (const auto& p : response.peaks)
+    if (!std::isfinite(p.frequency_hz) || !std::isfinite(p.magnitude))
+      throw NumericalError("pdamp frf: a response peak is not finite (" + response.brief_report() + ")");
+  setup.warnings.add(response.warnings);
+  const bool converged = response.outcome == st::FrequencyResponse::Outcome::kConverged;
+  if (!converged)
+    setup.warnings.add("some roots did not converge (" + std::to_string(response.unconverged_starts) +
+                       " Newton starts failed): the response may miss branches");
+
+  // Branches: the frequency span and stability of each.
+  struct BranchInfo {
+    double f_min = INFINITY, f_max = -INFINITY, x_max = 0.0;
+    std::size_t points = 0, stable = 0, unstable = 0, marginal = 0;
+  };
+  std::map<int, BranchInfo> info;
+  for (const auto& p : response.points)
+    for (const auto& r : p.roots) {
+      auto& b = info[r.branch_id];
+      b.f_min = std::min(b.f_min, p.frequency_hz);
+      b.f_max = std::max(b.f_max, p.frequency_hz);
+      if (!r.damper_amplitudes_m.empty()) b.x_max = std::max(b.x_max, r.damper_amplitudes_m.front());
+      ++b.points;
+      (r.stability == st::Stability::kStable ? b.stable : r.stability == st::Stability::kUnstable ? b.unstable : b.marginal)++;
+    }
+  json branches = json::array();
+  for (const auto& [id, b] : info)
+    branches.push_back({{"branch", id}, {"min_frequency_hz", b.f_min}, {"max_frequency_hz", b.f_max},
+                        {"points", b.points}, {"stable_points", b.stable}, {"unstable_points", b.unstable},
+                        {"marginal_points", b.marginal}, {"max_amplitude_m", b.x_max}});
+  json jumps = json::array();
+  for (const auto& e : response.branch_ends) {
+    json j = {{"kind", branch_end_kind(e.kind)}, {"frequency_hz", e.frequency_hz}, {"amplitude_m", e.damper_amplitude_m},
+              {"branch", e.branch_id}, {"branch_exists_below", e.ends_toward_higher_frequency}};
+    if (e.kind == st::BranchEnd::Kind::kFold) j["other_branch"] = e.other_branch_id;
+    jumps.push_back(std::move(j));
+  }
+
+  const std::string magnitude_label = base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+  if (files)
+    setup.warnings.add(write_frf_files(*files, response, damper_names(setup), magnitude_label,
+                                       c.name + ": frequency response (" + std::string(case_file::to_string(method)) + ")"));
+
+  const json peaks = peaks_json(response.peaks, response.output_names);
+  json frf = {{"file", file_json(files.get(), "frf.csv")},
+              {"branches_file", file_json(files.get(), "frf_branches.csv")},
+              {"plot", file_json(files.get(), "frf.png")},
+              {"method", case_file::to_string(method)},
+              {"outputs", response.output_names},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude)"
+                                 : "receptance |X/F| in m/N"},
+              {"excitation", base ? "base" : "force"},
+              {"frequencies", {{"min_hz", options.frequencies_hz.front()}, {"max_hz", options.frequencies_hz.back()},
+                               {"points", options.frequencies_hz.size()},
+                               {"spacing", task.spacing == surrogate::AxisSpacing::kLog ? "log" : "linear"}}},
+              {"peaks", peaks},
+              {"linear_peaks", peaks_json(response.linear_peaks, response.output_names)},
+              {"jumps", jumps},
+              {"branches", branches},
+              {"held_at_jump_points", held},
+              {"outcome", converged ? "converged" : "some_roots_not_converged"},
+              {"loss_evaluations", response.loss_evaluations},
+              {"solve_time_s", response.solve_time_s},
+              {"report", response.brief_report()},
+              {"warnings", setup.warnings.list()}};
+  json result = result_head(c, "frf", method);
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["branches"] = branches;
+  result["frf"] = frf;
+
+  std::vector<std::pair<std::string, std::string>> rows = {{"method", std::string(case_file::to_string(method))},
+                                                            {"outcome", frf["outcome"].get<std::string>()}};
+  for (const auto& p : response.peaks)
+    rows.push_back({"peak " + response.output_names[p.output],
+                    format_number(p.frequency_hz, 6) + " Hz, |out| = " + format_number(p.magnitude, 4) +
+                        (std::isfinite(p.damping_ratio) ? ", zeta = " + format_number(p.damping_ratio, 4) : "")});
+  for (const auto& p : response.linear_peaks)
+    rows.push_back({"without beds " + response.output_names[p.output],
+                    format_number(p.frequency_hz, 6) + " Hz, |out| = " + format_number(p.magnitude, 4)});
+  for (const auto& e : response.branch_ends)
+    if (e.kind != st::BranchEnd::Kind::kStrokeRange)
+      rows.push_back({std::string(branch_end_kind(e.kind)), format_number(e.frequency_hz, 6) + " Hz, X = " +
+                                                                 format_number(e.damper_amplitude_m, 4) + " m"});
+  result["frf"]["warnings"] = setup.warnings.list();
+  return finish(args, c, files.get(), "frf.json", result, setup.warnings, rows);
+}
+
+// ---------------------------------------------------------------- decay
+
+/// Modal amplitudes of the task's initial state: a released static load or given q_j(0).
+Eigen::VectorXd initial_modal_amplitudes(const Case& c, const case_file::StructureSetup& setup) {
+  const st::ModalModel& modal = setup.modal;
+  const auto& task = *c.task.decay;
+  const Eigen::Index modes = modal.mode_count();
+  if (task.initial_state == case_file::DecayTask::InitialState::kModalAmplitudes) {
+    if (static_cast<Eigen::Index>(task.modal_amplitudes.size()) > modes)
+      throw InputError(c.path, "/task/initial_state/values",
+                       "has " + std::to_string(task.modal_amplitudes.size()) + " entries, the structure keeps " +
+                           std::to_string(modes) + " modes (at most one value per mode)");
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(modes);
+    for (std::size_t j = 0; j < task.modal_amplitudes.size(); ++j) q[static_cast<Eigen::Index>(j)] = task.modal_amplitudes[j];
+    return q;
+  }
+  const Eigen::Vector2d force(task.load_force_n[0], task.load_force_n[1]);
+  if (setup.beam) {
+    const st::BeamModel& beam = *setup.beam;
+    std::optional<double> position;
+    for (const auto& p : beam.points)
+      if (p.name == task.load_point) position = p.position_m;
+    for (const auto& m : beam.point_masses)
+      if (m.name == task.load_point) position = m.position_m;
+    if (!position) throw InputError(c.path, "/task/initial_state/point", "'" + task.load_point + "' is not a named point of the beam");
+    return call_solver(c, "/task/initial_state",
+                       [&] { return st::static_deflection_modal_amplitudes(beam, modal, *position, force, 0.0); });
+  }
+  return call_solver(c, "/task/initial_state/point",
+                     [&] { return st::modal_static_deflection_amplitudes(modal, task.load_point, force); });
+}
+
+/// The loss models' own sentences (with numbers) at one sample: each layer at its damper's
+/// amplitude and the frequency the decay uses for the dominant mode there (its backbone's
+/// natural frequency with containers and beds, structure::backbone_point).
+void add_loss_messages(Warnings& warnings, const Setup& setup, const st::CoupledModel& coupled,
+                       const st::DecaySample& s, const std::string& when) {
+  Eigen::Index dominant = 0;
+  s.modal_amplitudes.maxCoeff(&dominant);
+  const double f =
+      st::backbone_point(coupled, static_cast<int>(dominant), s.modal_amplitudes[dominant]).natural_frequency_hz;
+  if (!std::isfinite(f)) return;
+  for (std::size_t d = 0; d < setup.s.dampers.size(); ++d) {
+    const double x = s.damper_amplitudes_m[d];
+    if (!(x > 0.0)) continue;
+    for (const auto& layer : setup.s.dampers[d].layers)
+      for (const auto& m : layer.loss_model->warning_messages(f, x))
+        warnings.add(when + ", " + setup.s.dampers[d].name + "/" + layer.name + " (X = " + format_number(x, 4) +
+                     " m, f = " + format_number(f, 4) + " Hz): " + m);
+  }
+}
+
+int run_decay_case(const ParsedArgs& args, const Case& c) {
+  require_task(c, TaskKind::kDecay, c.task.decay.has_value(), "\"initial_state\", \"duration_s\"");
+  const auto method = loss_method(args);
+  auto files = output_dir(args);
+  Setup setup = make_setup(c, method);
+  const auto& task = *c.task.decay;
+  const auto& modal = setup.s.modal;
+
+  const Eigen::VectorXd q0 = initial_modal_amplitudes(c, setup.s);
+  st::FreeDecayOptions options;
+  options.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
+  if (!(options.initial_modal_amplitudes.maxCoeff() > 0.0))
+    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+  options.duration_s = task.duration_s;
+  options.threshold_fraction = task.settling_threshold;
+  const double samples = std::clamp(std::ceil(kDecaySamplesPerPeriod * modal.natural_frequencies_hz[0] * task.duration_s),
+                                    kDecayMinSamples, kDecayMaxSamples);
+  options.sample_times_s = spaced(0.0, task.duration_s, static_cast<int>(samples) + 1, false);
+  if (const auto problems = options.validate(modal.mode_count()); !problems.empty())
+    throw InputError(c.path, "/task", problems.front());
+  const auto decay = call_solver(c, "/task", [&] { return st::free_decay(modal, setup.s.dampers, options); });
+
+  for (const auto& s : decay.samples)
+    if (!std::isfinite(s.threshold_measure_m) || !std::isfinite(s.mechanical_energy_j))
+      throw NumericalError("pdamp decay: the envelope is not finite at t = " + format_number(s.time_s) + " s (" +
+                           decay.brief_report() + ")");
+  if (decay.samples.empty()) throw NumericalError("pdamp decay: the solver returned no samples (" + decay.brief_report() + ")");
+  setup.warnings.add(decay.warnings);
+  const bool settled = decay.outcome == st::FreeDecay::Outcome::kSettled;
+  const auto coupled = call_solver(c, "/dampers", [&] { return st::couple(modal, setup.s.dampers); });
+  add_loss_messages(setup.warnings, setup, coupled, decay.samples.front(), "at the start");
+  if (settled) {
+    const auto at = std::lower_bound(decay.samples.begin(), decay.samples.end(), decay.settling_time_s,
+                                     [](const st::DecaySample& s, double t) { return s.time_s < t; });
+    add_loss_messages(setup.warnings, setup, coupled, at == decay.samples.end() ? decay.samples.back() : *at, "at settling");
+  } else {
+    setup.warnings.add("the decay did not settle within duration_s = " + format_number(task.duration_s) +
+                       " s (envelope " + format_number(decay.samples.back().threshold_measure_m, 4) + " m, threshold " +
+                       format_number(decay.threshold_used_m, 4) + " m): lengthen /task/duration_s");
+  }
+  if (files)
+    setup.warnings.add(write_decay_files(*files, decay, damper_names(setup),
+                                         c.name + ": free decay (" + std::string(case_file::to_string(method)) + ")"));
+
+  const auto& first = decay.samples.front();
+  const auto& last = decay.samples.back();
+  json layers = json::array();
+  double dissipated = last.structural_dissipated_energy_j;
+  for (double e : last.layer_dissipated_energy_j) dissipated += e;
+  for (std::size_t l = 0; l < decay.layer_names.size(); ++l)
+    layers.push_back({{"name", decay.layer_names[l]},
+                      {"dissipated_energy_j", last.layer_dissipated_energy_j[l]},
+                      {"share", dissipated > 0.0 ? last.layer_dissipated_energy_j[l] / dissipated : 0.0}});
+  std::vector<double> initial(q0.data(), q0.data() + q0.size());
+  json d = {{"file", file_json(files.get(), "decay.csv")},
+            {"plot", file_json(files.get(), "decay.png")},
+            {"method", case_file::to_string(method)},
+            {"settling_time_s", number_or_null(decay.settling_time_s)},
+            {"damping_ratio", number_or_null(decay.equivalent_damping_ratio)},
+            {"dominant_mode", decay.dominant_mode + 1},
+            {"outcome", settled ? "settled" : "not_settled"},
+            {"threshold_point", setup.s.dampers.front().point},
+            {"threshold_m", decay.threshold_used_m},
+            {"threshold_fraction", task.settling_threshold},
+            {"initial_envelope_m", first.threshold_measure_m},
+            {"initial_modal_amplitudes", initial},
+            {"initial_energy_j", first.mechanical_energy_j},
+            {"final_time_s", last.time_s},
+            {"final_envelope_m", last.threshold_measure_m},
+            {"final_energy_j", last.mechanical_energy_j},
+            {"structural_dissipated_energy_j", last.structural_dissipated_energy_j},
+            {"layers", layers},
+            {"samples", decay.samples.size()},
+            {"steps", decay.steps},
+            {"solve_time_s", decay.solve_time_s},
+            {"report", decay.brief_report()},
+            {"warnings", setup.warnings.list()}};
+  json result = result_head(c, "decay", method);
+  result["file"] = d["file"];
+  result["settling_time_s"] = d["settling_time_s"];
+  result["damping_ratio"] = d["damping_ratio"];
+  result["decay"] = d;
+  std::vector<std::pair<std::string, std::string>> rows = {
+      {"method", std::string(case_file::to_string(method))},
+      {"outcome", d["outcome"].get<std::string>()},
+      {"settling_time_s", settled ? format_number(decay.settling_time_s, 6) : "not settled"},
+      {"damping_ratio", std::isfinite(decay.equivalent_damping_ratio) ? format_number(decay.equivalent_damping_ratio, 4) : "-"},
+      {"dominant mode", std::to_string(decay.dominant_mode + 1)},
+      {"threshold_m", format_number(decay.threshold_used_m, 4)}};
+  for (const auto& l : layers)
+    rows.push_back({"dissipated by " + l["name"].get<std::string>(),
+                    format_number(l["dissipated_energy_j"].get<double>(), 4) + " J (" +
+                        format_number(100.0 * l["share"].get<double>(), 3) + "%)"});
+  result["decay"]["warnings"] = setup.warnings.list();
+  return finish(args, c, files.get(), "decay.json", result, setup.warnings, rows);
+}
+
+int run_modes(const ParsedArgs& args) { return run_modes_case(args, case_file::load_case(args.positional().at(0))); }
+int run_frf(const ParsedArgs& args) { return run_frf_case(args, case_file::load_case(args.positional().at(0))); }
+int run_decay(const ParsedArgs& args) { return run_decay_case(args, case_file::load_case(args.positional().at(0))); }
+
+}  // namespace
+
+int run_structure_task(const ParsedArgs& args, const Case& c) {
+  switch (c.task.kind) {
+    case TaskKind::kModes: return run_modes_case(args, c);
+    case TaskKind::kFrf: return run_frf_case(args, c);
+    case TaskKind::kDecay: return run_decay_case(args, c);
+    case TaskKind::kDamperDesign: break;
+  }
+  throw std::logic_error("run_structure_task: not a structure task");
+}
+
+std::vector<Command> structure_commands() {
+  return {
+      {{"modes", "pdamp modes CASE.json [--method formulas|field] [-o DIR] [--json]",
+        "natural frequencies (with the empty containers attached, and bare), mode shapes at the\n"
+        "named points, modal mass ratio per damper and backbones f(X), zeta_add(X) per mode",
+        {kMethodFlag, {"-o", "DIR", "write modes.csv, backbone_mode<j>.csv, backbone.gp/png/svg, modes.json\n"
+                                    "                          and case_resolved.json into DIR, atomically"},
+         kJsonFlag}, 1},
+       run_modes},
+      {{"frf", "pdamp frf CASE.json [--method formulas|field] [-o DIR] [--json]",
+        "frequency response of the structure with its dampers (task kind frf): every harmonic-\n"
+        "balance root, its stability, branches, jumps and peaks, and the response without beds",
+        {kMethodFlag, {"-o", "DIR", "write frf.csv, frf_branches.csv, frf.gp/png/svg, frf.json and\n"
+                                    "                          case_resolved.json into DIR, atomically"},
+         kJsonFlag}, 1},
+       run_frf},
+      {{"decay", "pdamp decay CASE.json [--method formulas|field] [-o DIR] [--json]",
+        "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"
+        "equivalent damping ratio and the energy each layer dissipates",
+        {kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg, decay.json and case_resolved.json\n"
+                                    "                          into DIR, atomically"},
+         kJsonFlag}, 1},
+       run_decay},
+  };
+}
+
+}  // namespace pdamp::cli

@@ -1,0 +1,23 @@
+// The Level III subcommands (pdamp modes, frf, decay) and the structure tasks of pdamp run:
+// a format-2 case through case_file::structure_setup and the structure solvers.
+#pragma once
+
+#include <vector>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "pdamp/case_file/case.hpp"
+
+namespace pdamp::cli {
+
+/// `--method formulas|field` (default formulas), shared with pdamp run.
+extern const FlagSpec kMethodFlag;
+
+/// pdamp modes, frf and decay, in the order `pdamp --help` lists them.
+std::vector<Command> structure_commands();
+
+/// Runs the case's task of kind modes, frf or decay exactly as the command of that name
+/// (pdamp run). Other kinds are not structure tasks: std::logic_error.
+int run_structure_task(const ParsedArgs& args, const case_file::Case& c);
+
+}  // namespace pdamp::cli

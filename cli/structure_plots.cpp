@@ -1,0 +1,287 @@
+// CSV tables and gnuplot pictures of pdamp modes, frf and decay (PNG and SVG, rendered
+// when gnuplot is there; the scripts stay with the data either way).
+#include "structure_plots.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <map>
+#include <sstream>
+
+namespace pdamp::cli {
+
+namespace {
+
+namespace st = structure;
+
+constexpr double kRadToDeg = 57.29577951308232;
+
+/// Line colours of the per-mode and per-output curves, cycled.
+const char* colour(std::size_t i) {
+  static const char* const colours[] = {"blue", "dark-orange", "dark-green", "purple", "brown", "dark-cyan", "red"};
+  return colours[i % (sizeof colours / sizeof colours[0])];
+}
+
+/// A CSV column label made of a user's name: no comma, quote or newline can break the header.
+std::string label(const std::string& name) { return safe_file_name(name); }
+
+/// Most jump frequencies marked in the FRF plot (a case with many would hide the curves).
+constexpr std::size_t kMaxJumpMarks = 30;
+
+}  // namespace
+
+void write_modes_table(OutputDir& out, const ModeTable& t) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "mode,frequency_hz,bare_frequency_hz,damping_ratio";
+  for (const auto& d : t.damper_names) csv << ",mass_ratio_" << label(d);
+  for (const auto& p : t.points) {
+    const std::string n = label(p.name);
+    csv << ',' << n << "_translation_x," << n << "_translation_y," << n << "_rotation";
+  }
+  csv << '\n';
+  for (std::size_t j = 0; j < t.frequency_hz.size(); ++j) {
+    const auto col = static_cast<Eigen::Index>(j);
+    csv << j + 1 << ',' << t.frequency_hz[j] << ',' << t.bare_frequency_hz[j] << ',' << t.damping_ratio[j];
+    for (Eigen::Index d = 0; d < t.mass_ratio.cols(); ++d) csv << ',' << t.mass_ratio(col, d);
+    for (const auto& p : t.points)
+      csv << ',' << p.translation(0, col) << ',' << p.translation(1, col) << ',' << p.rotation(col);
+    csv << '\n';
+  }
+  out.add("modes.csv", csv.str());
+}
+
+std::vector<std::string> write_backbone_files(OutputDir& out, const std::vector<st::Backbone>& backbones,
+                                              const std::vector<std::string>& layer_names, const std::string& title) {
+  std::vector<std::string> files;
+  for (const auto& b : backbones) {
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "damper_amplitude_m,modal_amplitude,natural_frequency_hz,damped_frequency_hz,added_damping_ratio,"
+           "structural_damping_ratio,effective_modal_mass_kg,converged";
+    for (const auto& l : layer_names) csv << ",eta_star_" << label(l);
+    csv << '\n';
+    for (const auto& p : b.points) {
+      csv << p.damper_amplitude_m << ',' << p.modal_amplitude << ',' << p.natural_frequency_hz << ','
+          << p.damped_frequency_hz << ',' << p.added_damping_ratio << ',' << p.structural_damping_ratio << ','
+          << p.effective_modal_mass_kg << ',' << (p.converged ? 1 : 0);
+      for (double eta : p.layer_eta_star) csv << ',' << eta;
+      csv << '\n';
+    }
+    const std::string name = "backbone_mode" + std::to_string(b.mode + 1) + ".csv";
+    out.add(name, csv.str());
+    files.push_back(name);
+  }
+  if (backbones.empty()) return {};
+  auto curves = [&](int column) {
+    std::ostringstream plot;
+    plot << "  plot ";
+    for (std::size_t i = 0; i < backbones.size(); ++i)
+      plot << (i ? ", \\\n       " : "") << "'" << files[i] << "' using 1:" << column << " with lines lw 2 lc rgb '"
+           << colour(i) << "' title 'mode " << backbones[i].mode + 1 << "'";
+    plot << "\n";
+    return plot.str();
+  };
+  std::ostringstream gp;
+  gp << "# backbones of pdamp modes: added damping ratio and damped natural frequency over the\n"
+     << "# reference damper's amplitude; run: gnuplot backbone.gp\n"
+     << "set datafile separator ','\nset logscale x\nset autoscale xfix\nset grid\nset key top left\nset format x '%.0e'\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900,900 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'backbone.svg' : 'backbone.png'\n"
+     << "  set multiplot layout 2,1 title " << gnuplot_string(title) << " noenhanced\n"
+     << "  set xlabel 'damper amplitude X / m'\n"
+     << "  set ylabel 'added damping ratio {/Symbol z}_{add}'\n"
+     << curves(5)
+     << "  set ylabel 'damped natural frequency f / Hz'\n"
+     << (backbones.size() > 1 ? "  set logscale y\n" : "")
+     << curves(4)
+     << "  unset logscale y\n"
+     << "  unset multiplot\n"
+     << "}\n";
+  return out.add_plot("backbone.gp", gp.str(), {"backbone.png", "backbone.svg"});
+}
+
+std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResponse& r,
+                                         const std::vector<std::string>& damper_names,
+                                         const std::string& magnitude_label, const std::string& title) {
+  const std::size_t outputs = r.output_names.size();
+  std::size_t max_roots = 0, max_held = 0;
+  for (const auto& p : r.points) {
+    max_roots = std::max(max_roots, p.roots.size());
+    max_held = std::max(max_held, p.held_at_jump.size());
+  }
+  // frf.csv: one row per frequency.
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "frequency_hz";
+  for (const auto& o : r.output_names) csv << ",linear_magnitude_" << label(o) << ",linear_phase_deg_" << label(o);
+  csv << ",roots,held_at_jump,converged";
+  for (std::size_t k = 0; k < max_roots; ++k) {
+    const std::string root = "root" + std::to_string(k + 1) + "_";
+    csv << ',' << root << "branch," << root << "stability";
+    for (const auto& d : damper_names) csv << ',' << root << "amplitude_m_" << label(d);
+    for (const auto& o : r.output_names) csv << ',' << root << "magnitude_" << label(o) << ',' << root << "phase_deg_" << label(o);
+  }
+  for (std::size_t k = 0; k < max_held; ++k) {
+    const std::string held = "held" + std::to_string(k + 1) + "_";
+    csv << ',' << held << "amplitude_m," << held << "upper_state_fraction";
+    for (const auto& o : r.output_names) csv << ',' << held << "magnitude_" << label(o) << ',' << held << "phase_deg_" << label(o);
+  }
+  csv << '\n';
+  for (const auto& p : r.points) {
+    csv << p.frequency_hz;
+    for (const auto& y : p.linear_outputs) csv << ',' << std::abs(y) << ',' << std::arg(y) * kRadToDeg;
+    csv << ',' << p.roots.size() << ',' << p.held_at_jump.size() << ',' << (p.converged ? 1 : 0);
+    for (std::size_t k = 0; k < max_roots; ++k) {
+      if (k < p.roots.size()) {
+        const auto& root = p.roots[k];
+        csv << ',' << root.branch_id << ',' << st::to_string(root.stability);
+        for (double x : root.damper_amplitudes_m) csv << ',' << x;
+        for (const auto& y : root.outputs) csv << ',' << std::abs(y) << ',' << std::arg(y) * kRadToDeg;
+      } else {
+        csv << std::string(2 + damper_names.size() + 2 * outputs, ',');
+      }
+    }
+    for (std::size_t k = 0; k < max_held; ++k) {
+      if (k < p.held_at_jump.size()) {
+        const auto& held = p.held_at_jump[k];
+        csv << ',' << held.damper_amplitude_m << ',' << held.upper_state_fraction;
+        for (const auto& y : held.outputs) csv << ',' << std::abs(y) << ',' << std::arg(y) * kRadToDeg;
+      } else {
+        csv << std::string(2 + 2 * outputs, ',');
+      }
+    }
+    csv << '\n';
+  }
+  out.add("frf.csv", csv.str());
+
+  // frf_branches.csv: the roots by branch (ascending frequency), then the held states.
+  std::map<int, std::vector<std::pair<double, const st::HarmonicRoot*>>> branches;
+  for (const auto& p : r.points)
+    for (const auto& root : p.roots) branches[root.branch_id].push_back({p.frequency_hz, &root});
+  std::ostringstream br;
+  br.precision(10);
+  br << "branch,frequency_hz,stability";
+  for (const auto& d : damper_names) br << ",amplitude_m_" << label(d);
+  for (const auto& o : r.output_names) br << ",magnitude_" << label(o);
+  br << '\n';
+  bool first = true;
+  for (auto& [id, roots] : branches) {
+    std::sort(roots.begin(), roots.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (!first) br << '\n';  // a blank line: gnuplot does not join two branches
+    first = false;
+    for (const auto& [f, root] : roots) {
+      br << id << ',' << f << ',' << st::to_string(root->stability);
+      for (double x : root->damper_amplitudes_m) br << ',' << x;
+      for (const auto& y : root->outputs) br << ',' << std::abs(y);
+      br << '\n';
+    }
+  }
+  bool any_held = false;
+  for (const auto& p : r.points)
+    for (const auto& held : p.held_at_jump) {
+      if (!any_held && !first) br << '\n';
+      any_held = true;
+      br << -1 << ',' << p.frequency_hz << ",held_at_jump";
+      for (std::size_t d = 0; d < damper_names.size(); ++d) br << ',' << (d == 0 ? held.damper_amplitude_m : std::nan(""));
+      for (const auto& y : held.outputs) br << ',' << std::abs(y);
+      br << '\n';
+    }
+  out.add("frf_branches.csv", br.str());
+
+  std::ostringstream gp;
+  gp << "# frequency response of pdamp frf: with the dampers (every branch; unstable dashed) and\n"
+     << "# without the beds (empty containers); run: gnuplot frf.gp\n"
+     << "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
+     << "set xlabel 'frequency f / Hz'\nset ylabel " << gnuplot_string(magnitude_label) << " noenhanced\n"
+     << "set title " << gnuplot_string(title) << " noenhanced\n";
+  std::size_t marks = 0;
+  for (const auto& end : r.branch_ends) {
+    if (end.kind == st::BranchEnd::Kind::kStrokeRange || marks >= kMaxJumpMarks) continue;
+    ++marks;
+    gp << "set arrow " << marks << " from " << end.frequency_hz << ", graph 0 to " << end.frequency_hz
+       << ", graph 1 nohead dt 3 lc rgb 'gray40'\n"
+       << "set label " << marks << " '" << (end.kind == st::BranchEnd::Kind::kFold ? "fold" : "jump") << "' at "
+       << end.frequency_hz << ", graph " << (marks % 2 ? 0.97 : 0.92) << " center font ',8' tc rgb 'gray30'\n";
+  }
+  gp << "state(s, c) = (stringcolumn(3) eq s) ? column(c) : 1/0\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,650 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'frf.svg' : 'frf.png'\n"
+     << "  plot ";
+  const std::size_t first_magnitude = 4 + damper_names.size();
+  for (std::size_t o = 0; o < outputs; ++o) {
+    const std::string name = outputs > 1 ? " (" + r.output_names[o] + ")" : "";
+    const std::size_t c = first_magnitude + o;
+    gp << (o ? ", \\\n       " : "") << "'frf.csv' using 1:" << 2 + 2 * o << " with lines lw 1.5 dt 4 lc rgb '"
+       << colour(o) << "' title " << gnuplot_string("without beds" + name) << " noenhanced, \\\n"
+       << "       'frf_branches.csv' using 2:(state('stable', " << c << ")) with lines lw 2 lc rgb '" << colour(o)
+       << "' title " << gnuplot_string("with dampers, stable" + name) << " noenhanced, \\\n"
+       << "       '' using 2:(state('unstable', " << c << ")) with lines lw 2 dt 2 lc rgb '" << colour(o)
+       << "' title " << gnuplot_string("unstable" + name) << " noenhanced, \\\n"
+       << "       '' using 2:(state('marginal', " << c << ")) with points pt 6 ps 0.6 lc rgb '" << colour(o)
+       << "' notitle";
+    if (any_held)
+      gp << ", \\\n       '' using 2:(state('held_at_jump', " << c << ")) with points pt 7 ps 0.5 lc rgb '" << colour(o)
+         << "' title " << gnuplot_string("held at a jump" + name) << " noenhanced";
+  }
+  gp << "\n}\n";
+  return out.add_plot("frf.gp", gp.str(), {"frf.png", "frf.svg"});
+}
+
+std::vector<std::string> write_decay_files(OutputDir& out, const st::FreeDecay& decay,
+                                           const std::vector<std::string>& damper_names, const std::string& title) {
+  const Eigen::Index modes = decay.samples.empty() ? 0 : decay.samples.front().modal_amplitudes.size();
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "time_s,envelope_m";
+  for (Eigen::Index j = 0; j < modes; ++j) csv << ",amplitude_mode" << j + 1;
+  for (const auto& d : damper_names) csv << ",damper_amplitude_m_" << label(d);
+  csv << ",mechanical_energy_j,structural_dissipated_energy_j";
+  for (const auto& l : decay.layer_names) csv << ",dissipated_energy_j_" << label(l);
+  for (const auto& l : decay.layer_names) csv << ",power_w_" << label(l);
+  csv << '\n';
+  for (const auto& s : decay.samples) {
+    csv << s.time_s << ',' << s.threshold_measure_m;
+    for (Eigen::Index j = 0; j < modes; ++j) csv << ',' << s.modal_amplitudes[j];
+    for (double x : s.damper_amplitudes_m) csv << ',' << x;
+    csv << ',' << s.mechanical_energy_j << ',' << s.structural_dissipated_energy_j;
+    for (double e : s.layer_dissipated_energy_j) csv << ',' << e;
+    for (double p : s.layer_power_w) csv << ',' << p;
+    csv << '\n';
+  }
+  out.add("decay.csv", csv.str());
+
+  const std::size_t energy_column = 3 + static_cast<std::size_t>(modes) + damper_names.size();  // mechanical energy
+  std::ostringstream gp;
+  gp << "# free decay of pdamp decay: envelope with threshold and settling time, and the energy\n"
+     << "# each layer has dissipated; run: gnuplot decay.gp\n"
+     << "set datafile separator ','\nset grid\n";
+  gp << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,900 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'decay.svg' : 'decay.png'\n"
+     << "  set multiplot layout 2,1 title " << gnuplot_string(title) << " noenhanced\n"
+     << "  set logscale y\n  set key top right\n"
+     << "  set xlabel 'time t / s'\n  set ylabel 'envelope at the threshold point / m'\n"
+     << "  set arrow 1 from graph 0, first " << decay.threshold_used_m << " to graph 1, first " << decay.threshold_used_m
+     << " nohead dt 2 lc rgb 'red'\n"
+     << "  set label 1 'threshold' at graph 0.99, first " << decay.threshold_used_m
+     << " right offset 0,0.7 tc rgb 'red'\n";
+  if (std::isfinite(decay.settling_time_s))
+    gp << "  set arrow 2 from " << decay.settling_time_s << ", graph 0 to " << decay.settling_time_s
+       << ", graph 1 nohead lw 2 lc rgb 'dark-green'\n"
+       << "  set label 2 " << gnuplot_string("settled: " + format_number(decay.settling_time_s, 4) + " s") << " at "
+       << decay.settling_time_s << ", graph 0.9 left offset 0.5,0 tc rgb 'dark-green'\n";
+  gp << "  plot 'decay.csv' using 1:2 with lines lw 2 lc rgb 'blue' title 'envelope'\n"
+     << "  unset arrow\n  unset label\n  unset logscale y\n  set key top left\n"
+     << "  set ylabel 'dissipated energy / J'\n"
+     << "  plot 'decay.csv' using 1:" << energy_column + 1 << " with lines lw 1.5 dt 2 lc rgb 'gray40' title 'structure'";
+  for (std::size_t l = 0; l < decay.layer_names.size(); ++l)
+    gp << ", \\\n       '' using 1:" << energy_column + 2 + l << " with lines lw 2 lc rgb '" << colour(l) << "' title "
+       << gnuplot_string(decay.layer_names[l]) << " noenhanced";
+  gp << "\n  unset multiplot\n}\n";
+  return out.add_plot("decay.gp", gp.str(), {"decay.png", "decay.svg"});
+}
+
+}  // namespace pdamp::cli

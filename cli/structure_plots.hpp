@@ -1,0 +1,50 @@
+// CSV tables and gnuplot pictures of the structure commands (pdamp modes, frf, decay):
+// the data files and the scripts that draw them (docs/structure_cli.md lists the columns).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "output.hpp"
+#include "pdamp/structure/backbone.hpp"
+#include "pdamp/structure/free_decay.hpp"
+#include "pdamp/structure/harmonic_balance.hpp"
+#include "pdamp/structure/modal_model.hpp"
+
+namespace pdamp::cli {
+
+/// What modes.csv holds: one row per reported mode (1-based in the file).
+struct ModeTable {
+  std::vector<double> frequency_hz;       ///< with the empty containers attached, Hz
+  std::vector<double> bare_frequency_hz;  ///< of the structure alone, Hz
+  std::vector<double> damping_ratio;      ///< structural ζ_j of the modal model
+  std::vector<std::string> damper_names;
+  Eigen::MatrixXd mass_ratio;             ///< modes x dampers: μ_dj = b_dj² Σ_l m_bed,l / m_j
+  std::vector<structure::PointModeShape> points;  ///< shapes (columns: modes of the model)
+};
+void write_modes_table(OutputDir& out, const ModeTable& table);
+
+/// backbone_mode<j>.csv for every backbone (j = mode + 1) and backbone.gp/png/svg:
+/// ζ_add(X) and the damped natural frequency f(X) per mode, X on a log axis.
+/// `layer_names` label the η* columns. Returns warnings (gnuplot missing or failing).
+std::vector<std::string> write_backbone_files(OutputDir& out, const std::vector<structure::Backbone>& backbones,
+                                              const std::vector<std::string>& layer_names, const std::string& title);
+
+/// frf.csv (one row per frequency: the linear response without beds, then every root and
+/// every state held at a jump), frf_branches.csv (one row per root, grouped by branch,
+/// a blank line between branches) and frf.gp/png/svg: |output| with and without the beds,
+/// every branch, unstable parts dashed, jump frequencies marked, log y.
+std::vector<std::string> write_frf_files(OutputDir& out, const structure::FrequencyResponse& response,
+                                         const std::vector<std::string>& damper_names,
+                                         const std::string& magnitude_label, const std::string& title);
+
+/// decay.csv (time, the envelope at the threshold point, each mode's amplitude, each
+/// damper's amplitude, energies, each layer's cumulative dissipated energy and power) and
+/// decay.gp/png/svg: the envelope with threshold and settling time (log y) over the
+/// per-layer dissipated energies.
+std::vector<std::string> write_decay_files(OutputDir& out, const structure::FreeDecay& decay,
+                                           const std::vector<std::string>& damper_names, const std::string& title);
+
+}  // namespace pdamp::cli

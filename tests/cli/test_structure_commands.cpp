@@ -1,0 +1,157 @@
+// Level III commands (pdamp modes, frf, decay, and pdamp run on their tasks): exit codes,
+// JSON keys, files in -o DIR, the /task and field_file errors, and two closed-form numbers.
+// Runs the built pdamp binary (support/run_pdamp.hpp); the solvers' physics is tested in
+// tests/structure/.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli/cli_support.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string data(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/" + name; }
+
+/// Runs `args` with --json, requires exit 0 and returns the one JSON object on stdout.
+json run_json(const std::string& args) {
+  const auto r = run_pdamp(args + " --json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return json::parse(r.out);
+}
+
+void require_files(const fs::path& dir, const std::vector<std::string>& names) {
+  for (const auto& name : names) {
+    INFO(name);
+    CHECK(fs::is_regular_file(dir / name));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("pdamp modes gives frequencies with containers and bare, shapes, mass ratios and backbones", "[cli][structure]") {
+  const TempDir dir("modes");
+  const json r = run_json("modes " + data("cantilever_modes.json") + " -o " + dir.path.string());
+  for (const char* key : {"task", "case", "method", "modes", "file", "backbone", "warnings", "outputs", "outcome"})
+    CHECK(r.contains(key));
+  CHECK(r["task"] == "modes");
+  CHECK(r["method"] == "formulas");
+  REQUIRE(r["modes"].size() == 2);  // the task's mode_count
+  for (const auto& m : r["modes"]) {
+    for (const char* key : {"mode", "frequency_hz", "bare_frequency_hz", "damping_ratio", "modal_mass_ratio",
+                            "modal_mass_ratio_per_damper", "shapes", "backbone"})
+      CHECK(m.contains(key));
+    // The 0.3 kg container lowers every frequency.
+    CHECK(m["frequency_hz"].get<double>() < m["bare_frequency_hz"].get<double>());
+    CHECK(m["shapes"].contains("tip"));
+    CHECK(m["shapes"]["tip"].contains("rotation"));
+    CHECK(m["backbone"]["points"] == 12);
+  }
+  CHECK(r["backbone"]["amplitude_source"] == "task");
+  CHECK(r["file"] == (dir.path / "modes.csv").string());
+  require_files(dir.path, {"modes.csv", "backbone_mode1.csv", "backbone_mode2.csv", "backbone.gp", "modes.json",
+                           "case_resolved.json"});
+}
+
+// Independent reference: the Euler-Bernoulli cantilever, f_1 = 1.8751²/(2πL²)·√(EI/ρA), with
+// L = 0.5 m, E = 206 GPa, ρ = 7850 kg/m³, 30 mm x 2 mm. 20 elements give 1.3e-7 (docs/structures.md);
+// 0.1% is the brief's tolerance. bare_frequency_hz is the structure without the container.
+TEST_CASE("pdamp modes: the first bare frequency of the cantilever is 1.8751^2/(2 pi L^2) sqrt(EI/rho A)", "[cli][structure]") {
+  const json r = run_json("modes " + data("cantilever_modes.json"));
+  const double length = 0.5, b = 0.03, d = 0.002, youngs = 206e9, density = 7850.0;
+  const double ei = youngs * b * d * d * d / 12.0, rho_a = density * b * d;
+  const double beta = 1.875104068711961;
+  const double expected = beta * beta / (2.0 * kPi * length * length) * std::sqrt(ei / rho_a);
+  CHECK(r["modes"][0]["bare_frequency_hz"].get<double>() == Approx(expected).epsilon(1e-3));
+  CHECK(r["file"].is_null());  // no -o: no files
+}
+
+// Independent reference: one mode of modal mass m = 0.5 kg at 2 Hz with shape 1 at the tip, a
+// 0.3 kg container there: f = 2 Hz·√(m/(m + m_c)) = 1.5811 Hz (exact for one mode).
+TEST_CASE("pdamp modes on one imported mode adds the container to the modal mass", "[cli][structure]") {
+  const json r = run_json("modes " + data("modal_data_tip_damper.json"));
+  REQUIRE(r["modes"].size() == 1);
+  CHECK(r["modes"][0]["bare_frequency_hz"].get<double>() == Approx(2.0).epsilon(1e-12));
+  CHECK(r["modes"][0]["frequency_hz"].get<double>() == Approx(2.0 * std::sqrt(0.5 / 0.8)).epsilon(1e-9));
+  // μ = b² m_bed / m_j with b = 1 and the 36-sphere bed (0.14797 kg).
+  CHECK(r["modes"][0]["modal_mass_ratio"].get<double>() == Approx(36 * 4.0 / 3.0 * kPi * 1.25e-7 * 7850.0 / 0.5).epsilon(1e-9));
+  CHECK(r["backbone"]["amplitude_source"] == "default");
+  CHECK(r["backbone"]["max_amplitude_m"].get<double>() == Approx(0.2).epsilon(1e-9));  // 2 x clearance 0.1 m
+}
+
+TEST_CASE("pdamp frf reports peaks, branches, jumps and the response without beds", "[cli][structure]") {
+  const TempDir dir("frf");
+  const json r = run_json("frf " + data("cantilever_frf.json") + " -o " + dir.path.string());
+  for (const char* key : {"task", "method", "file", "peaks", "branches", "warnings", "outputs", "frf"}) CHECK(r.contains(key));
+  const json& frf = r["frf"];
+  for (const char* key : {"file", "peaks", "linear_peaks", "jumps", "branches", "warnings", "method", "outcome"})
+    CHECK(frf.contains(key));
+  CHECK(frf["method"] == "formulas");
+  REQUIRE(!frf["peaks"].empty());
+  for (const char* key : {"frequency_hz", "magnitude", "damping_ratio"}) CHECK(frf["peaks"][0].contains(key));
+  REQUIRE(!frf["linear_peaks"].empty());
+  // The beds damp the resonance: the peak with dampers is far lower than without beds.
+  CHECK(frf["peaks"][0]["magnitude"].get<double>() < frf["linear_peaks"][0]["magnitude"].get<double>());
+  CHECK(frf["file"] == (dir.path / "frf.csv").string());
+  require_files(dir.path, {"frf.csv", "frf_branches.csv", "frf.gp", "frf.json", "case_resolved.json"});
+}
+
+TEST_CASE("pdamp frf on a case whose task is not frf is exit 2 naming /task", "[cli][structure]") {
+  const TempDir dir("frf_not");
+  const auto r = run_pdamp("frf " + data("modal_data_tip_damper.json") + " -o " + (dir.path / "out").string());
+  require_one_line_error(r, "modal_data_tip_damper.json: /task: pdamp frf needs a task of kind frf");
+  CHECK(!fs::exists(dir.path / "out" / "frf.csv"));  // nothing written
+  require_one_line_error(run_pdamp("decay " + data("cantilever_frf.json")), "/task: pdamp decay needs a task of kind decay");
+}
+
+TEST_CASE("pdamp decay reports the settling time, damping ratio and per-layer energies", "[cli][structure]") {
+  const TempDir dir("decay");
+  const json r = run_json("decay " + data("cantilever_decay.json") + " -o " + dir.path.string());
+  for (const char* key : {"task", "file", "settling_time_s", "damping_ratio", "warnings", "decay"}) CHECK(r.contains(key));
+  const json& decay = r["decay"];
+  for (const char* key : {"file", "settling_time_s", "damping_ratio", "dominant_mode", "outcome", "warnings", "layers"})
+    CHECK(decay.contains(key));
+  CHECK(decay["outcome"] == "settled");
+  CHECK(decay["settling_time_s"].get<double>() > 0.0);
+  CHECK(decay["settling_time_s"].get<double>() < 30.0);
+  CHECK(decay["dominant_mode"] == 1);
+  require_files(dir.path, {"decay.csv", "decay.gp", "decay.json", "case_resolved.json"});
+  // One imported mode released from a static load: runs; a decay that does not settle says so.
+  const json m = run_json("decay " + data("modal_data_tip_damper.json"));
+  CHECK(m["decay"]["outcome"] == "not_settled");
+  CHECK(m["settling_time_s"].is_null());
+}
+
+TEST_CASE("method field needs each layer's field_file and runs with one", "[cli][structure]") {
+  require_one_line_error(run_pdamp("frf " + data("cantilever_frf.json") + " --method field"),
+                         "cantilever_frf.json: /dampers/0/layers/0/field_file: required with --method field");
+  require_one_line_error(run_pdamp("modes " + data("cantilever_frf.json") + " --method dem"),
+                         "--method: 'dem': must be formulas or field");
+  // The layer is the shipped 36-sphere layer, so the shipped formulas field fits it.
+  const json r = run_json("frf " + data("cantilever_frf_field.json") + " --method field");
+  CHECK(r["method"] == "field");
+  CHECK(!r["frf"]["peaks"].empty());
+  CHECK(r["warnings"].is_array());
+}
+
+TEST_CASE("pdamp run on a format-2 frf case equals pdamp frf", "[cli][structure]") {
+  const json run = run_json("run " + data("cantilever_frf.json"));
+  const json frf = run_json("frf " + data("cantilever_frf.json"));
+  CHECK(run["task"] == "frf");
+  CHECK(run["peaks"] == frf["peaks"]);
+  CHECK(run["frf"]["linear_peaks"] == frf["frf"]["linear_peaks"]);
+  CHECK(run["frf"]["jumps"] == frf["frf"]["jumps"]);
+  CHECK(run["method"] == "formulas");  // run defaults to formulas
+  CHECK(run.contains("outputs"));
+  CHECK(run_json("run " + data("cantilever_modes.json"))["task"] == "modes");
+  CHECK(run_json("run " + data("cantilever_decay.json"))["task"] == "decay");
+}
