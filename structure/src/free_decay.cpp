@@ -190,9 +190,9 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
   (weights.cwiseProduct(a0)).maxCoeff(&dominant);
   result.dominant_mode = static_cast<int>(dominant);
 
-  EnvelopeSystem system(coupled, a0);
+  EnvelopeSystem envelopes(coupled, a0);
   const Eigen::Index layers = static_cast<Eigen::Index>(result.layer_names.size());
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(system.size()), next(system.size()), dy(system.size());
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(envelopes.size()), next(envelopes.size()), dy(envelopes.size());
   for (Eigen::Index j = 0; j < modes; ++j) y[j] = std::log(a0[j]);  // −inf for a mode at rest: stays at rest
   const double max_step = options.max_step_s > 0.0 ? options.max_step_s : options.duration_s / 20.0;
 
@@ -210,9 +210,9 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
       s.mechanical_energy_j += 0.5 * coupled.modal_masses_kg[j] * coupled.angular_frequencies_rad_s[j] *
                                coupled.angular_frequencies_rad_s[j] * s.modal_amplitudes[j] * s.modal_amplitudes[j];
     s.layer_dissipated_energy_j.assign(state.data() + modes, state.data() + modes + layers);
-    s.structural_dissipated_energy_j = state[system.size() - 1];
-    system.derivative(state, dy);
-    s.layer_power_w.assign(system.layer_power().data(), system.layer_power().data() + layers);
+    s.structural_dissipated_energy_j = state[envelopes.size() - 1];
+    envelopes.derivative(state, dy);
+    s.layer_power_w.assign(envelopes.layer_power().data(), envelopes.layer_power().data() + layers);
     result.samples.push_back(std::move(s));
   };
   auto check_second_mode = [&](double t, const Eigen::VectorXd& a) {
@@ -252,22 +252,22 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
   while (next_sample < options.sample_times_s.size() && options.sample_times_s[next_sample] <= 0.0) record(0.0, y), ++next_sample;
   check_second_mode(0.0, amplitudes(y));
   while (t < options.duration_s) {
-    system.derivative(y, dy);
-    const double fastest = system.rates().maxCoeff();
+    envelopes.derivative(y, dy);
+    const double fastest = envelopes.rates().maxCoeff();
     double dt = fastest > 0.0 ? std::min(max_step, options.step_log_change / fastest) : max_step;
     // Approaching a jump the steps shrink geometrically (at most half the remaining distance
     // in ln a): the orbit's η* has a square-root singularity at the onset (a saddle-node,
     // docs/collect_and_collide.md §3), which would cut RK4 to first order on a uniform step.
     for (Eigen::Index j = 0; j < modes; ++j) {
-      if (!(system.rates()[j] > 0.0)) continue;
+      if (!(envelopes.rates()[j] > 0.0)) continue;
       for (double jump : jump_log_amplitudes[static_cast<std::size_t>(j)])
-        if (y[j] > jump) dt = std::min(dt, std::max(0.5 * (y[j] - jump), 2.0 * kJumpApproach) / system.rates()[j]);
+        if (y[j] > jump) dt = std::min(dt, std::max(0.5 * (y[j] - jump), 2.0 * kJumpApproach) / envelopes.rates()[j]);
     }
     double target = options.duration_s;
     if (next_sample < options.sample_times_s.size()) target = std::min(target, options.sample_times_s[next_sample]);
     bool lands = t + dt >= target;
     if (lands) dt = target - t;
-    system.rk4_step(y, dt, next);
+    envelopes.rk4_step(y, dt, next);
     // A loss-model jump inside the step: shorten the step to end just past the first one, so
     // no RK4 stage averages the two sides (the step after it starts on the lower side).
     double first_crossing = dt;
@@ -278,10 +278,10 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
         const double below = jump - kJumpApproach;
         if (!(y[j] > below && next[j] <= below)) continue;
         double lo = 0.0, hi = dt;
-        Eigen::VectorXd trial(system.size());
+        Eigen::VectorXd trial(envelopes.size());
         for (int k = 0; k < kSettlingBisections; ++k) {
           const double mid = 0.5 * (lo + hi);
-          system.rk4_step(y, mid, trial);
+          envelopes.rk4_step(y, mid, trial);
           (trial[j] <= below ? hi : lo) = mid;
         }
         first_crossing = std::min(first_crossing, hi);
@@ -289,16 +289,16 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
     if (first_crossing < dt) {
       dt = first_crossing;
       lands = false;
-      system.rk4_step(y, dt, next);
+      envelopes.rk4_step(y, dt, next);
     }
     ++result.steps;
     if (!settled && measure(next) < result.threshold_used_m) {
       // Bisect the step for the crossing (the measure decreases monotonically).
       double lo = 0.0, hi = dt;
-      Eigen::VectorXd trial(system.size());
+      Eigen::VectorXd trial(envelopes.size());
       for (int k = 0; k < kSettlingBisections; ++k) {
         const double mid = 0.5 * (lo + hi);
-        system.rk4_step(y, mid, trial);
+        envelopes.rk4_step(y, mid, trial);
         (measure(trial) < result.threshold_used_m ? hi : lo) = mid;
       }
       result.settling_time_s = t + hi;
