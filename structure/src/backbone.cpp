@@ -1,6 +1,7 @@
 // Single-mode averaged backbones: natural frequency and added damping ratio over the
 // damper amplitude.
 #include "pdamp/structure/backbone.hpp"
+#include "numbers.hpp"
 
 #include "single_mode.hpp"
 
@@ -12,14 +13,9 @@
 namespace pdamp::structure {
 
 namespace {
-constexpr double kTwoPi = 6.28318530717958647692;
+using detail::kTwoPi;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 }  // namespace
 
 std::vector<std::string> BackboneOptions::validate() const {

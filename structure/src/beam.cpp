@@ -2,6 +2,7 @@
 // consistent masses), gravity's geometric stiffness and the modal reduction of the beam.
 // Model, conventions and limits: docs/structures.md, "Beam models".
 #include "pdamp/structure/beam.hpp"
+#include "numbers.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -33,12 +34,7 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 /// Local DOFs of the bending part (w1, θ1, w2, θ2) inside an element's (u1, w1, θ1, u2, w2, θ2).
 constexpr std::array<int, 4> kBendingDofs{1, 2, 4, 5};
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 std::string joined(const std::vector<std::string>& lines) {
   std::string text;

@@ -1,5 +1,6 @@
 // Dampers attached to a modal model: layer impedances and the coupled modal arrays.
 #include "pdamp/structure/damper_coupling.hpp"
+#include "numbers.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,16 +11,11 @@ namespace pdamp::structure {
 
 namespace {
 
-constexpr double kTwoPi = 6.28318530717958647692;
+using detail::kTwoPi;
 /// A drive direction is a unit vector to this relative tolerance (inputs from JSON carry ~1e-9).
 constexpr double kUnitTolerance = 1e-6;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 /// The named point's shapes, or nullptr (ModalModel::point throws; the coupling collects problems).
 const PointModeShape* find_point(const ModalModel& model, const std::string& name) {
@@ -206,7 +202,6 @@ Eigen::VectorXd natural_frequencies_with_containers_hz(const CoupledModel& coupl
   if (solver.info() != Eigen::Success) {
     throw std::runtime_error("natural_frequencies_with_containers_hz: the eigenproblem with the containers failed");
   }
-  constexpr double kTwoPi = 6.283185307179586476925;
   return solver.eigenvalues().cwiseMax(0.0).cwiseSqrt() / kTwoPi;
 }
 

@@ -1,5 +1,6 @@
 // Free decay by slowly varying amplitude: RK4 on the modal envelopes and the energies.
 #include "pdamp/structure/free_decay.hpp"
+#include "numbers.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -15,19 +16,14 @@ namespace pdamp::structure {
 
 namespace {
 
-constexpr double kTwoPi = 6.28318530717958647692;
+using detail::kTwoPi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Settling instant located by bisection of the last step: 2⁻⁶⁰ of one step.
 constexpr int kSettlingBisections = 60;
 /// Closest approach in ln a to a jump before a step crosses it (~40 graded steps from 0.05).
 constexpr double kJumpApproach = 1e-12;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 const PointModeShape& point_of(const ModalModel& model, const std::string& name) {
   for (const auto& p : model.points)

@@ -10,6 +10,7 @@
 //   (I + G·diag Z(X)) y = y_lin,   X_d = |y_d|,
 // a D-dimensional problem whatever the number of modes.
 #include "pdamp/structure/harmonic_balance.hpp"
+#include "numbers.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,7 +24,7 @@ namespace pdamp::structure {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double kTwoPi = 6.28318530717958647692;
+using detail::kTwoPi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// The side of a jump a piece ends on: the stroke one part in 10¹² inside the piece, far
 /// above round-off of the loss model's classification and far below any tolerance.
@@ -41,12 +42,7 @@ const PointModeShape& point_of(const ModalModel& model, const std::string& name)
   throw std::invalid_argument("harmonic_balance: point \"" + name + "\" is not a point of the modal model");
 }
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 /// The linear structure with empty containers at one frequency, and the loop closure.
 class FrequencyOperator {

@@ -1,5 +1,6 @@
 // Strict JSON import and export of modal data: every error names the JSON pointer and rule.
 #include "pdamp/structure/imported_modal_data.hpp"
+#include "numbers.hpp"
 
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -16,12 +17,7 @@ namespace {
 
 using nlohmann::json;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 using strict_json::pointer_token;
 

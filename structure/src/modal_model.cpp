@@ -1,5 +1,6 @@
 // ModalModel: look-up of named points and validation of the modal data (sizes, ranges).
 #include "pdamp/structure/modal_model.hpp"
+#include "numbers.hpp"
 
 #include <cmath>
 #include <set>
@@ -11,12 +12,7 @@
 namespace pdamp::structure {
 namespace {
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using detail::number;
 
 /// "<field> has N <what>, must have M (one per mode)" if the sizes differ.
 void check_count(std::vector<std::string>& problems, const std::string& field, Eigen::Index count,
@@ -120,7 +116,7 @@ std::vector<std::string> ModalModel::validate() const {
 Eigen::VectorXd modal_static_deflection_amplitudes(const ModalModel& model, const std::string& point,
                                                    const Eigen::Vector2d& force_n) {
   const PointModeShape& p = model.point(point);
-  constexpr double kTwoPi = 6.283185307179586476925;
+  using detail::kTwoPi;
   Eigen::VectorXd q(model.mode_count());
   for (Eigen::Index j = 0; j < model.mode_count(); ++j) {
     const double omega = kTwoPi * model.natural_frequencies_hz[j];
