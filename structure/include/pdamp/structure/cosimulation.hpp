@@ -1,0 +1,200 @@
+// Co-simulation: a ModalModel integrated in time with one reference-DEM World per damper,
+// the bed in the loop (PHYSICS.md §7 "Full verification", docs/cosimulation.md).
+#pragma once
+
+#include <complex>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "pdamp/dem_reference/container_motion.hpp"
+#include "pdamp/dem_reference/summary.hpp"
+#include "pdamp/dem_reference/world.hpp"
+#include "pdamp/dem_reference/world_options.hpp"
+#include "pdamp/structure/modal_model.hpp"
+
+namespace pdamp::structure {
+
+/// A particle damper whose bed is a DEM World. The container is rigid; its body frame is
+/// the World's frame at rest (gravity, compartments and placement as in `world`). The
+/// container's origin is the site: it moves along `container_drive_axis` by the site's
+/// displacement along `drive_direction` (the component across the drive is not passed to
+/// the bed) and, with `rotation`, turns about `container_rotation_axis` by the site's
+/// rotation about the structure's z. The bed's load along the drive (and its moment about
+/// the rotation axis) returns to the structure; the empty container is a point mass in
+/// x and y, as in damper_coupling.hpp (mass_with_containers_kg).
+struct CosimulationDamper {
+  std::string name;                           ///< label for reports and messages
+  std::string point;                          ///< named point of the ModalModel (the site)
+  Eigen::Vector2d drive_direction{1.0, 0.0};  ///< unit vector n in the structure's x-y plane
+  double container_mass_kg = 0.0;             ///< empty container m_c, kg, >= 0, finite
+  /// The bed. integration.time_step_s is overwritten by the co-simulation's common step
+  /// and max_impact_speed_m_s raised to the drive's (CosimulationOptions); threads as given.
+  dem_reference::WorldOptions world;
+  /// Unit vector of the container frame that follows n (the DEM's drive axis).
+  dem_reference::Vec3 container_drive_axis{1.0, 0.0, 0.0};
+  /// Unit vector of the container frame that is the structure's z (out of the plane),
+  /// perpendicular to container_drive_axis: the axis of the site's rotation.
+  dem_reference::Vec3 container_rotation_axis{0.0, 0.0, 1.0};
+  /// true: the container turns with the site (orientation and angular velocity passed to
+  /// World::step) and the bed's moment about the rotation axis returns to the modes;
+  /// false: the container only translates (a warning names the modes that rotate the site).
+  bool rotation = true;
+  /// One line per violated rule (field = value: rule), without the "dampers[i]." prefix.
+  std::vector<std::string> validate(const ModalModel& model) const;
+};
+
+enum class CosimulationExcitationKind {
+  kFreeDecay,        ///< no load: the release from the initial modal state
+  kBaseTranslation,  ///< u_base = U·e·sin(Ωt), every support moving rigidly
+  kPointForce,       ///< F(t) = F·e·sin(Ωt) at a named point
+};
+
+/// The excitation (structure frame, x-y plane).
+struct CosimulationExcitation {
+  CosimulationExcitationKind kind = CosimulationExcitationKind::kFreeDecay;
+  Eigen::Vector2d direction{0.0, 1.0};  ///< unit vector e (harmonic kinds)
+  double amplitude = 0.0;               ///< U in m (base) or F in N (force), > 0 for the harmonic kinds
+  double frequency_hz = 0.0;            ///< f = Ω/2π, Hz, > 0 for the harmonic kinds
+  std::string point;                    ///< kPointForce: named point where F acts
+};
+
+struct CosimulationOptions {
+  CosimulationExcitation excitation;
+  /// q(0), q̇(0) of the modes (relative to the base for base motion); empty = 0, else one per
+  /// mode, finite. A free decay needs one of them non-zero.
+  Eigen::VectorXd initial_modal_displacements;
+  Eigen::VectorXd initial_modal_velocities;
+  /// Free decay: simulated time, s, > 0. Harmonic kinds: ignored (periods below).
+  double duration_s = 0.0;
+  /// Harmonic kinds: periods run before the analysis, >= 0; with settle_until_stable the
+  /// largest number allowed (the run stops settling earlier once stable).
+  int transient_periods = 0;
+  /// Harmonic kinds: whole periods of the DFT (steady-state amplitudes), >= 1.
+  int analysed_periods = 1;
+  /// Harmonic kinds: end the transient once the period-to-period relative change of the
+  /// first damper's site amplitude along its drive (DFT at Ω of each period) has stayed
+  /// below stable_tolerance for two periods in a row.
+  bool settle_until_stable = false;
+  double stable_tolerance = 1e-3;  ///< in (0, 1)
+  /// Bed settling before the coupling starts, with the structure held in its initial state
+  /// and the container at rest there (dem_reference::settle), s: −1 = automatic
+  /// (dem_reference::automatic_settling_time_s of each world), else [0, 100].
+  double bed_settling_time_s = -1.0;
+  /// Output sampling of the time histories, s: rounded to whole steps (at least one);
+  /// 0 = automatic: period/64 for the harmonic kinds, duration/2000 for a free decay.
+  double sample_interval_s = 0.0;
+  /// Peak site speed along the drive the time-step rule assumes (dem_reference::
+  /// drive_impact_speed), m/s, >= 0; 0 = automatic: free decay from the initial energy
+  /// (√(2E₀ bᵀM⁻¹b), a bound), harmonic from twice the linear response without beds.
+  double peak_site_speed_m_s = 0.0;
+  /// Common time step, s: 0 = automatic (the smallest of the worlds' steps; harmonic: with
+  /// whole steps per period by dem_reference::drive_time_step), else at most every world's
+  /// automatic bound (otherwise refused).
+  double time_step_s = 0.0;
+  /// Progress callback interval, wall-clock s, > 0.
+  double progress_interval_s = 0.5;
+
+  /// All violations, one line each, "field = value: rule" (prefix "cosimulation.").
+  std::vector<std::string> validate(const ModalModel& model) const;
+};
+
+/// Sampled histories (row s = sample s; first sample at t = 0, the coupling's start).
+struct CosimulationHistory {
+  std::vector<double> time_s;
+  Eigen::MatrixXd modal_displacements;  ///< samples x modes, q (relative for base motion)
+  Eigen::MatrixXd site_displacement_m;  ///< samples x dampers: absolute site motion along n, m
+  Eigen::MatrixXd site_rotation_rad;    ///< samples x dampers: site rotation about z, rad
+  /// samples x dampers: force the bed exerts on the container along n, N (−load·a)
+  Eigen::MatrixXd container_load_n;
+  /// samples x dampers: moment the bed exerts on the container about the rotation axis, N m
+  Eigen::MatrixXd container_moment_nm;
+};
+
+/// First harmonics at Ω over whole periods (harmonic kinds), as complex amplitudes against
+/// the excitation's sin Ωt: y(t) ≈ Im(Ŷ e^{iΩt}), Ŷ = i·(2/N) Σ_k y_k e^{−iΩt_k} over the N
+/// steps of each period (y = Y sin Ωt gives Ŷ = Y; y = Y cos Ωt gives Ŷ = iY).
+struct CosimulationSteadyState {
+  double frequency_hz = 0.0;
+  int transient_periods = 0;  ///< periods run before the analysed ones
+  int analysed_periods = 0;
+  bool stable = false;        ///< settle_until_stable reached its tolerance (false when not asked)
+  Eigen::VectorXcd modal_amplitudes;                    ///< q̂_j
+  std::vector<std::complex<double>> site_amplitudes_m;  ///< ŷ_d along n (absolute), m
+  /// |ŷ_d| per unit excitation: transmissibility |ŷ/U| (base) or receptance |ŷ/F| in m/N.
+  std::vector<double> site_amplitude_per_excitation;
+  /// |ŷ| of the first damper's site in each period run (transient and analysed), m.
+  std::vector<double> period_site_amplitudes_m;
+};
+
+/// Energy over the coupled run in one inertial frame, J (docs/cosimulation.md §4).
+/// For base motion the rigid carried-mass term ½m_rigid u̇_b² is left out of both sides
+/// (a truncated modal model does not know m_rigid; it cancels exactly).
+struct CosimulationEnergy {
+  double excitation_work_j = 0.0;           ///< ∫F·v_point dt, or ∫R·u̇_b dt (base reaction)
+  double structural_damping_j = 0.0;        ///< ∫q̇ᵀCq̇ dt
+  double delta_structure_kinetic_j = 0.0;   ///< structure + containers, absolute velocities
+  double delta_structure_potential_j = 0.0; ///< ½qᵀKq
+  double dem_normal_damping_j = 0.0;        ///< Σ over the worlds
+  double dem_friction_j = 0.0;
+  double dem_rolling_j = 0.0;
+  double delta_bed_kinetic_j = 0.0;
+  double delta_bed_potential_j = 0.0;
+  double delta_bed_elastic_j = 0.0;
+  double container_work_j = 0.0;            ///< the worlds' own account of the work on the beds (cross-check)
+  /// |W − (D_s + D_dem + ΔE_s + ΔE_bed)| / max(|W|, D_s + D_dem, |ΔE_s|).
+  double relative_error = 0.0;
+  double dem_dissipated_j() const { return dem_normal_damping_j + dem_friction_j + dem_rolling_j; }
+};
+
+struct CosimulationResult {
+  /// kCompleted; kUnstable / kFailed when a World stopped (message: the damper and the
+  /// World's own reason and advice); the histories end there.
+  dem_reference::Outcome outcome = dem_reference::Outcome::kCompleted;
+  std::string message;
+  double time_step_s = 0.0;
+  std::int64_t steps = 0;              ///< coupled steps (bed settling not counted)
+  std::int64_t steps_per_period = 0;   ///< harmonic kinds, else 0
+  std::int64_t settling_steps = 0;
+  double simulated_time_s = 0.0;       ///< coupled time, s
+  double wall_time_s = 0.0;
+  /// Natural frequencies with the empty containers (beds removed), Hz.
+  Eigen::VectorXd frequencies_with_containers_hz;
+  Eigen::VectorXd final_modal_displacements;  ///< q at the last step (relative for base motion)
+  Eigen::VectorXd final_modal_velocities;     ///< q̇ at the last step
+  CosimulationHistory history;
+  CosimulationSteadyState steady_state;  ///< harmonic kinds only
+  CosimulationEnergy energy;
+  std::vector<dem_reference::WorldStatus> world_status;            ///< per damper
+  std::vector<dem_reference::ContainerState> final_container_states;  ///< per damper
+  std::vector<std::string> warnings;
+};
+
+struct CosimulationProgress {
+  std::string_view stage;          ///< "settling", "transient", "analysis", "decay"
+  double simulated_time_s = 0.0;   ///< since the coupling started
+  double end_time_s = 0.0;         ///< planned end (harmonic: with all transient periods)
+  double steps_per_s = 0.0;
+};
+using CosimulationProgressCallback = std::function<void(const CosimulationProgress&)>;
+
+/// Runs the co-simulation. The modal equations
+///   M q̈ + C q̇ + K q = f_exc(t) − Σ_d (b_d F_d + r_d M_d),   M = diag(m_j) + Σ m_c Φ_dᵀΦ_d,
+/// (F_d, M_d: what container d applies to its bed along n and about the rotation axis; b_d,
+/// r_d the site's drive and rotation shapes) are advanced with the worlds' step dt by
+/// velocity Verlet with the damping term trapezoidal (implicit, exact solve): the structure
+/// and the beds form one leapfrog, second order, with no lag in the coupling.
+/// Throws std::invalid_argument for invalid inputs (every violation, one per line) and for a
+/// step the structure cannot take (ω_max·dt > 0.2).
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options,
+                              const CosimulationProgressCallback& progress = {});
+
+/// Rodrigues rotation about a unit axis by angle θ (rad), row-major (body → world).
+dem_reference::Matrix3 rotation_about(const dem_reference::Vec3& unit_axis, double angle_rad);
+
+}  // namespace pdamp::structure

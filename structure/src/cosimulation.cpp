@@ -1,0 +1,578 @@
+// Co-simulation of a modal model with one reference-DEM World per damper (docs/cosimulation.md).
+#include "pdamp/structure/cosimulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "numbers.hpp"
+#include "pdamp/dem_reference/damper_simulation.hpp"
+#include "pdamp/dem_reference/drive_time_step.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+
+namespace pdamp::structure {
+
+namespace {
+
+namespace dem = pdamp::dem_reference;
+using detail::kTwoPi;
+using detail::number;
+using Clock = std::chrono::steady_clock;
+
+/// Unit vectors to this relative tolerance (inputs from JSON carry ~1e-9).
+constexpr double kUnitTolerance = 1e-6;
+/// The structure's Verlet step: ω_max·dt at most this (frequency error (ωdt)²/24 = 1.7e-4 at
+/// the limit); the automatic step is shortened to kStructureStepTarget/ω_max, whose frequency
+/// error (ωdt)²/24 is 1e-4 of that at 0.2 — far below the beds' own.
+constexpr double kStructureStepLimit = 0.2;
+constexpr double kStructureStepTarget = 0.05;
+/// The progress clock is read every this many steps.
+constexpr std::int64_t kProgressStride = 256;
+
+const PointModeShape* find_point(const ModalModel& model, const std::string& name) {
+  for (const auto& p : model.points)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+double norm3(const dem::Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+double dot3(const dem::Vec3& a, const dem::Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+// Streams rather than string concatenation: GCC 12 flags "(" + std::string with a false -Wrestrict.
+std::string vec3(const dem::Vec3& v) {
+  std::ostringstream out;
+  out.precision(12);
+  out << '(' << v[0] << ", " << v[1] << ", " << v[2] << ')';
+  return out.str();
+}
+std::string vec2(const Eigen::Vector2d& v) {
+  std::ostringstream out;
+  out.precision(12);
+  out << '(' << v.x() << ", " << v.y() << ')';
+  return out.str();
+}
+
+bool harmonic(const CosimulationExcitation& e) { return e.kind != CosimulationExcitationKind::kFreeDecay; }
+
+/// Joins violations into one message.
+std::string join(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += (out.empty() ? "" : "\n") + l;
+  return out;
+}
+
+}  // namespace
+
+dem::Matrix3 rotation_about(const dem::Vec3& k, double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad), t = 1.0 - c;
+  return {t * k[0] * k[0] + c,        t * k[0] * k[1] - s * k[2], t * k[0] * k[2] + s * k[1],
+          t * k[0] * k[1] + s * k[2], t * k[1] * k[1] + c,        t * k[1] * k[2] - s * k[0],
+          t * k[0] * k[2] - s * k[1], t * k[1] * k[2] + s * k[0], t * k[2] * k[2] + c};
+}
+
+std::vector<std::string> CosimulationDamper::validate(const ModalModel& model) const {
+  std::vector<std::string> problems;
+  if (!find_point(model, point)) problems.push_back("point = \"" + point + "\": must name a point of the modal model");
+  if (!(std::abs(drive_direction.norm() - 1.0) <= kUnitTolerance))
+    problems.push_back("drive_direction = " + vec2(drive_direction) + ": must be a unit vector");
+  if (!(container_mass_kg >= 0.0 && std::isfinite(container_mass_kg)))
+    problems.push_back("container_mass_kg = " + number(container_mass_kg) + ": must be >= 0 and finite");
+  const bool drive_unit = std::abs(norm3(container_drive_axis) - 1.0) <= kUnitTolerance;
+  const bool rotation_unit = std::abs(norm3(container_rotation_axis) - 1.0) <= kUnitTolerance;
+  if (!drive_unit) problems.push_back("container_drive_axis = " + vec3(container_drive_axis) + ": must be a unit vector");
+  if (!rotation_unit)
+    problems.push_back("container_rotation_axis = " + vec3(container_rotation_axis) + ": must be a unit vector");
+  if (drive_unit && rotation_unit && !(std::abs(dot3(container_drive_axis, container_rotation_axis)) <= kUnitTolerance))
+    problems.push_back("container_rotation_axis = " + vec3(container_rotation_axis) +
+                       ": must be perpendicular to container_drive_axis " + vec3(container_drive_axis));
+  for (auto& line : world.validate("world.")) problems.push_back(std::move(line));
+  return problems;
+}
+
+std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) const {
+  std::vector<std::string> p;
+  const std::string at = "cosimulation.";
+  const Eigen::Index modes = model.mode_count();
+  const auto& e = excitation;
+  if (harmonic(e)) {
+    if (!(std::abs(e.direction.norm() - 1.0) <= kUnitTolerance))
+      p.push_back(at + "excitation.direction = " + vec2(e.direction) + ": must be a unit vector");
+    if (!(e.amplitude > 0.0 && std::isfinite(e.amplitude)))
+      p.push_back(at + "excitation.amplitude = " + number(e.amplitude) + ": must be > 0 and finite (m or N)");
+    if (!(e.frequency_hz >= dem::limits::kMinFrequency_hz && e.frequency_hz <= dem::limits::kMaxFrequency_hz))
+      p.push_back(at + "excitation.frequency_hz = " + number(e.frequency_hz) + ": must be in [0.01, 10000] Hz");
+    if (e.kind == CosimulationExcitationKind::kPointForce && !find_point(model, e.point))
+      p.push_back(at + "excitation.point = \"" + e.point + "\": must name a point of the modal model");
+    if (e.kind == CosimulationExcitationKind::kBaseTranslation && model.base_participation.cols() != 2)
+      p.push_back(at + "excitation.kind = base translation: the modal model has no base participation");
+    if (!(transient_periods >= 0 && transient_periods <= dem::limits::kMaxPeriods))
+      p.push_back(at + "transient_periods = " + std::to_string(transient_periods) + ": must be in [0, 100000]");
+    if (!(analysed_periods >= 1 && analysed_periods <= dem::limits::kMaxPeriods))
+      p.push_back(at + "analysed_periods = " + std::to_string(analysed_periods) + ": must be in [1, 100000]");
+    if (settle_until_stable && !(stable_tolerance > 0.0 && stable_tolerance < 1.0))
+      p.push_back(at + "stable_tolerance = " + number(stable_tolerance) + ": must be in (0, 1)");
+  } else if (!(duration_s > 0.0 && std::isfinite(duration_s))) {
+    p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a free decay");
+  }
+  const auto check_initial = [&](const Eigen::VectorXd& v, const std::string& name) {
+    if (v.size() != 0 && v.size() != modes)
+      p.push_back(at + name + ": has " + std::to_string(v.size()) + " entries, must be empty or one per mode (" +
+                  std::to_string(modes) + ")");
+    else if (!v.allFinite())
+      p.push_back(at + name + ": must be finite");
+  };
+  check_initial(initial_modal_displacements, "initial_modal_displacements");
+  check_initial(initial_modal_velocities, "initial_modal_velocities");
+  if (!harmonic(e) && !(initial_modal_displacements.size() && initial_modal_displacements.cwiseAbs().maxCoeff() > 0) &&
+      !(initial_modal_velocities.size() && initial_modal_velocities.cwiseAbs().maxCoeff() > 0))
+    p.push_back(at + "initial_modal_displacements, initial_modal_velocities: a free decay needs a non-zero start");
+  if (!(bed_settling_time_s == -1.0 || (bed_settling_time_s >= 0.0 && bed_settling_time_s <= 100.0)))
+    p.push_back(at + "bed_settling_time_s = " + number(bed_settling_time_s) + ": must be -1 (automatic) or in [0, 100] s");
+  if (!(sample_interval_s >= 0.0 && std::isfinite(sample_interval_s)))
+    p.push_back(at + "sample_interval_s = " + number(sample_interval_s) + ": must be >= 0 and finite (0 = automatic)");
+  if (!(peak_site_speed_m_s >= 0.0 && peak_site_speed_m_s <= dem::limits::kMaxImpactSpeed_m_s))
+    p.push_back(at + "peak_site_speed_m_s = " + number(peak_site_speed_m_s) + ": must be in [0, 1000] m/s (0 = automatic)");
+  if (!(time_step_s == 0.0 ||
+        (time_step_s >= dem::limits::kMinTimeStep_s && time_step_s <= dem::limits::kMaxTimeStep_s)))
+    p.push_back(at + "time_step_s = " + number(time_step_s) + ": must be 0 (automatic) or in [1e-10, 1e-3] s");
+  if (!(progress_interval_s > 0.0 && std::isfinite(progress_interval_s)))
+    p.push_back(at + "progress_interval_s = " + number(progress_interval_s) + ": must be > 0 and finite");
+  return p;
+}
+
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, const CosimulationProgressCallback& progress) {
+  const auto wall_start = Clock::now();
+  // --- Validation: every violation, one per line.
+  std::vector<std::string> problems = model.validate();
+  if (dampers.empty()) problems.push_back("dampers: must hold at least one damper");
+  for (std::size_t d = 0; d < dampers.size(); ++d)
+    for (auto& line : dampers[d].validate(model)) problems.push_back("dampers[" + std::to_string(d) + "]." + line);
+  for (auto& line : options.validate(model)) problems.push_back(std::move(line));
+  if (!problems.empty()) throw std::invalid_argument(join(problems));
+
+  CosimulationResult result;
+  const auto& exc = options.excitation;
+  const bool is_harmonic = harmonic(exc);
+  const bool is_base = exc.kind == CosimulationExcitationKind::kBaseTranslation;
+  const Eigen::Index n = model.mode_count();
+  const std::size_t dcount = dampers.size();
+
+  // --- Modal arrays with the empty containers (damper_coupling's exact point masses).
+  std::vector<Damper> points;
+  for (const auto& d : dampers) {
+    Damper p;
+    p.name = d.name;
+    p.point = d.point;
+    p.drive_direction = d.drive_direction;
+    p.container_mass_kg = d.container_mass_kg;
+    points.push_back(p);
+  }
+  const CoupledModel coupled = couple(model, points);
+  const Eigen::MatrixXd& M = coupled.mass_with_containers_kg;
+  const Eigen::VectorXd& w = coupled.angular_frequencies_rad_s;
+  const Eigen::VectorXd K = model.modal_masses_kg.cwiseProduct(w.cwiseAbs2());
+  const Eigen::VectorXd C = 2.0 * model.modal_masses_kg.cwiseProduct(model.damping_ratios).cwiseProduct(w);
+  const Eigen::MatrixXd& B = coupled.drive_shapes;  // modes x dampers
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(dcount));  // rotation shapes
+  for (std::size_t d = 0; d < dcount; ++d) {
+    const Eigen::RowVectorXd& rot = model.point(dampers[d].point).rotation;
+    if (dampers[d].rotation) {
+      R.col(static_cast<Eigen::Index>(d)) = rot.transpose();
+    } else if (rot.cwiseAbs().maxCoeff() > 0.0) {
+      result.warnings.push_back("damper " + dampers[d].name + ": the site rotates (max |θ_j| = " +
+                                number(rot.cwiseAbs().maxCoeff()) +
+                                " rad per unit q) but rotation = false: the container only translates");
+    }
+  }
+  result.frequencies_with_containers_hz = natural_frequencies_with_containers_hz(coupled);
+  const Eigen::MatrixXd M_inv = M.inverse();
+
+  // Excitation: f_exc(t) = amplitude_vector · sin Ωt.
+  const double omega = is_harmonic ? kTwoPi * exc.frequency_hz : 0.0;
+  Eigen::VectorXd exc_shape = Eigen::VectorXd::Zero(n);  // modal load per unit sin Ωt
+  Eigen::VectorXd base_shape = Eigen::VectorXd::Zero(n);  // P_e = (Γ + Σ m_c Φ_dᵀ) e
+  std::vector<double> drive_dot_e(dcount, 0.0);            // n_d · e (base motion of the sites)
+  Eigen::VectorXd force_shape = Eigen::VectorXd::Zero(n);  // Φ_pᵀ e
+  if (exc.kind == CosimulationExcitationKind::kPointForce) {
+    force_shape = model.point(exc.point).translation.transpose() * exc.direction;
+    exc_shape = exc.amplitude * force_shape;
+  } else if (is_base) {
+    base_shape = (coupled.base_participation + coupled.container_participation) * exc.direction;
+    exc_shape = exc.amplitude * omega * omega * base_shape;  // −P_e ü_b, ü_b = −UΩ² sin Ωt
+    for (std::size_t d = 0; d < dcount; ++d) drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
+  }
+  const double U = is_base ? exc.amplitude : 0.0;
+
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n);
+  if (options.initial_modal_displacements.size()) q = options.initial_modal_displacements;
+  if (options.initial_modal_velocities.size()) v = options.initial_modal_velocities;
+
+  // --- Peak site speed for the time-step rule.
+  std::vector<double> peak_speed(dcount, options.peak_site_speed_m_s);
+  if (options.peak_site_speed_m_s == 0.0) {
+    const double e0 = 0.5 * v.dot(M * v) + 0.5 * q.dot(K.cwiseProduct(q));
+    for (std::size_t d = 0; d < dcount; ++d) {
+      const auto col = static_cast<Eigen::Index>(d);
+      // Free motion: |b·q̇| <= √(2E bᵀM⁻¹b) (Cauchy-Schwarz in the M norm).
+      peak_speed[d] = std::sqrt(2.0 * e0 * B.col(col).dot(M_inv * B.col(col)));
+    }
+    if (is_harmonic) {
+      Eigen::MatrixXcd D;
+      linear_dynamic_stiffness(coupled, omega, D);
+      const Eigen::VectorXcd qhat = D.partialPivLu().solve(exc_shape.cast<std::complex<double>>());
+      for (std::size_t d = 0; d < dcount; ++d) {
+        const auto col = static_cast<Eigen::Index>(d);
+        const std::complex<double> y = B.col(col).cast<std::complex<double>>().dot(qhat) + drive_dot_e[d] * U;
+        // Twice the linear steady state (the start transient can overshoot it), plus the start.
+        peak_speed[d] += 2.0 * std::abs(y) * omega;
+      }
+    }
+    for (auto& s : peak_speed) s = std::min(s, 0.5 * dem::limits::kMaxImpactSpeed_m_s);
+  }
+
+  // --- Common time step and the worlds' options.
+  std::vector<dem::WorldOptions> world_options;
+  const double omega_max = w.maxCoeff();
+  double dt = 0.0;
+  std::int64_t steps_per_period = 0;
+  if (is_harmonic) {
+    const double period = 1.0 / exc.frequency_hz;
+    for (std::size_t d = 0; d < dcount; ++d) {
+      dem::WorldOptions wo = dampers[d].world;
+      if (options.time_step_s > 0.0) wo.integration.time_step_s = options.time_step_s;
+      const dem::DriveTimeStep plan = dem::drive_time_step(
+          wo, dem::DriveTiming{period, 1, dem::drive_impact_speed(wo, peak_speed[d])});
+      for (const auto& wline : plan.warnings) result.warnings.push_back("damper " + dampers[d].name + ": " + wline);
+      steps_per_period = std::max(steps_per_period, plan.steps_per_period);
+      world_options.push_back(plan.world);
+    }
+    if (options.time_step_s == 0.0)
+      steps_per_period = std::max(
+          steps_per_period, static_cast<std::int64_t>(std::ceil(omega_max * period / kStructureStepTarget)));
+    dt = period / static_cast<double>(steps_per_period);
+  } else {
+    dt = dem::limits::kMaxTimeStep_s;
+    for (std::size_t d = 0; d < dcount; ++d) {
+      dem::WorldOptions wo = dampers[d].world;
+      wo.integration.max_impact_speed_m_s =
+          std::max(wo.integration.max_impact_speed_m_s, dem::drive_impact_speed(wo, peak_speed[d]));
+      wo.integration.time_step_s = 0.0;
+      dt = std::min(dt, dem::time_step_bound(wo).max_time_step_s);
+      world_options.push_back(wo);
+    }
+    if (options.time_step_s > 0.0) {
+      if (options.time_step_s > dt)
+        throw std::invalid_argument("cosimulation.time_step_s = " + number(options.time_step_s) +
+                                    ": must be <= the worlds' automatic bound " + number(dt) + " s");
+      dt = options.time_step_s;
+    } else {
+      dt = std::min(dt, kStructureStepTarget / omega_max);
+    }
+  }
+  if (omega_max * dt > kStructureStepLimit)
+    throw std::invalid_argument("cosimulation.time_step_s = " + number(dt) + ": the highest mode (" +
+                                number(omega_max / kTwoPi) + " Hz) needs ω·dt <= 0.2 for the modal Verlet step");
+  for (auto& wo : world_options) wo.integration.time_step_s = dt;
+  result.time_step_s = dt;
+  result.steps_per_period = steps_per_period;
+
+  // --- Planned length.
+  const std::int64_t transient_steps = is_harmonic ? options.transient_periods * steps_per_period : 0;
+  const std::int64_t planned_steps =
+      is_harmonic ? transient_steps + options.analysed_periods * steps_per_period
+                  : static_cast<std::int64_t>(std::llround(options.duration_s / dt));
+  double interval = options.sample_interval_s;
+  if (interval == 0.0) interval = is_harmonic ? 1.0 / (64.0 * exc.frequency_hz) : options.duration_s / 2000.0;
+  const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(interval / dt));
+  const std::int64_t max_samples = planned_steps / sample_every + 1;
+
+  // --- Container kinematics of damper d for modal state q at drive time t.
+  std::vector<double> site_y(dcount), site_theta(dcount);
+  const auto site_state = [&](std::size_t d, const Eigen::VectorXd& qq, double base, double base_velocity,
+                              const Eigen::VectorXd& qdot, dem::ContainerState& s) {
+    const auto col = static_cast<Eigen::Index>(d);
+    const auto& cd = dampers[d];
+    const double y = B.col(col).dot(qq) + drive_dot_e[d] * base;
+    const double ydot = B.col(col).dot(qdot) + drive_dot_e[d] * base_velocity;
+    const double theta = R.col(col).dot(qq);
+    const double theta_dot = R.col(col).dot(qdot);
+    for (int a = 0; a < 3; ++a) {
+      s.position_m[a] = cd.container_drive_axis[a] * y;
+      s.velocity_m_s[a] = cd.container_drive_axis[a] * ydot;
+      s.angular_velocity_rad_s[a] = cd.container_rotation_axis[a] * theta_dot;
+    }
+    s.orientation = theta == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, theta);
+    site_y[d] = y;
+    site_theta[d] = theta;
+  };
+
+  // --- Worlds, built at the start pose, and the beds settled with the structure held.
+  std::vector<dem::World> worlds;
+  worlds.reserve(dcount);
+  const double base_velocity0 = U * omega;  // u_b = U sin Ωt: u̇_b(0) = UΩ
+  std::vector<dem::ContainerState> states(dcount);
+  for (std::size_t d = 0; d < dcount; ++d) {
+    site_state(d, q, 0.0, base_velocity0, v, states[d]);
+    worlds.emplace_back(world_options[d], states[d]);
+  }
+  for (std::size_t d = 0; d < dcount; ++d) {
+    const double settling = options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
+                                                               : dem::automatic_settling_time_s(world_options[d]);
+    const auto steps = static_cast<std::int64_t>(std::llround(settling / dt));
+    result.settling_steps = std::max(result.settling_steps, steps);
+    if (progress) progress(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps) * dt, 0.0});
+    if (!dem::settle(worlds[d], states[d], steps)) {
+      result.outcome = worlds[d].status().outcome;
+      result.message = "damper " + dampers[d].name + " (settling): " + worlds[d].status().message;
+    }
+  }
+
+  // Bed loads on the structure: F_d along a and M_d about k, what the container applies to the bed.
+  std::vector<double> force(dcount, 0.0), moment(dcount, 0.0);
+  const auto read_load = [&](std::size_t d, const dem::ContainerLoad& load) {
+    force[d] = dot3(load.force_n, dampers[d].container_drive_axis);
+    moment[d] = dot3(load.moment_nm, dampers[d].container_rotation_axis);
+  };
+  for (std::size_t d = 0; d < dcount; ++d) read_load(d, worlds[d].load());
+
+  std::vector<dem::EnergyAccount> opening;
+  for (const auto& world : worlds) opening.push_back(world.energy());
+
+  // --- Preallocated loop state (the step loop allocates nothing).
+  Eigen::VectorXd g(n), tmp(n), acc(n), vh(n), q_new(n), v_new(n), acc_new(n), v_half_dt(n);
+  const Eigen::MatrixXd A_inv = (M + 0.5 * dt * Eigen::MatrixXd(C.asDiagonal())).inverse();
+  const auto modal_load = [&](double sin_t, const Eigen::VectorXd& qq, Eigen::VectorXd& out) {
+    out = sin_t * exc_shape - K.cwiseProduct(qq);
+    for (std::size_t d = 0; d < dcount; ++d) {
+      const auto col = static_cast<Eigen::Index>(d);
+      out -= force[d] * B.col(col);
+      if (moment[d] != 0.0) out -= moment[d] * R.col(col);
+    }
+  };
+  // sin Ωt and e^{−iΩt} at the steps of a period (harmonic), tabulated once.
+  std::vector<double> sin_table, cos_table;
+  if (is_harmonic) {
+    sin_table.resize(static_cast<std::size_t>(steps_per_period));
+    cos_table.resize(static_cast<std::size_t>(steps_per_period));
+    for (std::int64_t k = 0; k < steps_per_period; ++k) {
+      const double phase = kTwoPi * static_cast<double>(k) / static_cast<double>(steps_per_period);
+      sin_table[static_cast<std::size_t>(k)] = std::sin(phase);
+      cos_table[static_cast<std::size_t>(k)] = std::cos(phase);
+    }
+  }
+  const auto sin_at = [&](std::int64_t step) {
+    return is_harmonic ? sin_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  };
+  const auto cos_at = [&](std::int64_t step) {
+    return is_harmonic ? cos_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  };
+
+  auto& h = result.history;
+  h.time_s.reserve(static_cast<std::size_t>(max_samples));
+  h.modal_displacements.resize(max_samples, n);
+  h.site_displacement_m.resize(max_samples, static_cast<Eigen::Index>(dcount));
+  h.site_rotation_rad.resize(max_samples, static_cast<Eigen::Index>(dcount));
+  h.container_load_n.resize(max_samples, static_cast<Eigen::Index>(dcount));
+  h.container_moment_nm.resize(max_samples, static_cast<Eigen::Index>(dcount));
+  Eigen::Index samples = 0;
+  const auto record = [&](double t) {
+    if (samples >= max_samples) return;
+    h.time_s.push_back(t);
+    h.modal_displacements.row(samples) = q.transpose();
+    for (std::size_t d = 0; d < dcount; ++d) {
+      const auto col = static_cast<Eigen::Index>(d);
+      h.site_displacement_m(samples, col) = site_y[d];
+      h.site_rotation_rad(samples, col) = site_theta[d];
+      h.container_load_n(samples, col) = -force[d];
+      h.container_moment_nm(samples, col) = -moment[d];
+    }
+    ++samples;
+  };
+
+  // Structural energy in the inertial frame (without ½m_rigid u̇_b²): T' = ½q̇ᵀMq̇ + u̇_b P_eᵀq̇.
+  const auto structure_kinetic = [&](const Eigen::VectorXd& vv, double base_velocity) {
+    tmp.noalias() = M * vv;
+    return 0.5 * vv.dot(tmp) + base_velocity * base_shape.dot(vv);
+  };
+  const auto structure_potential = [&](const Eigen::VectorXd& qq) { return 0.5 * qq.dot(K.cwiseProduct(qq)); };
+  // Base reaction power R'·u̇_b = u̇_b (P_eᵀq̈ + Σ F_d n_d·e).
+  const auto base_power = [&](const Eigen::VectorXd& accel, double base_velocity) {
+    double r = base_shape.dot(accel);
+    for (std::size_t d = 0; d < dcount; ++d) r += force[d] * drive_dot_e[d];
+    return r * base_velocity;
+  };
+  const double kinetic0 = structure_kinetic(v, base_velocity0);
+  const double potential0 = structure_potential(q);
+
+  modal_load(0.0, q, g);
+  tmp = g - C.cwiseProduct(v);
+  acc.noalias() = M_inv * tmp;
+  double power = is_base ? base_power(acc, base_velocity0) : 0.0;
+  double work = 0.0, damping = 0.0;
+  record(0.0);
+
+  // DFT accumulators: per period (first damper's site, for the stability test) and analysed.
+  std::complex<double> period_sum(0.0, 0.0);
+  std::vector<std::complex<double>> site_sum(dcount, {0.0, 0.0});
+  Eigen::VectorXcd modal_sum = Eigen::VectorXcd::Zero(n);
+  auto& ss = result.steady_state;
+  if (is_harmonic) ss.period_site_amplitudes_m.reserve(static_cast<std::size_t>(options.transient_periods +
+                                                                                options.analysed_periods));
+  bool analysing = is_harmonic && (options.transient_periods == 0);
+  std::int64_t analysis_start = analysing ? 0 : -1;
+  int calm_periods = 0;
+  std::int64_t end_step = planned_steps;
+  const std::string_view decay_stage = "decay", transient_stage = "transient", analysis_stage = "analysis";
+
+  auto last_report = Clock::now();
+  std::int64_t last_report_step = 0;
+  std::int64_t step = 0;
+  const double half_dt = 0.5 * dt;
+  while (step < end_step && result.outcome == dem::Outcome::kCompleted) {
+    // Kick and drift of the modes (velocity Verlet; damping trapezoidal, solved exactly).
+    vh = v + half_dt * acc;
+    q_new = q + dt * vh;
+    const std::int64_t next = step + 1;
+    const double t_next = static_cast<double>(next) * dt;
+    const double base_next = U * sin_at(next);
+    const double base_velocity_next = U * omega * cos_at(next);
+    // The beds: each container at its new state; the half-step velocities are the Verlet ones.
+    for (std::size_t d = 0; d < dcount; ++d) {
+      const double y_old = site_y[d], theta_old = site_theta[d];
+      site_state(d, q_new, base_next, 0.0, vh, states[d]);
+      const double y_rate = (site_y[d] - y_old) / dt, theta_rate = (site_theta[d] - theta_old) / dt;
+      for (int a = 0; a < 3; ++a) {
+        states[d].velocity_m_s[a] = dampers[d].container_drive_axis[a] * y_rate;
+        states[d].angular_velocity_rad_s[a] = dampers[d].container_rotation_axis[a] * theta_rate;
+      }
+      const dem::ContainerLoad& load = worlds[d].step(states[d]);
+      if (worlds[d].status().outcome != dem::Outcome::kCompleted) {
+        result.outcome = worlds[d].status().outcome;
+        result.message = "damper " + dampers[d].name + " at t = " + number(t_next) + " s: " +
+                         worlds[d].status().message;
+      }
+      read_load(d, load);
+    }
+    if (result.outcome != dem::Outcome::kCompleted) break;
+    // The closing kick with the new loads: (M + dt/2 C) v_new = M vh + dt/2 g_new.
+    modal_load(sin_at(next), q_new, g);
+    tmp.noalias() = M * vh;
+    tmp += half_dt * g;
+    v_new.noalias() = A_inv * tmp;
+    tmp = g - C.cwiseProduct(v_new);
+    acc_new.noalias() = M_inv * tmp;
+    // Ledger, trapezoidal over the step (the worlds account their work the same way).
+    tmp = q_new - q;
+    damping += 0.5 * (C.cwiseProduct(v) + C.cwiseProduct(v_new)).dot(tmp);
+    if (exc.kind == CosimulationExcitationKind::kPointForce) {
+      work += 0.5 * exc.amplitude * (sin_at(step) + sin_at(next)) * force_shape.dot(tmp);
+    } else if (is_base) {
+      const double power_next = base_power(acc_new, base_velocity_next);
+      work += half_dt * (power + power_next);
+      power = power_next;
+    }
+    q.swap(q_new);
+    v.swap(v_new);
+    acc.swap(acc_new);
+    step = next;
+
+    if (is_harmonic) {
+      // e^{−iΩt}·i·(2/N): amplitude against sin Ωt.
+      const std::complex<double> kernel(sin_at(step), cos_at(step));  // i·e^{−iΩt} = sin + i cos
+      period_sum += site_y[0] * kernel;
+      if (analysing) {
+        for (std::size_t d = 0; d < dcount; ++d) site_sum[d] += site_y[d] * kernel;
+        for (Eigen::Index j = 0; j < n; ++j) modal_sum[j] += q[j] * kernel;
+      }
+      if (step % steps_per_period == 0) {
+        const double amplitude = std::abs(period_sum) * 2.0 / static_cast<double>(steps_per_period);
+        period_sum = {0.0, 0.0};
+        if (ss.period_site_amplitudes_m.size() < ss.period_site_amplitudes_m.capacity())
+          ss.period_site_amplitudes_m.push_back(amplitude);
+        if (!analysing) {
+          const auto& a = ss.period_site_amplitudes_m;
+          if (options.settle_until_stable && a.size() >= 2) {
+            const double change = std::abs(a[a.size() - 1] - a[a.size() - 2]) / std::max(a.back(), 1e-300);
+            calm_periods = change < options.stable_tolerance ? calm_periods + 1 : 0;
+            if (calm_periods >= 2) ss.stable = true;
+          }
+          if (ss.stable || step >= transient_steps) {
+            analysing = true;
+            analysis_start = step;
+            end_step = step + options.analysed_periods * steps_per_period;
+          }
+        }
+      }
+    }
+    if (step % sample_every == 0) record(t_next);
+    if (progress && step % kProgressStride == 0) {
+      const auto now = Clock::now();
+      const double since = std::chrono::duration<double>(now - last_report).count();
+      if (since >= options.progress_interval_s) {
+        progress(CosimulationProgress{!is_harmonic ? decay_stage : (analysing ? analysis_stage : transient_stage),
+                                      t_next, static_cast<double>(end_step) * dt,
+                                      static_cast<double>(step - last_report_step) / since});
+        last_report = now;
+        last_report_step = step;
+      }
+    }
+  }
+
+  // --- Results.
+  result.steps = step;
+  result.final_modal_displacements = q;
+  result.final_modal_velocities = v;
+  result.simulated_time_s = static_cast<double>(step) * dt;
+  h.modal_displacements.conservativeResize(samples, n);
+  h.site_displacement_m.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
+  h.site_rotation_rad.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
+  h.container_load_n.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
+  h.container_moment_nm.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
+
+  if (is_harmonic) {
+    ss.frequency_hz = exc.frequency_hz;
+    ss.transient_periods = static_cast<int>(std::max<std::int64_t>(analysis_start, 0) / steps_per_period);
+    const std::int64_t analysed_steps = analysis_start >= 0 ? step - analysis_start : 0;
+    ss.analysed_periods = static_cast<int>(analysed_steps / steps_per_period);
+    ss.modal_amplitudes = Eigen::VectorXcd::Zero(n);
+    if (analysed_steps > 0 && analysed_steps % steps_per_period == 0) {
+      const double scale = 2.0 / static_cast<double>(analysed_steps);
+      ss.modal_amplitudes = modal_sum * scale;
+      for (std::size_t d = 0; d < dcount; ++d) {
+        ss.site_amplitudes_m.push_back(site_sum[d] * scale);
+        ss.site_amplitude_per_excitation.push_back(std::abs(site_sum[d] * scale) / exc.amplitude);
+      }
+    }
+  }
+
+  auto& e = result.energy;
+  e.excitation_work_j = work;
+  e.structural_damping_j = damping;
+  const double base_velocity_end = U * omega * cos_at(step);
+  e.delta_structure_kinetic_j = structure_kinetic(v, base_velocity_end) - kinetic0;
+  e.delta_structure_potential_j = structure_potential(q) - potential0;
+  for (std::size_t d = 0; d < dcount; ++d) {
+    const dem::EnergyAccount now = worlds[d].energy();
+    e.dem_normal_damping_j += now.normal_damping_j - opening[d].normal_damping_j;
+    e.dem_friction_j += now.friction_j - opening[d].friction_j;
+    e.dem_rolling_j += now.rolling_j - opening[d].rolling_j;
+    e.delta_bed_kinetic_j += now.kinetic_j - opening[d].kinetic_j;
+    e.delta_bed_potential_j += now.potential_j - opening[d].potential_j;
+    e.delta_bed_elastic_j += now.elastic_j - opening[d].elastic_j;
+    e.container_work_j += now.container_work_j - opening[d].container_work_j;
+    result.world_status.push_back(worlds[d].status());
+    result.final_container_states.push_back(worlds[d].container());
+  }
+  const double dissipated = e.structural_damping_j + e.dem_dissipated_j();
+  const double delta = e.delta_structure_kinetic_j + e.delta_structure_potential_j + e.delta_bed_kinetic_j +
+                       e.delta_bed_potential_j + e.delta_bed_elastic_j;
+  const double scale = std::max({std::abs(e.excitation_work_j), dissipated,
+                                 std::abs(e.delta_structure_kinetic_j + e.delta_structure_potential_j)});
+  e.relative_error = scale > 0.0 ? std::abs(e.excitation_work_j - dissipated - delta) / scale : 0.0;
+  result.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace pdamp::structure
