@@ -7,7 +7,10 @@
 #include <cmath>
 #include <complex>
 #include <iostream>
+#include <cstdio>
 #include <map>
+#include <numbers>
+#include <sstream>
 #include <memory>
 #include <optional>
 #include <set>
@@ -23,6 +26,7 @@
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/beam.hpp"
+#include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
@@ -32,8 +36,13 @@ namespace pdamp::cli {
 
 const FlagSpec kMethodFlag{"--method", "M",
                            "source of each layer's eta*(f, X) and apparent mass: formulas (the closed\n"
-                           "                          forms of its model and clearance; default) or field (the\n"
-                           "                          layer's field_file, made by pdamp field)"};
+                           "                          forms of its model and clearance; default), field (the\n"
+                           "                          layer's field_file, made by pdamp field) or dem (frf and\n"
+                           "                          decay only: the structure co-simulated in time with each\n"
+                           "                          damper's bed as a DEM world, the case's dem settings)"};
+const FlagSpec kDemPointsFlag{"--dem-points", "N",
+                              "--method dem: frequencies of the stepped sine, linear over the task's\n"
+                              "                          band, [2, 1000] (default 9)"};
 
 namespace {
 
@@ -82,11 +91,17 @@ class Warnings {
 /// grid, a decay that did not settle).
 json number_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
+/// `--method dem`: the DEM co-simulation (pdamp frf and decay only).
+bool dem_method(const ParsedArgs& args) { return args.optional_text("--method").value_or("") == "dem"; }
+
 case_file::LossMethod loss_method(const ParsedArgs& args) {
   const std::string name = args.optional_text("--method").value_or("formulas");
   if (name == "formulas") return case_file::LossMethod::kFormulas;
   if (name == "field") return case_file::LossMethod::kField;
-  throw InputError("--method", "", "'" + name + "': must be formulas or field");
+  if (name == "dem")
+    throw InputError("--method", "", "'dem': pdamp modes takes formulas or field (the DEM co-simulation runs in "
+                                     "pdamp frf and pdamp decay)");
+  throw InputError("--method", "", "'" + name + "': must be formulas, field or dem");
 }
 
 std::unique_ptr<OutputDir> output_dir(const ParsedArgs& args) {
@@ -121,10 +136,12 @@ struct Setup {
   Warnings warnings;
 };
 
-Setup make_setup(const Case& c, case_file::LossMethod method) {
+/// `rotation_check`: warn where a site rotates (the loss models assume pure translation;
+/// the DEM co-simulation turns the container with the site and needs no such warning).
+Setup make_setup(const Case& c, case_file::LossMethod method, bool rotation_check = true) {
   Setup out{method, case_file::structure_setup(c, method), {}};
   out.warnings.add(out.s.warnings);
-  out.warnings.add(st::rotation_warnings(out.s.modal, out.s.dampers));
+  if (rotation_check) out.warnings.add(st::rotation_warnings(out.s.modal, out.s.dampers));
   if (out.s.rigid_modes_dropped > 0)
     out.warnings.add("the structure has " + std::to_string(out.s.rigid_modes_dropped) +
                      " rigid-body mode(s) at 0 Hz; they are not kept (docs/structures.md)");
@@ -366,9 +383,15 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
   return out;
 }
 
+int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files);
+
 int run_frf_case(const ParsedArgs& args, const Case& c) {
   require_task(c, TaskKind::kFrf, c.task.frf.has_value(),
                "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\"");
+  if (dem_method(args)) {
+    auto dem_files = output_dir(args);
+    return run_frf_dem(args, c, dem_files.get());
+  }
   const auto method = loss_method(args);
   auto files = output_dir(args);
   Setup setup = make_setup(c, method);
@@ -541,8 +564,456 @@ void add_loss_messages(Warnings& warnings, const Setup& setup, const st::Coupled
   }
 }
 
+// ---------------------------------------------------------------- --method dem
+
+/// --dem-points: frequencies of the stepped-sine DEM FRF (linear over the task's band).
+constexpr int kDefaultDemPoints = 9;
+constexpr long long kMaxDemPoints = 1000;
+/// Stepped sine: at most this many transient periods per frequency; the transient ends
+/// earlier once the period-to-period change of |ŷ| stays below kDemStableTolerance twice.
+constexpr int kDemMaxTransientPeriods = 100;
+constexpr double kDemStableTolerance = 1e-2;
+/// Decay samples: as the other methods (50 per period of the first mode, 2000..20000).
+
+/// One stderr line per progress report of the co-simulation (about twice a second).
+void print_cosim_progress(const std::string& label, const st::CosimulationProgress& p) {
+  char line[240];
+  std::snprintf(line, sizeof line, "%s: %-9s t = %8.3f / %.3f s  %6.2f k steps/s", label.c_str(),
+                std::string(p.stage).c_str(), p.simulated_time_s, p.end_time_s, p.steps_per_s * 1e-3);
+  std::cerr << line << std::endl;
+}
+
+/// The dampers of the case as co-simulation dampers (their beds as DEM worlds).
+std::vector<st::CosimulationDamper> dem_dampers(const Case& c) {
+  std::vector<st::CosimulationDamper> out;
+  for (std::size_t d = 0; d < c.dampers.size(); ++d) out.push_back(case_file::cosimulation_damper(c, d));
+  return out;
+}
+
+/// Runs the co-simulation: invalid inputs are exit 2 (naming /dem for the DEM's own
+/// refusals, e.g. a step above its bound), a World that stops is exit 3 with its advice.
+st::CosimulationResult run_cosimulation(const Case& c, const st::ModalModel& modal,
+                                        const std::vector<st::CosimulationDamper>& dampers,
+                                        const st::CosimulationOptions& options, const std::string& label) {
+  if (const auto problems = options.validate(modal); !problems.empty()) throw InputError(c.path, "/task", problems.front());
+  for (std::size_t d = 0; d < dampers.size(); ++d)
+    if (const auto problems = dampers[d].validate(modal); !problems.empty())
+      throw InputError(c.path, "/dampers/" + std::to_string(d), problems.front());
+  st::CosimulationResult r;
+  try {
+    r = st::cosimulate(modal, dampers, options, [&](const st::CosimulationProgress& p) { print_cosim_progress(label, p); });
+  } catch (const std::invalid_argument& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    throw InputError(c.path, "/dem", what);
+  }
+  if (r.outcome == dem_reference::Outcome::kUnstable)
+    throw NumericalError(label + ": DEM unstable: " + r.message +
+                         " (a smaller /dem/time_step_s, a larger /dem/steps_per_contact or /dem/max_impact_speed_m_s)");
+  if (r.outcome != dem_reference::Outcome::kCompleted) throw NumericalError(label + ": DEM failed: " + r.message);
+  return r;
+}
+
+json energy_json(const st::CosimulationEnergy& e) {
+  return {{"excitation_work_j", e.excitation_work_j},
+          {"structural_damping_j", e.structural_damping_j},
+          {"delta_structure_kinetic_j", e.delta_structure_kinetic_j},
+          {"delta_structure_potential_j", e.delta_structure_potential_j},
+          {"dem_dissipated_j", e.dem_dissipated_j()},
+          {"dem_normal_damping_j", e.dem_normal_damping_j},
+          {"dem_friction_j", e.dem_friction_j},
+          {"dem_rolling_j", e.dem_rolling_j},
+          {"delta_bed_kinetic_j", e.delta_bed_kinetic_j},
+          {"delta_bed_potential_j", e.delta_bed_potential_j},
+          {"delta_bed_elastic_j", e.delta_bed_elastic_j},
+          {"container_work_j", e.container_work_j},
+          {"relative_error", e.relative_error}};
+}
+
+/// Static site displacement along the first damper's drive under the beds' weight along
+/// the drives: the beds rest on their walls, so the free decay oscillates about
+/// y_s = b_0ᵀ K⁻¹ Σ_d b_d m_bed,d (g_d·a_d), K = diag(m_j ω_j²).
+double static_site_offset(const Case& c, const st::ModalModel& modal, const Eigen::MatrixXd& drive_shapes) {
+  Eigen::VectorXd load = Eigen::VectorXd::Zero(modal.mode_count());
+  for (std::size_t d = 0; d < c.dampers.size(); ++d) {
+    const auto& spec = c.dampers[d];
+    double bed = 0.0;
+    for (const auto& l : spec.layers) bed += l.bed_mass_kg;
+    load += drive_shapes.col(static_cast<Eigen::Index>(d)) * bed * spec.gravity_m_s2[static_cast<std::size_t>(spec.drive_axis)];
+  }
+  double y = 0.0;
+  for (Eigen::Index j = 0; j < modal.mode_count(); ++j) {
+    const double w = 2.0 * std::numbers::pi * modal.natural_frequencies_hz[j];
+    y += drive_shapes(j, 0) * load[j] / (modal.modal_masses_kg[j] * w * w);
+  }
+  return y;
+}
+
+/// The settling of a simulated site displacement: the envelope is the largest |y − y_s|
+/// over each whole period of the dominant mode (placed at its time); settled where the
+/// envelope, interpolated in ln between the last period at or above the threshold and the
+/// next, crosses it, if no later period rises above it again.
+struct SimulatedSettling {
+  std::vector<double> envelope_time_s, envelope_m;  ///< one per whole period
+  std::vector<double> sample_envelope_m;            ///< the envelope at every sample (linear in ln between periods)
+  double settling_time_s = NAN;
+  double frequency_hz = NAN;  ///< from the zero crossings of y − y_s up to settling (or the whole record)
+  double damping_ratio = NAN;
+};
+
+SimulatedSettling simulated_settling(const std::vector<double>& t, const Eigen::VectorXd& y, double offset,
+                                     double period_s, double initial_m, double threshold_m, double fallback_frequency_hz) {
+  SimulatedSettling out;
+  const std::size_t n = t.size();
+  std::size_t i = 0;
+  for (int k = 0;; ++k) {
+    const double end = (k + 1) * period_s;
+    if (end > t.back() + 1e-12 * period_s) break;
+    double peak = -1.0, at = 0.0;
+    for (; i < n && t[i] < end; ++i) {
+      const double r = std::abs(y[static_cast<Eigen::Index>(i)] - offset);
+      if (r > peak) peak = r, at = t[i];
+    }
+    if (peak < 0.0) break;
+    out.envelope_time_s.push_back(at);
+    out.envelope_m.push_back(peak);
+  }
+  const std::size_t m = out.envelope_m.size();
+  std::optional<std::size_t> last_above;
+  for (std::size_t k = 0; k < m; ++k)
+    if (out.envelope_m[k] >= threshold_m) last_above = k;
+  if (m > 0 && !last_above) out.settling_time_s = 0.0;
+  if (last_above && *last_above + 1 < m) {
+    const std::size_t a = *last_above, b = a + 1;
+    const double la = std::log(out.envelope_m[a]), lb = std::log(std::max(out.envelope_m[b], 1e-300));
+    const double s = la > lb ? (la - std::log(threshold_m)) / (la - lb) : 0.0;
+    out.settling_time_s = out.envelope_time_s[a] + std::clamp(s, 0.0, 1.0) * (out.envelope_time_s[b] - out.envelope_time_s[a]);
+  }
+  // The envelope at every sample (for the CSV and the plot).
+  out.sample_envelope_m.resize(n, NAN);
+  std::size_t k = 0;
+  for (std::size_t s = 0; s < n && m > 0; ++s) {
+    while (k + 1 < m && out.envelope_time_s[k + 1] <= t[s]) ++k;
+    if (t[s] <= out.envelope_time_s.front()) out.sample_envelope_m[s] = out.envelope_m.front();
+    else if (k + 1 >= m) out.sample_envelope_m[s] = out.envelope_m.back();
+    else {
+      const double w = (t[s] - out.envelope_time_s[k]) / (out.envelope_time_s[k + 1] - out.envelope_time_s[k]);
+      out.sample_envelope_m[s] = std::exp((1.0 - w) * std::log(std::max(out.envelope_m[k], 1e-300)) +
+                                          w * std::log(std::max(out.envelope_m[k + 1], 1e-300)));
+    }
+  }
+  // Frequency from the zero crossings of y − y_s (interpolated), up to the settling time.
+  const double until = std::isfinite(out.settling_time_s) && out.settling_time_s > 0.0 ? out.settling_time_s : t.back();
+  std::vector<double> crossings;
+  for (std::size_t s = 1; s < n && t[s] <= until; ++s) {
+    const double r0 = y[static_cast<Eigen::Index>(s - 1)] - offset, r1 = y[static_cast<Eigen::Index>(s)] - offset;
+    if ((r0 < 0.0) != (r1 < 0.0) && r0 != r1) crossings.push_back(t[s - 1] + (t[s] - t[s - 1]) * r0 / (r0 - r1));
+  }
+  out.frequency_hz = crossings.size() >= 3
+                         ? 0.5 * static_cast<double>(crossings.size() - 1) / (crossings.back() - crossings.front())
+                         : fallback_frequency_hz;
+  if (std::isfinite(out.settling_time_s) && out.settling_time_s > 0.0) {
+    const double decrement = std::log(initial_m / threshold_m) / (out.frequency_hz * out.settling_time_s);
+    out.damping_ratio = decrement / std::sqrt(4.0 * std::numbers::pi * std::numbers::pi + decrement * decrement);
+  }
+  return out;
+}
+
+int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  const auto& task = *c.task.decay;
+  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const st::ModalModel& modal = setup.s.modal;
+  const Eigen::VectorXd q0 = initial_modal_amplitudes(c, setup.s);
+  if (!(q0.cwiseAbs().maxCoeff() > 0.0))
+    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+  const auto dampers = dem_dampers(c);
+  std::vector<st::Damper> containers = setup.s.dampers;
+  for (auto& d : containers) d.layers.clear();
+  const auto empty = call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
+
+  // The settling measure as the other methods: Σ_j |b_j| |q0_j| at the first damper's site.
+  const Eigen::VectorXd weights = empty.drive_shapes.col(0).cwiseAbs();
+  const double measure0 = weights.dot(q0.cwiseAbs());
+  if (!(measure0 > 0.0))
+    throw InputError(c.path, "/task/initial_state", "does not move the first damper's site along its drive");
+  const double threshold = task.settling_threshold * measure0;
+  Eigen::Index dominant = 0;
+  weights.cwiseProduct(q0.cwiseAbs()).maxCoeff(&dominant);
+
+  st::CosimulationOptions options;
+  options.excitation.kind = st::CosimulationExcitationKind::kFreeDecay;
+  options.initial_modal_displacements = q0;
+  options.initial_modal_velocities = Eigen::VectorXd::Zero(q0.size());
+  options.duration_s = task.duration_s;
+  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  const double samples = std::clamp(std::ceil(kDecaySamplesPerPeriod * modal.natural_frequencies_hz[0] * task.duration_s),
+                                    kDecayMinSamples, kDecayMaxSamples);
+  options.sample_interval_s = task.duration_s / samples;
+  const auto r = run_cosimulation(c, modal, dampers, options, "pdamp decay (dem)");
+  setup.warnings.add(r.warnings);
+
+  const auto& h = r.history;
+  if (h.time_s.size() < 2) throw NumericalError("pdamp decay (dem): the co-simulation returned no history");
+  const Eigen::VectorXd y = h.site_displacement_m.col(0);
+  if (!y.allFinite()) throw NumericalError("pdamp decay (dem): the site displacement is not finite");
+  const double offset = static_site_offset(c, modal, empty.drive_shapes);
+  const double f_dom = r.frequencies_with_containers_hz[dominant];
+  const auto settle = simulated_settling(h.time_s, y, offset, 1.0 / f_dom, measure0, threshold, f_dom);
+  const bool settled = std::isfinite(settle.settling_time_s);
+  if (!settled)
+    setup.warnings.add("the decay did not settle within duration_s = " + format_number(task.duration_s) +
+                       " s (envelope " + format_number(settle.envelope_m.empty() ? NAN : settle.envelope_m.back(), 4) +
+                       " m, threshold " + format_number(threshold, 4) + " m): lengthen /task/duration_s");
+  if (r.energy.relative_error > 0.01)
+    setup.warnings.add("the co-simulation's energy ledger closes to " + format_number(r.energy.relative_error, 3) +
+                       " only (docs/cosimulation.md §4): a smaller /dem/time_step_s");
+
+  if (files) {
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "time_s";
+    for (const auto& d : dampers) csv << ",site_displacement_m_" << safe_file_name(d.name);
+    csv << ",envelope_m";
+    for (Eigen::Index j = 0; j < modal.mode_count(); ++j) csv << ",q_mode" << j + 1;
+    for (const auto& d : dampers) csv << ",site_rotation_rad_" << safe_file_name(d.name);
+    for (const auto& d : dampers) csv << ",bed_force_n_" << safe_file_name(d.name);
+    csv << '\n';
+    for (std::size_t s = 0; s < h.time_s.size(); ++s) {
+      const auto row = static_cast<Eigen::Index>(s);
+      csv << h.time_s[s];
+      for (Eigen::Index d = 0; d < h.site_displacement_m.cols(); ++d) csv << ',' << h.site_displacement_m(row, d);
+      csv << ',' << settle.sample_envelope_m[s];
+      for (Eigen::Index j = 0; j < h.modal_displacements.cols(); ++j) csv << ',' << h.modal_displacements(row, j);
+      for (Eigen::Index d = 0; d < h.site_rotation_rad.cols(); ++d) csv << ',' << h.site_rotation_rad(row, d);
+      for (Eigen::Index d = 0; d < h.container_load_n.cols(); ++d) csv << ',' << h.container_load_n(row, d);
+      csv << '\n';
+    }
+    files->add("decay_dem.csv", csv.str());
+    setup.warnings.add(write_decay_dem_plot(*files, offset, threshold, settle.settling_time_s,
+                                            dampers.size(), c.name + ": free decay (dem co-simulation)"));
+  }
+
+  std::vector<double> initial(q0.data(), q0.data() + q0.size());
+  json envelope = json::array();
+  for (std::size_t k = 0; k < settle.envelope_m.size(); ++k) envelope.push_back({settle.envelope_time_s[k], settle.envelope_m[k]});
+  json d = {{"file", file_json(files, "decay_dem.csv")},
+            {"plot", file_json(files, "decay_dem.png")},
+            {"method", "dem"},
+            {"settling_time_s", number_or_null(settle.settling_time_s)},
+            {"damping_ratio", number_or_null(settle.damping_ratio)},
+            {"dominant_mode", dominant + 1},
+            {"outcome", settled ? "settled" : "not_settled"},
+            {"threshold_point", setup.s.dampers.front().point},
+            {"threshold_m", threshold},
+            {"threshold_fraction", task.settling_threshold},
+            {"initial_envelope_m", measure0},
+            {"initial_modal_amplitudes", initial},
+            {"static_offset_m", offset},
+            {"envelope", "the largest |y - static_offset_m| of the first damper's site along its drive over each whole "
+                         "period of the dominant mode (with the empty containers)"},
+            {"envelope_period_s", 1.0 / f_dom},
+            {"envelope_points", envelope},
+            {"frequency_hz", settle.frequency_hz},
+            {"final_time_s", h.time_s.back()},
+            {"final_envelope_m", settle.envelope_m.empty() ? json(nullptr) : json(settle.envelope_m.back())},
+            {"energy_error", r.energy.relative_error},
+            {"energy", energy_json(r.energy)},
+            {"structural_dissipated_energy_j", r.energy.structural_damping_j},
+            {"dem_dissipated_energy_j", r.energy.dem_dissipated_j()},
+            {"samples", h.time_s.size()},
+            {"steps", r.steps},
+            {"settling_steps", r.settling_steps},
+            {"time_step_s", r.time_step_s},
+            {"solve_time_s", r.wall_time_s},
+            {"warnings", setup.warnings.list()}};
+  json result = {{"task", "decay"}, {"case", c.name}, {"method", "dem"}};
+  result["file"] = d["file"];
+  result["settling_time_s"] = d["settling_time_s"];
+  result["damping_ratio"] = d["damping_ratio"];
+  result["energy_balance_error"] = r.energy.relative_error;
+  result["decay"] = d;
+  std::vector<std::pair<std::string, std::string>> rows = {
+      {"method", "dem"},
+      {"outcome", d["outcome"].get<std::string>()},
+      {"settling_time_s", settled ? format_number(settle.settling_time_s, 6) : "not settled"},
+      {"damping_ratio", std::isfinite(settle.damping_ratio) ? format_number(settle.damping_ratio, 4) : "-"},
+      {"dominant mode", std::to_string(dominant + 1)},
+      {"threshold_m", format_number(threshold, 4)},
+      {"energy_error", format_number(r.energy.relative_error, 3)},
+      {"DEM steps", std::to_string(r.steps) + " of " + format_number(r.time_step_s, 3) + " s in " +
+                        format_number(r.wall_time_s, 3) + " s"}};
+  result["decay"]["warnings"] = setup.warnings.list();
+  return finish(args, c, files, "decay.json", result, setup.warnings, rows);
+}
+
+int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  const auto& task = *c.task.frf;
+  const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
+  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const st::ModalModel& modal = setup.s.modal;
+  const auto dampers = dem_dampers(c);
+  const bool base = task.excitation == case_file::FrfTask::Excitation::kBase;
+
+  st::CosimulationOptions options;
+  options.excitation.kind = base ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
+  options.excitation.direction = {task.direction[0], task.direction[1]};
+  options.excitation.amplitude = base ? task.base_amplitude_m : task.force_amplitude_n;
+  options.excitation.point = base ? std::string() : task.force_point;
+  options.transient_periods = kDemMaxTransientPeriods;
+  options.analysed_periods = c.dem.simulation.analysed_periods;
+  options.settle_until_stable = true;
+  options.stable_tolerance = kDemStableTolerance;
+  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  {  // the excitation's own checks first (exit 2 naming /task/excitation)
+    st::Excitation e;
+    e.kind = base ? st::Excitation::Kind::kBaseTranslation : st::Excitation::Kind::kPointForce;
+    e.direction = options.excitation.direction;
+    e.amplitude = options.excitation.amplitude;
+    e.point = options.excitation.point;
+    if (const auto problems = e.validate(modal); !problems.empty()) throw InputError(c.path, "/task/excitation", problems.front());
+  }
+  const auto frequencies = spaced(task.min_frequency_hz, task.max_frequency_hz, points, false);
+  const std::size_t outputs = dampers.size();
+
+  struct Point {
+    double f = 0.0;
+    std::vector<double> magnitude, phase_deg;
+    double spread = NAN;
+    double energy_error = 0.0;
+    int transient = 0;
+    bool stable = false;
+    std::int64_t steps = 0;
+    double dt = 0.0, wall = 0.0;
+  };
+  std::vector<Point> result_points;
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(modal.mode_count()), v = Eigen::VectorXd::Zero(modal.mode_count());
+  double solve_time = 0.0;
+  for (std::size_t i = 0; i < frequencies.size(); ++i) {
+    options.excitation.frequency_hz = frequencies[i];
+    options.initial_modal_displacements = q;
+    options.initial_modal_velocities = v;
+    const std::string label = "pdamp frf (dem) " + std::to_string(i + 1) + "/" + std::to_string(frequencies.size()) + " " +
+                              format_number(frequencies[i], 5) + " Hz";
+    const auto r = run_cosimulation(c, modal, dampers, options, label);
+    setup.warnings.add(r.warnings);
+    q = r.final_modal_displacements;
+    v = r.final_modal_velocities;
+    solve_time += r.wall_time_s;
+    const auto& ss = r.steady_state;
+    Point p;
+    p.f = frequencies[i];
+    for (std::size_t d = 0; d < outputs; ++d) {
+      p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
+      p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
+    }
+    // Spread: sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation.
+    const auto& per = ss.period_site_amplitudes_m;
+    const std::size_t na = static_cast<std::size_t>(std::max(ss.analysed_periods, 0));
+    if (na >= 2 && per.size() >= na) {
+      double mean = 0.0, var = 0.0;
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) mean += per[k];
+      mean /= static_cast<double>(na);
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) var += (per[k] - mean) * (per[k] - mean);
+      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / options.excitation.amplitude;
+    }
+    p.energy_error = r.energy.relative_error;
+    p.transient = ss.transient_periods;
+    p.stable = ss.stable;
+    p.steps = r.steps;
+    p.dt = r.time_step_s;
+    p.wall = r.wall_time_s;
+    for (double m : p.magnitude)
+      if (!std::isfinite(m)) throw NumericalError(label + ": the steady-state amplitude is not finite");
+    if (!p.stable)
+      setup.warnings.add("at " + format_number(p.f, 5) + " Hz the period-to-period change of the site amplitude did not stay "
+                         "below " + format_number(kDemStableTolerance) + " within " + std::to_string(kDemMaxTransientPeriods) +
+                         " transient periods: the analysed periods may still carry the transient");
+    if (p.energy_error > 0.01)
+      setup.warnings.add("at " + format_number(p.f, 5) + " Hz the co-simulation's energy ledger closes to " +
+                         format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
+    result_points.push_back(std::move(p));
+  }
+
+  json peaks = json::array();
+  std::vector<std::pair<std::string, std::string>> rows = {{"method", "dem"}};
+  for (std::size_t d = 0; d < outputs; ++d) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < result_points.size(); ++i)
+      if (result_points[i].magnitude[d] > result_points[best].magnitude[d]) best = i;
+    peaks.push_back({{"output", dampers[d].name},
+                     {"frequency_hz", result_points[best].f},
+                     {"magnitude", result_points[best].magnitude[d]},
+                     {"damping_ratio", nullptr}});
+    rows.push_back({"peak " + dampers[d].name, format_number(result_points[best].f, 6) + " Hz, |out| = " +
+                                                   format_number(result_points[best].magnitude[d], 4) + " (largest of " +
+                                                   std::to_string(result_points.size()) + " points)"});
+  }
+  json list = json::array();
+  for (const auto& p : result_points) {
+    json magnitude = json::object(), phase = json::object();
+    for (std::size_t d = 0; d < outputs; ++d) magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
+    list.push_back({{"frequency_hz", p.f}, {"magnitude", magnitude}, {"phase_deg", phase},
+                    {"magnitude_spread", number_or_null(p.spread)}, {"energy_error", p.energy_error},
+                    {"transient_periods", p.transient}, {"stable", p.stable}, {"steps", p.steps},
+                    {"time_step_s", p.dt}, {"solve_time_s", p.wall}});
+    rows.push_back({format_number(p.f, 6) + " Hz",
+                    "|out| = " + format_number(p.magnitude.front(), 4) +
+                        (std::isfinite(p.spread) ? " +- " + format_number(p.spread, 2) : "") +
+                        ", energy error " + format_number(p.energy_error, 2)});
+  }
+  const std::string magnitude_label = base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+  if (files) {
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "frequency_hz";
+    for (const auto& d : dampers) csv << ",magnitude_" << safe_file_name(d.name) << ",phase_deg_" << safe_file_name(d.name);
+    csv << ",magnitude_spread_" << safe_file_name(dampers.front().name)
+        << ",energy_error,transient_periods,stable,steps,time_step_s\n";
+    for (const auto& p : result_points) {
+      csv << p.f;
+      for (std::size_t d = 0; d < outputs; ++d) csv << ',' << p.magnitude[d] << ',' << p.phase_deg[d];
+      csv << ',' << (std::isfinite(p.spread) ? p.spread : 0.0) << ',' << p.energy_error << ',' << p.transient << ','
+          << (p.stable ? 1 : 0) << ',' << p.steps << ',' << p.dt << '\n';
+    }
+    files->add("frf_dem.csv", csv.str());
+    std::vector<std::string> names;
+    for (const auto& d : dampers) names.push_back(d.name);
+    setup.warnings.add(write_frf_dem_plot(*files, names, magnitude_label, c.name + ": stepped-sine DEM co-simulation"));
+  }
+  const std::string bed_state =
+      "each frequency starts from the previous one's final modal state (q, dq/dt) with a freshly settled bed "
+      "(the co-simulation cannot carry a bed over)";
+  json frf = {{"file", file_json(files, "frf_dem.csv")},
+              {"plot", file_json(files, "frf_dem.png")},
+              {"method", "dem"},
+              {"outputs", [&] { json n = json::array(); for (const auto& d : dampers) n.push_back(d.name); return n; }()},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic"
+                                 : "receptance |X/F| in m/N, first harmonic"},
+              {"excitation", base ? "base" : "force"},
+              {"frequencies", {{"min_hz", frequencies.front()}, {"max_hz", frequencies.back()},
+                               {"points", frequencies.size()}, {"spacing", "linear"}}},
+              {"points", list},
+              {"peaks", peaks},
+              {"stepped_sine", {{"bed_state", bed_state}, {"max_transient_periods", kDemMaxTransientPeriods},
+                                {"stable_tolerance", kDemStableTolerance},
+                                {"analysed_periods", options.analysed_periods}}},
+              {"solve_time_s", solve_time},
+              {"warnings", setup.warnings.list()}};
+  json result = {{"task", "frf"}, {"case", c.name}, {"method", "dem"}};
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["branches"] = json::array();
+  result["frf"] = frf;
+  result["frf"]["warnings"] = setup.warnings.list();
+  return finish(args, c, files, "frf.json", result, setup.warnings, rows);
+}
+
 int run_decay_case(const ParsedArgs& args, const Case& c) {
   require_task(c, TaskKind::kDecay, c.task.decay.has_value(), "\"initial_state\", \"duration_s\"");
+  if (dem_method(args)) {
+    auto dem_files = output_dir(args);
+    return run_decay_dem(args, c, dem_files.get());
+  }
   const auto method = loss_method(args);
   auto files = output_dir(args);
   Setup setup = make_setup(c, method);
@@ -663,17 +1134,20 @@ std::vector<Command> structure_commands() {
                                     "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
        run_modes},
-      {{"frf", "pdamp frf CASE.json [--method formulas|field] [-o DIR] [--json]",
+      {{"frf", "pdamp frf CASE.json [--method formulas|field|dem] [--dem-points N] [-o DIR] [--json]",
         "frequency response of the structure with its dampers (task kind frf): every harmonic-\n"
         "balance root, its stability, branches, jumps and peaks, and the response without beds",
-        {kMethodFlag, {"-o", "DIR", "write frf.csv, frf_branches.csv, frf.gp/png/svg, frf.json and\n"
-                                    "                          case_resolved.json into DIR, atomically"},
+        {kMethodFlag, kDemPointsFlag,
+         {"-o", "DIR", "write frf.csv, frf_branches.csv, frf.gp/png/svg (dem: frf_dem.csv,\n"
+                       "                          frf_dem.gp/png/svg), frf.json and case_resolved.json into DIR,\n"
+                       "                          atomically"},
          kJsonFlag}, 1},
        run_frf},
-      {{"decay", "pdamp decay CASE.json [--method formulas|field] [-o DIR] [--json]",
+      {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [-o DIR] [--json]",
         "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"
         "equivalent damping ratio and the energy each layer dissipates",
-        {kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg, decay.json and case_resolved.json\n"
+        {kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg (dem: decay_dem.csv,\n"
+                                    "                          decay_dem.gp/png/svg), decay.json and case_resolved.json\n"
                                     "                          into DIR, atomically"},
          kJsonFlag}, 1},
        run_decay},

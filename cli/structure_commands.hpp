@@ -10,8 +10,11 @@
 
 namespace pdamp::cli {
 
-/// `--method formulas|field` (default formulas), shared with pdamp run.
+/// `--method formulas|field|dem` (default formulas), shared with pdamp run.
 extern const FlagSpec kMethodFlag;
+/// `--dem-points N` of pdamp frf --method dem (default 9); pdamp run must list it among its
+/// flags to accept it on an frf task (without it, run uses the default).
+extern const FlagSpec kDemPointsFlag;
 
 /// pdamp modes, frf and decay, in the order `pdamp --help` lists them.
 std::vector<Command> structure_commands();

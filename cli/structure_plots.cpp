@@ -284,4 +284,56 @@ std::vector<std::string> write_decay_files(OutputDir& out, const st::FreeDecay& 
   return out.add_plot("decay.gp", gp.str(), {"decay.png", "decay.svg"});
 }
 
+std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, double threshold_m, double settling_time_s,
+                                              std::size_t dampers, const std::string& title) {
+  const std::size_t envelope_column = 2 + dampers;  // 1-based
+  std::ostringstream gp;
+  gp.precision(10);
+  gp << "# free decay of pdamp decay --method dem: the site displacement of the first damper along its\n"
+     << "# drive, the envelope (largest |y - offset| per period) and the threshold; run: gnuplot decay_dem.gp\n"
+     << "set datafile separator ','\nset grid\n";
+  gp << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'decay_dem.svg' : 'decay_dem.png'\n"
+     << "  set title " << gnuplot_string(title) << " noenhanced\n"
+     << "  set key top right\n  set xlabel 'time t / s'\n  set ylabel 'site displacement along the drive / m'\n"
+     << "  set arrow 1 from graph 0, first " << offset_m + threshold_m << " to graph 1, first " << offset_m + threshold_m
+     << " nohead dt 2 lc rgb 'red'\n"
+     << "  set arrow 3 from graph 0, first " << offset_m - threshold_m << " to graph 1, first " << offset_m - threshold_m
+     << " nohead dt 2 lc rgb 'red'\n";
+  if (std::isfinite(settling_time_s))
+    gp << "  set arrow 2 from " << settling_time_s << ", graph 0 to " << settling_time_s
+       << ", graph 1 nohead lw 2 lc rgb 'dark-green'\n"
+       << "  set label 2 " << gnuplot_string("settled: " + format_number(settling_time_s, 4) + " s") << " at "
+       << settling_time_s << ", graph 0.9 left offset 0.5,0 tc rgb 'dark-green'\n";
+  gp << "  plot 'decay_dem.csv' using 1:2 with lines lw 1 lc rgb 'blue' title 'site displacement', \\\n"
+     << "       '' using 1:(" << offset_m << " + $" << envelope_column << ") with lines lw 2 lc rgb 'dark-orange' title 'envelope', \\\n"
+     << "       '' using 1:(" << offset_m << " - $" << envelope_column << ") with lines lw 2 lc rgb 'dark-orange' notitle\n"
+     << "  unset arrow\n  unset label\n}\n";
+  return out.add_plot("decay_dem.gp", gp.str(), {"decay_dem.png", "decay_dem.svg"});
+}
+
+std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
+                                            const std::string& magnitude_label, const std::string& title) {
+  const std::size_t spread_column = 2 + 2 * damper_names.size();  // 1-based
+  std::ostringstream gp;
+  gp << "# stepped-sine frequency response of pdamp frf --method dem (first harmonic at each frequency,\n"
+     << "# error bars: the spread over the analysed periods); run: gnuplot frf_dem.gp\n"
+     << "set datafile separator ','\nset grid\n";
+  gp << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'frf_dem.svg' : 'frf_dem.png'\n"
+     << "  set title " << gnuplot_string(title) << " noenhanced\n"
+     << "  set logscale y\n  set key top right\n  set xlabel 'frequency / Hz'\n  set ylabel "
+     << gnuplot_string(magnitude_label) << " noenhanced\n"
+     << "  plot 'frf_dem.csv' using 1:2:" << spread_column << " with yerrorbars pt 7 lc rgb '" << colour(0)
+     << "' notitle, '' using 1:2 with lines lw 2 lc rgb '" << colour(0) << "' title "
+     << gnuplot_string(damper_names.front()) << " noenhanced";
+  for (std::size_t d = 1; d < damper_names.size(); ++d)
+    gp << ", \\\n       '' using 1:" << 2 + 2 * d << " with linespoints lw 2 pt 7 lc rgb '" << colour(d) << "' title "
+       << gnuplot_string(damper_names[d]) << " noenhanced";
+  gp << "\n}\n";
+  return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
+}
+
 }  // namespace pdamp::cli

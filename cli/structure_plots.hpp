@@ -47,4 +47,16 @@ std::vector<std::string> write_frf_files(OutputDir& out, const structure::Freque
 std::vector<std::string> write_decay_files(OutputDir& out, const structure::FreeDecay& decay,
                                            const std::vector<std::string>& damper_names, const std::string& title);
 
+/// decay_dem.gp/png/svg for decay_dem.csv (written by pdamp decay --method dem: time_s,
+/// site_displacement_m_<damper> x dampers, envelope_m, ...): the first damper's site
+/// displacement with offset ± envelope, offset ± threshold and the settling time.
+std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, double threshold_m, double settling_time_s,
+                                              std::size_t dampers, const std::string& title);
+
+/// frf_dem.gp/png/svg for frf_dem.csv (pdamp frf --method dem: frequency_hz, then
+/// magnitude_<d>, phase_deg_<d> per damper, then the first damper's spread): |output| per
+/// frequency (log y), the first with its spread as error bars.
+std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
+                                            const std::string& magnitude_label, const std::string& title);
+
 }  // namespace pdamp::cli

@@ -115,4 +115,45 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
   return out;
 }
 
+structure::CosimulationDamper cosimulation_damper(const Case& c, std::size_t damper_index) {
+  const DamperSpec& spec = c.dampers.at(damper_index);
+  structure::CosimulationDamper out;
+  out.name = spec.name;
+  out.point = spec.site;
+  out.drive_direction = {spec.drive_direction[0], spec.drive_direction[1]};
+  out.container_mass_kg = spec.container_mass_kg;
+  // The World does not depend on the operating point (stroke and frequency only set the
+  // harmonic drive, which the co-simulation replaces by the structure's motion).
+  double clearance = 0.0;
+  for (const LayerSpec& layer : spec.layers) clearance = std::max(clearance, layer.clearance_m);
+  const auto options = dem_options(c, damper_index, clearance > 0.0 ? clearance : 0.01, c.excitation.frequency_hz);
+  if (const auto problems = options.world.validate(""); !problems.empty())
+    throw dem_case_error(c, damper_index, problems.front());
+  out.world = options.world;
+  dem_reference::Vec3 a{0.0, 0.0, 0.0};
+  a[static_cast<std::size_t>(spec.drive_axis)] = 1.0;
+  out.container_drive_axis = a;
+  const auto& g = spec.gravity_m_s2;
+  const double g_norm = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+  dem_reference::Vec3 perp{g[0], g[1], g[2]};
+  perp[static_cast<std::size_t>(spec.drive_axis)] = 0.0;
+  const double perp_norm = std::sqrt(perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]);
+  dem_reference::Vec3 k{0.0, 0.0, 0.0};
+  if (g_norm > 0.0 && perp_norm > 0.01 * g_norm) {
+    const bool in_plane = c.structure && c.structure->kind == StructureSpec::Kind::kBeam &&
+                          c.structure->beam.axial_gravity_m_s2 != 0.0;
+    if (in_plane) {
+      k = {a[1] * perp[2] - a[2] * perp[1], a[2] * perp[0] - a[0] * perp[2], a[0] * perp[1] - a[1] * perp[0]};
+      const double n = std::sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
+      for (auto& v : k) v /= n;
+    } else {
+      for (std::size_t i = 0; i < 3; ++i) k[i] = -perp[i] / perp_norm;
+    }
+  } else {
+    k[static_cast<std::size_t>((spec.drive_axis + 2) % 3)] = 1.0;
+  }
+  out.container_rotation_axis = k;
+  return out;
+}
+
 }  // namespace pdamp::case_file

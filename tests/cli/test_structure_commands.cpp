@@ -135,7 +135,9 @@ TEST_CASE("method field needs each layer's field_file and runs with one", "[cli]
   require_one_line_error(run_pdamp("frf " + data("cantilever_frf.json") + " --method field"),
                          "cantilever_frf.json: /dampers/0/layers/0/field_file: required with --method field");
   require_one_line_error(run_pdamp("modes " + data("cantilever_frf.json") + " --method dem"),
-                         "--method: 'dem': must be formulas or field");
+                         "--method: 'dem': pdamp modes takes formulas or field");
+  require_one_line_error(run_pdamp("frf " + data("cantilever_frf.json") + " --method des"),
+                         "--method: 'des': must be formulas, field or dem");
   // The layer is the shipped 36-sphere layer, so the shipped formulas field fits it.
   const json r = run_json("frf " + data("cantilever_frf_field.json") + " --method field");
   CHECK(r["method"] == "field");
@@ -176,4 +178,64 @@ TEST_CASE("the shipped structure cases run end to end", "[cli][structure]") {
   CHECK(decay["decay"]["outcome"] == "settled");
   CHECK(decay["decay"]["settling_time_s"].get<double>() < 30.0);
   CHECK(decay["decay"]["layers"].size() == 3);
+}
+
+// --method dem: the structure co-simulated with each damper's bed as a DEM world
+// (structure::cosimulate). One imported 2 Hz mode, 8 softened spheres: each run well under
+// a few seconds. The physics of the co-simulation is tested in tests/structure/.
+TEST_CASE("pdamp decay --method dem: settling time, damping ratio, energy error and files", "[cli][structure][dem]") {
+  const TempDir dir("decay_dem");
+  const auto r = run_pdamp("decay " + data("one_mode_dem_decay.json") + " --method dem --json -o " + dir.path.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  CHECK(r.err.find("pdamp decay (dem):") != std::string::npos);  // progress on stderr
+  for (const char* key : {"task", "case", "method", "file", "settling_time_s", "damping_ratio", "energy_balance_error",
+                          "decay", "warnings", "outputs"})
+    CHECK(out.contains(key));
+  CHECK(out["method"] == "dem");
+  const json& d = out["decay"];
+  for (const char* key : {"file", "plot", "settling_time_s", "damping_ratio", "dominant_mode", "outcome", "warnings",
+                          "energy_error", "steps", "time_step_s", "threshold_m", "initial_envelope_m", "energy"})
+    CHECK(d.contains(key));
+  CHECK(d["outcome"] == "settled");
+  CHECK(d["dominant_mode"] == 1);
+  CHECK(d["energy_error"].get<double>() < 0.01);
+  CHECK(d["steps"].get<long long>() > 0);
+  // Released from q = 20 mm at unit shape, threshold 0.5 of it.
+  CHECK(d["initial_envelope_m"].get<double>() == Approx(0.02));
+  CHECK(d["threshold_m"].get<double>() == Approx(0.01));
+  const double t_s = out["settling_time_s"].get<double>();
+  CHECK(t_s > 0.5);
+  CHECK(t_s < 8.0);
+  // The beds damp: ζ_eq above the structure's 1%.
+  CHECK(out["damping_ratio"].get<double>() > 0.01);
+  CHECK(d["energy"]["dem_dissipated_j"].get<double>() > 0.0);
+  require_files(dir.path, {"decay_dem.csv", "decay_dem.gp", "decay.json", "case_resolved.json"});
+}
+
+TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies", "[cli][structure][dem]") {
+  const TempDir dir("frf_dem");
+  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 3 --json -o " +
+                           dir.path.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  for (const char* key : {"file", "peaks", "branches", "warnings", "frf", "outputs"}) CHECK(out.contains(key));
+  CHECK(out["method"] == "dem");
+  const json& points = out["frf"]["points"];
+  REQUIRE(points.size() == 3);
+  CHECK(points[0]["frequency_hz"].get<double>() == Approx(1.2));
+  CHECK(points[2]["frequency_hz"].get<double>() == Approx(2.0));
+  for (const auto& p : points) {
+    CHECK(p["energy_error"].get<double>() < 0.01);
+    CHECK(p["magnitude"]["damper_1"].get<double>() > 0.0);
+  }
+  // The mode with the container (2 Hz·√(0.5/0.8) = 1.58 Hz) is nearest the middle point.
+  REQUIRE(out["peaks"].size() == 1);
+  CHECK(out["peaks"][0]["frequency_hz"].get<double>() == Approx(1.6));
+  CHECK(out["peaks"][0]["magnitude"].get<double>() > points[0]["magnitude"]["damper_1"].get<double>());
+  require_files(dir.path, {"frf_dem.csv", "frf_dem.gp", "frf.json", "case_resolved.json"});
+  // Bad input: out of range --dem-points is exit 2.
+  CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 1").exit_code == 2);
 }

@@ -9,6 +9,7 @@
 
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/structure/beam.hpp"
+#include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/modal_model.hpp"
 
@@ -34,5 +35,20 @@ struct StructureSetup {
 /// Builds the structure and its dampers; CaseError (exit 2) for a case without a
 /// structure, a layer without `field_file` under kField, or an unreadable field file.
 StructureSetup structure_setup(const Case& c, LossMethod method);
+
+/// Damper `damper_index` of the case as a co-simulation damper (`--method dem`,
+/// docs/cosimulation.md): its site, drive direction and empty container mass, and its bed
+/// as the World of dem_options(c, damper_index, ...).world (one compartment per layer; the
+/// case's `dem` materials, contact, softening, integration, seed and threads; gravity in the
+/// container frame from the damper). The container's drive axis is the damper's
+/// `drive_axis`; its rotation axis (the structure's z in the container frame) is chosen:
+///  - gravity with a part g_perp across the drive (> 1% of |g|): on a beam with
+///    `axial_gravity_m_s2` != 0 gravity lies in the structure's plane, so z is the unit
+///    vector drive x g_perp; otherwise gravity is taken to be out of the plane and z is
+///    -g_perp/|g_perp| (the structure's z points up);
+///  - otherwise (no gravity, or gravity along the drive) the container axis after the
+///    drive axis in the cycle x -> y -> z -> x, plus one (drive x: z; y: x; z: y).
+/// CaseError naming the damper for a DEM option its World refuses.
+structure::CosimulationDamper cosimulation_damper(const Case& c, std::size_t damper_index);
 
 }  // namespace pdamp::case_file
