@@ -22,6 +22,7 @@
 #include "output.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/strict_json/input_file.hpp"
+#include "optimize_command.hpp"
 #include "plots.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
@@ -390,6 +391,7 @@ int run_run(const ParsedArgs& args) {
       throw InputError("--method", "", "applies to the structure tasks (modes, frf, decay); this case's task is damper_design");
     return run_damper_design(args, c);
   }
+  if (c.task.kind == case_file::TaskKind::kFillingRatios) return run_optimize_task(args, c);
   // modes, frf, decay: exactly as pdamp modes, frf and decay (structure_commands.cpp).
   return run_structure_task(args, c);
 }
@@ -816,11 +818,11 @@ const FlagSpec kModelOverrides[] = {
 const std::vector<Command>& commands() {
   static const std::vector<Command> all = [] {
     std::vector<Command> list = {
-      {{"run", "pdamp run CASE.json [--method formulas|field] [-o DIR] [--json]",
+      {{"run", "pdamp run CASE.json [--method formulas|field|dem] [--dem-points N] [-o DIR] [--json]",
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
-        "as pdamp modes, frf and decay, --method only for these)",
-        {kMethodFlag, kOutFlag, kJsonFlag}, 1},
+        "as pdamp modes, frf and decay, --method only for these; filling_ratios: as pdamp optimize)",
+        {kMethodFlag, kDemPointsFlag, kOutFlag, kJsonFlag}, 1},
        run_run},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",
@@ -897,6 +899,7 @@ const std::vector<Command>& commands() {
     // Level III after the damper commands, before validate.
     auto structure = structure_commands();
     list.insert(list.end() - 1, structure.begin(), structure.end());
+    list.insert(list.end() - 1, optimize_command());
     return list;
   }();
   return all;

@@ -514,35 +514,6 @@ int run_frf_case(const ParsedArgs& args, const Case& c) {
 
 // ---------------------------------------------------------------- decay
 
-/// Modal amplitudes of the task's initial state: a released static load or given q_j(0).
-Eigen::VectorXd initial_modal_amplitudes(const Case& c, const case_file::StructureSetup& setup) {
-  const st::ModalModel& modal = setup.modal;
-  const auto& task = *c.task.decay;
-  const Eigen::Index modes = modal.mode_count();
-  if (task.initial_state == case_file::DecayTask::InitialState::kModalAmplitudes) {
-    if (static_cast<Eigen::Index>(task.modal_amplitudes.size()) > modes)
-      throw InputError(c.path, "/task/initial_state/values",
-                       "has " + std::to_string(task.modal_amplitudes.size()) + " entries, the structure keeps " +
-                           std::to_string(modes) + " modes (at most one value per mode)");
-    Eigen::VectorXd q = Eigen::VectorXd::Zero(modes);
-    for (std::size_t j = 0; j < task.modal_amplitudes.size(); ++j) q[static_cast<Eigen::Index>(j)] = task.modal_amplitudes[j];
-    return q;
-  }
-  const Eigen::Vector2d force(task.load_force_n[0], task.load_force_n[1]);
-  if (setup.beam) {
-    const st::BeamModel& beam = *setup.beam;
-    std::optional<double> position;
-    for (const auto& p : beam.points)
-      if (p.name == task.load_point) position = p.position_m;
-    for (const auto& m : beam.point_masses)
-      if (m.name == task.load_point) position = m.position_m;
-    if (!position) throw InputError(c.path, "/task/initial_state/point", "'" + task.load_point + "' is not a named point of the beam");
-    return call_solver(c, "/task/initial_state",
-                       [&] { return st::static_deflection_modal_amplitudes(beam, modal, *position, force, 0.0); });
-  }
-  return call_solver(c, "/task/initial_state/point",
-                     [&] { return st::modal_static_deflection_amplitudes(modal, task.load_point, force); });
-}
 
 /// The loss models' own sentences (with numbers) at one sample: each layer at its damper's
 /// amplitude and the frequency the decay uses for the dominant mode there (its backbone's
@@ -723,7 +694,7 @@ int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   const auto& task = *c.task.decay;
   Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const st::ModalModel& modal = setup.s.modal;
-  const Eigen::VectorXd q0 = initial_modal_amplitudes(c, setup.s);
+  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
   if (!(q0.cwiseAbs().maxCoeff() > 0.0))
     throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
   const auto dampers = dem_dampers(c);
@@ -1020,7 +991,7 @@ int run_decay_case(const ParsedArgs& args, const Case& c) {
   const auto& task = *c.task.decay;
   const auto& modal = setup.s.modal;
 
-  const Eigen::VectorXd q0 = initial_modal_amplitudes(c, setup.s);
+  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
   st::FreeDecayOptions options;
   options.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
   if (!(options.initial_modal_amplitudes.maxCoeff() > 0.0))
@@ -1120,7 +1091,8 @@ int run_structure_task(const ParsedArgs& args, const Case& c) {
     case TaskKind::kModes: return run_modes_case(args, c);
     case TaskKind::kFrf: return run_frf_case(args, c);
     case TaskKind::kDecay: return run_decay_case(args, c);
-    case TaskKind::kDamperDesign: break;
+    case TaskKind::kDamperDesign:
+    case TaskKind::kFillingRatios: break;
   }
   throw std::logic_error("run_structure_task: not a structure task");
 }

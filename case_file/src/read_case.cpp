@@ -149,6 +149,7 @@ std::string_view to_string(TaskKind kind) {
     case TaskKind::kFrf: return "frf";
     case TaskKind::kDecay: return "decay";
     case TaskKind::kModes: return "modes";
+    case TaskKind::kFillingRatios: return "filling_ratios";
   }
   return "unknown";
 }

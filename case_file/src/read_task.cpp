@@ -1,5 +1,7 @@
 // Format 2 `task`: what `pdamp run` does, with the settings of its kind.
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
 #include "readers.hpp"
 
@@ -66,8 +68,72 @@ ModesTask read_modes(ObjectReader& r, const Case& c) {
   return t;
 }
 
+/// Spheres in one full slab of a layer's lattice: the product of the transverse counts of
+/// an explicit lattice, else the most spheres collected_lattice places in one slab.
+int spheres_per_slab(const LayerSpec& layer, int drive_axis) {
+  if (layer.packing.lattice_counts) {
+    int n = 1;
+    for (int axis = 0; axis < 3; ++axis)
+      if (axis != drive_axis) n *= (*layer.packing.lattice_counts)[static_cast<std::size_t>(axis)];
+    return n;
+  }
+  // slabs(count) is non-decreasing in count: bisect for the last count of one slab.
+  const auto one_slab = [&](int count) {
+    try {
+      return formulas::collected_lattice(layer.container, count, layer.particle_radius_m, layer.packing).slabs == 1;
+    } catch (const std::invalid_argument&) {
+      return false;  // does not fit
+    }
+  };
+  int lo = 1, hi = 2;
+  while (one_slab(hi) && hi < (1 << 24)) lo = hi, hi *= 2;
+  while (hi - lo > 1) {
+    const int mid = lo + (hi - lo) / 2;
+    (one_slab(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
+  FillingRatiosTask t;
+  t.objective = r.text("objective", std::string("settling_time"), {"settling_time", "integral_square"}) ==
+                        "integral_square"
+                    ? FillingRatiosTask::Objective::kIntegralSquare
+                    : FillingRatiosTask::Objective::kSettlingTime;
+  t.mass_budget_kg = r.number("mass_budget_kg", std::nullopt, {0.0, 1e6, true}, " kg");
+  t.backend = r.text("backend", std::string("nlopt"), {"nlopt", "ipopt"});
+  t.max_evaluations = r.integer("max_evaluations", FillingRatiosTask{}.max_evaluations, 2, 1000000);
+  t.global_evaluations = r.integer("global_evaluations", FillingRatiosTask{}.global_evaluations, 1, 1000000);
+  if (t.global_evaluations >= t.max_evaluations) r.fail("global_evaluations", "must be < max_evaluations");
+  // The candidates are the first damper's layers: boxes with room for two slabs.
+  const DamperSpec& damper = c.dampers.front();
+  double lightest_slab_kg = 0.0;
+  for (std::size_t k = 0; k < damper.layers.size(); ++k) {
+    const LayerSpec& layer = damper.layers[k];
+    const std::string at = "/dampers/0/layers/" + std::to_string(k);
+    if (layer.container.shape != formulas::ContainerShape::kBox)
+      throw CaseError(r.file(), at + "/container/shape",
+                      "must be box for task kind filling_ratios (a layer is a box of whole slabs)");
+    const double length = layer.container.inner_length(damper.drive_axis);
+    if (length < 4.0 * layer.particle_radius_m * (1.0 - 1e-9))
+      throw CaseError(r.file(), at + "/container/inner_size_m",
+                      "= " + number_text(length) + " m along the drive: task kind filling_ratios needs room for two "
+                      "slabs of 2r = " + number_text(2.0 * layer.particle_radius_m) + " m (one slab and its travel)");
+    const int per_slab = spheres_per_slab(layer, damper.drive_axis);
+    t.spheres_per_slab.push_back(per_slab);
+    const double slab_kg = per_slab * layer.bed_mass_kg / layer.particle_count;
+    lightest_slab_kg = k == 0 ? slab_kg : std::min(lightest_slab_kg, slab_kg);
+  }
+  if (t.mass_budget_kg < lightest_slab_kg * (1.0 - 1e-9))
+    r.fail("mass_budget_kg", "= " + number_text(t.mass_budget_kg) + ": must be >= the lightest whole slab of a layer, " +
+                                 number_text(lightest_slab_kg) + " kg");
+  t.decay = read_decay(r, c);
+  return t;
+}
+
 void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
-  const std::string kind = r.text("kind", std::string("damper_design"), {"damper_design", "frf", "decay", "modes"});
+  const std::string kind =
+      r.text("kind", std::string("damper_design"), {"damper_design", "frf", "decay", "modes", "filling_ratios"});
   if (kind == "frf") {
     task.kind = TaskKind::kFrf;
     task.frf = read_frf(r, c);
@@ -77,6 +143,9 @@ void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
   } else if (kind == "modes") {
     task.kind = TaskKind::kModes;
     task.modes = read_modes(r, c);
+  } else if (kind == "filling_ratios") {
+    task.kind = TaskKind::kFillingRatios;
+    task.filling_ratios = read_filling_ratios(r, c);
   }
 }
 

@@ -156,4 +156,37 @@ structure::CosimulationDamper cosimulation_damper(const Case& c, std::size_t dam
   return out;
 }
 
+Eigen::VectorXd initial_modal_amplitudes(const Case& c, const StructureSetup& setup, const DecayTask& task) {
+  const Eigen::Index modes = setup.modal.mode_count();
+  if (task.initial_state == DecayTask::InitialState::kModalAmplitudes) {
+    if (static_cast<Eigen::Index>(task.modal_amplitudes.size()) > modes) {
+      throw CaseError(c.path, "/task/initial_state/values",
+                      "has " + std::to_string(task.modal_amplitudes.size()) + " entries, the structure keeps " +
+                          std::to_string(modes) + " modes (at most one value per mode)");
+    }
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(modes);
+    for (std::size_t j = 0; j < task.modal_amplitudes.size(); ++j) q[static_cast<Eigen::Index>(j)] = task.modal_amplitudes[j];
+    return q;
+  }
+  const Eigen::Vector2d force(task.load_force_n[0], task.load_force_n[1]);
+  try {
+    if (setup.beam) {
+      std::optional<double> position;
+      for (const auto& p : setup.beam->points)
+        if (p.name == task.load_point) position = p.position_m;
+      for (const auto& m : setup.beam->point_masses)
+        if (m.name == task.load_point) position = m.position_m;
+      if (!position) {
+        throw CaseError(c.path, "/task/initial_state/point", "'" + task.load_point + "' is not a named point of the beam");
+      }
+      return st::static_deflection_modal_amplitudes(*setup.beam, setup.modal, *position, force, 0.0);
+    }
+    return st::modal_static_deflection_amplitudes(setup.modal, task.load_point, force);
+  } catch (const CaseError&) {
+    throw;
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(c.path, "/task/initial_state", e.what());
+  }
+}
+
 }  // namespace pdamp::case_file

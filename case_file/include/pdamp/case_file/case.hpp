@@ -117,7 +117,7 @@ struct StructureSpec {
   std::vector<std::string> point_names;
 };
 
-enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes };
+enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes, kFillingRatios };
 
 /// `task` kind frf: the frequency response over a band.
 struct FrfTask {
@@ -152,12 +152,29 @@ struct ModesTask {
   int backbone_points = 50;                 ///< [2, 10000]
 };
 
+/// `task` kind filling_ratios (issue 12 §1.3): the whole slabs each layer of the first
+/// damper holds, for the fastest free decay under a particle-mass budget (docs/optimizer.md).
+/// The layers' containers and lattices give the candidates; their counts, the start.
+struct FillingRatiosTask {
+  enum class Objective { kSettlingTime, kIntegralSquare };
+  Objective objective = Objective::kSettlingTime;
+  double mass_budget_kg = 0.0;  ///< Σ particle mass of the first damper's layers, kg, > 0
+  std::string backend = "nlopt";  ///< "nlopt" or "ipopt" (pdamp optimize --backend overrides)
+  int global_evaluations = 300;   ///< free decays of the global (ISRES) stage, [1, max_evaluations)
+  int max_evaluations = 1000;     ///< free decays of the relaxed solve, both stages, [2, 1000000]
+  /// The free decay: initial state, duration and settling threshold, as task kind decay.
+  DecayTask decay;
+  // Derived on load, one per layer of the first damper:
+  std::vector<int> spheres_per_slab;  ///< spheres in one full slab of the layer's lattice
+};
+
 /// What `pdamp run` does; the settings of the kind given (format 1: damper_design only).
 struct TaskSpec {
   TaskKind kind = TaskKind::kDamperDesign;
   std::optional<FrfTask> frf;
   std::optional<DecayTask> decay;
   std::optional<ModesTask> modes;
+  std::optional<FillingRatiosTask> filling_ratios;
 };
 
 struct Case {

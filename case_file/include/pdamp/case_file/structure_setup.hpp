@@ -36,6 +36,11 @@ struct StructureSetup {
 /// structure, a layer without `field_file` under kField, or an unreadable field file.
 StructureSetup structure_setup(const Case& c, LossMethod method);
 
+/// Modal amplitudes q_j(0) of a decay's initial state: a released static load (a beam:
+/// its exact static deflection projected on the kept modes; modal data: the kept modes'
+/// static response) or the given values. CaseError naming /task/initial_state otherwise.
+Eigen::VectorXd initial_modal_amplitudes(const Case& c, const StructureSetup& setup, const DecayTask& task);
+
 /// Damper `damper_index` of the case as a co-simulation damper (`--method dem`,
 /// docs/cosimulation.md): its site, drive direction and empty container mass, and its bed
 /// as the World of dem_options(c, damper_index, ...).world (one compartment per layer; the

@@ -1,0 +1,297 @@
+// Filling ratios of a multi-layer damper: relaxed solve, rounded neighbours, baseline.
+#include "pdamp/optimizer/filling_ratios.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "pdamp/optimizer/solve.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
+
+namespace pdamp::optimizer {
+
+namespace {
+
+constexpr double kFitsTolerance = 1e-9;   // as formulas::collected_lattice's "fits"
+constexpr double kEmptyLayerSlabs = 1e-9; // below: the layer holds nothing and is left out
+constexpr double kWholeTolerance = 1e-6;  // a relaxed n_k this close to a whole number is that number
+constexpr int kMaxLayers = 10;
+
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(10);
+  out << value;
+  return out.str();
+}
+
+double clock_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double total_mass(const FillingRatioOptions& o, std::span<const double> n) {
+  double m = 0.0;
+  for (std::size_t k = 0; k < n.size(); ++k) m += n[k] * o.layers[k].slab_mass_kg();
+  return m;
+}
+
+double total_slabs(std::span<const double> n) {
+  double s = 0.0;
+  for (double v : n) s += v;
+  return s;
+}
+
+/// Within the budget and slab limit, to a relative 1e-9 (the relaxed optimum sits on it).
+bool feasible(const FillingRatioOptions& o, std::span<const double> n) {
+  if (o.mass_budget_kg > 0.0 && total_mass(o, n) > o.mass_budget_kg * (1.0 + 1e-9)) return false;
+  if (o.max_total_slabs > 0 && total_slabs(n) > o.max_total_slabs + 1e-9) return false;
+  return true;
+}
+
+}  // namespace
+
+std::string_view to_string(FillingObjective objective) {
+  return objective == FillingObjective::kSettlingTime ? "settling_time" : "integral_square";
+}
+
+int LayerCandidate::max_slabs() const {
+  if (!(slab_length_m > 0.0) || !(inner_length_m > 0.0)) return 0;
+  return static_cast<int>(std::floor(inner_length_m / slab_length_m * (1.0 + kFitsTolerance))) - 1;
+}
+
+std::vector<std::string> FillingRatioOptions::validate() const {
+  std::vector<std::string> problems;
+  if (layers.empty() || static_cast<int>(layers.size()) > kMaxLayers)
+    problems.push_back("layers: has " + std::to_string(layers.size()) + " entries: must have 1 to " +
+                       std::to_string(kMaxLayers));
+  double lightest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    const auto& l = layers[k];
+    const std::string at = "layers[" + std::to_string(k) + "].";
+    if (l.name.empty()) problems.push_back(at + "name: must not be empty");
+    for (std::size_t j = 0; j < k; ++j)
+      if (layers[j].name == l.name) problems.push_back(at + "name = " + l.name + ": must be unique");
+    if (!(l.inner_length_m > 0.0 && std::isfinite(l.inner_length_m)))
+      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must be > 0 and finite");
+    if (!(l.slab_length_m > 0.0 && std::isfinite(l.slab_length_m)))
+      problems.push_back(at + "slab_length_m = " + number(l.slab_length_m) + ": must be > 0 and finite");
+    else if (l.max_slabs() < 1)
+      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must hold at least two slabs of " +
+                         number(l.slab_length_m) + " m (one slab and one slab of travel)");
+    if (l.spheres_per_slab < 1)
+      problems.push_back(at + "spheres_per_slab = " + std::to_string(l.spheres_per_slab) + ": must be >= 1");
+    if (!(l.sphere_mass_kg > 0.0 && std::isfinite(l.sphere_mass_kg)))
+      problems.push_back(at + "sphere_mass_kg = " + number(l.sphere_mass_kg) + ": must be > 0 and finite");
+    if (!(l.cross_section_m2 >= 0.0 && std::isfinite(l.cross_section_m2)) ||
+        !(l.sphere_volume_m3 >= 0.0 && std::isfinite(l.sphere_volume_m3)))
+      problems.push_back(at + "cross_section_m2, sphere_volume_m3: must be >= 0 and finite");
+    if (l.initial_slabs < 0 || l.initial_slabs > std::max(l.max_slabs(), 0))
+      problems.push_back(at + "initial_slabs = " + std::to_string(l.initial_slabs) + ": must be in [0, " +
+                         std::to_string(std::max(l.max_slabs(), 0)) + "]");
+    if (l.spheres_per_slab >= 1 && l.sphere_mass_kg > 0.0) lightest = std::min(lightest, l.slab_mass_kg());
+  }
+  if (!(mass_budget_kg >= 0.0 && std::isfinite(mass_budget_kg)))
+    problems.push_back("mass_budget_kg = " + number(mass_budget_kg) + ": must be >= 0 and finite");
+  else if (mass_budget_kg > 0.0 && std::isfinite(lightest) && mass_budget_kg < lightest * (1.0 - 1e-9))
+    problems.push_back("mass_budget_kg = " + number(mass_budget_kg) + ": must be >= the lightest slab, " +
+                       number(lightest) + " kg (no layer could hold a whole slab)");
+  if (max_total_slabs < 0) problems.push_back("max_total_slabs = " + std::to_string(max_total_slabs) + ": must be >= 0");
+  if (mass_budget_kg == 0.0 && max_total_slabs == 0)
+    problems.push_back("mass_budget_kg = 0 and max_total_slabs = 0: give at least one constraint");
+  if (integral_samples < 10 || integral_samples > 100000)
+    problems.push_back("integral_samples = " + std::to_string(integral_samples) + ": must be in [10, 100000]");
+  if (!(decay.duration_s > 0.0 && std::isfinite(decay.duration_s)))
+    problems.push_back("decay.duration_s = " + number(decay.duration_s) + ": must be > 0 and finite");
+  return problems;
+}
+
+structure::Damper filling_damper(const FillingRatioOptions& options, std::span<const double> slabs) {
+  if (slabs.size() != options.layers.size())
+    throw std::invalid_argument("filling_damper: " + std::to_string(slabs.size()) + " slab counts for " +
+                                std::to_string(options.layers.size()) + " layers");
+  structure::Damper damper = options.damper;
+  damper.layers.clear();
+  for (std::size_t k = 0; k < slabs.size(); ++k) {
+    const auto& l = options.layers[k];
+    const double n = slabs[k];
+    if (!(n >= 0.0 && n <= l.max_slabs()))
+      throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + number(n) + ": must be in [0, " +
+                                  std::to_string(l.max_slabs()) + "]");
+    if (n <= kEmptyLayerSlabs) continue;
+    structure::DamperLayer layer;
+    layer.name = l.name;
+    layer.bed_mass_kg = n * l.slab_mass_kg();
+    layer.loss_model = std::make_shared<surrogate::ClosedFormLossModel>(
+        options.model, l.inner_length_m - n * l.slab_length_m, options.model_options);
+    damper.layers.push_back(std::move(layer));
+  }
+  return damper;
+}
+
+FillingDesign evaluate_filling_design(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                      std::span<const double> slabs) {
+  FillingDesign design;
+  std::vector<structure::Damper> dampers = {filling_damper(options, slabs)};
+  dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
+  for (std::size_t k = 0; k < slabs.size(); ++k) {
+    const auto& l = options.layers[k];
+    LayerDesign d;
+    d.name = l.name;
+    d.slabs = slabs[k];
+    d.filling_ratio = slabs[k] * l.slab_length_m / l.inner_length_m;
+    d.clearance_m = l.inner_length_m - slabs[k] * l.slab_length_m;
+    d.bed_mass_kg = slabs[k] * l.slab_mass_kg();
+    d.particles = slabs[k] * l.spheres_per_slab;
+    d.volume_fraction = l.cross_section_m2 > 0.0
+                            ? d.particles * l.sphere_volume_m3 / (l.inner_length_m * l.cross_section_m2)
+                            : 0.0;
+    design.total_slabs += static_cast<int>(std::lround(slabs[k]));
+    design.layers.push_back(std::move(d));
+  }
+  design.total_mass_kg = total_mass(options, slabs);
+  design.feasible = feasible(options, slabs);
+
+  structure::FreeDecayOptions decay = options.decay;
+  const bool integral = options.objective == FillingObjective::kIntegralSquare;
+  const int samples = integral ? options.integral_samples : 2;
+  decay.sample_times_s.resize(static_cast<std::size_t>(samples));
+  for (int i = 0; i < samples; ++i) decay.sample_times_s[static_cast<std::size_t>(i)] = decay.duration_s * i / (samples - 1);
+  decay.sample_times_s.back() = decay.duration_s;
+  const auto result = structure::free_decay(model, dampers, decay);
+
+  design.settled = result.outcome == structure::FreeDecay::Outcome::kSettled;
+  design.settling_time_s = result.settling_time_s;
+  design.integral_square_m2_s = std::numeric_limits<double>::quiet_NaN();
+  if (integral) {
+    double sum = 0.0;
+    for (std::size_t i = 1; i < result.samples.size(); ++i) {
+      const auto& a = result.samples[i - 1];
+      const auto& b = result.samples[i];
+      sum += 0.25 * (b.time_s - a.time_s) *
+             (a.threshold_measure_m * a.threshold_measure_m + b.threshold_measure_m * b.threshold_measure_m);
+    }
+    design.integral_square_m2_s = sum;
+    design.objective = sum;
+  } else if (design.settled) {
+    design.objective = result.settling_time_s;
+  } else {
+    const double end = result.samples.back().threshold_measure_m;
+    design.objective = decay.duration_s * (1.0 + std::log(std::max(end / result.threshold_used_m, 1.0)));
+  }
+  return design;
+}
+
+FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                           const Options& solver) {
+  if (const auto problems = options.validate(); !problems.empty()) {
+    std::string text;
+    for (const auto& p : problems) text += (text.empty() ? "" : "\n") + p;
+    throw std::invalid_argument(text);
+  }
+  const double start = clock_s();
+  FillingRatioResult out;
+  const std::size_t n_layers = options.layers.size();
+  auto evaluate = [&](std::span<const double> n) {
+    ++out.decay_evaluations;
+    return evaluate_filling_design(model, options, n);
+  };
+
+  std::vector<double> initial(n_layers);
+  for (std::size_t k = 0; k < n_layers; ++k) initial[k] = options.layers[k].initial_slabs;
+  out.initial = evaluate(initial);
+  if (!out.initial.feasible)
+    out.warnings.push_back("the starting design (the case's particle counts) exceeds the budget: the search starts "
+                           "inside the bounds instead");
+
+  // 1. The continuous relaxation: n_k real, mass and clearance linear in n_k.
+  Problem problem;
+  for (std::size_t k = 0; k < n_layers; ++k) {
+    const auto& l = options.layers[k];
+    const double upper = l.max_slabs();
+    problem.variables.push_back({"slabs_" + l.name, "", 0.0, upper, std::clamp<double>(l.initial_slabs, 0.0, upper)});
+  }
+  problem.objective = {std::string(to_string(options.objective)),
+                       [&](std::span<const double> x) { return evaluate(x).objective; }, nullptr};
+  if (options.mass_budget_kg > 0.0) {
+    // Scaled to kg/budget so that the constraint tolerance is relative.
+    problem.constraints.push_back(
+        {"mass_budget_kg",
+         [&](std::span<const double> x) { return total_mass(options, x) / options.mass_budget_kg - 1.0; },
+         [&](std::span<const double>, std::span<double> g) {
+           for (std::size_t k = 0; k < n_layers; ++k) g[k] = options.layers[k].slab_mass_kg() / options.mass_budget_kg;
+         }});
+  }
+  if (options.max_total_slabs > 0) {
+    problem.constraints.push_back(
+        {"max_total_slabs", [&](std::span<const double> x) { return total_slabs(x) / options.max_total_slabs - 1.0; },
+         [&](std::span<const double>, std::span<double> g) {
+           for (std::size_t k = 0; k < n_layers; ++k) g[k] = 1.0 / options.max_total_slabs;
+         }});
+  }
+  out.summary = solve(problem, solver);
+  out.relaxed = evaluate(out.summary.x);
+
+  // 2. Every rounded neighbour of the relaxed optimum (floor/ceil per fractional n_k).
+  std::vector<double> base(n_layers);
+  std::vector<std::size_t> fractional;
+  for (std::size_t k = 0; k < n_layers; ++k) {
+    const double x = out.summary.x[k];
+    const double whole = std::round(x);
+    if (std::abs(x - whole) <= kWholeTolerance) {
+      base[k] = whole;
+    } else {
+      base[k] = std::floor(x);
+      fractional.push_back(k);
+    }
+  }
+  out.neighbours_total = 1 << fractional.size();
+  double best = std::numeric_limits<double>::infinity();
+  for (int mask = 0; mask < out.neighbours_total; ++mask) {
+    std::vector<double> n = base;
+    for (std::size_t b = 0; b < fractional.size(); ++b)
+      if (mask & (1 << b)) n[fractional[b]] += 1.0;
+    if (!feasible(options, n)) continue;
+    ++out.neighbours_feasible;
+    out.neighbours.push_back(evaluate(n));
+    if (out.neighbours.back().objective < best) {
+      best = out.neighbours.back().objective;
+      out.chosen = out.neighbours.back();
+    }
+  }
+  if (out.neighbours.empty()) {
+    // Cannot happen for a feasible relaxed point (flooring only lowers mass and slabs).
+    throw std::runtime_error("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
+                             out.summary.brief_report() + ")");
+  }
+
+  // 3. The single-layer baseline: all mass in one layer, exhaustive over layer and slabs.
+  double best_single = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < n_layers; ++k) {
+    for (int s = 1; s <= options.layers[k].max_slabs(); ++s) {
+      std::vector<double> n(n_layers, 0.0);
+      n[k] = s;
+      if (!feasible(options, n)) break;
+      ++out.baseline_evaluations;
+      auto d = evaluate(n);
+      if (d.objective < best_single) {
+        best_single = d.objective;
+        out.baseline = std::move(d);
+        out.baseline_layer = options.layers[k].name;
+      }
+    }
+  }
+  if (out.baseline_evaluations > 0 && out.baseline.objective < out.chosen.objective)
+    out.warnings.push_back("the best single-layer design (" + out.baseline_layer + ", objective " +
+                           number(out.baseline.objective) + ") beats the chosen multi-layer design (objective " +
+                           number(out.chosen.objective) +
+                           "): the relaxed optimum is a local one; raise the global stage's evaluations");
+  if (!out.chosen.settled && options.objective == FillingObjective::kSettlingTime)
+    out.warnings.push_back("the chosen design does not settle within the duration: lengthen it");
+  out.solve_time_s = clock_s() - start;
+  return out;
+}
+
+}  // namespace pdamp::optimizer
