@@ -384,10 +384,16 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
 }
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files);
+int run_frf_compare(const ParsedArgs& args, const Case& c);
 
 int run_frf_case(const ParsedArgs& args, const Case& c) {
   require_task(c, TaskKind::kFrf, c.task.frf.has_value(),
                "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\"");
+  if (args.has("--compare")) {
+    if (args.optional_text("--method"))
+      throw InputError("--compare", "", "runs every method (formulas, field, dem): give no --method with it");
+    return run_frf_compare(args, c);
+  }
   if (dem_method(args)) {
     auto dem_files = output_dir(args);
     return run_frf_dem(args, c, dem_files.get());
@@ -565,14 +571,16 @@ std::vector<st::CosimulationDamper> dem_dampers(const Case& c) {
 /// refusals, e.g. a step above its bound), a World that stops is exit 3 with its advice.
 st::CosimulationResult run_cosimulation(const Case& c, const st::ModalModel& modal,
                                         const std::vector<st::CosimulationDamper>& dampers,
-                                        const st::CosimulationOptions& options, const std::string& label) {
+                                        const st::CosimulationOptions& options, const std::string& label,
+                                        st::CosimulationState* state = nullptr) {
   if (const auto problems = options.validate(modal); !problems.empty()) throw InputError(c.path, "/task", problems.front());
   for (std::size_t d = 0; d < dampers.size(); ++d)
     if (const auto problems = dampers[d].validate(modal); !problems.empty())
       throw InputError(c.path, "/dampers/" + std::to_string(d), problems.front());
   st::CosimulationResult r;
   try {
-    r = st::cosimulate(modal, dampers, options, [&](const st::CosimulationProgress& p) { print_cosim_progress(label, p); });
+    const auto report = [&](const st::CosimulationProgress& p) { print_cosim_progress(label, p); };
+    r = state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
   } catch (const std::invalid_argument& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
@@ -817,10 +825,31 @@ int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   return finish(args, c, files, "decay.json", result, setup.warnings, rows);
 }
 
-int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+/// One frequency of the stepped-sine DEM FRF.
+struct DemPoint {
+  double f = 0.0, requested_f = 0.0;
+  std::vector<double> magnitude, phase_deg;
+  double spread = NAN;
+  double energy_error = 0.0;
+  int transient = 0;
+  bool stable = false;
+  std::int64_t steps = 0;
+  double dt = 0.0, wall = 0.0;
+};
+struct DemSweep {
+  std::vector<DemPoint> points;
+  std::vector<double> frequencies;  ///< requested
+  std::vector<st::CosimulationDamper> dampers;
+  bool base = false;
+  int analysed_periods = 0;
+  double solve_time = 0.0;
+};
+
+/// The stepped sine of --method dem (and of --compare): up in frequency over the task's
+/// band, each frequency continuing the previous one's final state (bed included).
+DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   const auto& task = *c.task.frf;
   const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
-  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const st::ModalModel& modal = setup.s.modal;
   const auto dampers = dem_dampers(c);
   const bool base = task.excitation == case_file::FrfTask::Excitation::kBase;
@@ -835,6 +864,10 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   options.settle_until_stable = true;
   options.stable_tolerance = kDemStableTolerance;
   options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  // The drive is U sin(Ω(t − t_i) + π/2) from each frequency's start t_i: every run ends on
+  // whole periods, so each junction is at the turning point, base (or force) at its
+  // amplitude with zero rate on both sides: displacement and velocity of the base continue.
+  options.excitation_phase_rad = std::numbers::pi / 2.0;
   {  // the excitation's own checks first (exit 2 naming /task/excitation)
     st::Excitation e;
     e.kind = base ? st::Excitation::Kind::kBaseTranslation : st::Excitation::Kind::kPointForce;
@@ -846,33 +879,36 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   const auto frequencies = spaced(task.min_frequency_hz, task.max_frequency_hz, points, false);
   const std::size_t outputs = dampers.size();
 
-  struct Point {
-    double f = 0.0;
-    std::vector<double> magnitude, phase_deg;
-    double spread = NAN;
-    double energy_error = 0.0;
-    int transient = 0;
-    bool stable = false;
-    std::int64_t steps = 0;
-    double dt = 0.0, wall = 0.0;
-  };
-  std::vector<Point> result_points;
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(modal.mode_count()), v = Eigen::VectorXd::Zero(modal.mode_count());
+  std::vector<DemPoint> result_points;
+  // One step for the whole sweep (the carried worlds keep theirs): the smallest automatic
+  // step over the frequencies, each period then the nearest whole number of it.
+  double sweep_dt = INFINITY;
+  for (const double f : frequencies) {
+    st::CosimulationOptions o = options;
+    o.excitation.frequency_hz = f;
+    if (const auto problems = o.validate(modal); !problems.empty()) throw InputError(c.path, "/task", problems.front());
+    try {
+      sweep_dt = std::min(sweep_dt, st::cosimulation_time_step(modal, dampers, o).time_step_s);
+    } catch (const std::invalid_argument& e) {
+      std::string what = e.what();
+      std::replace(what.begin(), what.end(), '\n', ' ');
+      throw InputError(c.path, "/dem", what);
+    }
+  }
+  st::CosimulationState state;  // the bed, the modes and the drive's phase, carried over
   double solve_time = 0.0;
   for (std::size_t i = 0; i < frequencies.size(); ++i) {
     options.excitation.frequency_hz = frequencies[i];
-    options.initial_modal_displacements = q;
-    options.initial_modal_velocities = v;
+    options.time_step_s = state.started() ? 0.0 : sweep_dt;
     const std::string label = "pdamp frf (dem) " + std::to_string(i + 1) + "/" + std::to_string(frequencies.size()) + " " +
                               format_number(frequencies[i], 5) + " Hz";
-    const auto r = run_cosimulation(c, modal, dampers, options, label);
+    const auto r = run_cosimulation(c, modal, dampers, options, label, &state);
     setup.warnings.add(r.warnings);
-    q = r.final_modal_displacements;
-    v = r.final_modal_velocities;
     solve_time += r.wall_time_s;
     const auto& ss = r.steady_state;
-    Point p;
-    p.f = frequencies[i];
+    DemPoint p;
+    p.f = ss.frequency_hz;
+    p.requested_f = frequencies[i];
     for (std::size_t d = 0; d < outputs; ++d) {
       p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
       p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
@@ -904,6 +940,25 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
                          format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
     result_points.push_back(std::move(p));
   }
+  DemSweep out;
+  out.points = std::move(result_points);
+  out.frequencies = frequencies;
+  out.dampers = dampers;
+  out.base = base;
+  out.analysed_periods = options.analysed_periods;
+  out.solve_time = solve_time;
+  return out;
+}
+
+int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const DemSweep sweep = dem_frf_sweep(args, c, setup);
+  const auto& result_points = sweep.points;
+  const auto& frequencies = sweep.frequencies;
+  const auto& dampers = sweep.dampers;
+  const bool base = sweep.base;
+  const std::size_t outputs = dampers.size();
+  const double solve_time = sweep.solve_time;
 
   json peaks = json::array();
   std::vector<std::pair<std::string, std::string>> rows = {{"method", "dem"}};
@@ -923,7 +978,8 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   for (const auto& p : result_points) {
     json magnitude = json::object(), phase = json::object();
     for (std::size_t d = 0; d < outputs; ++d) magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
-    list.push_back({{"frequency_hz", p.f}, {"magnitude", magnitude}, {"phase_deg", phase},
+    list.push_back({{"frequency_hz", p.f}, {"requested_frequency_hz", p.requested_f}, {"magnitude", magnitude},
+                    {"phase_deg", phase},
                     {"magnitude_spread", number_or_null(p.spread)}, {"energy_error", p.energy_error},
                     {"transient_periods", p.transient}, {"stable", p.stable}, {"steps", p.steps},
                     {"time_step_s", p.dt}, {"solve_time_s", p.wall}});
@@ -952,8 +1008,8 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
     setup.warnings.add(write_frf_dem_plot(*files, names, magnitude_label, c.name + ": stepped-sine DEM co-simulation"));
   }
   const std::string bed_state =
-      "each frequency starts from the previous one's final modal state (q, dq/dt) with a freshly settled bed "
-      "(the co-simulation cannot carry a bed over)";
+      "up in frequency, each frequency continues the previous one's final state: modes (q, dq/dt), the bed "
+      "(particles and contacts) and the drive's phase; the bed is settled once, before the first frequency";
   json frf = {{"file", file_json(files, "frf_dem.csv")},
               {"plot", file_json(files, "frf_dem.png")},
               {"method", "dem"},
@@ -965,18 +1021,163 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
                                {"points", frequencies.size()}, {"spacing", "linear"}}},
               {"points", list},
               {"peaks", peaks},
-              {"stepped_sine", {{"bed_state", bed_state}, {"max_transient_periods", kDemMaxTransientPeriods},
+              {"bed_carried_over", true},
+              {"stepped_sine", {{"bed_state", bed_state}, {"bed_carried_over", true},
+                                {"drive", "sin(2 pi f (t - t_i) + pi/2) from each frequency's start t_i: the junctions "
+                                          "are at the turning point, the base displacement and velocity (or the "
+                                          "force) continuous"},
+                                {"time_step_s", result_points.empty() ? 0.0 : result_points.front().dt},
+                                {"max_transient_periods", kDemMaxTransientPeriods},
                                 {"stable_tolerance", kDemStableTolerance},
-                                {"analysed_periods", options.analysed_periods}}},
+                                {"analysed_periods", sweep.analysed_periods}}},
               {"solve_time_s", solve_time},
               {"warnings", setup.warnings.list()}};
   json result = {{"task", "frf"}, {"case", c.name}, {"method", "dem"}};
   result["file"] = frf["file"];
   result["peaks"] = peaks;
   result["branches"] = json::array();
+  result["bed_carried_over"] = true;
   result["frf"] = frf;
   result["frf"]["warnings"] = setup.warnings.list();
   return finish(args, c, files, "frf.json", result, setup.warnings, rows);
+}
+
+// ---------------------------------------------------------------- --compare
+
+/// The harmonic-balance FRF of the task for one loss method (formulas or field), as pdamp frf.
+st::FrequencyResponse task_response(const Case& c, Setup& setup) {
+  const auto& task = *c.task.frf;
+  st::Excitation excitation;
+  excitation.direction = {task.direction[0], task.direction[1]};
+  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
+    excitation.kind = st::Excitation::Kind::kBaseTranslation;
+    excitation.amplitude = task.base_amplitude_m;
+  } else {
+    excitation.kind = st::Excitation::Kind::kPointForce;
+    excitation.amplitude = task.force_amplitude_n;
+    excitation.point = task.force_point;
+  }
+  if (const auto problems = excitation.validate(setup.s.modal); !problems.empty())
+    throw InputError(c.path, "/task/excitation", problems.front());
+  st::HarmonicBalanceOptions options;
+  options.frequencies_hz = spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
+                                  task.spacing == surrogate::AxisSpacing::kLog);
+  auto response =
+      call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+  for (const auto& p : response.peaks)
+    if (!std::isfinite(p.frequency_hz) || !std::isfinite(p.magnitude))
+      throw NumericalError("pdamp frf --compare: a response peak is not finite (" + response.brief_report() + ")");
+  const std::string method(case_file::to_string(setup.method));
+  setup.warnings.add(response.warnings, method + ": ");
+  if (response.outcome != st::FrequencyResponse::Outcome::kConverged)
+    setup.warnings.add(method + ": some roots did not converge (" + std::to_string(response.unconverged_starts) +
+                       " Newton starts failed): the response may miss branches");
+  return response;
+}
+
+/// The largest peak of the first output, or nullptr.
+const st::ResponsePeak* first_output_peak(const st::FrequencyResponse& r) {
+  const st::ResponsePeak* best = nullptr;
+  for (const auto& p : r.peaks)
+    if (p.output == 0 && (!best || p.magnitude > best->magnitude)) best = &p;
+  return best;
+}
+
+/// Relative differences of a method's largest first-output peak from the DEM's.
+json agreement_json(const st::ResponsePeak* peak, double dem_f, double dem_magnitude) {
+  if (!peak) return nullptr;
+  return {{"frequency_hz", peak->frequency_hz},
+          {"magnitude", peak->magnitude},
+          {"frequency_relative_difference", (peak->frequency_hz - dem_f) / dem_f},
+          {"magnitude_relative_difference", (peak->magnitude - dem_magnitude) / dem_magnitude}};
+}
+
+/// pdamp frf --compare: formulas, field (when every layer has a field_file) and the DEM
+/// stepped sine on one case, one figure and one table.
+int run_frf_compare(const ParsedArgs& args, const Case& c) {
+  auto files = output_dir(args);
+  Setup formulas = make_setup(c, case_file::LossMethod::kFormulas);
+  const st::FrequencyResponse f_response = task_response(c, formulas);
+  Warnings& warnings = formulas.warnings;
+
+  bool every_field = true;
+  for (const auto& d : c.dampers)
+    for (const auto& l : d.layers) every_field = every_field && !l.field_file.empty();
+  std::optional<st::FrequencyResponse> field_response;
+  if (every_field) {
+    Setup field = make_setup(c, case_file::LossMethod::kField);
+    field_response = task_response(c, field);
+    warnings.add(field.warnings.list());
+  } else {
+    warnings.add("--compare: the field curve is skipped: not every layer has a field_file (make one with pdamp field)");
+  }
+
+  Setup dem_setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const DemSweep sweep = dem_frf_sweep(args, c, dem_setup);
+  warnings.add(dem_setup.warnings.list(), "dem: ");
+  if (sweep.points.empty()) throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < sweep.points.size(); ++i)
+    if (sweep.points[i].magnitude.front() > sweep.points[best].magnitude.front()) best = i;
+  const DemPoint& dem_peak = sweep.points[best];
+
+  const std::vector<std::string>& names = f_response.output_names;
+  const std::string output = names.empty() ? std::string() : names.front();
+  const std::string magnitude_label = sweep.base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+  std::vector<CompareDemPoint> dem_points;
+  json dem_list = json::array();
+  for (const auto& p : sweep.points) {
+    dem_points.push_back({p.f, p.magnitude.front(), std::isfinite(p.spread) ? p.spread : 0.0});
+    dem_list.push_back({{"frequency_hz", p.f}, {"magnitude", p.magnitude.front()},
+                        {"magnitude_spread", number_or_null(p.spread)}, {"energy_error", p.energy_error},
+                        {"stable", p.stable}});
+  }
+  if (files)
+    warnings.add(write_frf_compare_files(*files, f_response, field_response ? &*field_response : nullptr, dem_points,
+                                         magnitude_label,
+                                         c.name + (field_response ? ": formulas, field and DEM" : ": formulas and DEM (no field)")));
+
+  const json f_peaks = peaks_json(f_response.peaks, names);
+  const json field_peaks = field_response ? peaks_json(field_response->peaks, field_response->output_names) : json(nullptr);
+  json compare = {
+      {"output", output},
+      {"formulas", {{"peaks", f_peaks}}},
+      {"field", field_response ? json{{"peaks", field_peaks}} : json(nullptr)},
+      {"dem", {{"peak", {{"output", output}, {"frequency_hz", dem_peak.f}, {"magnitude", dem_peak.magnitude.front()},
+                         {"magnitude_spread", number_or_null(dem_peak.spread)}}},
+               {"points", dem_list},
+               {"bed_carried_over", true},
+               {"peak_note", "the largest of the stepped-sine points: its frequency is resolved to the point spacing"}}},
+      {"agreement",
+       {{"reference", "dem"},
+        {"definition", "(method - dem) / dem of the largest peak of the first output"},
+        {"formulas", agreement_json(first_output_peak(f_response), dem_peak.f, dem_peak.magnitude.front())},
+        {"field", field_response ? agreement_json(first_output_peak(*field_response), dem_peak.f, dem_peak.magnitude.front())
+                                 : json(nullptr)}}},
+      {"file", file_json(files.get(), "frf_compare.csv")},
+      {"plot", file_json(files.get(), "frf_compare.png")},
+      {"dem_solve_time_s", sweep.solve_time}};
+  json result = {{"task", "frf"}, {"case", c.name}, {"method", "compare"}};
+  result["file"] = compare["file"];
+  result["peaks"] = f_peaks;  // the contract's peaks: the formulas' (compare holds all three)
+  result["branches"] = json::array();
+  result["compare"] = compare;
+  std::vector<std::pair<std::string, std::string>> rows = {{"method", "compare (formulas, field, dem)"}};
+  const auto row = [&](const std::string& name, const json& a) {
+    if (a.is_null()) {
+      rows.push_back({name, "-"});
+      return;
+    }
+    rows.push_back({name, format_number(a["frequency_hz"].get<double>(), 6) + " Hz, |out| = " +
+                              format_number(a["magnitude"].get<double>(), 4) + " (vs dem: f " +
+                              format_number(100.0 * a["frequency_relative_difference"].get<double>(), 3) + "%, |out| " +
+                              format_number(100.0 * a["magnitude_relative_difference"].get<double>(), 3) + "%)"});
+  };
+  row("peak formulas", compare["agreement"]["formulas"]);
+  row("peak field", compare["agreement"]["field"]);
+  rows.push_back({"peak dem", format_number(dem_peak.f, 6) + " Hz, |out| = " + format_number(dem_peak.magnitude.front(), 4) +
+                                  " (largest of " + std::to_string(sweep.points.size()) + " points)"});
+  return finish(args, c, files.get(), "frf.json", result, warnings, rows);
 }
 
 int run_decay_case(const ParsedArgs& args, const Case& c) {
@@ -1106,13 +1307,16 @@ std::vector<Command> structure_commands() {
                                     "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
        run_modes},
-      {{"frf", "pdamp frf CASE.json [--method formulas|field|dem] [--dem-points N] [-o DIR] [--json]",
+      {{"frf", "pdamp frf CASE.json [--method formulas|field|dem | --compare] [--dem-points N] [-o DIR] [--json]",
         "frequency response of the structure with its dampers (task kind frf): every harmonic-\n"
         "balance root, its stability, branches, jumps and peaks, and the response without beds",
         {kMethodFlag, kDemPointsFlag,
+         {"--compare", "", "run formulas, field (when every layer has a field_file, else skipped\n"
+                           "                          with a warning) and dem on the case: one figure frf_compare.png/svg,\n"
+                           "                          frf_compare.csv, and the peaks' relative differences from dem"},
          {"-o", "DIR", "write frf.csv, frf_branches.csv, frf.gp/png/svg (dem: frf_dem.csv,\n"
-                       "                          frf_dem.gp/png/svg), frf.json and case_resolved.json into DIR,\n"
-                       "                          atomically"},
+                       "                          frf_dem.gp/png/svg; --compare: frf_compare.csv/gp/png/svg), frf.json\n"
+                       "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
        run_frf},
       {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [-o DIR] [--json]",

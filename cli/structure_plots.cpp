@@ -336,4 +336,57 @@ std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<st
   return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
 }
 
+std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::FrequencyResponse& formulas,
+                                                 const st::FrequencyResponse* field,
+                                                 const std::vector<CompareDemPoint>& dem,
+                                                 const std::string& magnitude_label, const std::string& title) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "source,branch,frequency_hz,stability,magnitude,magnitude_spread\n";
+  bool first = true;
+  const auto branches = [&](const st::FrequencyResponse& r, const std::string& source) {
+    std::map<int, std::vector<std::pair<double, const st::HarmonicRoot*>>> by_branch;
+    for (const auto& p : r.points)
+      for (const auto& root : p.roots)
+        if (!root.outputs.empty()) by_branch[root.branch_id].push_back({p.frequency_hz, &root});
+    for (auto& [id, roots] : by_branch) {
+      std::sort(roots.begin(), roots.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      if (!first) csv << '\n';  // a blank line: gnuplot does not join two branches
+      first = false;
+      for (const auto& [f, root] : roots)
+        csv << source << ',' << id << ',' << f << ',' << st::to_string(root->stability) << ','
+            << std::abs(root->outputs.front()) << ",0\n";
+    }
+  };
+  branches(formulas, "formulas");
+  if (field) branches(*field, "field");
+  if (!first) csv << '\n';
+  for (const auto& p : dem)
+    csv << "dem,0," << p.frequency_hz << ",dem," << p.magnitude << ',' << p.spread << '\n';
+  out.add("frf_compare.csv", csv.str());
+
+  std::ostringstream gp;
+  gp << "# pdamp frf --compare: the first output by the closed-form loss models (formulas), the\n"
+     << "# layers' effective fields (field) and the stepped-sine DEM co-simulation (points, error bars:\n"
+     << "# spread over the analysed periods); unstable harmonic-balance roots dashed; run: gnuplot frf_compare.gp\n"
+     << "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
+     << "set xlabel 'frequency f / Hz'\nset ylabel " << gnuplot_string(magnitude_label) << " noenhanced\n"
+     << "set title " << gnuplot_string(title) << " noenhanced\n"
+     << "sel(s, t, c) = (stringcolumn(1) eq s && stringcolumn(4) eq t) ? column(c) : 1/0\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,650 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'frf_compare.svg' : 'frf_compare.png'\n"
+     << "  plot 'frf_compare.csv' using 3:(sel('formulas', 'stable', 5)) with lines lw 2 lc rgb '" << colour(0)
+     << "' title 'formulas', \\\n"
+     << "       '' using 3:(sel('formulas', 'unstable', 5)) with lines lw 2 dt 2 lc rgb '" << colour(0)
+     << "' title 'formulas, unstable', \\\n";
+  if (field)
+    gp << "       '' using 3:(sel('field', 'stable', 5)) with lines lw 2 lc rgb '" << colour(1) << "' title 'field', \\\n"
+       << "       '' using 3:(sel('field', 'unstable', 5)) with lines lw 2 dt 2 lc rgb '" << colour(1)
+       << "' title 'field, unstable', \\\n";
+  gp << "       '' using 3:(sel('dem', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
+     << "' title 'DEM (stepped sine)'\n}\n";
+  return out.add_plot("frf_compare.gp", gp.str(), {"frf_compare.png", "frf_compare.svg"});
+}
+
 }  // namespace pdamp::cli

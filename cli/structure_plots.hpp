@@ -59,4 +59,21 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
 std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
                                             const std::string& magnitude_label, const std::string& title);
 
+/// One DEM point of pdamp frf --compare: the stepped sine's first harmonic and its spread.
+struct CompareDemPoint {
+  double frequency_hz = 0.0;
+  double magnitude = 0.0;
+  double spread = 0.0;  ///< sample standard deviation over the analysed periods (0 if not defined)
+};
+
+/// frf_compare.csv (source,branch,frequency_hz,stability,magnitude,magnitude_spread: the
+/// formulas' and the field's roots by branch, unstable ones marked, then the DEM points; a
+/// blank line between branches) and frf_compare.gp/png/svg: the first output of each source
+/// on one log-y axis, formulas and field as lines (unstable parts dashed), DEM as points
+/// with error bars. `field` may be null (skipped).
+std::vector<std::string> write_frf_compare_files(OutputDir& out, const structure::FrequencyResponse& formulas,
+                                                 const structure::FrequencyResponse* field,
+                                                 const std::vector<CompareDemPoint>& dem,
+                                                 const std::string& magnitude_label, const std::string& title);
+
 }  // namespace pdamp::cli

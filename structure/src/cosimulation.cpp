@@ -28,6 +28,13 @@ constexpr double kUnitTolerance = 1e-6;
 /// error (ωdt)²/24 is 1e-4 of that at 0.2 — far below the beds' own.
 constexpr double kStructureStepLimit = 0.2;
 constexpr double kStructureStepTarget = 0.05;
+/// A continuation warns when its frequency moves by more than this fraction to fit whole
+/// steps of the carried dt, or when the carried dt exceeds the run's own automatic step by
+/// more than this fraction (a few per cent fewer steps per contact change nothing measurable;
+/// the automatic step of a continuation also counts the state's energy, which the sweep's
+/// planning from rest does not).
+constexpr double kFrequencyChangeWarning = 1e-4;
+constexpr double kCarriedStepMargin = 0.1;
 /// The progress clock is read every this many steps.
 constexpr std::int64_t kProgressStride = 256;
 
@@ -141,18 +148,81 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
   return p;
 }
 
-CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                              const CosimulationOptions& options, const CosimulationProgressCallback& progress) {
-  const auto wall_start = Clock::now();
-  // --- Validation: every violation, one per line.
+namespace {
+
+/// Everything a run needs before its worlds: modal arrays with the empty containers, the
+/// excitation's shapes and the assumed peak site speeds.
+struct Prepared {
+  CoupledModel coupled;
+  Eigen::MatrixXd M, M_inv, B, R;
+  Eigen::VectorXd w, K, C;
+  double omega = 0.0, U = 0.0;
+  Eigen::VectorXd exc_shape, base_shape, force_shape;
+  std::vector<double> drive_dot_e, peak_speed;
+  std::vector<std::string> warnings;
+};
+
+/// Every violation of the inputs, one per line (a continuation drops the free decay's
+/// need of a non-zero start: it starts from the state).
+void validate_inputs(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                     const CosimulationOptions& options, bool continuation) {
   std::vector<std::string> problems = model.validate();
   if (dampers.empty()) problems.push_back("dampers: must hold at least one damper");
   for (std::size_t d = 0; d < dampers.size(); ++d)
     for (auto& line : dampers[d].validate(model)) problems.push_back("dampers[" + std::to_string(d) + "]." + line);
-  for (auto& line : options.validate(model)) problems.push_back(std::move(line));
+  for (auto& line : options.validate(model))
+    if (!(continuation && line.find("a free decay needs a non-zero start") != std::string::npos))
+      problems.push_back(std::move(line));
+  if (!std::isfinite(options.excitation_phase_rad))
+    problems.push_back("cosimulation.excitation_phase_rad = " + number(options.excitation_phase_rad) + ": must be finite");
   if (!problems.empty()) throw std::invalid_argument(join(problems));
+}
 
-  CosimulationResult result;
+/// Whether `state` can be continued with these inputs: one line per misfit.
+void validate_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                    const CosimulationOptions& options, const CosimulationState& state) {
+  std::vector<std::string> p;
+  const std::string at = "cosimulation state: ";
+  if (state.worlds.size() != dampers.size())
+    p.push_back(at + "holds " + std::to_string(state.worlds.size()) + " world(s) for " + std::to_string(dampers.size()) +
+                " damper(s): continue a state with the dampers that made it");
+  for (std::size_t d = 0; d < state.worlds.size(); ++d)
+    if (state.worlds[d].status().outcome != dem::Outcome::kCompleted)
+      p.push_back(at + "world " + std::to_string(d) + " stopped (" + state.worlds[d].status().message +
+                  "): it cannot be continued");
+  if (state.modal_displacements.size() != model.mode_count() || state.modal_velocities.size() != model.mode_count())
+    p.push_back(at + "modal state has " + std::to_string(state.modal_displacements.size()) + " entries, the model " +
+                std::to_string(model.mode_count()) + " modes");
+  if (!(state.time_step_s > 0.0)) p.push_back(at + "time_step_s = " + number(state.time_step_s) + ": must be > 0");
+  if (options.initial_modal_displacements.size() || options.initial_modal_velocities.size())
+    p.push_back("cosimulation.initial_modal_displacements, initial_modal_velocities: must be empty when continuing a "
+                "state (the run starts from the state's q, dq/dt)");
+  if (options.time_step_s != 0.0 && std::abs(options.time_step_s - state.time_step_s) > 1e-12 * state.time_step_s)
+    p.push_back("cosimulation.time_step_s = " + number(options.time_step_s) + ": must be 0 or the state's step " +
+                number(state.time_step_s) + " s when continuing (the worlds keep their step)");
+  const auto& a = state.excitation;
+  const auto& b = options.excitation;
+  if (a.kind != b.kind) {
+    p.push_back("cosimulation.excitation.kind: must be the state's when continuing (a harmonic run continues a "
+                "harmonic run of the same load, a free decay a free decay)");
+  } else if (harmonic(b)) {
+    if ((a.direction - b.direction).norm() > 1e-12)
+      p.push_back("cosimulation.excitation.direction = " + vec2(b.direction) + ": must be the state's " +
+                  vec2(a.direction) + " when continuing");
+    if (std::abs(a.amplitude - b.amplitude) > 1e-12 * std::abs(a.amplitude))
+      p.push_back("cosimulation.excitation.amplitude = " + number(b.amplitude) + ": must be the state's " +
+                  number(a.amplitude) + " when continuing (only the frequency may change)");
+    if (a.point != b.point)
+      p.push_back("cosimulation.excitation.point = \"" + b.point + "\": must be the state's \"" + a.point +
+                  "\" when continuing");
+  }
+  if (!p.empty()) throw std::invalid_argument(join(p));
+}
+
+/// Modal arrays, excitation shapes and peak speeds for the start q, v at frequency f_hz.
+Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                 const CosimulationOptions& options, double f_hz, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  Prepared P;
   const auto& exc = options.excitation;
   const bool is_harmonic = harmonic(exc);
   const bool is_base = exc.kind == CosimulationExcitationKind::kBaseTranslation;
@@ -169,84 +239,92 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     p.container_mass_kg = d.container_mass_kg;
     points.push_back(p);
   }
-  const CoupledModel coupled = couple(model, points);
-  const Eigen::MatrixXd& M = coupled.mass_with_containers_kg;
-  const Eigen::VectorXd& w = coupled.angular_frequencies_rad_s;
-  const Eigen::VectorXd K = model.modal_masses_kg.cwiseProduct(w.cwiseAbs2());
-  const Eigen::VectorXd C = 2.0 * model.modal_masses_kg.cwiseProduct(model.damping_ratios).cwiseProduct(w);
-  const Eigen::MatrixXd& B = coupled.drive_shapes;  // modes x dampers
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(dcount));  // rotation shapes
+  P.coupled = couple(model, points);
+  P.M = P.coupled.mass_with_containers_kg;
+  P.w = P.coupled.angular_frequencies_rad_s;
+  P.K = model.modal_masses_kg.cwiseProduct(P.w.cwiseAbs2());
+  P.C = 2.0 * model.modal_masses_kg.cwiseProduct(model.damping_ratios).cwiseProduct(P.w);
+  P.B = P.coupled.drive_shapes;  // modes x dampers
+  P.R = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(dcount));  // rotation shapes
   for (std::size_t d = 0; d < dcount; ++d) {
     const Eigen::RowVectorXd& rot = model.point(dampers[d].point).rotation;
     if (dampers[d].rotation) {
-      R.col(static_cast<Eigen::Index>(d)) = rot.transpose();
+      P.R.col(static_cast<Eigen::Index>(d)) = rot.transpose();
     } else if (rot.cwiseAbs().maxCoeff() > 0.0) {
-      result.warnings.push_back("damper " + dampers[d].name + ": the site rotates (max |θ_j| = " +
-                                number(rot.cwiseAbs().maxCoeff()) +
-                                " rad per unit q) but rotation = false: the container only translates");
+      P.warnings.push_back("damper " + dampers[d].name + ": the site rotates (max |θ_j| = " +
+                           number(rot.cwiseAbs().maxCoeff()) +
+                           " rad per unit q) but rotation = false: the container only translates");
     }
   }
-  result.frequencies_with_containers_hz = natural_frequencies_with_containers_hz(coupled);
-  const Eigen::MatrixXd M_inv = M.inverse();
+  P.M_inv = P.M.inverse();
 
-  // Excitation: f_exc(t) = amplitude_vector · sin Ωt.
-  const double omega = is_harmonic ? kTwoPi * exc.frequency_hz : 0.0;
-  Eigen::VectorXd exc_shape = Eigen::VectorXd::Zero(n);  // modal load per unit sin Ωt
-  Eigen::VectorXd base_shape = Eigen::VectorXd::Zero(n);  // P_e = (Γ + Σ m_c Φ_dᵀ) e
-  std::vector<double> drive_dot_e(dcount, 0.0);            // n_d · e (base motion of the sites)
-  Eigen::VectorXd force_shape = Eigen::VectorXd::Zero(n);  // Φ_pᵀ e
+  // Excitation: f_exc(t) = amplitude_vector · sin ψ.
+  P.omega = is_harmonic ? kTwoPi * f_hz : 0.0;
+  const double omega = P.omega;
+  P.exc_shape = Eigen::VectorXd::Zero(n);    // modal load per unit sin ψ
+  P.base_shape = Eigen::VectorXd::Zero(n);   // P_e = (Γ + Σ m_c Φ_dᵀ) e
+  P.drive_dot_e.assign(dcount, 0.0);         // n_d · e (base motion of the sites)
+  P.force_shape = Eigen::VectorXd::Zero(n);  // Φ_pᵀ e
   if (exc.kind == CosimulationExcitationKind::kPointForce) {
-    force_shape = model.point(exc.point).translation.transpose() * exc.direction;
-    exc_shape = exc.amplitude * force_shape;
+    P.force_shape = model.point(exc.point).translation.transpose() * exc.direction;
+    P.exc_shape = exc.amplitude * P.force_shape;
   } else if (is_base) {
-    base_shape = (coupled.base_participation + coupled.container_participation) * exc.direction;
-    exc_shape = exc.amplitude * omega * omega * base_shape;  // −P_e ü_b, ü_b = −UΩ² sin Ωt
-    for (std::size_t d = 0; d < dcount; ++d) drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
+    P.base_shape = (P.coupled.base_participation + P.coupled.container_participation) * exc.direction;
+    P.exc_shape = exc.amplitude * omega * omega * P.base_shape;  // −P_e ü_b, ü_b = −UΩ² sin ψ
+    for (std::size_t d = 0; d < dcount; ++d) P.drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
   }
-  const double U = is_base ? exc.amplitude : 0.0;
-
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n);
-  if (options.initial_modal_displacements.size()) q = options.initial_modal_displacements;
-  if (options.initial_modal_velocities.size()) v = options.initial_modal_velocities;
+  P.U = is_base ? exc.amplitude : 0.0;
 
   // --- Peak site speed for the time-step rule.
-  std::vector<double> peak_speed(dcount, options.peak_site_speed_m_s);
+  P.peak_speed.assign(dcount, options.peak_site_speed_m_s);
   if (options.peak_site_speed_m_s == 0.0) {
-    const double e0 = 0.5 * v.dot(M * v) + 0.5 * q.dot(K.cwiseProduct(q));
+    const double e0 = 0.5 * v.dot(P.M * v) + 0.5 * q.dot(P.K.cwiseProduct(q));
     for (std::size_t d = 0; d < dcount; ++d) {
       const auto col = static_cast<Eigen::Index>(d);
       // Free motion: |b·q̇| <= √(2E bᵀM⁻¹b) (Cauchy-Schwarz in the M norm).
-      peak_speed[d] = std::sqrt(2.0 * e0 * B.col(col).dot(M_inv * B.col(col)));
+      P.peak_speed[d] = std::sqrt(2.0 * e0 * P.B.col(col).dot(P.M_inv * P.B.col(col)));
     }
     if (is_harmonic) {
       Eigen::MatrixXcd D;
-      linear_dynamic_stiffness(coupled, omega, D);
-      const Eigen::VectorXcd qhat = D.partialPivLu().solve(exc_shape.cast<std::complex<double>>());
+      linear_dynamic_stiffness(P.coupled, omega, D);
+      const Eigen::VectorXcd qhat = D.partialPivLu().solve(P.exc_shape.cast<std::complex<double>>());
       for (std::size_t d = 0; d < dcount; ++d) {
         const auto col = static_cast<Eigen::Index>(d);
-        const std::complex<double> y = B.col(col).cast<std::complex<double>>().dot(qhat) + drive_dot_e[d] * U;
+        const std::complex<double> y = P.B.col(col).cast<std::complex<double>>().dot(qhat) + P.drive_dot_e[d] * P.U;
         // Twice the linear steady state (the start transient can overshoot it), plus the start.
-        peak_speed[d] += 2.0 * std::abs(y) * omega;
+        P.peak_speed[d] += 2.0 * std::abs(y) * omega;
       }
     }
-    for (auto& s : peak_speed) s = std::min(s, 0.5 * dem::limits::kMaxImpactSpeed_m_s);
+    for (auto& s : P.peak_speed) s = std::min(s, 0.5 * dem::limits::kMaxImpactSpeed_m_s);
   }
+  return P;
+}
 
-  // --- Common time step and the worlds' options.
-  std::vector<dem::WorldOptions> world_options;
-  const double omega_max = w.maxCoeff();
+/// The common time step of a fresh start and the worlds' options (time_step_s still theirs).
+struct StepPlan {
   double dt = 0.0;
   std::int64_t steps_per_period = 0;
+  std::vector<dem::WorldOptions> world_options;
+  std::vector<std::string> warnings;
+};
+StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const CosimulationOptions& options,
+                   double f_hz) {
+  StepPlan plan;
+  const bool is_harmonic = harmonic(options.excitation);
+  const std::size_t dcount = dampers.size();
+  const double omega_max = P.w.maxCoeff();
+  double& dt = plan.dt;
+  std::int64_t& steps_per_period = plan.steps_per_period;
   if (is_harmonic) {
-    const double period = 1.0 / exc.frequency_hz;
+    const double period = 1.0 / f_hz;
     for (std::size_t d = 0; d < dcount; ++d) {
       dem::WorldOptions wo = dampers[d].world;
       if (options.time_step_s > 0.0) wo.integration.time_step_s = options.time_step_s;
-      const dem::DriveTimeStep plan = dem::drive_time_step(
-          wo, dem::DriveTiming{period, 1, dem::drive_impact_speed(wo, peak_speed[d])});
-      for (const auto& wline : plan.warnings) result.warnings.push_back("damper " + dampers[d].name + ": " + wline);
-      steps_per_period = std::max(steps_per_period, plan.steps_per_period);
-      world_options.push_back(plan.world);
+      const dem::DriveTimeStep drive = dem::drive_time_step(
+          wo, dem::DriveTiming{period, 1, dem::drive_impact_speed(wo, P.peak_speed[d])});
+      for (const auto& wline : drive.warnings) plan.warnings.push_back("damper " + dampers[d].name + ": " + wline);
+      steps_per_period = std::max(steps_per_period, drive.steps_per_period);
+      plan.world_options.push_back(drive.world);
     }
     if (options.time_step_s == 0.0)
       steps_per_period = std::max(
@@ -257,10 +335,10 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     for (std::size_t d = 0; d < dcount; ++d) {
       dem::WorldOptions wo = dampers[d].world;
       wo.integration.max_impact_speed_m_s =
-          std::max(wo.integration.max_impact_speed_m_s, dem::drive_impact_speed(wo, peak_speed[d]));
+          std::max(wo.integration.max_impact_speed_m_s, dem::drive_impact_speed(wo, P.peak_speed[d]));
       wo.integration.time_step_s = 0.0;
       dt = std::min(dt, dem::time_step_bound(wo).max_time_step_s);
-      world_options.push_back(wo);
+      plan.world_options.push_back(wo);
     }
     if (options.time_step_s > 0.0) {
       if (options.time_step_s > dt)
@@ -274,9 +352,117 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   if (omega_max * dt > kStructureStepLimit)
     throw std::invalid_argument("cosimulation.time_step_s = " + number(dt) + ": the highest mode (" +
                                 number(omega_max / kTwoPi) + " Hz) needs ω·dt <= 0.2 for the modal Verlet step");
-  for (auto& wo : world_options) wo.integration.time_step_s = dt;
+  return plan;
+}
+
+Eigen::VectorXd start_vector(const Eigen::VectorXd& given, Eigen::Index n) {
+  return given.size() ? given : Eigen::VectorXd::Zero(n);
+}
+
+}  // namespace
+
+CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                            const CosimulationOptions& options) {
+  validate_inputs(model, dampers, options, false);
+  const Eigen::Index n = model.mode_count();
+  const double f = options.excitation.frequency_hz;
+  const Prepared P = prepare(model, dampers, options, f, start_vector(options.initial_modal_displacements, n),
+                             start_vector(options.initial_modal_velocities, n));
+  StepPlan plan = plan_step(P, dampers, options, f);
+  return {plan.dt, plan.steps_per_period, std::move(plan.warnings)};
+}
+
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, const CosimulationProgressCallback& progress) {
+  CosimulationState state;
+  return cosimulate(model, dampers, options, state, progress);
+}
+
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, CosimulationState& state,
+                              const CosimulationProgressCallback& progress) {
+  const auto wall_start = Clock::now();
+  const bool continuation = state.started();
+  // --- Validation: every violation, one per line.
+  validate_inputs(model, dampers, options, continuation);
+  if (continuation) validate_state(model, dampers, options, state);
+
+  CosimulationResult result;
+  result.continued = continuation;
+  const auto& exc = options.excitation;
+  const bool is_harmonic = harmonic(exc);
+  const bool is_base = exc.kind == CosimulationExcitationKind::kBaseTranslation;
+  const Eigen::Index n = model.mode_count();
+  const std::size_t dcount = dampers.size();
+
+  Eigen::VectorXd q = continuation ? state.modal_displacements : start_vector(options.initial_modal_displacements, n);
+  Eigen::VectorXd v = continuation ? state.modal_velocities : start_vector(options.initial_modal_velocities, n);
+
+  // --- Frequency, step and steps per period. A continuation keeps the worlds' step: the
+  // period takes the nearest whole number of them (the frequency run is 1/(N dt)).
+  double f_run = is_harmonic ? exc.frequency_hz : 0.0;
+  double dt = 0.0;
+  std::int64_t steps_per_period = 0;
+  std::vector<dem::WorldOptions> world_options;
+  if (continuation) {
+    dt = state.time_step_s;
+    if (is_harmonic) {
+      steps_per_period = std::max<std::int64_t>(1, std::llround(1.0 / (exc.frequency_hz * dt)));
+      if (steps_per_period < 8)
+        throw std::invalid_argument("cosimulation.excitation.frequency_hz = " + number(exc.frequency_hz) +
+                                    ": a period of the state's step " + number(dt) + " s is only " +
+                                    std::to_string(steps_per_period) + " steps (at least 8)");
+      const double whole = 1.0 / (static_cast<double>(steps_per_period) * dt);
+      if (std::abs(whole - exc.frequency_hz) > 1e-12 * exc.frequency_hz) f_run = whole;
+      if (std::abs(whole - exc.frequency_hz) > kFrequencyChangeWarning * exc.frequency_hz)
+        result.warnings.push_back("frequency " + number(exc.frequency_hz) + " Hz run as " + number(whole) + " Hz: " +
+                                  std::to_string(steps_per_period) + " whole steps of the carried-over step " +
+                                  number(dt) + " s per period");
+    }
+  }
+  const Prepared P = prepare(model, dampers, options, f_run, q, v);
+  for (const auto& wline : P.warnings) result.warnings.push_back(wline);
+  if (continuation) {
+    // The step this frequency would take on its own: a warning if the carried one is longer.
+    CosimulationOptions automatic = options;
+    automatic.time_step_s = 0.0;
+    const StepPlan own = plan_step(P, dampers, automatic, f_run);
+    if (dt > own.dt * (1.0 + kCarriedStepMargin))
+      result.warnings.push_back("the carried-over step " + number(dt) + " s is above the automatic step " +
+                                number(own.dt) + " s" + (is_harmonic ? " at " + number(f_run) + " Hz" : std::string()) +
+                                ": contacts are resolved more coarsely (plan the sweep's step with "
+                                "cosimulation_time_step at its most demanding frequency)");
+    if (P.w.maxCoeff() * dt > kStructureStepLimit)
+      throw std::invalid_argument("cosimulation state: time_step_s = " + number(dt) + ": the highest mode needs ω·dt <= 0.2");
+  } else {
+    StepPlan plan = plan_step(P, dampers, options, f_run);
+    for (auto& wline : plan.warnings) result.warnings.push_back(std::move(wline));
+    dt = plan.dt;
+    steps_per_period = plan.steps_per_period;
+    world_options = std::move(plan.world_options);
+    for (auto& wo : world_options) wo.integration.time_step_s = dt;
+  }
+  const CoupledModel& coupled = P.coupled;
+  const Eigen::MatrixXd& M = P.M;
+  const Eigen::MatrixXd& M_inv = P.M_inv;
+  const Eigen::VectorXd& K = P.K;
+  const Eigen::VectorXd& C = P.C;
+  const Eigen::MatrixXd& B = P.B;
+  const Eigen::MatrixXd& R = P.R;
+  const double omega = P.omega;
+  const double U = P.U;
+  const Eigen::VectorXd& exc_shape = P.exc_shape;
+  const Eigen::VectorXd& base_shape = P.base_shape;
+  const Eigen::VectorXd& force_shape = P.force_shape;
+  const std::vector<double>& drive_dot_e = P.drive_dot_e;
+  result.frequencies_with_containers_hz = natural_frequencies_with_containers_hz(coupled);
   result.time_step_s = dt;
   result.steps_per_period = steps_per_period;
+  // The drive's phase at the start: a harmonic continuation goes on where the last run ended.
+  const double phase0 = continuation ? state.excitation_phase_rad : (is_harmonic ? options.excitation_phase_rad : 0.0);
+  const double t0 = continuation ? state.time_s : 0.0;
+  result.start_time_s = t0;
+
 
   // --- Planned length.
   const std::int64_t transient_steps = is_harmonic ? options.transient_periods * steps_per_period : 0;
@@ -308,16 +494,39 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     site_theta[d] = theta;
   };
 
-  // --- Worlds, built at the start pose, and the beds settled with the structure held.
-  std::vector<dem::World> worlds;
-  worlds.reserve(dcount);
-  const double base_velocity0 = U * omega;  // u_b = U sin Ωt: u̇_b(0) = UΩ
+  // sin ψ and cos ψ, ψ = 2πk/N + φ, at the steps of a period (harmonic), tabulated once.
+  std::vector<double> sin_table, cos_table;
+  if (is_harmonic) {
+    sin_table.resize(static_cast<std::size_t>(steps_per_period));
+    cos_table.resize(static_cast<std::size_t>(steps_per_period));
+    for (std::int64_t k = 0; k < steps_per_period; ++k) {
+      const double phase = kTwoPi * static_cast<double>(k) / static_cast<double>(steps_per_period) + phase0;
+      sin_table[static_cast<std::size_t>(k)] = std::sin(phase);
+      cos_table[static_cast<std::size_t>(k)] = std::cos(phase);
+    }
+  }
+  const auto sin_at = [&](std::int64_t step) {
+    return is_harmonic ? sin_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  };
+  const auto cos_at = [&](std::int64_t step) {
+    return is_harmonic ? cos_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  };
+
+  // --- Worlds, built at the start pose, and the beds settled with the structure held;
+  // a continuation takes the state's worlds as they are.
+  if (!continuation) {
+    state.worlds.clear();
+    state.worlds.reserve(dcount);
+  }
+  std::vector<dem::World>& worlds = state.worlds;
+  const double base0 = U * sin_at(0);                  // u_b = U sin ψ
+  const double base_velocity0 = U * omega * cos_at(0);  // u̇_b = UΩ cos ψ
   std::vector<dem::ContainerState> states(dcount);
   for (std::size_t d = 0; d < dcount; ++d) {
-    site_state(d, q, 0.0, base_velocity0, v, states[d]);
-    worlds.emplace_back(world_options[d], states[d]);
+    site_state(d, q, base0, base_velocity0, v, states[d]);
+    if (!continuation) worlds.emplace_back(world_options[d], states[d]);
   }
-  for (std::size_t d = 0; d < dcount; ++d) {
+  for (std::size_t d = 0; d < dcount && !continuation; ++d) {
     const double settling = options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
                                                                : dem::automatic_settling_time_s(world_options[d]);
     const auto steps = static_cast<std::int64_t>(std::llround(settling / dt));
@@ -351,24 +560,6 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
       if (moment[d] != 0.0) out -= moment[d] * R.col(col);
     }
   };
-  // sin Ωt and e^{−iΩt} at the steps of a period (harmonic), tabulated once.
-  std::vector<double> sin_table, cos_table;
-  if (is_harmonic) {
-    sin_table.resize(static_cast<std::size_t>(steps_per_period));
-    cos_table.resize(static_cast<std::size_t>(steps_per_period));
-    for (std::int64_t k = 0; k < steps_per_period; ++k) {
-      const double phase = kTwoPi * static_cast<double>(k) / static_cast<double>(steps_per_period);
-      sin_table[static_cast<std::size_t>(k)] = std::sin(phase);
-      cos_table[static_cast<std::size_t>(k)] = std::cos(phase);
-    }
-  }
-  const auto sin_at = [&](std::int64_t step) {
-    return is_harmonic ? sin_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
-  };
-  const auto cos_at = [&](std::int64_t step) {
-    return is_harmonic ? cos_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
-  };
-
   auto& h = result.history;
   h.time_s.reserve(static_cast<std::size_t>(max_samples));
   h.modal_displacements.resize(max_samples, n);
@@ -406,12 +597,12 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const double kinetic0 = structure_kinetic(v, base_velocity0);
   const double potential0 = structure_potential(q);
 
-  modal_load(0.0, q, g);
+  modal_load(sin_at(0), q, g);
   tmp = g - C.cwiseProduct(v);
   acc.noalias() = M_inv * tmp;
   double power = is_base ? base_power(acc, base_velocity0) : 0.0;
   double work = 0.0, damping = 0.0;
-  record(0.0);
+  record(t0);
 
   // DFT accumulators: per period (first damper's site, for the stability test) and analysed.
   std::complex<double> period_sum(0.0, 0.0);
@@ -435,7 +626,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     vh = v + half_dt * acc;
     q_new = q + dt * vh;
     const std::int64_t next = step + 1;
-    const double t_next = static_cast<double>(next) * dt;
+    const double t_next = t0 + static_cast<double>(next) * dt;
     const double base_next = U * sin_at(next);
     const double base_velocity_next = U * omega * cos_at(next);
     // The beds: each container at its new state; the half-step velocities are the Verlet ones.
@@ -512,7 +703,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
       const double since = std::chrono::duration<double>(now - last_report).count();
       if (since >= options.progress_interval_s) {
         progress(CosimulationProgress{!is_harmonic ? decay_stage : (analysing ? analysis_stage : transient_stage),
-                                      t_next, static_cast<double>(end_step) * dt,
+                                      static_cast<double>(step) * dt, static_cast<double>(end_step) * dt,
                                       static_cast<double>(step - last_report_step) / since});
         last_report = now;
         last_report_step = step;
@@ -532,7 +723,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   h.container_moment_nm.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
 
   if (is_harmonic) {
-    ss.frequency_hz = exc.frequency_hz;
+    ss.frequency_hz = f_run;
     ss.transient_periods = static_cast<int>(std::max<std::int64_t>(analysis_start, 0) / steps_per_period);
     const std::int64_t analysed_steps = analysis_start >= 0 ? step - analysis_start : 0;
     ss.analysed_periods = static_cast<int>(analysed_steps / steps_per_period);
@@ -571,6 +762,20 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const double scale = std::max({std::abs(e.excitation_work_j), dissipated,
                                  std::abs(e.delta_structure_kinetic_j + e.delta_structure_potential_j)});
   e.relative_error = scale > 0.0 ? std::abs(e.excitation_work_j - dissipated - delta) / scale : 0.0;
+  // --- The state for the next run.
+  state.modal_displacements = q;
+  state.modal_velocities = v;
+  state.time_s = t0 + static_cast<double>(step) * dt;
+  state.steps += step;
+  state.time_step_s = dt;
+  state.excitation = exc;
+  state.excitation.frequency_hz = f_run;
+  state.excitation_phase_rad = 0.0;
+  if (is_harmonic) {
+    const double phase = std::fmod(phase0 + kTwoPi * static_cast<double>(step % steps_per_period) /
+                                                static_cast<double>(steps_per_period), kTwoPi);
+    state.excitation_phase_rad = phase < 0.0 ? phase + kTwoPi : phase;
+  }
   result.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return result;
 }

@@ -225,17 +225,52 @@ TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies", 
   CHECK(out["method"] == "dem");
   const json& points = out["frf"]["points"];
   REQUIRE(points.size() == 3);
-  CHECK(points[0]["frequency_hz"].get<double>() == Approx(1.2));
-  CHECK(points[2]["frequency_hz"].get<double>() == Approx(2.0));
+  // Up in frequency, each from the previous final state (bed included); the frequency run is
+  // the nearest whole number of the sweep's step per period (within 1/(2N), N ~ 6e4 here).
+  CHECK(out["bed_carried_over"] == true);
+  CHECK(out["frf"]["stepped_sine"]["bed_carried_over"] == true);
+  CHECK(points[0]["frequency_hz"].get<double>() == Approx(1.2).epsilon(1e-4));
+  CHECK(points[2]["frequency_hz"].get<double>() == Approx(2.0).epsilon(1e-4));
+  CHECK(points[2]["requested_frequency_hz"].get<double>() == 2.0);
+  CHECK(points[0]["time_step_s"] == points[2]["time_step_s"]);  // one step for the sweep
   for (const auto& p : points) {
     CHECK(p["energy_error"].get<double>() < 0.01);
     CHECK(p["magnitude"]["damper_1"].get<double>() > 0.0);
   }
   // The mode with the container (2 Hz·√(0.5/0.8) = 1.58 Hz) is nearest the middle point.
   REQUIRE(out["peaks"].size() == 1);
-  CHECK(out["peaks"][0]["frequency_hz"].get<double>() == Approx(1.6));
+  CHECK(out["peaks"][0]["frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
   CHECK(out["peaks"][0]["magnitude"].get<double>() > points[0]["magnitude"]["damper_1"].get<double>());
   require_files(dir.path, {"frf_dem.csv", "frf_dem.gp", "frf.json", "case_resolved.json"});
   // Bad input: out of range --dem-points is exit 2.
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 1").exit_code == 2);
+}
+
+// --compare: formulas, field (skipped here: the layer has no field_file) and the DEM stepped
+// sine on one case, one figure and table; the agreement is each method's peak against DEM's.
+TEST_CASE("pdamp frf --compare: formulas, field and DEM in one figure with the peaks' agreement", "[cli][structure][dem]") {
+  const TempDir dir("frf_compare");
+  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --dem-points 3 --json -o " +
+                           dir.path.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  for (const char* key : {"file", "peaks", "branches", "warnings", "compare", "outputs"}) CHECK(out.contains(key));
+  CHECK(out["method"] == "compare");
+  const json& c = out["compare"];
+  REQUIRE(c["formulas"]["peaks"].size() == 1);
+  CHECK(c["field"].is_null());
+  CHECK(r.err.find("the field curve is skipped") != std::string::npos);
+  REQUIRE(c["dem"]["points"].size() == 3);
+  CHECK(c["dem"]["peak"]["frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
+  CHECK(c["dem"]["peak"]["magnitude"].get<double>() > 0.0);
+  const json& a = c["agreement"]["formulas"];
+  for (const char* key : {"frequency_relative_difference", "magnitude_relative_difference"}) CHECK(a.contains(key));
+  const double f_formulas = c["formulas"]["peaks"][0]["frequency_hz"].get<double>();
+  const double f_dem = c["dem"]["peak"]["frequency_hz"].get<double>();
+  CHECK(a["frequency_relative_difference"].get<double>() == Approx((f_formulas - f_dem) / f_dem));
+  CHECK(std::abs(a["frequency_relative_difference"].get<double>()) < 0.1);  // both near the 1.58 Hz mode
+  CHECK(c["agreement"]["field"].is_null());
+  require_files(dir.path, {"frf_compare.csv", "frf_compare.gp", "frf.json", "case_resolved.json"});
+  CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --method dem").exit_code == 2);
 }

@@ -336,3 +336,120 @@ TEST_CASE("invalid co-simulation inputs are refused naming field and rule", "[co
     CHECK_THAT(what, Catch::Contains("a free decay needs a non-zero start"));
   }
 }
+
+// Continuation (CosimulationState): the state carries the worlds (particles, contacts, step),
+// q, q̇, the time and the drive's phase, so two runs at one frequency continued from the state
+// are one run of the combined length. The loop does the same arithmetic on the same numbers in
+// the same order (the drive's tables are indexed by step modulo the period, the runs end on
+// whole periods, the opening acceleration is recomputed from the same q, q̇ and bed load), so
+// the end states are bit-identical; the ledgers are sums over the two runs, equal to round-off.
+// Impacting spheres, so a bed that was re-settled would differ at once.
+TEST_CASE("two continued runs equal one run of the combined length and the ledger closes across the junction",
+          "[cosimulation]") {
+  const dem::WorldOptions world = bed(0.005, {0.03, 0.0201, 0.0201}, {1, 2, 2}, 2e8, {0.0, 0.0, -9.80665},
+                                      dem::InitialPlacement::kCollectedLattice);
+  const ModalModel model = one_dof(10.0, 0.01, 0.1, 1.0, 0.0, 0.08);
+  const std::vector<CosimulationDamper> dampers{tip_damper(world, 0.02)};
+  CosimulationOptions o;
+  o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
+  o.excitation.direction = {0.0, 1.0};
+  o.excitation.amplitude = 1e-3;
+  o.excitation.frequency_hz = 9.0;
+  for (const double phase : {0.0, kPi / 2}) {
+    INFO("start phase " << phase);
+    o.excitation_phase_rad = phase;
+    CosimulationOptions whole = o;
+    whole.transient_periods = 2;
+    whole.analysed_periods = 3;
+    CosimulationState one;
+    const CosimulationResult r = cosimulate(model, dampers, whole, one);
+    REQUIRE(r.outcome == dem::Outcome::kCompleted);
+    CHECK(!r.continued);
+    CosimulationOptions first = o, second = o;
+    first.analysed_periods = 2;
+    second.analysed_periods = 3;
+    CosimulationState state;
+    const CosimulationResult a = cosimulate(model, dampers, first, state);
+    REQUIRE(a.outcome == dem::Outcome::kCompleted);
+    REQUIRE(state.started());
+    CHECK(state.excitation_phase_rad == phase);
+    CHECK(state.steps == a.steps);
+    second.excitation_phase_rad = 1.0;  // ignored: the continuation starts at the state's phase
+    const CosimulationResult b = cosimulate(model, dampers, second, state);
+    REQUIRE(b.outcome == dem::Outcome::kCompleted);
+    CHECK(b.continued);
+    CHECK(b.settling_steps == 0);
+    CHECK(b.time_step_s == a.time_step_s);
+    CHECK(b.start_time_s == Approx(a.simulated_time_s).epsilon(1e-14));
+    CHECK(b.history.time_s.front() == Approx(a.simulated_time_s).epsilon(1e-14));
+    // Bit-identical end state: modes, every particle, the container.
+    CHECK(a.steps + b.steps == r.steps);
+    CHECK(state.modal_displacements[0] == one.modal_displacements[0]);
+    CHECK(state.modal_velocities[0] == one.modal_velocities[0]);
+    CHECK(state.worlds[0].state_hash() == one.worlds[0].state_hash());
+    CHECK(b.steady_state.site_amplitudes_m[0] == r.steady_state.site_amplitudes_m[0]);
+    // The ledger: each run's closes, and the sum of the two is the combined run's (round-off).
+    const auto& ea = a.energy;
+    const auto& eb = b.energy;
+    const auto& e = r.energy;
+    const double w = ea.excitation_work_j + eb.excitation_work_j;
+    const double dissipated = ea.structural_damping_j + eb.structural_damping_j + ea.dem_dissipated_j() +
+                              eb.dem_dissipated_j();
+    const double delta = ea.delta_structure_kinetic_j + eb.delta_structure_kinetic_j + ea.delta_structure_potential_j +
+                         eb.delta_structure_potential_j + ea.delta_bed_kinetic_j + eb.delta_bed_kinetic_j +
+                         ea.delta_bed_potential_j + eb.delta_bed_potential_j + ea.delta_bed_elastic_j +
+                         eb.delta_bed_elastic_j;
+    INFO("W " << w << " J, D " << dissipated << " J, ΔE " << delta << " J; combined error " << e.relative_error);
+    CHECK(e.dem_dissipated_j() > 0.1 * e.structural_damping_j);  // real impacts
+    CHECK(w == Approx(e.excitation_work_j).epsilon(1e-12));
+    CHECK(dissipated == Approx(e.structural_damping_j + e.dem_dissipated_j()).epsilon(1e-12));
+    CHECK(std::abs(w - dissipated - delta) / std::max(std::abs(w), dissipated) < 0.01);
+    CHECK(std::abs((w - dissipated - delta) - e.excitation_work_j + e.structural_damping_j + e.dem_dissipated_j() +
+                   e.delta_structure_kinetic_j + e.delta_structure_potential_j + e.delta_bed_kinetic_j +
+                   e.delta_bed_potential_j + e.delta_bed_elastic_j) < 1e-12 * std::abs(w));
+  }
+}
+
+// A stepped sine: the next frequency continues the state at the phase where the last ended;
+// with a carried step that does not divide the new period the frequency is the nearest whole
+// number of steps (a warning), and a state that does not fit is refused naming the field.
+TEST_CASE("a continuation at a new frequency keeps the step, the phase and the bed, and checks its inputs",
+          "[cosimulation]") {
+  const ModalModel model = one_dof(10.0, 0.02, 1.0, 1.0, 0.0, 0.8);
+  const std::vector<CosimulationDamper> dampers{tip_damper(lone_sphere(), 0.25)};
+  CosimulationOptions o;
+  o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
+  o.excitation.direction = {0.0, 1.0};
+  o.excitation.amplitude = 1e-4;
+  o.excitation.frequency_hz = 8.0;
+  o.excitation_phase_rad = kPi / 2;
+  o.analysed_periods = 2;
+  CosimulationState state;
+  const CosimulationResult a = cosimulate(model, dampers, o, state);
+  REQUIRE(a.outcome == dem::Outcome::kCompleted);
+  o.excitation.frequency_hz = 8.37;
+  const CosimulationResult b = cosimulate(model, dampers, o, state);
+  REQUIRE(b.outcome == dem::Outcome::kCompleted);
+  CHECK(b.time_step_s == a.time_step_s);
+  const double N = std::round(1.0 / (8.37 * a.time_step_s));
+  CHECK(b.steady_state.frequency_hz == Approx(1.0 / (N * a.time_step_s)).epsilon(1e-12));
+  CHECK(std::abs(b.steady_state.frequency_hz - 8.37) <= 8.37 / (2 * N) * (1 + 1e-9));
+  CHECK(state.excitation_phase_rad == Approx(kPi / 2).epsilon(1e-12));
+  // The junction at ψ = π/2: the base at U with velocity 0 on both sides, so b's first site
+  // position is a's last, y = b q + U (b = 1), and the container did not jump.
+  CHECK(b.history.site_displacement_m(0, 0) == Approx(a.final_modal_displacements[0] + 1e-4).epsilon(1e-12));
+  CHECK(a.final_container_states[0].position_m[0] == Approx(a.final_modal_displacements[0] + 1e-4).epsilon(1e-12));
+  // Misfits: another amplitude, initial values, a state for other dampers.
+  CosimulationOptions bad = o;
+  bad.excitation.amplitude = 2e-4;
+  bad.initial_modal_displacements = Eigen::VectorXd::Constant(1, 0.0);
+  try {
+    cosimulate(model, dampers, bad, state);
+    FAIL("no exception");
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains("cosimulation.excitation.amplitude = 0.0002: must be the state's"));
+    CHECK_THAT(what, Catch::Contains("must be empty when continuing"));
+  }
+  CHECK_THROWS_WITH(cosimulate(model, {dampers[0], dampers[0]}, o, state), Catch::Contains("holds 1 world(s) for 2"));
+}

@@ -98,6 +98,11 @@ struct CosimulationOptions {
   double time_step_s = 0.0;
   /// Progress callback interval, wall-clock s, > 0.
   double progress_interval_s = 0.5;
+  /// Harmonic kinds: phase φ of the drive at the coupling's start, rad, finite: the base
+  /// moves as U·sin(Ω(t − t₀) + φ), the force is F·sin(Ω(t − t₀) + φ). 0 (default) is the
+  /// historical sin Ωt. A continuation of a harmonic CosimulationState ignores it: its drive
+  /// starts at the state's excitation_phase_rad (the signal continues, docs/cosimulation.md §6).
+  double excitation_phase_rad = 0.0;
 
   /// All violations, one line each, "field = value: rule" (prefix "cosimulation.").
   std::vector<std::string> validate(const ModalModel& model) const;
@@ -116,9 +121,13 @@ struct CosimulationHistory {
 };
 
 /// First harmonics at Ω over whole periods (harmonic kinds), as complex amplitudes against
-/// the excitation's sin Ωt: y(t) ≈ Im(Ŷ e^{iΩt}), Ŷ = i·(2/N) Σ_k y_k e^{−iΩt_k} over the N
-/// steps of each period (y = Y sin Ωt gives Ŷ = Y; y = Y cos Ωt gives Ŷ = iY).
+/// the excitation's sin ψ, ψ = Ω(t − t₀) + φ (the drive's phase): y(t) ≈ Im(Ŷ e^{iψ}),
+/// Ŷ = i·(2/N) Σ_k y_k e^{−iψ_k} over the N steps of each period (y = Y sin ψ gives Ŷ = Y;
+/// y = Y cos ψ gives Ŷ = iY).
 struct CosimulationSteadyState {
+  /// The frequency run, Hz: the requested one, except in a continuation whose carried-over
+  /// step dt does not divide its period: then 1/(N·dt), N = round(1/(f·dt)) whole steps
+  /// (a relative change of at most 1/(2N); a warning above 1e-4).
   double frequency_hz = 0.0;
   int transient_periods = 0;  ///< periods run before the analysed ones
   int analysed_periods = 0;
@@ -160,7 +169,11 @@ struct CosimulationResult {
   std::int64_t steps = 0;              ///< coupled steps (bed settling not counted)
   std::int64_t steps_per_period = 0;   ///< harmonic kinds, else 0
   std::int64_t settling_steps = 0;
-  double simulated_time_s = 0.0;       ///< coupled time, s
+  double simulated_time_s = 0.0;       ///< coupled time of this run, s
+  /// Time of the run's first sample, s: 0 for a fresh start, the state's time_s for a
+  /// continuation (history times continue the previous run's).
+  double start_time_s = 0.0;
+  bool continued = false;              ///< the run continued a CosimulationState (no settling)
   double wall_time_s = 0.0;
   /// Natural frequencies with the empty containers (beds removed), Hz.
   Eigen::VectorXd frequencies_with_containers_hz;
@@ -182,6 +195,25 @@ struct CosimulationProgress {
 };
 using CosimulationProgressCallback = std::function<void(const CosimulationProgress&)>;
 
+/// The end of a co-simulation run, to be continued by the next (a stepped sine: each
+/// frequency starts from the previous one's final state, bed included). Filled by
+/// cosimulate(…, state, …); pass it back unchanged. It owns the worlds: the particles, their
+/// contacts (tangential springs, rolling history), the container pose and the time step.
+struct CosimulationState {
+  std::vector<dem_reference::World> worlds;  ///< one per damper, at the end of the last run
+  Eigen::VectorXd modal_displacements;       ///< q at the end (relative for base motion)
+  Eigen::VectorXd modal_velocities;          ///< q̇ at the end
+  double time_s = 0.0;                       ///< coupled time since the first run's start, s
+  std::int64_t steps = 0;                    ///< coupled steps since the first run's start
+  double time_step_s = 0.0;                  ///< the worlds' step, s (fixed for all continuations)
+  CosimulationExcitation excitation;         ///< the excitation of the last run
+  /// Harmonic: the drive's phase ψ at the end, rad, in [0, 2π). Runs end on whole periods,
+  /// so this is the last run's start phase; the next run starts its sine there.
+  double excitation_phase_rad = 0.0;
+  /// true once a run has filled the state (worlds built, beds settled).
+  bool started() const { return !worlds.empty(); }
+};
+
 /// Runs the co-simulation. The modal equations
 ///   M q̈ + C q̇ + K q = f_exc(t) − Σ_d (b_d F_d + r_d M_d),   M = diag(m_j) + Σ m_c Φ_dᵀΦ_d,
 /// (F_d, M_d: what container d applies to its bed along n and about the rotation axis; b_d,
@@ -193,6 +225,35 @@ using CosimulationProgressCallback = std::function<void(const CosimulationProgre
 CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                               const CosimulationOptions& options,
                               const CosimulationProgressCallback& progress = {});
+
+/// The same run, continuing `state` when it has started, and leaving the run's end in it.
+/// - Fresh (state.started() false): as above (worlds built, beds settled); then the state
+///   holds the worlds, q, q̇, t, dt, the excitation and the drive's end phase.
+/// - Continuation: no new worlds, no settling; q(0), q̇(0) are the state's (the options'
+///   initial_modal_* must be empty); dt is the state's (options.time_step_s must be 0 or
+///   equal); the excitation must have the state's kind, direction, amplitude and point
+///   (harmonic: the frequency may change; a free decay continues a free decay only); a
+///   harmonic drive starts at the state's end phase, so the base displacement and the force
+///   are continuous at the junction (with φ = π/2 the base velocity too, docs/cosimulation.md
+///   §6); history times continue from state.time_s. Two runs continued at one frequency are
+///   bit-identical to one run of the combined length (tests/structure/test_cosimulation.cpp).
+///   A new frequency whose automatic step is > 10% below the carried dt warns (plan the
+///   sweep's dt at its most demanding frequency: cosimulation_time_step()).
+/// Throws std::invalid_argument as above, and for a state that does not fit (one line each).
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, CosimulationState& state,
+                              const CosimulationProgressCallback& progress = {});
+
+/// The common step a fresh cosimulate() would take for these inputs, s, and its whole steps
+/// per period (harmonic, else 0), without building worlds (a stepped sine takes the smallest
+/// over its frequencies as options.time_step_s of its first run). Throws as cosimulate().
+struct CosimulationTimeStep {
+  double time_step_s = 0.0;
+  std::int64_t steps_per_period = 0;
+  std::vector<std::string> warnings;
+};
+CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                            const CosimulationOptions& options);
 
 /// Rodrigues rotation about a unit axis by angle θ (rad), row-major (body → world).
 dem_reference::Matrix3 rotation_about(const dem_reference::Vec3& unit_axis, double angle_rad);
