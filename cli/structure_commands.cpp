@@ -386,6 +386,33 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files);
 int run_frf_compare(const ParsedArgs& args, const Case& c);
 
+/// The frf task's excitation, checked against the modal model (exit 2 naming /task/excitation).
+st::Excitation task_excitation(const Case& c, const st::ModalModel& modal) {
+  const auto& task = *c.task.frf;
+  st::Excitation excitation;
+  excitation.direction = {task.direction[0], task.direction[1]};
+  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
+    excitation.kind = st::Excitation::Kind::kBaseTranslation;
+    excitation.amplitude = task.base_amplitude_m;
+  } else {
+    excitation.kind = st::Excitation::Kind::kPointForce;
+    excitation.amplitude = task.force_amplitude_n;
+    excitation.point = task.force_point;
+  }
+  if (const auto problems = excitation.validate(modal); !problems.empty())
+    throw InputError(c.path, "/task/excitation", problems.front());
+  return excitation;
+}
+
+/// The harmonic balance over the frf task's frequencies for the setup's loss models.
+st::FrequencyResponse task_harmonic_balance(const Case& c, const Setup& setup, const st::Excitation& excitation) {
+  const auto& task = *c.task.frf;
+  st::HarmonicBalanceOptions options;
+  options.frequencies_hz = spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
+                                  task.spacing == surrogate::AxisSpacing::kLog);
+  return call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+}
+
 int run_frf_case(const ParsedArgs& args, const Case& c) {
   require_task(c, TaskKind::kFrf, c.task.frf.has_value(),
                "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\"");
@@ -403,25 +430,9 @@ int run_frf_case(const ParsedArgs& args, const Case& c) {
   Setup setup = make_setup(c, method);
   const auto& task = *c.task.frf;
 
-  st::Excitation excitation;
-  excitation.direction = {task.direction[0], task.direction[1]};
-  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
-    excitation.kind = st::Excitation::Kind::kBaseTranslation;
-    excitation.amplitude = task.base_amplitude_m;
-  } else {
-    excitation.kind = st::Excitation::Kind::kPointForce;
-    excitation.amplitude = task.force_amplitude_n;
-    excitation.point = task.force_point;
-  }
-  if (const auto problems = excitation.validate(setup.s.modal); !problems.empty())
-    throw InputError(c.path, "/task/excitation", problems.front());
+  const st::Excitation excitation = task_excitation(c, setup.s.modal);
   const bool base = excitation.kind == st::Excitation::Kind::kBaseTranslation;
-
-  st::HarmonicBalanceOptions options;
-  options.frequencies_hz = spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
-                                  task.spacing == surrogate::AxisSpacing::kLog);
-  const auto response =
-      call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+  const auto response = task_harmonic_balance(c, setup, excitation);
 
   std::size_t with_state = 0, held = 0;
   for (const auto& p : response.points) {
@@ -482,8 +493,9 @@ int run_frf_case(const ParsedArgs& args, const Case& c) {
               {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude)"
                                  : "receptance |X/F| in m/N"},
               {"excitation", base ? "base" : "force"},
-              {"frequencies", {{"min_hz", options.frequencies_hz.front()}, {"max_hz", options.frequencies_hz.back()},
-                               {"points", options.frequencies_hz.size()},
+              {"frequencies", {{"min_hz", response.points.front().frequency_hz},
+                               {"max_hz", response.points.back().frequency_hz},
+                               {"points", response.points.size()},
                                {"spacing", task.spacing == surrogate::AxisSpacing::kLog ? "log" : "linear"}}},
               {"peaks", peaks},
               {"linear_peaks", peaks_json(response.linear_peaks, response.output_names)},
@@ -1046,24 +1058,7 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
 
 /// The harmonic-balance FRF of the task for one loss method (formulas or field), as pdamp frf.
 st::FrequencyResponse task_response(const Case& c, Setup& setup) {
-  const auto& task = *c.task.frf;
-  st::Excitation excitation;
-  excitation.direction = {task.direction[0], task.direction[1]};
-  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
-    excitation.kind = st::Excitation::Kind::kBaseTranslation;
-    excitation.amplitude = task.base_amplitude_m;
-  } else {
-    excitation.kind = st::Excitation::Kind::kPointForce;
-    excitation.amplitude = task.force_amplitude_n;
-    excitation.point = task.force_point;
-  }
-  if (const auto problems = excitation.validate(setup.s.modal); !problems.empty())
-    throw InputError(c.path, "/task/excitation", problems.front());
-  st::HarmonicBalanceOptions options;
-  options.frequencies_hz = spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
-                                  task.spacing == surrogate::AxisSpacing::kLog);
-  auto response =
-      call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+  auto response = task_harmonic_balance(c, setup, task_excitation(c, setup.s.modal));
   for (const auto& p : response.peaks)
     if (!std::isfinite(p.frequency_hz) || !std::isfinite(p.magnitude))
       throw NumericalError("pdamp frf --compare: a response peak is not finite (" + response.brief_report() + ")");
