@@ -24,6 +24,7 @@
 #include "pdamp/strict_json/input_file.hpp"
 #include "optimize_command.hpp"
 #include "plots.hpp"
+#include "report.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
@@ -364,6 +365,7 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
     files->add_json("case_resolved.json", c.resolved);
     result["warnings"] = warnings;
     files->add_json("design.json", result);
+    stage_run_report(*files, c, result, warnings);
     outputs = files->commit();
   }
   result["warnings"] = warnings;
@@ -386,6 +388,7 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
 
 int run_run(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
+  const RunReportScope report;  // with -o DIR, the task also stages DIR/report.html
   if (c.task.kind == case_file::TaskKind::kDamperDesign) {
     if (args.has("--method"))
       throw InputError("--method", "", "applies to the structure tasks (modes, frf, decay); this case's task is damper_design");
@@ -822,7 +825,7 @@ const std::vector<Command>& commands() {
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
         "as pdamp modes, frf and decay, --method only for these; filling_ratios: as pdamp optimize)",
-        {kMethodFlag, kDemPointsFlag, kOutFlag, kJsonFlag}, 1},
+        {kMethodFlag, kDemPointsFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, 1},
        run_run},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",

@@ -3,7 +3,10 @@
 // CSV and a decay plot of the chosen design against the single-layer baseline.
 #include "optimize_command.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <numbers>
@@ -17,7 +20,10 @@
 
 #include "errors.hpp"
 #include "output.hpp"
+#include "report.hpp"
+#include "structure_commands.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/optimizer/filling_ratios.hpp"
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/structure/beam.hpp"
@@ -25,6 +31,9 @@
 #include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::cli {
+
+const FlagSpec kNoVerifyFlag{"--no-verify", "",
+                             "skip the DEM verification the task's verify block asks for (the optimisation only)"};
 
 namespace {
 
@@ -49,6 +58,7 @@ json number_or_null(double value) { return std::isfinite(value) ? json(value) : 
 struct Problem {
   st::ModalModel modal;
   opt::FillingRatioOptions options;
+  Eigen::VectorXd initial_modal_displacements;  ///< q(0), signed (the DEM verification releases from it)
   std::vector<std::string> warnings;
 };
 
@@ -88,6 +98,7 @@ Problem make_problem(const Case& c) {
     p.options.layers.push_back(l);
   }
   const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup, task.decay);
+  p.initial_modal_displacements = q0;
   p.options.decay.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
   if (!(p.options.decay.initial_modal_amplitudes.maxCoeff() > 0.0))
     throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
@@ -195,6 +206,290 @@ opt::Backend backend_of(const ParsedArgs& args, const FillingRatiosTask& task) {
   return *opt::backend_from_string(task.backend);
 }
 
+
+// ---------------------------------------------------------------- DEM verification
+
+const FlagSpec kVerifyFlag{"--verify", "",
+                           "run the DEM verification (the task's verify settings, or their defaults when the\n"
+                           "                          task has none): DEM-in-the-loop free decay of the chosen and the\n"
+                           "                          baseline design against the closed forms (docs/optimizer.md)"};
+
+/// The case with the first damper's layers holding design `d`'s whole slabs (layers of
+/// 0 slabs left out) and the verification's further softening on every DEM material: what
+/// the DEM builds for that design. The lattice is the case's (auto or explicit transverse
+/// counts), n slabs along the drive, so h = L − n·2r as the optimiser has it.
+Case design_case(const Case& c, const opt::FillingDesign& d, double softening) {
+  const FillingRatiosTask& task = *c.task.filling_ratios;
+  Case out = c;
+  case_file::DamperSpec& damper = out.dampers.front();
+  std::vector<case_file::LayerSpec> kept;
+  for (std::size_t k = 0; k < damper.layers.size(); ++k) {
+    const long slabs = std::lround(d.layers.at(k).slabs);
+    if (slabs <= 0) continue;
+    case_file::LayerSpec layer = damper.layers[k];
+    layer.particle_count = static_cast<int>(slabs) * task.spheres_per_slab.at(k);
+    if (layer.packing.lattice_counts) {
+      (*layer.packing.lattice_counts)[static_cast<std::size_t>(damper.drive_axis)] = static_cast<int>(slabs);
+      layer.compartment.lattice_counts.assign(layer.packing.lattice_counts->begin(), layer.packing.lattice_counts->end());
+    }
+    try {
+      layer.bed = formulas::collected_lattice(layer.container, layer.particle_count, layer.particle_radius_m, layer.packing);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.path, "/dampers/0/layers/" + std::to_string(k) + "/particles",
+                       "the verified design's " + std::to_string(layer.particle_count) + " spheres: " + e.what());
+    }
+    layer.clearance_m = layer.bed.clearance_m;
+    layer.bed_mass_kg = d.layers[k].bed_mass_kg;
+    layer.compartment.particles.front().count = layer.particle_count;
+    kept.push_back(std::move(layer));
+  }
+  damper.layers = std::move(kept);
+  for (auto& m : out.dem.simulation.world.materials) m.material.youngs_modulus_pa *= softening;
+  return out;
+}
+
+/// ½∫e² dt of sampled values (trapezoid), m²·s.
+double half_integral_square(const std::vector<double>& t, const std::vector<double>& e) {
+  double sum = 0.0;
+  for (std::size_t i = 1; i < t.size() && i < e.size(); ++i)
+    sum += 0.25 * (t[i] - t[i - 1]) * (e[i] * e[i] + e[i - 1] * e[i - 1]);
+  return sum;
+}
+
+/// One design checked by the DEM: the prediction over the verification's duration and the
+/// DEM's decay over the same time.
+struct DesignCheck {
+  std::string name;               ///< "chosen" or "baseline"
+  const opt::FillingDesign* design = nullptr;
+  opt::FillingDesign predicted;   ///< the closed forms over verify.duration_s
+  double predicted_end_envelope_m = NAN;
+  std::vector<double> predicted_envelope_m;  ///< at the DEM's sample times
+  DemDecay dem;
+  double dem_objective = NAN;     ///< settling time (NaN: not settled) or ½∫e² dt
+  double dem_end_envelope_m = NAN;
+  std::string compared;           ///< "objective", "end_envelope" or "settled_only_one"
+  double relative_difference = NAN;
+  bool passed = false;
+  int particles = 0;
+};
+
+bool settling_objective(const Problem& p) { return p.options.objective == opt::FillingObjective::kSettlingTime; }
+
+double predicted_objective(const Problem& p, const DesignCheck& d) {
+  return settling_objective(p) ? d.predicted.settling_time_s : d.predicted.integral_square_m2_s;
+}
+
+/// a ahead of b (settles sooner, or the smaller objective): settled beats not settled; two
+/// unsettled decays rank by their envelopes at the end.
+bool ahead(double objective_a, double end_a, double objective_b, double end_b) {
+  if (std::isfinite(objective_a) && std::isfinite(objective_b)) return objective_a < objective_b;
+  if (std::isfinite(objective_a) != std::isfinite(objective_b)) return std::isfinite(objective_a);
+  return end_a < end_b;
+}
+
+DesignCheck check_design(const Case& c, const Problem& p, const case_file::VerifySpec& verify, const std::string& name,
+                         const opt::FillingDesign& design) {
+  DesignCheck out;
+  out.name = name;
+  out.design = &design;
+  for (const auto& l : design.layers) out.particles += static_cast<int>(std::lround(l.particles));
+  const std::vector<double> slabs = slabs_of(design);
+  opt::FillingRatioOptions options = p.options;
+  options.decay.duration_s = verify.duration_s;
+  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
+
+  const Case dc = design_case(c, design, verify.stiffness_softening);
+  std::vector<st::CosimulationDamper> dem_dampers;
+  for (std::size_t d = 0; d < dc.dampers.size(); ++d) dem_dampers.push_back(case_file::cosimulation_damper(dc, d));
+  std::vector<st::Damper> containers = {p.options.damper};
+  containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
+  case_file::DecayTask decay = c.task.filling_ratios->decay;
+  decay.duration_s = verify.duration_s;
+  out.dem = run_dem_decay(dc, p.modal, containers, dem_dampers, p.initial_modal_displacements, decay,
+                          "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s");
+  const auto& settle = out.dem.settling;
+  out.dem_end_envelope_m = settle.envelope_m.empty() ? NAN : settle.envelope_m.back();
+  out.dem_objective = settling_objective(p) ? settle.settling_time_s
+                                            : half_integral_square(out.dem.cosimulation.history.time_s, settle.sample_envelope_m);
+
+  // The prediction at the DEM's instants (its envelope for the plot and the end value).
+  st::FreeDecayOptions at_samples = options.decay;
+  at_samples.sample_times_s = out.dem.cosimulation.history.time_s;
+  at_samples.sample_times_s.front() = 0.0;
+  for (auto& t : at_samples.sample_times_s) t = std::clamp(t, 0.0, verify.duration_s);
+  at_samples.sample_times_s.back() = verify.duration_s;
+  std::vector<st::Damper> dampers = {opt::filling_damper(options, slabs)};
+  dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
+  const st::FreeDecay curve = st::free_decay(p.modal, dampers, at_samples);
+  for (const auto& s : curve.samples) out.predicted_envelope_m.push_back(s.threshold_measure_m);
+  out.predicted_end_envelope_m = out.predicted_envelope_m.empty() ? NAN : out.predicted_envelope_m.back();
+
+  const double predicted = predicted_objective(p, out);
+  if (std::isfinite(predicted) && std::isfinite(out.dem_objective)) {
+    out.compared = "objective";
+    out.relative_difference = (out.dem_objective - predicted) / predicted;
+  } else if (!std::isfinite(predicted) && !std::isfinite(out.dem_objective)) {
+    out.compared = "end_envelope";  // neither settled: how far each got
+    out.relative_difference = (out.dem_end_envelope_m - out.predicted_end_envelope_m) / out.predicted_end_envelope_m;
+  } else {
+    out.compared = "settled_only_one";
+  }
+  out.passed = std::isfinite(out.relative_difference) && std::abs(out.relative_difference) <= verify.tolerance_relative;
+  return out;
+}
+
+std::string seconds_or_not_settled(double t) {
+  return std::isfinite(t) ? format_number(t, 4) + " s" : std::string("not settled");
+}
+
+struct Verification {
+  std::vector<DesignCheck> designs;  ///< chosen, baseline
+  bool predicted_chosen_ahead = false;
+  bool dem_chosen_ahead = false;
+  bool ranking_passed = false;
+  bool passed = false;
+  double wall_time_s = 0.0;
+  json result;
+};
+
+json verification_json(const Problem& p, const case_file::VerifySpec& verify, double dem_softening, const Verification& v) {
+  json designs = json::object();
+  for (const auto& d : v.designs) {
+    const auto& r = d.dem.cosimulation;
+    designs[d.name] = {
+        {"slabs", slabs_of(*d.design)},
+        {"particles", d.particles},
+        {"bed_mass_kg", d.design->total_mass_kg},
+        {"predicted", {{"settled", d.predicted.settled},
+                       {"settling_time_s", number_or_null(d.predicted.settling_time_s)},
+                       {"objective", number_or_null(predicted_objective(p, d))},
+                       {"end_envelope_m", number_or_null(d.predicted_end_envelope_m)}}},
+        {"dem", {{"settled", std::isfinite(d.dem.settling.settling_time_s)},
+                 {"outcome", std::isfinite(d.dem.settling.settling_time_s) ? "settled" : "not_settled"},
+                 {"settling_time_s", number_or_null(d.dem.settling.settling_time_s)},
+                 {"objective", number_or_null(d.dem_objective)},
+                 {"end_envelope_m", number_or_null(d.dem_end_envelope_m)},
+                 {"damping_ratio", number_or_null(d.dem.settling.damping_ratio)},
+                 {"threshold_m", d.dem.threshold_m},
+                 {"initial_envelope_m", d.dem.initial_envelope_m},
+                 {"energy_error", r.energy.relative_error},
+                 {"dem_dissipated_energy_j", r.energy.dem_dissipated_j()},
+                 {"structural_dissipated_energy_j", r.energy.structural_damping_j},
+                 {"steps", r.steps},
+                 {"time_step_s", r.time_step_s},
+                 {"solve_time_s", r.wall_time_s}}},
+        {"compared", d.compared},
+        {"relative_difference", number_or_null(d.relative_difference)},
+        {"passed", d.passed}};
+  }
+  return {{"method", "dem"},
+          {"what", "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
+                   "optimiser's modal model, from the task's initial state, against the closed forms over the same time"},
+          {"objective", std::string(opt::to_string(p.options.objective))},
+          {"duration_s", verify.duration_s},
+          {"tolerance_relative", verify.tolerance_relative},
+          {"stiffness_softening", verify.stiffness_softening},
+          {"dem_stiffness_softening", dem_softening},
+          {"effective_stiffness_softening", dem_softening * verify.stiffness_softening},
+          {"require_ranking", verify.require_ranking},
+          {"designs", designs},
+          {"ranking", {{"predicted_chosen_ahead", v.predicted_chosen_ahead},
+                       {"dem_chosen_ahead", v.dem_chosen_ahead},
+                       {"passed", v.ranking_passed}}},
+          {"passed", v.passed},
+          {"wall_time_s", v.wall_time_s}};
+}
+
+Verification verify_designs(const Case& c, const Problem& p, const opt::FillingRatioResult& r,
+                            const case_file::VerifySpec& verify) {
+  const auto start = std::chrono::steady_clock::now();
+  Verification v;
+  // The two DEM runs are independent (one World each, single-threaded by default): run
+  // them at once, the baseline on a second thread; its exceptions come back through get().
+  auto baseline = std::async(std::launch::async, [&] { return check_design(c, p, verify, "baseline", r.baseline); });
+  DesignCheck chosen;
+  try {
+    chosen = check_design(c, p, verify, "chosen", r.chosen);
+  } catch (...) {
+    baseline.wait();  // the thread uses c, p and r: let it end before they go
+    throw;
+  }
+  v.designs.push_back(std::move(chosen));
+  v.designs.push_back(baseline.get());
+  const DesignCheck& a = v.designs[0];
+  const DesignCheck& b = v.designs[1];
+  v.predicted_chosen_ahead = ahead(predicted_objective(p, a), a.predicted_end_envelope_m, predicted_objective(p, b),
+                                   b.predicted_end_envelope_m);
+  v.dem_chosen_ahead = ahead(a.dem_objective, a.dem_end_envelope_m, b.dem_objective, b.dem_end_envelope_m);
+  v.ranking_passed = v.dem_chosen_ahead;
+  v.passed = a.passed && b.passed && (!verify.require_ranking || v.ranking_passed);
+  v.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  v.result = verification_json(p, verify, c.dem.stiffness_softening, v);
+  return v;
+}
+
+/// verify_decay.csv (one block per design: the DEM's site displacement and envelope and the
+/// predicted envelope at the same instants) and its plot.
+std::vector<std::string> write_verification_files(OutputDir& files, const Case& c, const Verification& v) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "# design, time_s, site_displacement_m (DEM), dem_envelope_m, predicted_envelope_m, threshold_m; "
+         "one block per design (chosen, then baseline), blocks separated by two blank lines\n";
+  csv << "design,time_s,site_displacement_m,dem_envelope_m,predicted_envelope_m,threshold_m\n";
+  for (std::size_t k = 0; k < v.designs.size(); ++k) {
+    const auto& d = v.designs[k];
+    const auto& h = d.dem.cosimulation.history;
+    if (k > 0) csv << "\n\n";
+    for (std::size_t i = 0; i < h.time_s.size(); ++i)
+      csv << d.name << ',' << h.time_s[i] << ',' << h.site_displacement_m(static_cast<Eigen::Index>(i), 0) - d.dem.static_offset_m
+          << ',' << d.dem.settling.sample_envelope_m[i] << ','
+          << (i < d.predicted_envelope_m.size() ? d.predicted_envelope_m[i] : NAN) << ',' << d.dem.threshold_m << '\n';
+  }
+  files.add("verify_decay.csv", csv.str());
+  std::ostringstream gp;
+  gp << "# DEM verification of pdamp optimize: envelopes, DEM against the closed forms; run: gnuplot verify_decay.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(c.name + ": DEM verification (DEM in the loop vs closed forms)") << " noenhanced\n"
+     << "set xlabel 'time t / s'\nset ylabel 'envelope at the damper site / mm'\nset grid\nset key top right\n"
+     << "set logscale y\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'verify_decay.svg' : 'verify_decay.png'\n"
+     << "  plot 'verify_decay.csv' index 0 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'blue' title 'chosen, DEM', \\\n"
+     << "       '' index 0 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'blue' title 'chosen, closed forms', \\\n"
+     << "       '' index 1 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer, DEM', \\\n"
+     << "       '' index 1 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'red' title 'best single layer, closed forms', \\\n"
+     << "       '' index 0 using 2:($6*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
+     << "}\n";
+  return files.add_plot("verify_decay.gp", gp.str(), {"verify_decay.png", "verify_decay.svg"});
+}
+
+std::vector<std::pair<std::string, std::string>> verification_rows(const Problem& p, const Verification& v,
+                                                                   const case_file::VerifySpec& verify) {
+  std::vector<std::pair<std::string, std::string>> rows;
+  const bool settling = settling_objective(p);
+  for (const auto& d : v.designs) {
+    const double pred = predicted_objective(p, d);
+    std::string line = settling ? "predicted " + seconds_or_not_settled(pred) + ", DEM " + seconds_or_not_settled(d.dem_objective)
+                                : "predicted " + format_number(pred, 4) + " m2 s, DEM " + format_number(d.dem_objective, 4) + " m2 s";
+    line += "; end envelope predicted " + format_number(d.predicted_end_envelope_m * 1e3, 4) + " mm, DEM " +
+            format_number(d.dem_end_envelope_m * 1e3, 4) + " mm; energy error " +
+            format_number(d.dem.cosimulation.energy.relative_error, 2) + "; " +
+            (d.compared == "settled_only_one" ? std::string("only one settled")
+                                              : "difference " + format_number(100.0 * d.relative_difference, 3) + " %") +
+            ": " + (d.passed ? "pass" : "FAIL");
+    rows.push_back({"verify " + d.name, line});
+  }
+  rows.push_back({"verify ranking", std::string("chosen ahead of baseline: predicted ") +
+                                        (v.predicted_chosen_ahead ? "yes" : "no") + ", DEM " +
+                                        (v.dem_chosen_ahead ? "yes" : "no") + (v.ranking_passed ? ": pass" : ": FAIL")});
+  rows.push_back({"verification", std::string(v.passed ? "PASS" : "FAIL") + " (tolerance " +
+                                      format_number(100.0 * verify.tolerance_relative, 3) + " %, " +
+                                      format_number(verify.duration_s, 4) + " s simulated each, " +
+                                      format_number(v.wall_time_s, 4) + " s wall)"});
+  return rows;
+}
+
 }  // namespace
 
 int run_optimize_task(const ParsedArgs& args, const Case& c) {
@@ -225,6 +520,26 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
   warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());
   for (const auto* d : {&r.chosen, &r.relaxed, &r.baseline})
     if (!std::isfinite(d->objective)) throw NumericalError("pdamp optimize: a design's objective is not finite");
+
+  // The DEM verification: the task's verify block, or --verify with its defaults.
+  if (args.has("--verify") && args.has("--no-verify"))
+    throw InputError("--verify", "", "and --no-verify exclude each other");
+  std::optional<case_file::VerifySpec> verify = task.verify;
+  if (!verify && args.has("--verify")) {
+    verify = case_file::VerifySpec{};
+    verify->duration_s = task.decay.duration_s;
+  }
+  if (args.has("--no-verify")) verify.reset();
+  std::optional<Verification> verification;
+  if (verify) {
+    verification = verify_designs(c, p, r, *verify);
+    for (const auto& d : verification->designs)
+      for (const auto& w : d.dem.warnings) warnings.push_back("verify (" + d.name + "): " + w);
+    if (!verification->passed)
+      warnings.push_back("the DEM verification failed (tolerance " + format_number(verify->tolerance_relative, 3) +
+                         (verification->ranking_passed ? "" : "; the DEM does not rank the chosen design ahead of the baseline") +
+                         "): see verification in the result");
+  }
 
   json neighbours = json::array();
   for (const auto& d : r.neighbours) {
@@ -266,10 +581,13 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
                   {"report", s.brief_report()}}},
       {"decay_evaluations", r.decay_evaluations},
       {"solve_time_s", r.solve_time_s}};
+  result["verification"] = verification ? verification->result : json(nullptr);
   json outputs = json::array();
   if (files) {
     try {
       for (auto& w : write_files(*files, c, p, r)) warnings.push_back(w);
+      if (verification)
+        for (auto& w : write_verification_files(*files, c, *verification)) warnings.push_back(w);
     } catch (const std::invalid_argument& e) {
       throw NumericalError(std::string("pdamp optimize: the comparison decays failed: ") + e.what());
     }
@@ -277,6 +595,7 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
     result["warnings"] = warnings;
     files->add_json("case_resolved.json", c.resolved);
     files->add_json("optimize.json", result);
+    stage_run_report(*files, c, result, warnings);
     outputs = files->commit();
   } else {
     result["file"] = nullptr;
@@ -304,19 +623,23 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
     rows.push_back({"chosen " + l.name, std::to_string(std::lround(l.slabs)) + " slabs, phi = " +
                                             format_number(l.filling_ratio, 4) + ", h = " + format_number(l.clearance_m * 1e3, 4) +
                                             " mm, m = " + format_number(l.bed_mass_kg * 1e3, 4) + " g"});
+  if (verification)
+    for (auto& row : verification_rows(p, *verification, *verify)) rows.push_back(std::move(row));
   for (const auto& path : outputs) rows.push_back({"wrote", path.get<std::string>()});
   std::cout << key_value_table(rows);
   return kExitOk;
 }
 
 Command optimize_command() {
-  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [-o DIR] [--json]",
+  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--verify|--no-verify] [-o DIR] [--json]",
            "optimise the case's task (kind filling_ratios: whole slabs per layer of the first damper\n"
            "for the fastest free decay under a particle-mass budget; relaxed solve, rounded\n"
-           "neighbours, single-layer baseline; docs/optimizer.md)",
-           {kBackendFlag,
-            {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg\n"
-                          "                          and case_resolved.json into DIR, atomically"},
+           "neighbours, single-layer baseline; docs/optimizer.md); with the task's verify block\n"
+           "or --verify, the DEM-in-the-loop check of the chosen and baseline designs",
+           {kBackendFlag, kVerifyFlag, kNoVerifyFlag,
+            {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg,\n"
+                          "                          case_resolved.json and with the verification verify_decay.csv,\n"
+                          "                          verify_decay.gp/png/svg into DIR, atomically"},
             {"--json", "", "print exactly one JSON object on stdout"}},
            1},
           [](const ParsedArgs& args) { return run_optimize_task(args, case_file::load_case(args.positional().at(0))); }};

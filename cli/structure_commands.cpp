@@ -30,6 +30,7 @@
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
+#include "report.hpp"
 #include "structure_plots.hpp"
 
 namespace pdamp::cli {
@@ -185,6 +186,7 @@ int finish(const ParsedArgs& args, const Case& c, OutputDir* files, const std::s
     result["warnings"] = warnings.list();
     files->add_json("case_resolved.json", c.resolved);
     files->add_json(json_name, result);
+    stage_run_report(*files, c, result, warnings.list());
     outputs = files->commit();
   }
   result["warnings"] = warnings.list();
@@ -569,7 +571,7 @@ void print_cosim_progress(const std::string& label, const st::CosimulationProgre
   char line[240];
   std::snprintf(line, sizeof line, "%s: %-9s t = %8.3f / %.3f s  %6.2f k steps/s", label.c_str(),
                 std::string(p.stage).c_str(), p.simulated_time_s, p.end_time_s, p.steps_per_s * 1e-3);
-  std::cerr << line << std::endl;
+  std::cerr << (std::string(line) + "\n") << std::flush;  // one write: runs on two threads do not split lines
 }
 
 /// The dampers of the case as co-simulation dampers (their beds as DEM worlds).
@@ -640,18 +642,7 @@ double static_site_offset(const Case& c, const st::ModalModel& modal, const Eige
   return y;
 }
 
-/// The settling of a simulated site displacement: the envelope is the largest |y − y_s|
-/// over each whole period of the dominant mode (placed at its time); settled where the
-/// envelope, interpolated in ln between the last period at or above the threshold and the
-/// next, crosses it, if no later period rises above it again.
-struct SimulatedSettling {
-  std::vector<double> envelope_time_s, envelope_m;  ///< one per whole period
-  std::vector<double> sample_envelope_m;            ///< the envelope at every sample (linear in ln between periods)
-  double settling_time_s = NAN;
-  double frequency_hz = NAN;  ///< from the zero crossings of y − y_s up to settling (or the whole record)
-  double damping_ratio = NAN;
-};
-
+/// The settling of a simulated site displacement (SimulatedSettling, structure_commands.hpp).
 SimulatedSettling simulated_settling(const std::vector<double>& t, const Eigen::VectorXd& y, double offset,
                                      double period_s, double initial_m, double threshold_m, double fallback_frequency_hz) {
   SimulatedSettling out;
@@ -710,15 +701,12 @@ SimulatedSettling simulated_settling(const std::vector<double>& t, const Eigen::
   return out;
 }
 
-int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
-  const auto& task = *c.task.decay;
-  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
-  const st::ModalModel& modal = setup.s.modal;
-  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
-  if (!(q0.cwiseAbs().maxCoeff() > 0.0))
-    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
-  const auto dampers = dem_dampers(c);
-  std::vector<st::Damper> containers = setup.s.dampers;
+}  // namespace
+
+DemDecay run_dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
+                       const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
+                       const case_file::DecayTask& task, const std::string& label,
+                       const std::string& duration_pointer) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -740,24 +728,52 @@ int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   const double samples = std::clamp(std::ceil(kDecaySamplesPerPeriod * modal.natural_frequencies_hz[0] * task.duration_s),
                                     kDecayMinSamples, kDecayMaxSamples);
   options.sample_interval_s = task.duration_s / samples;
-  const auto r = run_cosimulation(c, modal, dampers, options, "pdamp decay (dem)");
-  setup.warnings.add(r.warnings);
+  DemDecay out;
+  out.cosimulation = run_cosimulation(c, modal, dampers, options, label);
+  const auto& r = out.cosimulation;
+  out.warnings = r.warnings;
 
   const auto& h = r.history;
-  if (h.time_s.size() < 2) throw NumericalError("pdamp decay (dem): the co-simulation returned no history");
+  if (h.time_s.size() < 2) throw NumericalError(label + ": the co-simulation returned no history");
   const Eigen::VectorXd y = h.site_displacement_m.col(0);
-  if (!y.allFinite()) throw NumericalError("pdamp decay (dem): the site displacement is not finite");
-  const double offset = static_site_offset(c, modal, empty.drive_shapes);
-  const double f_dom = r.frequencies_with_containers_hz[dominant];
-  const auto settle = simulated_settling(h.time_s, y, offset, 1.0 / f_dom, measure0, threshold, f_dom);
-  const bool settled = std::isfinite(settle.settling_time_s);
-  if (!settled)
-    setup.warnings.add("the decay did not settle within duration_s = " + format_number(task.duration_s) +
-                       " s (envelope " + format_number(settle.envelope_m.empty() ? NAN : settle.envelope_m.back(), 4) +
-                       " m, threshold " + format_number(threshold, 4) + " m): lengthen /task/duration_s");
+  if (!y.allFinite()) throw NumericalError(label + ": the site displacement is not finite");
+  out.static_offset_m = static_site_offset(c, modal, empty.drive_shapes);
+  out.dominant_mode = dominant;
+  out.dominant_frequency_hz = r.frequencies_with_containers_hz[dominant];
+  out.initial_envelope_m = measure0;
+  out.threshold_m = threshold;
+  out.settling = simulated_settling(h.time_s, y, out.static_offset_m, 1.0 / out.dominant_frequency_hz, measure0,
+                                    threshold, out.dominant_frequency_hz);
+  if (!std::isfinite(out.settling.settling_time_s))
+    out.warnings.push_back("the decay did not settle within duration_s = " + format_number(task.duration_s) +
+                           " s (envelope " +
+                           format_number(out.settling.envelope_m.empty() ? NAN : out.settling.envelope_m.back(), 4) +
+                           " m, threshold " + format_number(threshold, 4) + " m): lengthen " + duration_pointer);
   if (r.energy.relative_error > 0.01)
-    setup.warnings.add("the co-simulation's energy ledger closes to " + format_number(r.energy.relative_error, 3) +
-                       " only (docs/cosimulation.md §4): a smaller /dem/time_step_s");
+    out.warnings.push_back("the co-simulation's energy ledger closes to " + format_number(r.energy.relative_error, 3) +
+                           " only (docs/cosimulation.md §4): a smaller /dem/time_step_s");
+  return out;
+}
+
+namespace {
+
+int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  const auto& task = *c.task.decay;
+  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const st::ModalModel& modal = setup.s.modal;
+  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
+  if (!(q0.cwiseAbs().maxCoeff() > 0.0))
+    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+  const auto dampers = dem_dampers(c);
+  const DemDecay decay = run_dem_decay(c, modal, setup.s.dampers, dampers, q0, task, "pdamp decay (dem)", "/task/duration_s");
+  setup.warnings.add(decay.warnings);
+  const auto& r = decay.cosimulation;
+  const auto& h = r.history;
+  const auto& settle = decay.settling;
+  const double offset = decay.static_offset_m, threshold = decay.threshold_m, measure0 = decay.initial_envelope_m;
+  const double f_dom = decay.dominant_frequency_hz;
+  const Eigen::Index dominant = decay.dominant_mode;
+  const bool settled = std::isfinite(settle.settling_time_s);
 
   if (files) {
     std::ostringstream csv;

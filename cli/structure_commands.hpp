@@ -2,11 +2,18 @@
 // a format-2 case through case_file::structure_setup and the structure solvers.
 #pragma once
 
+#include <cmath>
+#include <string>
 #include <vector>
+
+#include <Eigen/Dense>
 
 #include "args.hpp"
 #include "commands.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/structure/cosimulation.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+#include "pdamp/structure/modal_model.hpp"
 
 namespace pdamp::cli {
 
@@ -22,5 +29,41 @@ std::vector<Command> structure_commands();
 /// Runs the case's task of kind modes, frf or decay exactly as the command of that name
 /// (pdamp run). Other kinds are not structure tasks: std::logic_error.
 int run_structure_task(const ParsedArgs& args, const case_file::Case& c);
+
+/// The settling of a simulated site displacement: the envelope is the largest |y − y_s|
+/// over each whole period of the dominant mode (placed at its time); settled where the
+/// envelope, interpolated in ln between the last period at or above the threshold and the
+/// next, crosses it, if no later period rises above it again.
+struct SimulatedSettling {
+  std::vector<double> envelope_time_s, envelope_m;  ///< one per whole period
+  std::vector<double> sample_envelope_m;            ///< the envelope at every sample (linear in ln between periods)
+  double settling_time_s = NAN;                     ///< s; NaN: not settled within the record
+  double frequency_hz = NAN;  ///< from the zero crossings of y − y_s up to settling (or the whole record)
+  double damping_ratio = NAN;
+};
+
+/// A DEM-in-the-loop free decay of the first damper's site (pdamp decay --method dem,
+/// pdamp optimize --verify).
+struct DemDecay {
+  structure::CosimulationResult cosimulation;
+  SimulatedSettling settling;
+  double static_offset_m = 0.0;        ///< y_s: the beds' weight along the drives, m
+  double initial_envelope_m = 0.0;     ///< Σ_j |b_j| |q0_j| at the first damper's site, m
+  double threshold_m = 0.0;            ///< settling_threshold · initial_envelope_m, m
+  double dominant_frequency_hz = 0.0;  ///< of the dominant mode with the empty containers
+  Eigen::Index dominant_mode = 0;      ///< 0-based
+  std::vector<std::string> warnings;   ///< the co-simulation's, not settled, energy ledger above 1%
+};
+
+/// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds,
+/// structure::cosimulate) from rest at q0 over task.duration_s, and measures its settling
+/// against task.settling_threshold. `containers`: the same dampers as the structure sees
+/// them (their layers are ignored; drive shapes and the static offset of the case's beds).
+/// Progress lines on stderr start with `label`; `duration_pointer` is named in the
+/// not-settled warning. Exit 2 (InputError) for refused options, 3 for a World that stops.
+DemDecay run_dem_decay(const case_file::Case& c, const structure::ModalModel& modal,
+                       std::vector<structure::Damper> containers,
+                       const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
+                       const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer);
 
 }  // namespace pdamp::cli

@@ -28,7 +28,9 @@ void read_materials(ObjectReader& r, const json& root, Case& c) {
       (void)value;
       if (name.empty()) m.fail("", "a material needs a name (the key \"\" is empty)");
       const fm::Material defaults = c.materials.count(name) ? c.materials.at(name) : fm::Material{};
-      m.object(name, true, [&](ObjectReader& one) { c.materials[name] = read_material(one, defaults); });
+      // A copy of the key: clang 14 cannot capture a structured binding in a lambda (C++20 P1091).
+      const std::string key = name;
+      m.object(key, true, [&](ObjectReader& one) { c.materials[key] = read_material(one, defaults); });
     }
   });
   for (const auto& [name, material] : c.materials) {

@@ -94,6 +94,16 @@ int spheres_per_slab(const LayerSpec& layer, int drive_axis) {
   return lo;
 }
 
+/// `verify` of task kind filling_ratios (the DEM check of the chosen and baseline designs).
+VerifySpec read_verify(ObjectReader& r, const DecayTask& decay) {
+  VerifySpec v;
+  v.tolerance_relative = r.number("tolerance_relative", VerifySpec{}.tolerance_relative, {0.0, 10.0, true});
+  v.duration_s = r.number("duration_s", decay.duration_s, limits::kDuration, " s");
+  v.stiffness_softening = r.number("stiffness_softening", VerifySpec{}.stiffness_softening, {1e-6, 1.0});
+  v.require_ranking = r.boolean("require_ranking", VerifySpec{}.require_ranking);
+  return v;
+}
+
 FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
   FillingRatiosTask t;
   t.objective = r.text("objective", std::string("settling_time"), {"settling_time", "integral_square"}) ==
@@ -128,6 +138,7 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
     r.fail("mass_budget_kg", "= " + number_text(t.mass_budget_kg) + ": must be >= the lightest whole slab of a layer, " +
                                  number_text(lightest_slab_kg) + " kg");
   t.decay = read_decay(r, c);
+  r.object("verify", false, [&](ObjectReader& v) { t.verify = read_verify(v, t.decay); });
   return t;
 }
 

@@ -138,3 +138,65 @@ TEST_CASE("an invalid modal data file is named with its own pointer", "[case_fil
   std::filesystem::remove(modal);
   require_case_error(path, modal, "", "no such file");
 }
+
+// `task.verify` of kind filling_ratios (issue 12 §3): the DEM check of the optimised design.
+namespace {
+
+/// The shipped optimisation case with one edit of its task, written into `dir`.
+std::string edited_optimize_case(const pdamp::test::TempDir& dir, const std::function<void(json&)>& edit) {
+  std::ifstream in(std::string(PDAMP_SOURCE_DIR) + "/cases/manipulator_link_optimize.json");
+  json c = json::parse(in);
+  edit(c["task"]);
+  const std::string path = (dir.path / "optimize_case.json").string();
+  std::ofstream(path) << c.dump(2);
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("a filling_ratios task reads its verify block, with defaults for the keys left out", "[case_file]") {
+  const pdamp::test::TempDir dir("verify_block");
+  // Empty block: the documented defaults; the duration is the task's own (40 s in the case).
+  const Case defaults = load_case(edited_optimize_case(dir, [](json& t) { t["verify"] = json::object(); }));
+  REQUIRE(defaults.task.filling_ratios.has_value());
+  REQUIRE(defaults.task.filling_ratios->verify.has_value());
+  const auto& v = *defaults.task.filling_ratios->verify;
+  CHECK(v.tolerance_relative == 0.3);
+  CHECK(v.duration_s == defaults.task.filling_ratios->decay.duration_s);
+  CHECK(v.duration_s == 40.0);
+  CHECK(v.stiffness_softening == 1.0);
+  CHECK(v.require_ranking);
+  CHECK(defaults.resolved["task"]["verify"]["tolerance_relative"] == 0.3);
+  CHECK(defaults.resolved["task"]["verify"]["duration_s"] == 40.0);
+  CHECK(defaults.resolved["task"]["verify"]["require_ranking"] == true);
+
+  const Case given = load_case(edited_optimize_case(dir, [](json& t) {
+    t["verify"] = {{"tolerance_relative", 0.5}, {"duration_s", 12.5}, {"stiffness_softening", 0.01},
+                   {"require_ranking", false}};
+  }));
+  const auto& g = *given.task.filling_ratios->verify;
+  CHECK(g.tolerance_relative == 0.5);
+  CHECK(g.duration_s == 12.5);
+  CHECK(g.stiffness_softening == 0.01);
+  CHECK_FALSE(g.require_ranking);
+
+  // Absent: no verification asked.
+  const Case none = load_case(edited_optimize_case(dir, [](json& t) { t.erase("verify"); }));
+  CHECK_FALSE(none.task.filling_ratios->verify.has_value());
+}
+
+TEST_CASE("a bad verify block is refused naming its key and the allowed range", "[case_file]") {
+  const pdamp::test::TempDir dir("verify_errors");
+  const auto refused = [&](const json& verify, const std::string& pointer, const std::string& rule) {
+    const std::string path = edited_optimize_case(dir, [&](json& t) { t["verify"] = verify; });
+    require_case_error(path, path, pointer, rule);
+  };
+  refused({{"tolerance_relative", 0.0}}, "/task/verify/tolerance_relative", "> 0 and <= 10");
+  refused({{"tolerance_relative", 11.0}}, "/task/verify/tolerance_relative", "<= 10");
+  refused({{"duration_s", -1.0}}, "/task/verify/duration_s", "> 0");
+  refused({{"stiffness_softening", 0.0}}, "/task/verify/stiffness_softening", ">= 1e-06 and <= 1");
+  refused({{"stiffness_softening", 2.0}}, "/task/verify/stiffness_softening", "<= 1");
+  refused({{"require_ranking", "yes"}}, "/task/verify/require_ranking", "must be true or false");
+  refused({{"tolerance", 0.3}}, "/task/verify/tolerance", "tolerance_relative");  // unknown key: the allowed ones named
+  refused(json::array(), "/task/verify", "must be a JSON object");
+}

@@ -152,6 +152,26 @@ struct ModesTask {
   int backbone_points = 50;                 ///< [2, 10000]
 };
 
+/// `verify` of task kind filling_ratios (issue 12 §3): the DEM-in-the-loop free decay
+/// (structure::cosimulate) of the chosen and of the baseline design, reported against the
+/// closed forms' prediction with pass or fail (docs/optimizer.md, "DEM verification").
+struct VerifySpec {
+  /// A design passes when its DEM objective (settling time, or ½∫e² dt) lies within this
+  /// fraction of the predicted one, |DEM − predicted| <= tolerance·predicted; both not
+  /// settled: the envelopes at the end, the same way. Dimensionless, (0, 10].
+  double tolerance_relative = 0.3;
+  /// Simulated time of each DEM decay, s, (0, 1e5]; default the task's duration_s. The
+  /// prediction is evaluated over the same time.
+  double duration_s = 0.0;
+  /// Further factor on every Young's modulus of the verification's DEM runs only, on top of
+  /// /dem/stiffness_softening (the runs use E·dem·verify), (0, 1]: a softer contact takes a
+  /// larger time step. 1 = the /dem settings unchanged.
+  double stiffness_softening = 1.0;
+  /// true: the verification fails unless the DEM ranks the designs as the prediction does
+  /// (the chosen design ahead of the baseline).
+  bool require_ranking = true;
+};
+
 /// `task` kind filling_ratios (issue 12 §1.3): the whole slabs each layer of the first
 /// damper holds, for the fastest free decay under a particle-mass budget (docs/optimizer.md).
 /// The layers' containers and lattices give the candidates; their counts, the start.
@@ -164,6 +184,9 @@ struct FillingRatiosTask {
   int max_evaluations = 1000;     ///< free decays of the relaxed solve, both stages, [2, 1000000]
   /// The free decay: initial state, duration and settling threshold, as task kind decay.
   DecayTask decay;
+  /// `verify`: present when the task asks for the DEM verification (pdamp run and pdamp
+  /// optimize run it; `pdamp optimize --verify` runs it with these defaults when absent).
+  std::optional<VerifySpec> verify;
   // Derived on load, one per layer of the first damper:
   std::vector<int> spheres_per_slab;  ///< spheres in one full slab of the layer's lattice
 };

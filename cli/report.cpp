@@ -1,0 +1,336 @@
+// DIR/report.html of pdamp run: a page built from the result JSON and the staged pictures.
+// The CLI only formats here: numbers come from the result, pictures from gnuplot.
+#include "report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace pdamp::cli {
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+bool g_report_requested = false;
+
+/// Rows of the generic key-number table at most (a result is a few dozen numbers; the
+/// long series belong in the CSV files).
+constexpr std::size_t kMaxGenericRows = 120;
+/// Rows of one JSON array shown as a table at most.
+constexpr std::size_t kMaxArrayRows = 40;
+
+/// Keys that are paths, prose or bulky series, not key numbers.
+bool skipped_key(const std::string& key) {
+  static const char* const kSkipped[] = {"file", "plot", "outputs", "warnings", "report", "message", "envelope",
+                                         "envelope_points", "energy", "what", "rule", "designs", "verification",
+                                         "solver", "rounding"};
+  return std::any_of(std::begin(kSkipped), std::end(kSkipped), [&](const char* s) { return key == s; });
+}
+
+std::string scalar_text(const json& v) {
+  if (v.is_null()) return "–";
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_number_integer() || v.is_number_unsigned()) return std::to_string(v.get<long long>());
+  if (v.is_number()) return format_number(v.get<double>(), 6);
+  if (v.is_string()) return v.get<std::string>();
+  return v.dump();
+}
+
+bool is_scalar(const json& v) { return !v.is_object() && !v.is_array(); }
+
+/// A short array of numbers ([x, y], per-layer slabs) reads as one value.
+bool is_short_number_list(const json& v) {
+  return v.is_array() && v.size() <= 8 && std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); });
+}
+
+std::string list_text(const json& v) {
+  std::string out;
+  for (const auto& x : v) out += (out.empty() ? "" : ", ") + scalar_text(x);
+  return out;
+}
+
+/// The key numbers: top-level scalars and those one object down ("decay / settling_time_s").
+void flatten(const json& object, const std::string& prefix, int depth, std::vector<std::pair<std::string, std::string>>& rows) {
+  for (const auto& [key, value] : object.items()) {
+    if (rows.size() >= kMaxGenericRows || skipped_key(key)) continue;
+    const std::string name = prefix.empty() ? key : prefix + " / " + key;
+    if (is_scalar(value)) rows.push_back({name, scalar_text(value)});
+    else if (is_short_number_list(value)) rows.push_back({name, list_text(value)});
+    else if (value.is_object() && depth < 1) flatten(value, name, depth + 1, rows);
+  }
+}
+
+std::string table(const std::vector<std::string>& head, const std::vector<std::vector<std::string>>& rows) {
+  std::ostringstream out;
+  out << "<table>\n<tr>";
+  for (const auto& h : head) out << "<th>" << html_escape(h) << "</th>";
+  out << "</tr>\n";
+  for (const auto& row : rows) {
+    out << "<tr>";
+    for (const auto& cell : row) out << "<td>" << html_escape(cell) << "</td>";
+    out << "</tr>\n";
+  }
+  out << "</table>\n";
+  return out.str();
+}
+
+/// Arrays of flat objects (peaks, modes) as tables: one column per scalar key.
+std::string array_tables(const json& result) {
+  std::ostringstream out;
+  std::vector<std::pair<std::string, const json*>> arrays;
+  for (const auto& [key, value] : result.items()) {
+    if (skipped_key(key)) continue;
+    if (value.is_array()) arrays.push_back({key, &value});
+    if (value.is_object())
+      for (const auto& [inner, v] : value.items())
+        if (v.is_array() && !skipped_key(inner)) arrays.push_back({key + " / " + inner, &v});
+  }
+  for (const auto& [name, array] : arrays) {
+    if (array->empty() || !std::all_of(array->begin(), array->end(), [](const json& e) { return e.is_object(); })) continue;
+    std::vector<std::string> columns;
+    for (const auto& e : *array)
+      for (const auto& [k, v] : e.items())
+        if (is_scalar(v) && std::find(columns.begin(), columns.end(), k) == columns.end()) columns.push_back(k);
+    if (columns.empty()) continue;
+    std::vector<std::vector<std::string>> rows;
+    for (std::size_t i = 0; i < array->size() && i < kMaxArrayRows; ++i) {
+      std::vector<std::string> row;
+      for (const auto& col : columns) row.push_back((*array)[i].contains(col) ? scalar_text((*array)[i][col]) : "");
+      rows.push_back(row);
+    }
+    out << "<h3>" << html_escape(name) << "</h3>\n" << table(columns, rows);
+    if (array->size() > kMaxArrayRows)
+      out << "<p class=\"note\">" << array->size() - kMaxArrayRows << " more rows in the result JSON.</p>\n";
+  }
+  return out.str();
+}
+
+std::string mm(const json& v) { return v.is_number() ? format_number(v.get<double>() * 1e3, 4) : "–"; }
+std::string seconds(const json& v) { return v.is_number() ? format_number(v.get<double>(), 5) : "not settled"; }
+
+/// filling_ratios: the designs side by side.
+std::string designs_section(const json& result) {
+  if (!result.contains("designs") || !result["designs"].is_object()) return "";
+  std::vector<std::vector<std::string>> rows;
+  for (const char* name : {"chosen", "relaxed", "baseline", "initial"}) {
+    if (!result["designs"].contains(name)) continue;
+    const json& d = result["designs"][name];
+    std::string slabs, clearances;
+    for (const auto& l : d["layers"]) {
+      slabs += (slabs.empty() ? "" : ", ") + scalar_text(l["slabs"]);
+      clearances += (clearances.empty() ? "" : ", ") + mm(l["clearance_m"]);
+    }
+    rows.push_back({name, slabs, clearances, mm(d["total_mass_kg"]) + " g", seconds(d["settling_time_s"]),
+                    scalar_text(d["objective"])});
+  }
+  std::string layers;
+  for (const auto& l : result["designs"]["chosen"]["layers"]) layers += (layers.empty() ? "" : ", ") + scalar_text(l["name"]);
+  return "<h2>Designs</h2>\n<p>Layers: " + html_escape(layers) + " (whole slabs n, clearance h = L − n·2r).</p>\n" +
+         table({"design", "slabs n", "clearance h / mm", "particle mass", "settling time / s", "objective"}, rows);
+}
+
+std::string solver_section(const json& result) {
+  if (!result.contains("solver") || !result["solver"].is_object()) return "";
+  std::vector<std::pair<std::string, std::string>> rows;
+  flatten(result["solver"], "", 1, rows);
+  if (result["solver"].contains("report")) rows.push_back({"report", scalar_text(result["solver"]["report"])});
+  if (result.contains("rounding") && result["rounding"].contains("rule"))
+    rows.push_back({"rounding", scalar_text(result["rounding"]["rule"])});
+  std::vector<std::vector<std::string>> cells;
+  for (const auto& [k, v] : rows) cells.push_back({k, v});
+  return "<h2>Optimiser</h2>\n" + table({"", ""}, cells);
+}
+
+std::string verification_section(const json& result) {
+  if (!result.contains("verification") || !result["verification"].is_object()) return "";
+  const json& v = result["verification"];
+  const bool settling = v.value("objective", std::string()) == "settling_time";
+  std::vector<std::vector<std::string>> rows;
+  for (const char* name : {"chosen", "baseline"}) {
+    if (!v["designs"].contains(name)) continue;
+    const json& d = v["designs"][name];
+    const auto objective = [&](const json& side) {
+      return settling ? seconds(side["settling_time_s"]) : scalar_text(side["objective"]);
+    };
+    rows.push_back({name, objective(d["predicted"]), objective(d["dem"]), mm(d["predicted"]["end_envelope_m"]),
+                    mm(d["dem"]["end_envelope_m"]), scalar_text(d["dem"]["energy_error"]),
+                    d["relative_difference"].is_number() ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
+                                                         : "only one settled",
+                    d["passed"].get<bool>() ? "pass" : "FAIL"});
+  }
+  const std::string unit = settling ? "settling time / s" : "½∫e² dt / m² s";
+  std::ostringstream out;
+  out << "<h2>DEM verification</h2>\n<p>" << html_escape(scalar_text(v["what"])) << ". Simulated "
+      << html_escape(scalar_text(v["duration_s"])) << " s each, stiffness softening "
+      << html_escape(scalar_text(v["effective_stiffness_softening"])) << ", tolerance "
+      << html_escape(format_number(100.0 * v["tolerance_relative"].get<double>(), 3)) << " %.</p>\n"
+      << table({"design", "predicted " + unit, "DEM " + unit, "predicted envelope at end / mm", "DEM envelope at end / mm",
+                "DEM energy error", "DEM − predicted", "result"},
+               rows);
+  const json& r = v["ranking"];
+  out << "<p>Ranking (chosen design ahead of the best single layer): predicted "
+      << (r["predicted_chosen_ahead"].get<bool>() ? "yes" : "no") << ", DEM "
+      << (r["dem_chosen_ahead"].get<bool>() ? "yes" : "no") << ": " << (r["passed"].get<bool>() ? "pass" : "FAIL")
+      << ".</p>\n<p class=\"verdict " << (v["passed"].get<bool>() ? "pass" : "fail") << "\">Verification: "
+      << (v["passed"].get<bool>() ? "PASS" : "FAIL") << "</p>\n";
+  return out.str();
+}
+
+/// What a picture shows, by its file name.
+std::string caption(const std::string& file_name) {
+  static const std::map<std::string, std::string> kCaptions = {
+      {"eta_curve", "η*(X) of the closed forms: the onset (the cliff to the scattered state), the ideal peak and the design stroke"},
+      {"backbone", "backbones: natural frequency and added damping against the damper's amplitude"},
+      {"frf", "frequency response with the dampers and without the beds"},
+      {"frf_dem", "frequency response, DEM in the loop"},
+      {"frf_compare", "frequency response: closed forms, field and DEM"},
+      {"decay", "free decay with the dampers and without the beds"},
+      {"decay_dem", "free decay, DEM in the loop"},
+      {"decay_compare", "free-decay envelopes: chosen design, best single layer, case start"},
+      {"verify_decay", "DEM verification: envelopes by the DEM (solid) and by the closed forms (dashed)"},
+      {"force_velocity", "DEM: container force and velocity"},
+      {"field_map", "effective field"},
+      {"field_cuts", "effective field: cuts with the closed form"}};
+  const std::string stem = fs::path(file_name).stem().string();
+  const auto it = kCaptions.find(stem);
+  return it == kCaptions.end() ? stem : it->second;
+}
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The pictures staged in `folder`: each plot's PNG, or its SVG where there is no PNG.
+std::vector<ReportPicture> staged_pictures(const fs::path& folder) {
+  std::map<std::string, fs::path> png, svg;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    if (!entry.is_regular_file()) continue;
+    const auto ext = entry.path().extension().string();
+    if (ext == ".png") png[entry.path().stem().string()] = entry.path();
+    if (ext == ".svg") svg[entry.path().stem().string()] = entry.path();
+  }
+  for (const auto& [stem, path] : png) svg.erase(stem);
+  std::vector<ReportPicture> out;
+  for (const auto* set : {&png, &svg})
+    for (const auto& [stem, path] : *set) out.push_back({path.filename().string(), read_bytes(path)});
+  return out;
+}
+
+}  // namespace
+
+RunReportScope::RunReportScope() : previous_(g_report_requested) { g_report_requested = true; }
+RunReportScope::~RunReportScope() { g_report_requested = previous_; }
+
+std::string html_escape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char ch : text) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+std::string base64(std::string_view bytes) {
+  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8) |
+                       static_cast<unsigned char>(bytes[i + 2]);
+    for (int s = 18; s >= 0; s -= 6) out += kAlphabet[(v >> s) & 63];
+  }
+  if (i < bytes.size()) {
+    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+std::string report_html(const ReportInput& in) {
+  const json& r = in.result;
+  const std::string task = r.is_object() && r.contains("task") ? scalar_text(r["task"]) : "";
+  std::ostringstream out;
+  out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      // No script and no fetch may run, whatever a text contains: pictures are data: URIs.
+      << "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src data:; style-src 'unsafe-inline'\">\n"
+      << "<title>pdamp report: " << html_escape(in.case_name) << "</title>\n"
+      << "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}"
+         "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #bbb;padding:2px 8px;text-align:left;"
+         "vertical-align:top}th{background:#eee}img{max-width:100%;border:1px solid #ddd}"
+         ".note{color:#555}.verdict{font-weight:bold}.pass{color:#060}.fail{color:#b00}"
+         "li.warning{color:#840}</style>\n</head>\n<body>\n";
+  out << "<h1>" << html_escape(in.case_name) << "</h1>\n";
+  if (!in.case_description.empty()) out << "<p>" << html_escape(in.case_description) << "</p>\n";
+  out << "<p class=\"note\">Task " << html_escape(task) << ", case file " << html_escape(in.case_file)
+      << "; written by pdamp run. All numbers in SI units as in the result JSON.</p>\n";
+
+  std::vector<std::pair<std::string, std::string>> rows;
+  if (r.is_object()) flatten(r, "", 0, rows);
+  std::vector<std::vector<std::string>> cells;
+  for (const auto& [k, v] : rows) cells.push_back({k, v});
+  out << "<h2>Key numbers</h2>\n" << table({"quantity", "value"}, cells);
+  if (r.is_object()) out << designs_section(r) << solver_section(r) << verification_section(r) << array_tables(r);
+
+  out << "<h2>Plots</h2>\n";
+  if (!in.gnuplot_found)
+    out << "<p class=\"note\">gnuplot was not found: this report has no plots. The data (CSV) and the gnuplot scripts "
+           "(.gp) are in the output folder; run <code>gnuplot NAME.gp</code> there once gnuplot is installed.</p>\n";
+  else if (in.pictures.empty())
+    out << "<p class=\"note\">This task wrote no plots.</p>\n";
+  for (const auto& p : in.pictures) {
+    const bool svg = fs::path(p.file_name).extension() == ".svg";
+    out << "<figure>\n<img alt=\"" << html_escape(p.file_name) << "\" src=\"data:" << (svg ? "image/svg+xml" : "image/png")
+        << ";base64," << base64(p.bytes) << "\">\n<figcaption>" << html_escape(caption(p.file_name)) << " ("
+        << html_escape(p.file_name) << ")</figcaption>\n</figure>\n";
+  }
+
+  out << "<h2>Warnings</h2>\n";
+  if (in.warnings.empty()) out << "<p>None.</p>\n";
+  else {
+    out << "<ul>\n";
+    for (const auto& w : in.warnings) out << "<li class=\"warning\">" << html_escape(w) << "</li>\n";
+    out << "</ul>\n";
+  }
+  out << "</body>\n</html>\n";
+  return out.str();
+}
+
+void stage_run_report(OutputDir& files, const case_file::Case& c, const json& result,
+                      const std::vector<std::string>& warnings) {
+  if (!g_report_requested) return;
+  const fs::path page = files.staged_path("report.html");
+  ReportInput in;
+  in.case_name = c.name;
+  in.case_description = c.description;
+  in.case_file = c.path;
+  in.result = result;
+  in.warnings = warnings;
+  in.pictures = staged_pictures(page.parent_path());
+  in.gnuplot_found = gnuplot_available();
+  std::ofstream out(page, std::ios::binary | std::ios::trunc);
+  out << report_html(in);
+  if (!out) throw std::runtime_error("cannot write " + page.string());
+}
+
+}  // namespace pdamp::cli

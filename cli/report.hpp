@@ -1,0 +1,63 @@
+// The one-page HTML report of `pdamp run -o DIR` (DIR/report.html): case, key numbers of
+// the result, the run's plots embedded as data URIs (readable offline), the optimiser's
+// summary, the DEM verification and the warnings. Every text from the case is escaped.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "output.hpp"
+#include "pdamp/case_file/case.hpp"
+
+namespace pdamp::cli {
+
+/// While one is alive (pdamp run, for the duration of its task), stage_run_report writes
+/// the report; other commands write none. Not thread-safe (one task per process).
+class RunReportScope {
+ public:
+  RunReportScope();
+  ~RunReportScope();
+  RunReportScope(const RunReportScope&) = delete;
+  RunReportScope& operator=(const RunReportScope&) = delete;
+
+ private:
+  bool previous_;
+};
+
+/// Call just before files.commit(): under a RunReportScope stages report.html built from
+/// the result JSON, the warnings and the pictures already staged in `files` (PNG, else
+/// SVG, as produced by gnuplot); otherwise does nothing.
+void stage_run_report(OutputDir& files, const case_file::Case& c, const nlohmann::json& result,
+                      const std::vector<std::string>& warnings);
+
+/// A picture for the report: its file name (caption key) and its bytes.
+struct ReportPicture {
+  std::string file_name;  ///< "eta_curve.png"; .png or .svg
+  std::string bytes;
+};
+
+/// Everything the page shows; the texts are raw (report_html escapes them).
+struct ReportInput {
+  std::string case_name;
+  std::string case_description;
+  std::string case_file;
+  nlohmann::json result;              ///< the task's result JSON (results.json of the run)
+  std::vector<std::string> warnings;
+  std::vector<ReportPicture> pictures;
+  bool gnuplot_found = true;          ///< false: a note instead of the plots
+};
+
+/// The self-contained page: no script, no external resource (a Content-Security-Policy
+/// allows only inline style and data: images), so nothing in it can run.
+std::string report_html(const ReportInput& input);
+
+/// `text` with & < > " ' as character references: inert inside elements and quoted attributes.
+std::string html_escape(std::string_view text);
+
+/// Standard base64 (RFC 4648 §4, padded), for data URIs.
+std::string base64(std::string_view bytes);
+
+}  // namespace pdamp::cli

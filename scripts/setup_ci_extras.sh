@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Install what the CI-only sanitizer and fuzz builds need beyond scripts/setup.sh:
+# clang, the compiler-rt runtimes of ASan/UBSan/libFuzzer (libclang-rt-14-dev: only a
+# Recommends of clang, which --no-install-recommends skips, so it is named here) and
+# llvm-symbolizer (llvm-14) for readable reports. A no-op when all are present.
+# Usage: scripts/setup_ci_extras.sh   (called by .ci/run; see docs/ci.md)
+set -euo pipefail
+
+packages=(clang libclang-rt-14-dev llvm-14)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup_ci_extras: installing ${missing[*]}" >&2
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+
+# The runtimes must really be there: a clang without them fails only at link time.
+for lib in libclang_rt.asan-x86_64.a libclang_rt.ubsan_standalone-x86_64.a libclang_rt.fuzzer-x86_64.a; do
+  file=$(clang++ -print-file-name="$lib")
+  [ -f "$file" ] || { echo "setup_ci_extras: clang finds no $lib after the install" >&2; exit 1; }
+done

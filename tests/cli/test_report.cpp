@@ -1,0 +1,141 @@
+// The HTML report of pdamp run -o DIR (cli/report.cpp): escaping of hostile case text,
+// base64 against RFC 4648's vectors, embedded pictures, the no-gnuplot note, and that
+// only pdamp run writes it.
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli/cli_support.hpp"
+#include "report.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+const std::string kHostile = "<script>alert('x')</script><img src=x onerror=alert(1)>&\"";
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+/// Nothing in the page can run: every tag is one the report itself writes (no script, no
+/// element a hostile text brought in), and every picture is a data: URI.
+void require_inert(const std::string& html) {
+  const std::string page = lower(html);
+  CHECK(page.find("<script") == std::string::npos);
+  CHECK(page.find("javascript:") == std::string::npos);
+  static const std::vector<std::string> kOwnTags = {"!doctype", "html", "head", "meta", "title", "style", "body",
+                                                    "h1", "h2", "h3", "p", "table", "tr", "th", "td", "figure",
+                                                    "img", "figcaption", "ul", "li", "code"};
+  for (std::size_t at = page.find('<'); at != std::string::npos; at = page.find('<', at + 1)) {
+    std::size_t end = at + 1;
+    if (end < page.size() && page[end] == '/') ++end;
+    std::size_t stop = end;
+    while (stop < page.size() && (std::isalnum(static_cast<unsigned char>(page[stop])) || page[stop] == '!')) ++stop;
+    const std::string tag = page.substr(end, stop - end);
+    INFO("tag <" << tag << "> at " << at);
+    CHECK(std::find(kOwnTags.begin(), kOwnTags.end(), tag) != kOwnTags.end());
+    if (tag == "img") CHECK(page.compare(stop, 4, " alt") == 0);  // <img alt="..." src="data:...">
+  }
+  for (std::size_t at = page.find(" src=\""); at != std::string::npos; at = page.find(" src=\"", at + 1))
+    CHECK(page.compare(at + 6, 5, "data:") == 0);
+}
+
+}  // namespace
+
+TEST_CASE("html_escape turns the five markup characters into character references", "[cli][report]") {
+  CHECK(pdamp::cli::html_escape("a<b>&\"c'") == "a&lt;b&gt;&amp;&quot;c&#39;");
+  CHECK(pdamp::cli::html_escape("plain text, μ = 0.3") == "plain text, μ = 0.3");  // UTF-8 untouched
+}
+
+TEST_CASE("base64 gives RFC 4648's test vectors", "[cli][report]") {
+  // RFC 4648 §10.
+  CHECK(pdamp::cli::base64("") == "");
+  CHECK(pdamp::cli::base64("f") == "Zg==");
+  CHECK(pdamp::cli::base64("fo") == "Zm8=");
+  CHECK(pdamp::cli::base64("foo") == "Zm9v");
+  CHECK(pdamp::cli::base64("foob") == "Zm9vYg==");
+  CHECK(pdamp::cli::base64("fooba") == "Zm9vYmE=");
+  CHECK(pdamp::cli::base64("foobar") == "Zm9vYmFy");
+  CHECK(pdamp::cli::base64(std::string("\xff\x00\x80", 3)) == "/wCA");  // high bytes and a NUL
+}
+
+TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs", "[cli][report]") {
+  pdamp::cli::ReportInput in;
+  in.case_name = kHostile;
+  in.case_description = "description " + kHostile;
+  in.case_file = "/cases/" + kHostile + ".json";
+  in.result = {{"task", "decay"}, {"case", kHostile}, {"settling_time_s", 17.25}, {"decay", {{"outcome", kHostile}}}};
+  in.warnings = {"warning " + kHostile};
+  in.pictures = {{"decay.png", "\x89PNG\r\n\x1a\n"}};
+  const std::string html = pdamp::cli::report_html(in);
+  require_inert(html);
+  CHECK(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;") != std::string::npos);
+  CHECK(html.find("Content-Security-Policy") != std::string::npos);
+  CHECK(html.find("17.25") != std::string::npos);  // the key number
+  // The PNG signature 89 50 4E 47 0D 0A 1A 0A is "iVBORw0KGgo=" in base64.
+  CHECK(html.find("src=\"data:image/png;base64,iVBORw0KGgo=\"") != std::string::npos);
+  CHECK(html.find("gnuplot was not found") == std::string::npos);
+
+  in.pictures.clear();
+  in.gnuplot_found = false;
+  CHECK(pdamp::cli::report_html(in).find("gnuplot was not found") != std::string::npos);
+}
+
+TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {
+  const TempDir dir("report_run");
+  const std::string path = (dir.path / "hostile.json").string();
+  {
+    std::ifstream in(case_path("low_intensity_36_spheres.json"));
+    json c = json::parse(in);
+    c["name"] = kHostile;
+    c["description"] = kHostile;
+    std::ofstream(path) << c.dump(2);
+  }
+  const fs::path out = dir.path / "out";
+  const auto r = run_pdamp({"run", path, "-o", out.string(), "--json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(fs::is_regular_file(out / "report.html"));
+  const std::string html = slurp(out / "report.html");
+  require_inert(html);
+  CHECK(html.find("&lt;script&gt;") != std::string::npos);
+  // The design table: the 36-sphere bed's clearance h_roll = 0.1 m (docs/cases.md) and
+  // the rolling design stroke 0.4 h = 0.04 m (PHYSICS.md §3).
+  CHECK(html.find("clearance_m") != std::string::npos);
+  CHECK(html.find("0.04") != std::string::npos);
+  if (fs::is_regular_file(out / "eta_curve.png")) {
+    CHECK(html.find("data:image/png;base64,iVBORw0KGgo") != std::string::npos);  // the PNG, embedded
+    CHECK(html.find("eta_curve.png") != std::string::npos);
+  } else {
+    CHECK(html.find("gnuplot was not found") != std::string::npos);
+  }
+  // report.html is part of the run's set of outputs (the manifest), so the next run replaces it.
+  const json listed = json::parse(slurp(out / ".pdamp-outputs.json"));
+  CHECK(std::find(listed["files"].begin(), listed["files"].end(), "report.html") != listed["files"].end());
+  const json result = json::parse(r.out);
+  CHECK(std::any_of(result["outputs"].begin(), result["outputs"].end(),
+                    [](const json& p) { return p.get<std::string>().find("report.html") != std::string::npos; }));
+
+  // A structure task: the decay's settling time is in the key numbers, its plot embedded.
+  const fs::path decay_out = dir.path / "decay";
+  const std::string decay_case = std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/cantilever_decay.json";
+  REQUIRE(run_pdamp({"run", decay_case, "-o", decay_out.string()}).exit_code == 0);
+  const std::string decay_html = slurp(decay_out / "report.html");
+  CHECK(decay_html.find("settling_time_s") != std::string::npos);
+  if (fs::is_regular_file(decay_out / "decay.png")) CHECK(decay_html.find("decay.png") != std::string::npos);
+
+  // pdamp decay (not run) into a fresh folder: no report.
+  const fs::path plain = dir.path / "plain";
+  REQUIRE(run_pdamp({"decay", decay_case, "-o", plain.string()}).exit_code == 0);
+  CHECK_FALSE(fs::exists(plain / "report.html"));
+}
