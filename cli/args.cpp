@@ -105,4 +105,9 @@ std::optional<long long> ParsedArgs::optional_integer(const std::string& flag, l
   return static_cast<long long>(*value);
 }
 
+std::vector<FlagSpec> concat_flags(std::vector<FlagSpec> first, const std::vector<FlagSpec>& rest) {
+  first.insert(first.end(), rest.begin(), rest.end());
+  return first;
+}
+
 }  // namespace pdamp::cli

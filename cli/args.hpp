@@ -27,6 +27,9 @@ struct CommandSpec {
 
 std::string help_text(const CommandSpec& spec);
 
+/// `first` followed by `rest` (a command's own flags and a shared group).
+std::vector<FlagSpec> concat_flags(std::vector<FlagSpec> first, const std::vector<FlagSpec>& rest);
+
 class ParsedArgs {
  public:
   ParsedArgs(const CommandSpec& spec, const std::vector<std::string>& args);

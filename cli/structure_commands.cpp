@@ -16,6 +16,9 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <chrono>
+#include <exception>
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
@@ -30,6 +33,7 @@
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
+#include "pdamp/structure/sampled_response.hpp"
 #include "report.hpp"
 #include "structure_plots.hpp"
 
@@ -41,9 +45,16 @@ const FlagSpec kMethodFlag{"--method", "M",
                            "                          layer's field_file, made by pdamp field) or dem (frf and\n"
                            "                          decay only: the structure co-simulated in time with each\n"
                            "                          damper's bed as a DEM world, the case's dem settings)"};
-const FlagSpec kDemPointsFlag{"--dem-points", "N",
-                              "--method dem: frequencies of the stepped sine, linear over the task's\n"
-                              "                          band, [2, 1000] (default 9)"};
+const std::vector<FlagSpec> kDemSweepFlags{
+    {"--dem-points", "N",
+     "--method dem: frequencies of the stepped sine, linear over its band,\n"
+     "                          [2, 1000] (default 9)"},
+    {"--dem-min-frequency", "HZ", "--method dem: lowest frequency of the stepped sine, Hz, > 0\n"
+                                  "                          (default: the task's min_frequency_hz)"},
+    {"--dem-max-frequency", "HZ", "--method dem: highest frequency of the stepped sine, Hz, above the\n"
+                                  "                          lowest (default: the task's max_frequency_hz)"},
+    {"--dem-sweep", "D", "--method dem: up, down or both (default both: the two directions\n"
+                         "                          run in parallel on a machine of two or more cores)"}};
 
 namespace {
 
@@ -381,7 +392,8 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
     out.push_back({{"output", p.output < names.size() ? names[p.output] : std::to_string(p.output)},
                    {"frequency_hz", p.frequency_hz},
                    {"magnitude", p.magnitude},
-                   {"damping_ratio", number_or_null(p.damping_ratio)}});
+                   {"damping_ratio", number_or_null(p.damping_ratio)},
+                   {"band_centre_hz", number_or_null(p.band_centre_hz)}});
   return out;
 }
 
@@ -855,31 +867,128 @@ int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
 
 /// One frequency of the stepped-sine DEM FRF.
 struct DemPoint {
+  std::string sweep;  ///< "up" or "down"
   double f = 0.0, requested_f = 0.0;
   std::vector<double> magnitude, phase_deg;
-  double spread = NAN;
+  double spread = NAN;          ///< sample standard deviation of the analysed periods' |ŷ|, per unit excitation
+  double standard_error = NAN;  ///< spread/√(analysed periods): periods taken as independent
   double energy_error = 0.0;
   int transient = 0;
   bool stable = false;
   std::int64_t steps = 0;
   double dt = 0.0, wall = 0.0;
 };
-struct DemSweep {
+/// One direction of the stepped sine: its points in the order run, its warnings.
+struct DemBranch {
+  std::string sweep;
   std::vector<DemPoint> points;
-  std::vector<double> frequencies;  ///< requested
-  std::vector<st::CosimulationDamper> dampers;
-  bool base = false;
-  int analysed_periods = 0;
+  std::vector<std::string> warnings;
   double solve_time = 0.0;
 };
+struct DemSweep {
+  std::vector<DemBranch> branches;  ///< up first, then down (those asked for)
+  std::vector<double> frequencies;  ///< requested, ascending
+  std::vector<st::CosimulationDamper> dampers;
+  bool base = false;
+  bool parallel = false;
+  int analysed_periods = 0;
+  double solve_time = 0.0;  ///< wall time of the whole sweep (both directions)
+  double time_step_s = 0.0;
+};
 
-/// The stepped sine of --method dem (and of --compare): up in frequency over the task's
-/// band, each frequency continuing the previous one's final state (bed included).
+/// The points of one branch in ascending frequency, and its resonance measures
+/// (sampled_response.hpp) of the first output.
+struct DemBranchPeak {
+  std::vector<const DemPoint*> ascending;
+  st::SampledPeak peak;
+};
+DemBranchPeak dem_branch_peak(const DemBranch& branch) {
+  DemBranchPeak out;
+  for (const auto& p : branch.points) out.ascending.push_back(&p);
+  std::sort(out.ascending.begin(), out.ascending.end(), [](const DemPoint* a, const DemPoint* b) { return a->f < b->f; });
+  std::vector<double> f, m, se;
+  for (const DemPoint* p : out.ascending) {
+    f.push_back(p->f);
+    m.push_back(p->magnitude.front());
+    se.push_back(std::isfinite(p->standard_error) ? p->standard_error : 0.0);
+  }
+  out.peak = st::sampled_peak(f, m, se);
+  return out;
+}
+
+/// One direction of the stepped sine: each frequency continues the previous one's final
+/// state (bed included); the bed is settled once, before the first.
+DemBranch run_dem_branch(const Case& c, const st::ModalModel& modal, const std::vector<st::CosimulationDamper>& dampers,
+                         st::CosimulationOptions options, const std::vector<double>& frequencies, const std::string& sweep,
+                         double sweep_dt) {
+  DemBranch branch;
+  branch.sweep = sweep;
+  st::CosimulationState state;  // the bed, the modes and the drive's phase, carried over
+  for (std::size_t i = 0; i < frequencies.size(); ++i) {
+    options.excitation.frequency_hz = frequencies[i];
+    options.time_step_s = state.started() ? 0.0 : sweep_dt;
+    const std::string label = "pdamp frf (dem) " + sweep + " " + std::to_string(i + 1) + "/" +
+                              std::to_string(frequencies.size()) + " " + format_number(frequencies[i], 5) + " Hz";
+    const auto r = run_cosimulation(c, modal, dampers, options, label, &state);
+    for (const auto& w : r.warnings) branch.warnings.push_back(w);
+    branch.solve_time += r.wall_time_s;
+    const auto& ss = r.steady_state;
+    DemPoint p;
+    p.sweep = sweep;
+    p.f = ss.frequency_hz;
+    p.requested_f = frequencies[i];
+    for (std::size_t d = 0; d < dampers.size(); ++d) {
+      p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
+      p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
+    }
+    // Spread: sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation.
+    const auto& per = ss.period_site_amplitudes_m;
+    const std::size_t na = static_cast<std::size_t>(std::max(ss.analysed_periods, 0));
+    if (na >= 2 && per.size() >= na) {
+      double mean = 0.0, var = 0.0;
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) mean += per[k];
+      mean /= static_cast<double>(na);
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) var += (per[k] - mean) * (per[k] - mean);
+      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / options.excitation.amplitude;
+      p.standard_error = p.spread / std::sqrt(static_cast<double>(na));
+    }
+    p.energy_error = r.energy.relative_error;
+    p.transient = ss.transient_periods;
+    p.stable = ss.stable;
+    p.steps = r.steps;
+    p.dt = r.time_step_s;
+    p.wall = r.wall_time_s;
+    for (double m : p.magnitude)
+      if (!std::isfinite(m)) throw NumericalError(label + ": the steady-state amplitude is not finite");
+    if (!p.stable)
+      branch.warnings.push_back(sweep + " sweep at " + format_number(p.f, 5) + " Hz: the period-to-period change of the "
+                                "site amplitude did not stay below " + format_number(kDemStableTolerance) + " within " +
+                                std::to_string(kDemMaxTransientPeriods) +
+                                " transient periods: the analysed periods may still carry the transient");
+    if (p.energy_error > 0.01)
+      branch.warnings.push_back(sweep + " sweep at " + format_number(p.f, 5) + " Hz: the co-simulation's energy ledger "
+                                "closes to " + format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
+    branch.points.push_back(std::move(p));
+  }
+  return branch;
+}
+
+/// The stepped sine of --method dem (and of --compare): up and down in frequency over the
+/// band (--dem-min/max-frequency, default the task's), the two directions on two threads
+/// when the machine has two cores (each DEM world then on one thread).
 DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   const auto& task = *c.task.frf;
   const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
+  const double f_min = args.optional_number("--dem-min-frequency", {0.0, 1e6, true}).value_or(task.min_frequency_hz);
+  const double f_max = args.optional_number("--dem-max-frequency", {0.0, 1e6, true}).value_or(task.max_frequency_hz);
+  if (!(f_max > f_min))
+    throw InputError("--dem-max-frequency", "", format_number(f_max) + " Hz: must exceed the lowest frequency " +
+                                                    format_number(f_min) + " Hz (--dem-min-frequency or the task's)");
+  const std::string direction = args.optional_text("--dem-sweep").value_or("both");
+  if (direction != "up" && direction != "down" && direction != "both")
+    throw InputError("--dem-sweep", "", "'" + direction + "': must be up, down or both");
   const st::ModalModel& modal = setup.s.modal;
-  const auto dampers = dem_dampers(c);
+  auto dampers = dem_dampers(c);
   const bool base = task.excitation == case_file::FrfTask::Excitation::kBase;
 
   st::CosimulationOptions options;
@@ -904,10 +1013,8 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
     e.point = options.excitation.point;
     if (const auto problems = e.validate(modal); !problems.empty()) throw InputError(c.path, "/task/excitation", problems.front());
   }
-  const auto frequencies = spaced(task.min_frequency_hz, task.max_frequency_hz, points, false);
-  const std::size_t outputs = dampers.size();
+  const auto frequencies = spaced(f_min, f_max, points, false);
 
-  std::vector<DemPoint> result_points;
   // One step for the whole sweep (the carried worlds keep theirs): the smallest automatic
   // step over the frequencies, each period then the nearest whole number of it.
   double sweep_dt = INFINITY;
@@ -923,121 +1030,146 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
       throw InputError(c.path, "/dem", what);
     }
   }
-  st::CosimulationState state;  // the bed, the modes and the drive's phase, carried over
-  double solve_time = 0.0;
-  for (std::size_t i = 0; i < frequencies.size(); ++i) {
-    options.excitation.frequency_hz = frequencies[i];
-    options.time_step_s = state.started() ? 0.0 : sweep_dt;
-    const std::string label = "pdamp frf (dem) " + std::to_string(i + 1) + "/" + std::to_string(frequencies.size()) + " " +
-                              format_number(frequencies[i], 5) + " Hz";
-    const auto r = run_cosimulation(c, modal, dampers, options, label, &state);
-    setup.warnings.add(r.warnings);
-    solve_time += r.wall_time_s;
-    const auto& ss = r.steady_state;
-    DemPoint p;
-    p.f = ss.frequency_hz;
-    p.requested_f = frequencies[i];
-    for (std::size_t d = 0; d < outputs; ++d) {
-      p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
-      p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
-    }
-    // Spread: sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation.
-    const auto& per = ss.period_site_amplitudes_m;
-    const std::size_t na = static_cast<std::size_t>(std::max(ss.analysed_periods, 0));
-    if (na >= 2 && per.size() >= na) {
-      double mean = 0.0, var = 0.0;
-      for (std::size_t k = per.size() - na; k < per.size(); ++k) mean += per[k];
-      mean /= static_cast<double>(na);
-      for (std::size_t k = per.size() - na; k < per.size(); ++k) var += (per[k] - mean) * (per[k] - mean);
-      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / options.excitation.amplitude;
-    }
-    p.energy_error = r.energy.relative_error;
-    p.transient = ss.transient_periods;
-    p.stable = ss.stable;
-    p.steps = r.steps;
-    p.dt = r.time_step_s;
-    p.wall = r.wall_time_s;
-    for (double m : p.magnitude)
-      if (!std::isfinite(m)) throw NumericalError(label + ": the steady-state amplitude is not finite");
-    if (!p.stable)
-      setup.warnings.add("at " + format_number(p.f, 5) + " Hz the period-to-period change of the site amplitude did not stay "
-                         "below " + format_number(kDemStableTolerance) + " within " + std::to_string(kDemMaxTransientPeriods) +
-                         " transient periods: the analysed periods may still carry the transient");
-    if (p.energy_error > 0.01)
-      setup.warnings.add("at " + format_number(p.f, 5) + " Hz the co-simulation's energy ledger closes to " +
-                         format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
-    result_points.push_back(std::move(p));
-  }
+  std::vector<std::pair<std::string, std::vector<double>>> directions;
+  if (direction != "down") directions.push_back({"up", frequencies});
+  if (direction != "up") directions.push_back({"down", std::vector<double>(frequencies.rbegin(), frequencies.rend())});
+
   DemSweep out;
-  out.points = std::move(result_points);
   out.frequencies = frequencies;
-  out.dampers = dampers;
   out.base = base;
   out.analysed_periods = options.analysed_periods;
-  out.solve_time = solve_time;
+  out.time_step_s = sweep_dt;
+  out.parallel = directions.size() > 1 && std::thread::hardware_concurrency() >= 2;
+  // Two sweeps on two cores: one thread each (the worlds' own OpenMP would oversubscribe).
+  if (out.parallel)
+    for (auto& d : dampers) d.world.threads = 1;
+  out.branches.resize(directions.size());
+  const auto started = std::chrono::steady_clock::now();
+  const auto run = [&](std::size_t k) {
+    out.branches[k] = run_dem_branch(c, modal, dampers, options, directions[k].second, directions[k].first, sweep_dt);
+  };
+  if (out.parallel) {
+    // An exception in a sweep's thread is carried to this one and rethrown after both end
+    // (the first one in order: up before down).
+    std::vector<std::exception_ptr> errors(directions.size());
+    std::vector<std::thread> threads;
+    for (std::size_t k = 0; k < directions.size(); ++k)
+      threads.emplace_back([&, k] {
+        try {
+          run(k);
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
+      });
+    for (auto& t : threads) t.join();
+    for (const auto& e : errors)
+      if (e) std::rethrow_exception(e);
+  } else {
+    for (std::size_t k = 0; k < directions.size(); ++k) run(k);
+  }
+  out.solve_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  for (const auto& b : out.branches) setup.warnings.add(b.warnings);
+  out.dampers = std::move(dampers);
   return out;
+}
+
+/// A branch's resonance measures of the first output as JSON (sampled_response.hpp).
+json dem_peak_json(const std::string& output, const DemBranch& branch, const DemBranchPeak& bp) {
+  const DemPoint& top = *bp.ascending[bp.peak.index];
+  return {{"output", output},
+          {"sweep", branch.sweep},
+          {"frequency_hz", bp.peak.frequency_hz},
+          {"largest_point_frequency_hz", top.f},
+          {"magnitude", bp.peak.magnitude},
+          {"magnitude_standard_error", number_or_null(top.standard_error)},
+          {"band_low_hz", number_or_null(bp.peak.band.low_hz)},
+          {"band_high_hz", number_or_null(bp.peak.band.high_hz)},
+          {"band_centre_hz", number_or_null(bp.peak.band_centre_hz)},
+          {"indistinguishable_low_hz", bp.peak.indistinguishable_low_hz},
+          {"indistinguishable_high_hz", bp.peak.indistinguishable_high_hz},
+          {"damping_ratio", nullptr}};
+}
+
+const char* const kDemPeakNote =
+    "frequency_hz: vertex of the parabola through the largest point and its neighbours; band: where the points "
+    "stay >= 0.9 of the largest (linear between points), its centre a flat top's better-conditioned resonance "
+    "frequency; indistinguishable: the points within two standard errors of the largest (the argmax lies among "
+    "them); standard error = spread/sqrt(analysed periods)";
+
+std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
+  const DemPoint& top = *bp.ascending[bp.peak.index];
+  return format_number(bp.peak.frequency_hz, 5) + " Hz (largest of " + std::to_string(points) + " points at " +
+         format_number(top.f, 5) + " Hz), |out| = " + format_number(bp.peak.magnitude, 4) +
+         (std::isfinite(top.standard_error) ? " +- " + format_number(top.standard_error, 2) : "") +
+         ", 0.9 band centre " + format_number(bp.peak.band_centre_hz, 5) + " Hz, argmax within [" +
+         format_number(bp.peak.indistinguishable_low_hz, 4) + ", " + format_number(bp.peak.indistinguishable_high_hz, 4) +
+         "] Hz";
 }
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const DemSweep sweep = dem_frf_sweep(args, c, setup);
-  const auto& result_points = sweep.points;
   const auto& frequencies = sweep.frequencies;
   const auto& dampers = sweep.dampers;
   const bool base = sweep.base;
   const std::size_t outputs = dampers.size();
-  const double solve_time = sweep.solve_time;
 
   json peaks = json::array();
   std::vector<std::pair<std::string, std::string>> rows = {{"method", "dem"}};
-  for (std::size_t d = 0; d < outputs; ++d) {
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < result_points.size(); ++i)
-      if (result_points[i].magnitude[d] > result_points[best].magnitude[d]) best = i;
-    peaks.push_back({{"output", dampers[d].name},
-                     {"frequency_hz", result_points[best].f},
-                     {"magnitude", result_points[best].magnitude[d]},
-                     {"damping_ratio", nullptr}});
-    rows.push_back({"peak " + dampers[d].name, format_number(result_points[best].f, 6) + " Hz, |out| = " +
-                                                   format_number(result_points[best].magnitude[d], 4) + " (largest of " +
-                                                   std::to_string(result_points.size()) + " points)"});
-  }
   json list = json::array();
-  for (const auto& p : result_points) {
-    json magnitude = json::object(), phase = json::object();
-    for (std::size_t d = 0; d < outputs; ++d) magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
-    list.push_back({{"frequency_hz", p.f}, {"requested_frequency_hz", p.requested_f}, {"magnitude", magnitude},
-                    {"phase_deg", phase},
-                    {"magnitude_spread", number_or_null(p.spread)}, {"energy_error", p.energy_error},
-                    {"transient_periods", p.transient}, {"stable", p.stable}, {"steps", p.steps},
-                    {"time_step_s", p.dt}, {"solve_time_s", p.wall}});
-    rows.push_back({format_number(p.f, 6) + " Hz",
-                    "|out| = " + format_number(p.magnitude.front(), 4) +
-                        (std::isfinite(p.spread) ? " +- " + format_number(p.spread, 2) : "") +
-                        ", energy error " + format_number(p.energy_error, 2)});
+  for (const auto& branch : sweep.branches) {
+    const DemBranchPeak bp = dem_branch_peak(branch);
+    peaks.push_back(dem_peak_json(dampers.front().name, branch, bp));
+    for (std::size_t d = 1; d < outputs; ++d) {  // the other outputs: their largest point
+      std::size_t best = 0;
+      for (std::size_t i = 1; i < branch.points.size(); ++i)
+        if (branch.points[i].magnitude[d] > branch.points[best].magnitude[d]) best = i;
+      peaks.push_back({{"output", dampers[d].name}, {"sweep", branch.sweep}, {"frequency_hz", branch.points[best].f},
+                       {"magnitude", branch.points[best].magnitude[d]}, {"damping_ratio", nullptr}});
+    }
+    rows.push_back({"peak " + branch.sweep + " " + dampers.front().name, dem_peak_row(bp, branch.points.size())});
+    for (const auto& p : branch.points) {
+      json magnitude = json::object(), phase = json::object();
+      for (std::size_t d = 0; d < outputs; ++d) magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
+      list.push_back({{"sweep", p.sweep}, {"frequency_hz", p.f}, {"requested_frequency_hz", p.requested_f},
+                      {"magnitude", magnitude}, {"phase_deg", phase},
+                      {"magnitude_spread", number_or_null(p.spread)},
+                      {"magnitude_standard_error", number_or_null(p.standard_error)}, {"energy_error", p.energy_error},
+                      {"transient_periods", p.transient}, {"stable", p.stable}, {"steps", p.steps},
+                      {"time_step_s", p.dt}, {"solve_time_s", p.wall}});
+      rows.push_back({branch.sweep + " " + format_number(p.f, 6) + " Hz",
+                      "|out| = " + format_number(p.magnitude.front(), 4) +
+                          (std::isfinite(p.standard_error) ? " +- " + format_number(p.standard_error, 2) : "") +
+                          ", energy error " + format_number(p.energy_error, 2)});
+    }
   }
   const std::string magnitude_label = base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
   if (files) {
     std::ostringstream csv;
     csv.precision(10);
-    csv << "frequency_hz";
+    csv << "sweep,frequency_hz";
     for (const auto& d : dampers) csv << ",magnitude_" << safe_file_name(d.name) << ",phase_deg_" << safe_file_name(d.name);
-    csv << ",magnitude_spread_" << safe_file_name(dampers.front().name)
-        << ",energy_error,transient_periods,stable,steps,time_step_s\n";
-    for (const auto& p : result_points) {
-      csv << p.f;
-      for (std::size_t d = 0; d < outputs; ++d) csv << ',' << p.magnitude[d] << ',' << p.phase_deg[d];
-      csv << ',' << (std::isfinite(p.spread) ? p.spread : 0.0) << ',' << p.energy_error << ',' << p.transient << ','
-          << (p.stable ? 1 : 0) << ',' << p.steps << ',' << p.dt << '\n';
-    }
+    csv << ",magnitude_spread_" << safe_file_name(dampers.front().name) << ",magnitude_standard_error_"
+        << safe_file_name(dampers.front().name) << ",energy_error,transient_periods,stable,steps,time_step_s\n";
+    for (const auto& branch : sweep.branches)
+      for (const DemPoint* p : dem_branch_peak(branch).ascending) {
+        csv << p->sweep << ',' << p->f;
+        for (std::size_t d = 0; d < outputs; ++d) csv << ',' << p->magnitude[d] << ',' << p->phase_deg[d];
+        csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
+            << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->energy_error << ','
+            << p->transient << ',' << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->dt << '\n';
+      }
     files->add("frf_dem.csv", csv.str());
     std::vector<std::string> names;
     for (const auto& d : dampers) names.push_back(d.name);
     setup.warnings.add(write_frf_dem_plot(*files, names, magnitude_label, c.name + ": stepped-sine DEM co-simulation"));
   }
   const std::string bed_state =
-      "up in frequency, each frequency continues the previous one's final state: modes (q, dq/dt), the bed "
-      "(particles and contacts) and the drive's phase; the bed is settled once, before the first frequency";
+      "each direction (up, down) continues from frequency to frequency with the previous one's final state: modes "
+      "(q, dq/dt), the bed (particles and contacts) and the drive's phase; the bed is settled once, before a "
+      "direction's first frequency";
+  json sweeps = json::array();
+  for (const auto& b : sweep.branches) sweeps.push_back(b.sweep);
   json frf = {{"file", file_json(files, "frf_dem.csv")},
               {"plot", file_json(files, "frf_dem.png")},
               {"method", "dem"},
@@ -1049,17 +1181,22 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
                                {"points", frequencies.size()}, {"spacing", "linear"}}},
               {"points", list},
               {"peaks", peaks},
+              {"peak_note", kDemPeakNote},
               {"bed_carried_over", true},
-              {"stepped_sine", {{"bed_state", bed_state}, {"bed_carried_over", true},
+              {"stepped_sine", {{"sweeps", sweeps},
+                                {"parallel", sweep.parallel},
+                                {"bed_state", bed_state}, {"bed_carried_over", true},
                                 {"drive", "sin(2 pi f (t - t_i) + pi/2) from each frequency's start t_i: the junctions "
                                           "are at the turning point, the base displacement and velocity (or the "
                                           "force) continuous"},
-                                {"time_step_s", result_points.empty() ? 0.0 : result_points.front().dt},
+                                {"time_step_s", sweep.time_step_s},
                                 {"max_transient_periods", kDemMaxTransientPeriods},
                                 {"stable_tolerance", kDemStableTolerance},
                                 {"analysed_periods", sweep.analysed_periods}}},
-              {"solve_time_s", solve_time},
+              {"solve_time_s", sweep.solve_time},
               {"warnings", setup.warnings.list()}};
+  rows.push_back({"DEM wall time", format_number(sweep.solve_time, 4) + " s (" +
+                                       (sweep.parallel ? "directions in parallel" : "one after the other") + ")"});
   json result = {{"task", "frf"}, {"case", c.name}, {"method", "dem"}};
   result["file"] = frf["file"];
   result["peaks"] = peaks;
@@ -1094,13 +1231,19 @@ const st::ResponsePeak* first_output_peak(const st::FrequencyResponse& r) {
   return best;
 }
 
-/// Relative differences of a method's largest first-output peak from the DEM's.
-json agreement_json(const st::ResponsePeak* peak, double dem_f, double dem_magnitude) {
+/// Relative differences of a method's largest first-output peak from a DEM branch's, for
+/// the peak (argmax) frequency, the 0.9 band's centre and the magnitude.
+json agreement_json(const st::ResponsePeak* peak, const st::SampledPeak& dem) {
   if (!peak) return nullptr;
+  const auto relative = [](double a, double b) { return number_or_null((a - b) / b); };
   return {{"frequency_hz", peak->frequency_hz},
+          {"band_centre_hz", number_or_null(peak->band_centre_hz)},
           {"magnitude", peak->magnitude},
-          {"frequency_relative_difference", (peak->frequency_hz - dem_f) / dem_f},
-          {"magnitude_relative_difference", (peak->magnitude - dem_magnitude) / dem_magnitude}};
+          {"frequency_relative_difference", relative(peak->frequency_hz, dem.frequency_hz)},
+          {"band_centre_relative_difference", relative(peak->band_centre_hz, dem.band_centre_hz)},
+          {"magnitude_relative_difference", relative(peak->magnitude, dem.magnitude)},
+          {"frequency_within_dem_indistinguishable",
+           peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz}};
 }
 
 /// pdamp frf --compare: formulas, field (when every layer has a field_file) and the DEM
@@ -1126,22 +1269,43 @@ int run_frf_compare(const ParsedArgs& args, const Case& c) {
   Setup dem_setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const DemSweep sweep = dem_frf_sweep(args, c, dem_setup);
   warnings.add(dem_setup.warnings.list(), "dem: ");
-  if (sweep.points.empty()) throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < sweep.points.size(); ++i)
-    if (sweep.points[i].magnitude.front() > sweep.points[best].magnitude.front()) best = i;
-  const DemPoint& dem_peak = sweep.points[best];
+  if (sweep.branches.empty() || sweep.branches.front().points.empty())
+    throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
 
   const std::vector<std::string>& names = f_response.output_names;
   const std::string output = names.empty() ? std::string() : names.front();
   const std::string magnitude_label = sweep.base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
   std::vector<CompareDemPoint> dem_points;
-  json dem_list = json::array();
-  for (const auto& p : sweep.points) {
-    dem_points.push_back({p.f, p.magnitude.front(), std::isfinite(p.spread) ? p.spread : 0.0});
-    dem_list.push_back({{"frequency_hz", p.f}, {"magnitude", p.magnitude.front()},
-                        {"magnitude_spread", number_or_null(p.spread)}, {"energy_error", p.energy_error},
-                        {"stable", p.stable}});
+  json dem_list = json::array(), dem_peaks = json::array(), agreement = json::array();
+  std::vector<std::pair<std::string, std::string>> rows = {{"method", "compare (formulas, field, dem)"}};
+  const auto row = [&](const std::string& name, const json& a) {
+    if (a.is_null()) {
+      rows.push_back({name, "-"});
+      return;
+    }
+    const auto percent = [](const json& v) { return v.is_null() ? std::string("-") : format_number(100.0 * v.get<double>(), 3); };
+    rows.push_back({name, format_number(a["frequency_hz"].get<double>(), 5) + " Hz, |out| = " +
+                              format_number(a["magnitude"].get<double>(), 4) + " (vs dem: f " +
+                              percent(a["frequency_relative_difference"]) + "%, 0.9 band centre " +
+                              percent(a["band_centre_relative_difference"]) + "%, |out| " +
+                              percent(a["magnitude_relative_difference"]) + "%)"});
+  };
+  for (const auto& branch : sweep.branches) {
+    const DemBranchPeak bp = dem_branch_peak(branch);
+    for (const DemPoint* p : bp.ascending) {
+      dem_points.push_back({p->f, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, branch.sweep});
+      dem_list.push_back({{"sweep", branch.sweep}, {"frequency_hz", p->f}, {"magnitude", p->magnitude.front()},
+                          {"magnitude_spread", number_or_null(p->spread)},
+                          {"magnitude_standard_error", number_or_null(p->standard_error)},
+                          {"energy_error", p->energy_error}, {"stable", p->stable}});
+    }
+    dem_peaks.push_back(dem_peak_json(output, branch, bp));
+    const json a_formulas = agreement_json(first_output_peak(f_response), bp.peak);
+    const json a_field = field_response ? agreement_json(first_output_peak(*field_response), bp.peak) : json(nullptr);
+    agreement.push_back({{"reference", "dem " + branch.sweep}, {"formulas", a_formulas}, {"field", a_field}});
+    rows.push_back({"peak dem " + branch.sweep, dem_peak_row(bp, branch.points.size())});
+    row("peak formulas vs " + branch.sweep, a_formulas);
+    row("peak field vs " + branch.sweep, a_field);
   }
   if (files)
     warnings.add(write_frf_compare_files(*files, f_response, field_response ? &*field_response : nullptr, dem_points,
@@ -1154,17 +1318,9 @@ int run_frf_compare(const ParsedArgs& args, const Case& c) {
       {"output", output},
       {"formulas", {{"peaks", f_peaks}}},
       {"field", field_response ? json{{"peaks", field_peaks}} : json(nullptr)},
-      {"dem", {{"peak", {{"output", output}, {"frequency_hz", dem_peak.f}, {"magnitude", dem_peak.magnitude.front()},
-                         {"magnitude_spread", number_or_null(dem_peak.spread)}}},
-               {"points", dem_list},
-               {"bed_carried_over", true},
-               {"peak_note", "the largest of the stepped-sine points: its frequency is resolved to the point spacing"}}},
-      {"agreement",
-       {{"reference", "dem"},
-        {"definition", "(method - dem) / dem of the largest peak of the first output"},
-        {"formulas", agreement_json(first_output_peak(f_response), dem_peak.f, dem_peak.magnitude.front())},
-        {"field", field_response ? agreement_json(first_output_peak(*field_response), dem_peak.f, dem_peak.magnitude.front())
-                                 : json(nullptr)}}},
+      {"dem", {{"peaks", dem_peaks}, {"points", dem_list}, {"bed_carried_over", true}, {"peak_note", kDemPeakNote}}},
+      {"agreement_definition", "(method - dem) / dem of the largest peak of the first output, per DEM sweep direction"},
+      {"agreement", agreement},
       {"file", file_json(files.get(), "frf_compare.csv")},
       {"plot", file_json(files.get(), "frf_compare.png")},
       {"dem_solve_time_s", sweep.solve_time}};
@@ -1173,21 +1329,6 @@ int run_frf_compare(const ParsedArgs& args, const Case& c) {
   result["peaks"] = f_peaks;  // the contract's peaks: the formulas' (compare holds all three)
   result["branches"] = json::array();
   result["compare"] = compare;
-  std::vector<std::pair<std::string, std::string>> rows = {{"method", "compare (formulas, field, dem)"}};
-  const auto row = [&](const std::string& name, const json& a) {
-    if (a.is_null()) {
-      rows.push_back({name, "-"});
-      return;
-    }
-    rows.push_back({name, format_number(a["frequency_hz"].get<double>(), 6) + " Hz, |out| = " +
-                              format_number(a["magnitude"].get<double>(), 4) + " (vs dem: f " +
-                              format_number(100.0 * a["frequency_relative_difference"].get<double>(), 3) + "%, |out| " +
-                              format_number(100.0 * a["magnitude_relative_difference"].get<double>(), 3) + "%)"});
-  };
-  row("peak formulas", compare["agreement"]["formulas"]);
-  row("peak field", compare["agreement"]["field"]);
-  rows.push_back({"peak dem", format_number(dem_peak.f, 6) + " Hz, |out| = " + format_number(dem_peak.magnitude.front(), 4) +
-                                  " (largest of " + std::to_string(sweep.points.size()) + " points)"});
   return finish(args, c, files.get(), "frf.json", result, warnings, rows);
 }
 
@@ -1318,17 +1459,17 @@ std::vector<Command> structure_commands() {
                                     "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
        run_modes},
-      {{"frf", "pdamp frf CASE.json [--method formulas|field|dem | --compare] [--dem-points N] [-o DIR] [--json]",
+      {{"frf", "pdamp frf CASE.json [--method formulas|field|dem | --compare] [--dem-points N] [--dem-sweep D] [-o DIR] [--json]",
         "frequency response of the structure with its dampers (task kind frf): every harmonic-\n"
         "balance root, its stability, branches, jumps and peaks, and the response without beds",
-        {kMethodFlag, kDemPointsFlag,
+        concat_flags({kMethodFlag,
          {"--compare", "", "run formulas, field (when every layer has a field_file, else skipped\n"
                            "                          with a warning) and dem on the case: one figure frf_compare.png/svg,\n"
                            "                          frf_compare.csv, and the peaks' relative differences from dem"},
          {"-o", "DIR", "write frf.csv, frf_branches.csv, frf.gp/png/svg (dem: frf_dem.csv,\n"
                        "                          frf_dem.gp/png/svg; --compare: frf_compare.csv/gp/png/svg), frf.json\n"
                        "                          and case_resolved.json into DIR, atomically"},
-         kJsonFlag}, 1},
+         kJsonFlag}, kDemSweepFlags), 1},
        run_frf},
       {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [-o DIR] [--json]",
         "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"

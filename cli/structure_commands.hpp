@@ -19,9 +19,10 @@ namespace pdamp::cli {
 
 /// `--method formulas|field|dem` (default formulas), shared with pdamp run.
 extern const FlagSpec kMethodFlag;
-/// `--dem-points N` of pdamp frf --method dem (default 9); pdamp run must list it among its
-/// flags to accept it on an frf task (without it, run uses the default).
-extern const FlagSpec kDemPointsFlag;
+/// The stepped sine's flags of pdamp frf --method dem (--dem-points, --dem-min-frequency,
+/// --dem-max-frequency, --dem-sweep); pdamp run lists them among its flags to accept them
+/// on an frf task (without them, run uses the defaults).
+extern const std::vector<FlagSpec> kDemSweepFlags;
 
 /// pdamp modes, frf and decay, in the order `pdamp --help` lists them.
 std::vector<Command> structure_commands();

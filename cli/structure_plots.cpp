@@ -315,23 +315,34 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
 
 std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
                                             const std::string& magnitude_label, const std::string& title) {
-  const std::size_t spread_column = 2 + 2 * damper_names.size();  // 1-based
+  // frf_dem.csv: sweep, frequency_hz, then magnitude and phase per damper, then the spread.
+  const std::size_t spread_column = 3 + 2 * damper_names.size();  // 1-based
   std::ostringstream gp;
   gp << "# stepped-sine frequency response of pdamp frf --method dem (first harmonic at each frequency,\n"
-     << "# error bars: the spread over the analysed periods); run: gnuplot frf_dem.gp\n"
-     << "set datafile separator ','\nset grid\n";
+     << "# up and down in frequency; error bars: the spread over the analysed periods); run: gnuplot frf_dem.gp\n"
+     << "set datafile separator ','\nset grid\n"
+     << "sel(s, c) = (stringcolumn(1) eq s) ? column(c) : 1/0\n";
   gp << "do for [t in 'pngcairo svg'] {\n"
      << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'frf_dem.svg' : 'frf_dem.png'\n"
      << "  set title " << gnuplot_string(title) << " noenhanced\n"
      << "  set logscale y\n  set key top right\n  set xlabel 'frequency / Hz'\n  set ylabel "
-     << gnuplot_string(magnitude_label) << " noenhanced\n"
-     << "  plot 'frf_dem.csv' using 1:2:" << spread_column << " with yerrorbars pt 7 lc rgb '" << colour(0)
-     << "' notitle, '' using 1:2 with lines lw 2 lc rgb '" << colour(0) << "' title "
-     << gnuplot_string(damper_names.front()) << " noenhanced";
-  for (std::size_t d = 1; d < damper_names.size(); ++d)
-    gp << ", \\\n       '' using 1:" << 2 + 2 * d << " with linespoints lw 2 pt 7 lc rgb '" << colour(d) << "' title "
-       << gnuplot_string(damper_names[d]) << " noenhanced";
+     << gnuplot_string(magnitude_label) << " noenhanced\n  plot ";
+  // The first damper's points carry the spread as error bars.
+  const std::string errorbars = std::string(":").append(std::to_string(spread_column)).append(" with yerrorbars");
+  bool first = true;
+  for (std::size_t d = 0; d < damper_names.size(); ++d)
+    for (const char* sweep : {"up", "down"}) {
+      const bool up = std::string(sweep) == "up";
+      const std::string column = std::to_string(3 + 2 * d);
+      const std::string name = gnuplot_string(damper_names[d] + ", " + sweep);
+      if (!first) gp << ", \\\n       ";
+      first = false;
+      gp << "'frf_dem.csv' using 2:(sel('" << sweep << "', " << column << "))"
+         << (d == 0 ? errorbars : std::string(" with points")) << " pt "
+         << (up ? 7 : 6) << " lc rgb '" << colour(d) << "' notitle, '' using 2:(sel('" << sweep << "', " << column
+         << ")) with lines lw 2 dt " << (up ? 1 : 2) << " lc rgb '" << colour(d) << "' title " << name << " noenhanced";
+    }
   gp << "\n}\n";
   return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
 }
@@ -362,7 +373,7 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
   if (field) branches(*field, "field");
   if (!first) csv << '\n';
   for (const auto& p : dem)
-    csv << "dem,0," << p.frequency_hz << ",dem," << p.magnitude << ',' << p.spread << '\n';
+    csv << "dem_" << p.sweep << ",0," << p.frequency_hz << ",dem," << p.magnitude << ',' << p.spread << '\n';
   out.add("frf_compare.csv", csv.str());
 
   std::ostringstream gp;
@@ -384,8 +395,10 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
     gp << "       '' using 3:(sel('field', 'stable', 5)) with lines lw 2 lc rgb '" << colour(1) << "' title 'field', \\\n"
        << "       '' using 3:(sel('field', 'unstable', 5)) with lines lw 2 dt 2 lc rgb '" << colour(1)
        << "' title 'field, unstable', \\\n";
-  gp << "       '' using 3:(sel('dem', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
-     << "' title 'DEM (stepped sine)'\n}\n";
+  gp << "       '' using 3:(sel('dem_up', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
+     << "' title 'DEM, stepped sine up', \\\n"
+     << "       '' using 3:(sel('dem_down', 'dem', 5)):6 with yerrorbars pt 6 ps 1.2 lc rgb '" << colour(3)
+     << "' title 'DEM, stepped sine down'\n}\n";
   return out.add_plot("frf_compare.gp", gp.str(), {"frf_compare.png", "frf_compare.svg"});
 }
 

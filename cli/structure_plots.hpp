@@ -64,6 +64,7 @@ struct CompareDemPoint {
   double frequency_hz = 0.0;
   double magnitude = 0.0;
   double spread = 0.0;  ///< sample standard deviation over the analysed periods (0 if not defined)
+  std::string sweep;    ///< "up" or "down"
 };
 
 /// frf_compare.csv (source,branch,frequency_hz,stability,magnitude,magnitude_spread: the

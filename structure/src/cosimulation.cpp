@@ -71,6 +71,23 @@ std::string join(const std::vector<std::string>& lines) {
 
 }  // namespace
 
+bool amplitudes_settled(const std::vector<double>& period_amplitudes, double tolerance) {
+  constexpr std::size_t w = kSettledWindowPeriods;
+  const std::size_t n = period_amplitudes.size();
+  if (n < 2 * w) return false;
+  double a = 0.0, b = 0.0;
+  for (std::size_t k = 0; k < w; ++k) a += period_amplitudes[n - 1 - k], b += period_amplitudes[n - 1 - w - k];
+  a /= static_cast<double>(w);
+  b /= static_cast<double>(w);
+  double ss = 0.0;
+  for (std::size_t k = 0; k < w; ++k) {
+    ss += (period_amplitudes[n - 1 - k] - a) * (period_amplitudes[n - 1 - k] - a);
+    ss += (period_amplitudes[n - 1 - w - k] - b) * (period_amplitudes[n - 1 - w - k] - b);
+  }
+  const double pooled_sd = std::sqrt(ss / static_cast<double>(2 * w - 2));
+  return std::abs(a - b) <= tolerance * a + 2.0 * pooled_sd * std::sqrt(2.0 / static_cast<double>(w));
+}
+
 dem::Matrix3 rotation_about(const dem::Vec3& k, double angle_rad) {
   const double c = std::cos(angle_rad), s = std::sin(angle_rad), t = 1.0 - c;
   return {t * k[0] * k[0] + c,        t * k[0] * k[1] - s * k[2], t * k[0] * k[2] + s * k[1],
@@ -684,9 +701,8 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
           ss.period_site_amplitudes_m.push_back(amplitude);
         if (!analysing) {
           const auto& a = ss.period_site_amplitudes_m;
-          if (options.settle_until_stable && a.size() >= 2) {
-            const double change = std::abs(a[a.size() - 1] - a[a.size() - 2]) / std::max(a.back(), 1e-300);
-            calm_periods = change < options.stable_tolerance ? calm_periods + 1 : 0;
+          if (options.settle_until_stable) {
+            calm_periods = amplitudes_settled(a, options.stable_tolerance) ? calm_periods + 1 : 0;
             if (calm_periods >= 2) ss.stable = true;
           }
           if (ss.stable || step >= transient_steps) {

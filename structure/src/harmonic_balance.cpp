@@ -10,6 +10,7 @@
 //   (I + G·diag Z(X)) y = y_lin,   X_d = |y_d|,
 // a D-dimensional problem whatever the number of modes.
 #include "pdamp/structure/harmonic_balance.hpp"
+#include "pdamp/structure/sampled_response.hpp"
 #include "numbers.hpp"
 
 #include <algorithm>
@@ -664,33 +665,12 @@ void find_peaks(const std::vector<double>& f, const std::vector<double>& c, std:
     ResponsePeak peak;
     peak.output = output;
     peak.magnitude = c[k];
-    if (end > k) {
-      peak.frequency_hz = 0.5 * (f[k] + f[end]);
-    } else {
-      // Vertex of the parabola through the three samples (non-uniform spacing).
-      const double x0 = f[k - 1], x1 = f[k], x2 = f[k + 1];
-      const double y0 = c[k - 1], y1 = c[k], y2 = c[k + 1];
-      const double num = (x1 - x0) * (x1 - x0) * (y1 - y2) - (x1 - x2) * (x1 - x2) * (y1 - y0);
-      const double den = (x1 - x0) * (y1 - y2) - (x1 - x2) * (y1 - y0);
-      peak.frequency_hz = den != 0.0 ? x1 - 0.5 * num / den : x1;
-    }
-    const double half = c[k] / std::sqrt(2.0);
-    double f_lo = kNaN, f_hi = kNaN;
-    for (std::size_t i = k; i > 0; --i) {
-      if (!std::isfinite(c[i - 1])) break;
-      if (c[i - 1] < half) {
-        f_lo = f[i - 1] + (half - c[i - 1]) / (c[i] - c[i - 1]) * (f[i] - f[i - 1]);
-        break;
-      }
-    }
-    for (std::size_t i = end; i + 1 < n; ++i) {
-      if (!std::isfinite(c[i + 1])) break;
-      if (c[i + 1] < half) {
-        f_hi = f[i] + (c[i] - half) / (c[i] - c[i + 1]) * (f[i + 1] - f[i]);
-        break;
-      }
-    }
-    peak.damping_ratio = (f_hi - f_lo) / (2.0 * peak.frequency_hz);
+    peak.frequency_hz = end > k ? 0.5 * (f[k] + f[end])
+                                : parabola_vertex(f[k - 1], c[k - 1], f[k], c[k], f[k + 1], c[k + 1]);
+    const LevelCrossings half_power = level_crossings(f, c, k, end, c[k] / std::sqrt(2.0));
+    const LevelCrossings band = outer_level_crossings(f, c, k, kResonanceBandFraction * c[k]);
+    peak.band_centre_hz = 0.5 * (band.low_hz + band.high_hz);
+    peak.damping_ratio = (half_power.high_hz - half_power.low_hz) / (2.0 * peak.frequency_hz);
     peaks.push_back(peak);
     k = end;
   }

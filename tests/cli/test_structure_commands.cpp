@@ -214,7 +214,7 @@ TEST_CASE("pdamp decay --method dem: settling time, damping ratio, energy error 
   require_files(dir.path, {"decay_dem.csv", "decay_dem.gp", "decay.json", "case_resolved.json"});
 }
 
-TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies", "[cli][structure][dem]") {
+TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies, up and down", "[cli][structure][dem]") {
   const TempDir dir("frf_dem");
   const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 3 --json -o " +
                            dir.path.string());
@@ -224,26 +224,55 @@ TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies", 
   for (const char* key : {"file", "peaks", "branches", "warnings", "frf", "outputs"}) CHECK(out.contains(key));
   CHECK(out["method"] == "dem");
   const json& points = out["frf"]["points"];
-  REQUIRE(points.size() == 3);
-  // Up in frequency, each from the previous final state (bed included); the frequency run is
-  // the nearest whole number of the sweep's step per period (within 1/(2N), N ~ 6e4 here).
+  REQUIRE(points.size() == 6);
+  // Up, then down in frequency, each from the previous final state (bed included); the
+  // frequency run is the nearest whole number of the sweep's step per period (within
+  // 1/(2N), N ~ 6e4 here).
   CHECK(out["bed_carried_over"] == true);
-  CHECK(out["frf"]["stepped_sine"]["bed_carried_over"] == true);
+  CHECK(out["frf"]["stepped_sine"]["sweeps"] == json::array({"up", "down"}));
+  for (int k = 0; k < 3; ++k) {
+    CHECK(points[k]["sweep"] == "up");
+    CHECK(points[3 + k]["sweep"] == "down");
+    CHECK(points[k]["requested_frequency_hz"].get<double>() == Approx(1.2 + 0.4 * k));
+    CHECK(points[3 + k]["requested_frequency_hz"].get<double>() == Approx(2.0 - 0.4 * k));
+  }
   CHECK(points[0]["frequency_hz"].get<double>() == Approx(1.2).epsilon(1e-4));
-  CHECK(points[2]["frequency_hz"].get<double>() == Approx(2.0).epsilon(1e-4));
-  CHECK(points[2]["requested_frequency_hz"].get<double>() == 2.0);
   CHECK(points[0]["time_step_s"] == points[2]["time_step_s"]);  // one step for the sweep
   for (const auto& p : points) {
     CHECK(p["energy_error"].get<double>() < 0.01);
     CHECK(p["magnitude"]["damper_1"].get<double>() > 0.0);
   }
-  // The mode with the container (2 Hz·√(0.5/0.8) = 1.58 Hz) is nearest the middle point.
-  REQUIRE(out["peaks"].size() == 1);
-  CHECK(out["peaks"][0]["frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
-  CHECK(out["peaks"][0]["magnitude"].get<double>() > points[0]["magnitude"]["damper_1"].get<double>());
+  // The mode with the container (2 Hz·√(0.5/0.8) = 1.58 Hz) is nearest the middle point;
+  // the parabola through the three points puts the peak within their span, and a 0.4 Hz
+  // spacing on a peak places it to about 10%.
+  REQUIRE(out["peaks"].size() == 2);
+  for (const auto& peak : out["peaks"]) {
+    CHECK(peak["largest_point_frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
+    CHECK(peak["frequency_hz"].get<double>() == Approx(1.58).epsilon(0.1));
+    CHECK(peak["magnitude"].get<double>() > points[0]["magnitude"]["damper_1"].get<double>());
+    CHECK(peak["indistinguishable_low_hz"].get<double>() <= peak["largest_point_frequency_hz"].get<double>());
+  }
   require_files(dir.path, {"frf_dem.csv", "frf_dem.gp", "frf.json", "case_resolved.json"});
-  // Bad input: out of range --dem-points is exit 2.
+  // Bad input is exit 2: --dem-points out of range, an unknown direction, an empty band.
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 1").exit_code == 2);
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-sweep sideways"),
+                         "--dem-sweep: 'sideways': must be up, down or both");
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") +
+                                   " --method dem --dem-min-frequency 2 --dem-max-frequency 1.5"),
+                         "--dem-max-frequency: 1.5 Hz: must exceed the lowest frequency 2 Hz");
+}
+
+TEST_CASE("pdamp frf --method dem --dem-sweep up: one direction over the given band", "[cli][structure][dem]") {
+  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") +
+                           " --method dem --dem-sweep up --dem-points 2 --dem-min-frequency 1.5 --dem-max-frequency 1.7 --json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  const json& points = out["frf"]["points"];
+  REQUIRE(points.size() == 2);
+  CHECK(points[0]["requested_frequency_hz"].get<double>() == 1.5);
+  CHECK(points[1]["requested_frequency_hz"].get<double>() == 1.7);
+  CHECK(out["frf"]["stepped_sine"]["parallel"] == false);
 }
 
 // --compare: formulas, field (skipped here: the layer has no field_file) and the DEM stepped
@@ -261,16 +290,24 @@ TEST_CASE("pdamp frf --compare: formulas, field and DEM in one figure with the p
   REQUIRE(c["formulas"]["peaks"].size() == 1);
   CHECK(c["field"].is_null());
   CHECK(r.err.find("the field curve is skipped") != std::string::npos);
-  REQUIRE(c["dem"]["points"].size() == 3);
-  CHECK(c["dem"]["peak"]["frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
-  CHECK(c["dem"]["peak"]["magnitude"].get<double>() > 0.0);
-  const json& a = c["agreement"]["formulas"];
-  for (const char* key : {"frequency_relative_difference", "magnitude_relative_difference"}) CHECK(a.contains(key));
-  const double f_formulas = c["formulas"]["peaks"][0]["frequency_hz"].get<double>();
-  const double f_dem = c["dem"]["peak"]["frequency_hz"].get<double>();
-  CHECK(a["frequency_relative_difference"].get<double>() == Approx((f_formulas - f_dem) / f_dem));
-  CHECK(std::abs(a["frequency_relative_difference"].get<double>()) < 0.1);  // both near the 1.58 Hz mode
-  CHECK(c["agreement"]["field"].is_null());
+  REQUIRE(c["dem"]["points"].size() == 6);  // up and down
+  REQUIRE(c["dem"]["peaks"].size() == 2);
+  REQUIRE(c["agreement"].size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const json& peak = c["dem"]["peaks"][k];
+    CHECK(peak["largest_point_frequency_hz"].get<double>() == Approx(1.6).epsilon(1e-4));
+    CHECK(peak["magnitude"].get<double>() > 0.0);
+    const json& a = c["agreement"][k]["formulas"];
+    CHECK(c["agreement"][k]["reference"] == (k == 0 ? "dem up" : "dem down"));
+    for (const char* key : {"frequency_relative_difference", "magnitude_relative_difference",
+                            "band_centre_relative_difference", "frequency_within_dem_indistinguishable"})
+      CHECK(a.contains(key));
+    const double f_formulas = c["formulas"]["peaks"][0]["frequency_hz"].get<double>();
+    const double f_dem = peak["frequency_hz"].get<double>();
+    CHECK(a["frequency_relative_difference"].get<double>() == Approx((f_formulas - f_dem) / f_dem));
+    CHECK(std::abs(a["frequency_relative_difference"].get<double>()) < 0.1);  // both near the 1.58 Hz mode
+    CHECK(c["agreement"][k]["field"].is_null());
+  }
   require_files(dir.path, {"frf_compare.csv", "frf_compare.gp", "frf.json", "case_resolved.json"});
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --method dem").exit_code == 2);
 }

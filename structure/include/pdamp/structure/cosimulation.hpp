@@ -76,9 +76,9 @@ struct CosimulationOptions {
   int transient_periods = 0;
   /// Harmonic kinds: whole periods of the DFT (steady-state amplitudes), >= 1.
   int analysed_periods = 1;
-  /// Harmonic kinds: end the transient once the period-to-period relative change of the
-  /// first damper's site amplitude along its drive (DFT at Ω of each period) has stayed
-  /// below stable_tolerance for two periods in a row.
+  /// Harmonic kinds: end the transient once the first damper's site amplitude along its
+  /// drive (DFT at Ω of each period) has stopped drifting: amplitudes_settled on the
+  /// periods run so far, at two period ends in a row.
   bool settle_until_stable = false;
   double stable_tolerance = 1e-3;  ///< in (0, 1)
   /// Bed settling before the coupling starts, with the structure held in its initial state
@@ -256,6 +256,18 @@ CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::
                                             const CosimulationOptions& options);
 
 /// Rodrigues rotation about a unit axis by angle θ (rad), row-major (body → world).
+/// Periods averaged by each of the two windows of amplitudes_settled.
+inline constexpr std::size_t kSettledWindowPeriods = 4;
+
+/// The steady-state test of a stepped sine, made for a DEM bed whose per-period amplitude
+/// scatters by a few per cent (chaotic impacts), so a period-to-period change never stays
+/// below a tight tolerance: the means A (last kSettledWindowPeriods amplitudes) and B (the
+/// ones before) agree, |A − B| <= tolerance·A + 2·s·√(2/w), s the pooled sample standard
+/// deviation of the two windows. A drift that the scatter hides is accepted only up to
+/// twice the standard error of A − B; a smooth response (no bed) has s ≈ 0 and meets
+/// the tolerance alone. False with fewer than 2w amplitudes.
+bool amplitudes_settled(const std::vector<double>& period_amplitudes, double tolerance);
+
 dem_reference::Matrix3 rotation_about(const dem_reference::Vec3& unit_axis, double angle_rad);
 
 }  // namespace pdamp::structure

@@ -128,6 +128,10 @@ struct ResponsePeak {
   /// (linear interpolation between grid frequencies); NaN where a crossing is missing in
   /// the grid. Exact to O(ζ²) for an isolated linear mode.
   double damping_ratio = 0.0;
+  /// Centre of the band where the curve stays ≥ kResonanceBandFraction × magnitude
+  /// (sampled_response.hpp: a flat top's better-conditioned resonance frequency); NaN
+  /// where an edge is missing in the grid.
+  double band_centre_hz = 0.0;
 };
 
 struct FrequencyResponse {

@@ -1,0 +1,123 @@
+// The resonance measures of a sampled response (structure/sampled_response.hpp) and the
+// stepped sine's steady-state test (amplitudes_settled), against curves whose answers are
+// known in closed form.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "pdamp/structure/cosimulation.hpp"
+#include "pdamp/structure/sampled_response.hpp"
+
+namespace st = pdamp::structure;
+
+namespace {
+
+/// |H| of a base-excited SDOF, absolute transmissibility: √(1 + (2ζr)²)/√((1 − r²)² + (2ζr)²).
+double transmissibility(double f, double fn, double zeta) {
+  const double r = f / fn, a = 2.0 * zeta * r;
+  return std::sqrt(1.0 + a * a) / std::sqrt((1.0 - r * r) * (1.0 - r * r) + a * a);
+}
+
+}  // namespace
+
+TEST_CASE("sampled_peak: a parabola's vertex and a tent's 0.9 band are exact", "[structure][sampled_response]") {
+  // c = 10 − (f − 1.73)² on a coarse non-uniform grid: the parabola through any three
+  // samples is the curve itself, so the vertex is 1.73.
+  const std::vector<double> f = {0.73, 1.1, 1.6, 1.9, 2.3, 2.73};
+  std::vector<double> parabola, tent;
+  for (double x : f) parabola.push_back(10.0 - (x - 1.73) * (x - 1.73));
+  const auto peak = st::sampled_peak(f, parabola);
+  CHECK(peak.index == 2);
+  CHECK(peak.frequency_hz == Approx(1.73).epsilon(1e-12));
+  // Without standard errors the argmax is the peak sample.
+  CHECK(peak.indistinguishable_low_hz == 1.6);
+  CHECK(peak.indistinguishable_high_hz == 1.6);
+  // c = 10 − 2|f − 1.73| is linear on each flank, so is the interpolation: the level 0.9
+  // of the largest sample (9.74 at 1.6) is crossed at 1.73 ± (10 − 0.9·9.74)/2 exactly
+  // (the samples there bracket it on one flank each).
+  for (double x : f) tent.push_back(10.0 - 2.0 * std::abs(x - 1.73));
+  const auto band = st::sampled_peak(f, tent);
+  const double half_width = (10.0 - 0.9 * 9.74) / 2.0;
+  CHECK(band.band.low_hz == Approx(1.73 - half_width).epsilon(1e-12));
+  CHECK(band.band.high_hz == Approx(1.73 + half_width).epsilon(1e-12));
+  CHECK(band.band_centre_hz == Approx(1.73).epsilon(1e-12));
+}
+
+TEST_CASE("sampled_peak: the argmax of a linear mode, and a held plateau's band centre", "[structure][sampled_response]") {
+  // A damped transmissibility (ζ = 0.25, fn = 1.8 Hz) sampled every 0.05 Hz: the parabola
+  // finds the linear SDOF's transmissibility peak r = √(√(1 + 8ζ²) − 1)/(2ζ) within 1%.
+  const double fn = 1.8;
+  std::vector<double> f;
+  for (double x = 1.0; x <= 2.6 + 1e-9; x += 0.05) f.push_back(x);
+  const auto sampled = [&](auto&& curve) {
+    std::vector<double> c;
+    for (double x : f) c.push_back(curve(x));
+    return c;
+  };
+  const double zeta = 0.25;
+  const double r_peak = std::sqrt(std::sqrt(1.0 + 8.0 * zeta * zeta) - 1.0) / (2.0 * zeta);
+  CHECK(st::sampled_peak(f, sampled([&](double x) { return transmissibility(x, fn, zeta); })).frequency_hz ==
+        Approx(r_peak * fn).epsilon(0.01));
+  // A damper that holds its stroke (the amplitude-limited plateau of a tuned particle
+  // damper): a lightly damped mode capped at 3.4, the cap tilted by ±1.5% across the band
+  // (a DEM bed's scatter, a slightly different loss model). The argmax jumps from one end
+  // of the plateau to the other; the band's centre, set by the steep flanks, stays put.
+  const auto capped = [&](double tilt) {
+    return sampled([&](double x) { return std::min(transmissibility(x, fn, 0.01), 3.4 * (1.0 + tilt * (x - fn))); });
+  };
+  const auto up = st::sampled_peak(f, capped(0.03));
+  const auto down = st::sampled_peak(f, capped(-0.03));
+  const double argmax_shift = std::abs(up.frequency_hz - down.frequency_hz);
+  const double centre_shift = std::abs(up.band_centre_hz - down.band_centre_hz);
+  CHECK(argmax_shift > 0.2);         // of the plateau's width (T > 3.4 for 1.3 < f < 2.1 Hz about)
+  CHECK(centre_shift < 0.1 * argmax_shift);
+}
+
+TEST_CASE("sampled_peak: standard errors widen the argmax's range to the points it cannot be told from",
+          "[structure][sampled_response]") {
+  const std::vector<double> f = {1.0, 1.1, 1.2, 1.3, 1.4};
+  const std::vector<double> c = {2.0, 3.1, 3.3, 3.15, 2.0};
+  // se 0.05: 3.3 − 0.1 = 3.2; 3.1 + 0.1 = 3.2 (in), 3.15 + 0.1 (in), 2 + 0.1 (out).
+  const auto peak = st::sampled_peak(f, c, {0.05, 0.05, 0.05, 0.05, 0.05});
+  CHECK(peak.indistinguishable_low_hz == 1.1);
+  CHECK(peak.indistinguishable_high_hz == 1.3);
+  CHECK(std::isnan(st::sampled_peak({1.0, 2.0}, {1.0, 2.0}).band.high_hz));  // no fall on the right
+  // A dip inside the band (a DEM point's scatter) does not cut it: the outermost crossings.
+  const auto dipped = st::sampled_peak({1.0, 1.1, 1.2, 1.3, 1.4, 1.5}, {1.0, 3.0, 3.3, 2.9, 3.1, 1.0});
+  CHECK(dipped.band.low_hz == Approx(1.0 + 0.1 * (2.97 - 1.0) / 2.0));
+  CHECK(dipped.band.high_hz == Approx(1.4 + 0.1 * (3.1 - 2.97) / 2.1));
+  CHECK_THROWS_AS(st::sampled_peak({1.0, 1.0}, {1.0, 2.0}), std::invalid_argument);
+  CHECK_THROWS_AS(st::sampled_peak({1.0, 2.0}, {1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(st::sampled_peak({1.0, 2.0}, {1.0, 2.0}, {0.1, -0.1}), std::invalid_argument);
+}
+
+TEST_CASE("amplitudes_settled: stationary scatter settles, a drift beyond the scatter does not",
+          "[structure][cosimulation]") {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.04);  // 4% per-period scatter, as a DEM bed
+  const std::size_t w = st::kSettledWindowPeriods;
+  std::vector<double> drifting, smooth_decay;
+  for (std::size_t k = 0; k < 2 * w; ++k) {
+    // A transient decaying 15% per period: the windows differ by far more than the scatter.
+    drifting.push_back(1.0 + std::pow(0.85, static_cast<double>(k)) + 0.01 * noise(rng));
+    smooth_decay.push_back(1.0 + 0.2 * std::exp(-0.05 * static_cast<double>(k)));
+  }
+  // Over many draws the stationary series is accepted about 95% of the time (2 standard
+  // errors); the window test is not a lottery as a 1% period-to-period test is.
+  int accepted = 0, trials = 2000;
+  for (int t = 0; t < trials; ++t) {
+    std::vector<double> a;
+    for (std::size_t k = 0; k < 2 * w; ++k) a.push_back(1.0 + noise(rng));
+    accepted += st::amplitudes_settled(a, 1e-2) ? 1 : 0;
+  }
+  CHECK(accepted > 0.9 * trials);
+  CHECK_FALSE(st::amplitudes_settled(drifting, 1e-2));
+  // No scatter, a slow decay: window means 1.186 and 1.152 (2.9% apart), the trend inside a
+  // window adds 2·s·√(2/w) = 0.9%: 1% does not accept it, 5% does.
+  CHECK_FALSE(st::amplitudes_settled(smooth_decay, 1e-2));
+  CHECK(st::amplitudes_settled(smooth_decay, 5e-2));
+  CHECK_FALSE(st::amplitudes_settled(std::vector<double>(2 * w - 1, 1.0), 1e-2));  // too few periods
+}
