@@ -203,9 +203,11 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
     }
     if (line_number == 1) {
       if (value != header) {
-        throw std::invalid_argument(file_name + ": line 1: this results file belongs to another sweep (" +
-                                    header_difference(value, header) +
-                                    "); delete or move it to start a new sweep, its points are not mixed in");
+        // printable(): the difference quotes the file's values, and dump() leaves DEL and
+        // other bytes that are not JSON control characters as they are (fuzz_sweep_log).
+        throw std::invalid_argument(strict_json::printable(
+            file_name + ": line 1: this results file belongs to another sweep (" + header_difference(value, header) +
+            "); delete or move it to start a new sweep, its points are not mixed in"));
       }
       continue;
     }
