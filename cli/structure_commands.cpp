@@ -870,6 +870,7 @@ struct DemPoint {
   std::string sweep;  ///< "up" or "down"
   double f = 0.0, requested_f = 0.0;
   std::vector<double> magnitude, phase_deg;
+  std::vector<double> bed_eta_star, bed_apparent_mass_fraction;  ///< per damper, in the loop (Level II measure)
   double spread = NAN;          ///< sample standard deviation of the analysed periods' |ŷ|, per unit excitation
   double standard_error = NAN;  ///< spread/√(analysed periods): periods taken as independent
   double energy_error = 0.0;
@@ -940,6 +941,8 @@ DemBranch run_dem_branch(const Case& c, const st::ModalModel& modal, const std::
     for (std::size_t d = 0; d < dampers.size(); ++d) {
       p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
       p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
+      p.bed_eta_star.push_back(ss.bed_reduced_loss_factor.at(d));
+      p.bed_apparent_mass_fraction.push_back(ss.bed_apparent_mass_fraction.at(d));
     }
     // Spread: sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation.
     const auto& per = ss.period_site_amplitudes_m;
@@ -1129,10 +1132,15 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
     }
     rows.push_back({"peak " + branch.sweep + " " + dampers.front().name, dem_peak_row(bp, branch.points.size())});
     for (const auto& p : branch.points) {
-      json magnitude = json::object(), phase = json::object();
-      for (std::size_t d = 0; d < outputs; ++d) magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
+      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
+      for (std::size_t d = 0; d < outputs; ++d) {
+        magnitude[dampers[d].name] = p.magnitude[d], phase[dampers[d].name] = p.phase_deg[d];
+        eta[dampers[d].name] = number_or_null(p.bed_eta_star[d]);
+        mass[dampers[d].name] = number_or_null(p.bed_apparent_mass_fraction[d]);
+      }
       list.push_back({{"sweep", p.sweep}, {"frequency_hz", p.f}, {"requested_frequency_hz", p.requested_f},
                       {"magnitude", magnitude}, {"phase_deg", phase},
+                      {"bed_eta_star", eta}, {"bed_apparent_mass_fraction", mass},
                       {"magnitude_spread", number_or_null(p.spread)},
                       {"magnitude_standard_error", number_or_null(p.standard_error)}, {"energy_error", p.energy_error},
                       {"transient_periods", p.transient}, {"stable", p.stable}, {"steps", p.steps},
@@ -1140,7 +1148,9 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
       rows.push_back({branch.sweep + " " + format_number(p.f, 6) + " Hz",
                       "|out| = " + format_number(p.magnitude.front(), 4) +
                           (std::isfinite(p.standard_error) ? " +- " + format_number(p.standard_error, 2) : "") +
-                          ", energy error " + format_number(p.energy_error, 2)});
+                          ", bed eta* " + format_number(p.bed_eta_star.front(), 3) + ", m_app/m_bed " +
+                          format_number(p.bed_apparent_mass_fraction.front(), 3) + ", energy error " +
+                          format_number(p.energy_error, 2)});
     }
   }
   const std::string magnitude_label = base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
@@ -1150,14 +1160,17 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
     csv << "sweep,frequency_hz";
     for (const auto& d : dampers) csv << ",magnitude_" << safe_file_name(d.name) << ",phase_deg_" << safe_file_name(d.name);
     csv << ",magnitude_spread_" << safe_file_name(dampers.front().name) << ",magnitude_standard_error_"
-        << safe_file_name(dampers.front().name) << ",energy_error,transient_periods,stable,steps,time_step_s\n";
+        << safe_file_name(dampers.front().name) << ",bed_eta_star_" << safe_file_name(dampers.front().name)
+        << ",bed_apparent_mass_fraction_" << safe_file_name(dampers.front().name)
+        << ",energy_error,transient_periods,stable,steps,time_step_s\n";
     for (const auto& branch : sweep.branches)
       for (const DemPoint* p : dem_branch_peak(branch).ascending) {
         csv << p->sweep << ',' << p->f;
         for (std::size_t d = 0; d < outputs; ++d) csv << ',' << p->magnitude[d] << ',' << p->phase_deg[d];
         csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
-            << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->energy_error << ','
-            << p->transient << ',' << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->dt << '\n';
+            << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->bed_eta_star.front() << ','
+            << p->bed_apparent_mass_fraction.front() << ',' << p->energy_error << ',' << p->transient << ','
+            << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->dt << '\n';
       }
     files->add("frf_dem.csv", csv.str());
     std::vector<std::string> names;

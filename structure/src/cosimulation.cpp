@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -623,7 +624,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
 
   // DFT accumulators: per period (first damper's site, for the stability test) and analysed.
   std::complex<double> period_sum(0.0, 0.0);
-  std::vector<std::complex<double>> site_sum(dcount, {0.0, 0.0});
+  std::vector<std::complex<double>> site_sum(dcount, {0.0, 0.0}), bed_force_sum(dcount, {0.0, 0.0});
   Eigen::VectorXcd modal_sum = Eigen::VectorXcd::Zero(n);
   auto& ss = result.steady_state;
   if (is_harmonic) ss.period_site_amplitudes_m.reserve(static_cast<std::size_t>(options.transient_periods +
@@ -691,7 +692,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
       const std::complex<double> kernel(sin_at(step), cos_at(step));  // i·e^{−iΩt} = sin + i cos
       period_sum += site_y[0] * kernel;
       if (analysing) {
-        for (std::size_t d = 0; d < dcount; ++d) site_sum[d] += site_y[d] * kernel;
+        for (std::size_t d = 0; d < dcount; ++d) site_sum[d] += site_y[d] * kernel, bed_force_sum[d] += force[d] * kernel;
         for (Eigen::Index j = 0; j < n; ++j) modal_sum[j] += q[j] * kernel;
       }
       if (step % steps_per_period == 0) {
@@ -748,8 +749,19 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
       const double scale = 2.0 / static_cast<double>(analysed_steps);
       ss.modal_amplitudes = modal_sum * scale;
       for (std::size_t d = 0; d < dcount; ++d) {
-        ss.site_amplitudes_m.push_back(site_sum[d] * scale);
-        ss.site_amplitude_per_excitation.push_back(std::abs(site_sum[d] * scale) / exc.amplitude);
+        const std::complex<double> y = site_sum[d] * scale, force_hat = bed_force_sum[d] * scale;
+        ss.site_amplitudes_m.push_back(y);
+        ss.site_amplitude_per_excitation.push_back(std::abs(y) / exc.amplitude);
+        ss.bed_force_amplitudes_n.push_back(force_hat);
+        const double omega_run = kTwoPi * f_run;
+        const std::complex<double> velocity = std::complex<double>(0.0, omega_run) * y;
+        const std::complex<double> f_conj_v = force_hat * std::conj(velocity);
+        const double m_bed = worlds[d].bed_mass_kg(), v2 = std::norm(velocity);
+        const bool defined = m_bed > 0.0 && v2 > 0.0;
+        constexpr double undefined = std::numeric_limits<double>::quiet_NaN();
+        ss.bed_reduced_loss_factor.push_back(defined ? (0.5 * f_conj_v.real() / omega_run) / (0.5 * m_bed * v2)
+                                                     : undefined);
+        ss.bed_apparent_mass_fraction.push_back(defined ? f_conj_v.imag() / (omega_run * v2 * m_bed) : undefined);
       }
     }
   }

@@ -241,7 +241,14 @@ TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies, u
   for (const auto& p : points) {
     CHECK(p["energy_error"].get<double>() < 0.01);
     CHECK(p["magnitude"]["damper_1"].get<double>() > 0.0);
+    // The bed's in-loop complex power: finite everywhere (over 3 periods a bed still
+    // settling from the resonance may give energy back, η* < 0: the down sweep's 1.2 Hz).
+    CHECK(std::isfinite(p["bed_eta_star"]["damper_1"].get<double>()));
+    CHECK(std::abs(p["bed_apparent_mass_fraction"]["damper_1"].get<double>()) < 2.0);
   }
+  // At the resonance the bed is stationary and dissipates.
+  CHECK(points[1]["bed_eta_star"]["damper_1"].get<double>() > 0.0);
+  CHECK(points[4]["bed_eta_star"]["damper_1"].get<double>() > 0.0);
   // The mode with the container (2 Hz·√(0.5/0.8) = 1.58 Hz) is nearest the middle point;
   // the parabola through the three points puts the peak within their span, and a 0.4 Hz
   // spacing on a peak places it to about 10%.

@@ -141,7 +141,7 @@ TEST_CASE("ModalModel::validate reports sizes, ranges and non-finite shapes one 
   ModalModel model = modal_model_from_json(two_modes());
   REQUIRE(model.validate().empty());
   model.natural_frequencies_hz[0] = -1.0;
-  model.damping_ratios.resize(1);
+  model.damping_ratios.conservativeResize(1);  // keeps the first value (resize would leave it undefined)
   model.modal_masses_kg[1] = 0.0;
   model.points[0].translation(1, 1) = std::nan("");
   model.base_participation = Eigen::MatrixXd::Zero(2, 1);

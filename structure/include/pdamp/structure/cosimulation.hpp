@@ -138,6 +138,14 @@ struct CosimulationSteadyState {
   std::vector<double> site_amplitude_per_excitation;
   /// |ŷ| of the first damper's site in each period run (transient and analysed), m.
   std::vector<double> period_site_amplitudes_m;
+  /// F̂_d: the force the container applies to its bed along n, N (the convention above).
+  std::vector<std::complex<double>> bed_force_amplitudes_n;
+  /// Each bed's reduced loss factor and apparent mass in the loop, by the Level II measure
+  /// (PHYSICS.md §1, formulas::ComplexPower) on F̂_d and V̂_d = iΩŷ_d: P = ½F̂ conj V̂,
+  /// η* = (Re P/Ω)/(½ m_bed |V̂|²), m_app/m_bed = Im(F̂ conj V̂)/(Ω|V̂|² m_bed). They make
+  /// a stepped-sine point comparable with pdamp dem and with the field at the same (f, X).
+  std::vector<double> bed_reduced_loss_factor;
+  std::vector<double> bed_apparent_mass_fraction;
 };
 
 /// Energy over the coupled run in one inertial frame, J (docs/cosimulation.md §4).
