@@ -225,6 +225,8 @@ void read_dampers(ObjectReader& root, Case& c) {
     d.site = read_point_name(r, "site", c);
     d.drive_direction = read_plane_direction(r, "drive_direction", std::nullopt);
     d.container_mass_kg = r.number("container_mass_kg", std::nullopt, limits::kMass, " kg");
+    d.container_rotary_inertia_kg_m2 =
+        r.number("container_rotary_inertia_kg_m2", 0.0, limits::kRotaryInertia, " kg m^2");
     read_damper_drive(r, d);
     if (!r.has("layers")) r.fail("layers", "required (an array of at least one layer)");
     r.array("layers", [&](ObjectReader& l) {

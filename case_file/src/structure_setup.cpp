@@ -96,6 +96,7 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
     damper.point = spec.site;
     damper.drive_direction = {spec.drive_direction[0], spec.drive_direction[1]};
     damper.container_mass_kg = spec.container_mass_kg;
+    damper.container_rotary_inertia_kg_m2 = spec.container_rotary_inertia_kg_m2;
     for (const LayerSpec& layer : spec.layers) {
       damper.length_along_drive_m = std::max(damper.length_along_drive_m, layer.container.inner_length(spec.drive_axis));
     }
@@ -122,6 +123,7 @@ structure::CosimulationDamper cosimulation_damper(const Case& c, std::size_t dam
   out.point = spec.site;
   out.drive_direction = {spec.drive_direction[0], spec.drive_direction[1]};
   out.container_mass_kg = spec.container_mass_kg;
+  out.container_rotary_inertia_kg_m2 = spec.container_rotary_inertia_kg_m2;
   // The World does not depend on the operating point (stroke and frequency only set the
   // harmonic drive, which the co-simulation replaces by the structure's motion).
   double clearance = 0.0;

@@ -103,6 +103,9 @@ std::vector<std::string> CosimulationDamper::validate(const ModalModel& model) c
     problems.push_back("drive_direction = " + vec2(drive_direction) + ": must be a unit vector");
   if (!(container_mass_kg >= 0.0 && std::isfinite(container_mass_kg)))
     problems.push_back("container_mass_kg = " + number(container_mass_kg) + ": must be >= 0 and finite");
+  if (!(container_rotary_inertia_kg_m2 >= 0.0 && std::isfinite(container_rotary_inertia_kg_m2)))
+    problems.push_back("container_rotary_inertia_kg_m2 = " + number(container_rotary_inertia_kg_m2) +
+                       ": must be >= 0 and finite");
   const bool drive_unit = std::abs(norm3(container_drive_axis) - 1.0) <= kUnitTolerance;
   const bool rotation_unit = std::abs(norm3(container_rotation_axis) - 1.0) <= kUnitTolerance;
   if (!drive_unit) problems.push_back("container_drive_axis = " + vec3(container_drive_axis) + ": must be a unit vector");
@@ -255,6 +258,7 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
     p.point = d.point;
     p.drive_direction = d.drive_direction;
     p.container_mass_kg = d.container_mass_kg;
+    p.container_rotary_inertia_kg_m2 = d.container_rotary_inertia_kg_m2;
     points.push_back(p);
   }
   P.coupled = couple(model, points);

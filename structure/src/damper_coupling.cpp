@@ -65,6 +65,9 @@ std::vector<std::string> Damper::validate(const ModalModel& model) const {
                        "): must be a unit vector");
   if (!(container_mass_kg >= 0.0 && std::isfinite(container_mass_kg)))
     problems.push_back("container_mass_kg = " + number(container_mass_kg) + ": must be >= 0 and finite");
+  if (!(container_rotary_inertia_kg_m2 >= 0.0 && std::isfinite(container_rotary_inertia_kg_m2)))
+    problems.push_back("container_rotary_inertia_kg_m2 = " + number(container_rotary_inertia_kg_m2) +
+                       ": must be >= 0 and finite");
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const std::string prefix = "layers[" + std::to_string(l) + "].";
     if (!(layers[l].bed_mass_kg > 0.0 && std::isfinite(layers[l].bed_mass_kg)))
@@ -183,9 +186,12 @@ CoupledModel couple(const ModalModel& model, const std::vector<Damper>& dampers,
   coupled.base_participation = model.base_participation;
   coupled.container_participation = Eigen::MatrixXd::Zero(modes, 2);
   for (std::size_t d = 0; d < dampers.size(); ++d) {
-    const Eigen::MatrixXd& shape = find_point(model, dampers[d].point)->translation;  // 2 x modes
+    const PointModeShape& site = *find_point(model, dampers[d].point);
+    const Eigen::MatrixXd& shape = site.translation;  // 2 x modes
     const double container = dampers[d].container_mass_kg;
     coupled.mass_with_containers_kg += container * shape.transpose() * shape;
+    if (dampers[d].container_rotary_inertia_kg_m2 > 0.0)  // kinetic energy ½J θ̇², θ = θ_d q
+      coupled.mass_with_containers_kg += dampers[d].container_rotary_inertia_kg_m2 * site.rotation.transpose() * site.rotation;
     coupled.container_participation += container * shape.transpose();
     coupled.drive_shapes.col(static_cast<Eigen::Index>(d)) = shape.transpose() * dampers[d].drive_direction;
   }

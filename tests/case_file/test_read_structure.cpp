@@ -200,3 +200,13 @@ TEST_CASE("a bad verify block is refused naming its key and the allowed range", 
   refused({{"tolerance", 0.3}}, "/task/verify/tolerance", "tolerance_relative");  // unknown key: the allowed ones named
   refused(json::array(), "/task/verify", "must be a JSON object");
 }
+
+TEST_CASE("a damper's container_rotary_inertia_kg_m2 defaults to 0, is read in kg m^2 and refuses a negative value",
+          "[case_file]") {
+  CHECK(load_case(data(kCantilever)).dampers[0].container_rotary_inertia_kg_m2 == 0.0);
+  const pdamp::test::TempDir dir("rotary_inertia");
+  const std::string good = edited(dir, kCantilever, [](json& c) { c["dampers"][0]["container_rotary_inertia_kg_m2"] = 2.5e-4; });
+  CHECK(load_case(good).dampers[0].container_rotary_inertia_kg_m2 == 2.5e-4);
+  const std::string bad = edited(dir, kCantilever, [](json& c) { c["dampers"][0]["container_rotary_inertia_kg_m2"] = -1.0; });
+  require_case_error(bad, bad, "/dampers/0/container_rotary_inertia_kg_m2", ">= 0");
+}

@@ -60,6 +60,7 @@ struct DamperSpec {
   PlaneVector drive_direction{1.0, 0.0};
   /// Format 2: mass of the empty container, kg (0 in format 1, which has no structure).
   double container_mass_kg = 0.0;
+  double container_rotary_inertia_kg_m2 = 0.0;  ///< about the out-of-plane axis at the site, kg·m² (0: neglected)
   formulas::DamperModel model = formulas::DamperModel::kAuto;
   int drive_axis = 0;  ///< the container-frame axis of the drive, 0..2 (x, y, z)
   formulas::Vec3 gravity_m_s2{0.0, 0.0, -formulas::kStandardGravity};  ///< container frame

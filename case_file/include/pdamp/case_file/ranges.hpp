@@ -60,6 +60,8 @@ inline constexpr Range kPoisson{0.0, 0.5};
 inline constexpr Range kImpactSpeed{0.0, dem_reference::limits::kMaxImpactSpeed_m_s, true};
 /// Bed mass: (0, 1e6] kg.
 inline constexpr Range kMass{0.0, 1e6, true};
+/// Rotary inertia: [0, 1e6] kg·m², 0 allowed (neglected).
+inline constexpr Range kRotaryInertia{0.0, 1e6};
 /// Gravity components: |g_i| <= 1e4 m/s² (1000 g, a centrifuge rig), 0 allowed.
 inline constexpr Range kGravity{-dem_reference::limits::kMaxGravity_m_s2, dem_reference::limits::kMaxGravity_m_s2};
 /// Force amplitudes and static loads on a structure, N: |F| <= 1e7 (a 1000 t weight).

@@ -32,6 +32,7 @@ struct CosimulationDamper {
   std::string point;                          ///< named point of the ModalModel (the site)
   Eigen::Vector2d drive_direction{1.0, 0.0};  ///< unit vector n in the structure's x-y plane
   double container_mass_kg = 0.0;             ///< empty container m_c, kg, >= 0, finite
+  double container_rotary_inertia_kg_m2 = 0.0; ///< about the out-of-plane axis at the site, kg·m², >= 0 (Damper)
   /// The bed. integration.time_step_s is overwritten by the co-simulation's common step
   /// and max_impact_speed_m_s raised to the drive's (CosimulationOptions); threads as given.
   dem_reference::WorldOptions world;

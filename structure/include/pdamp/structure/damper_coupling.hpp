@@ -28,7 +28,8 @@ struct DamperLayer {
 /// The container is rigid and follows the point's translation: its empty mass acts along
 /// x and y as a point mass, added exactly to the modal dynamic stiffness as
 /// −Ω² m_c Φ_dᵀΦ_d (Φ_d the 2 x modes translation rows at the point; this couples the modes,
-/// the modal basis is not recomputed; the container's rotary inertia is neglected). The beds
+/// the modal basis is not recomputed), and its rotary inertia J_c about the out-of-plane axis
+/// through the site as −Ω² J_c θ_dᵀθ_d (θ_d the point's rotation row). The beds
 /// act along the drive direction n only (across the drive they are taken as carried by the
 /// base without dissipation: neither mass nor damping is added there).
 struct Damper {
@@ -36,6 +37,10 @@ struct Damper {
   std::string point;                           ///< named point of the ModalModel
   Eigen::Vector2d drive_direction{1.0, 0.0};   ///< unit vector n in the x-y plane (the container's drive axis)
   double container_mass_kg = 0.0;              ///< empty container m_c, kg, >= 0
+  /// Empty container's moment of inertia about the out-of-plane axis through the site,
+  /// kg·m², >= 0 (0: neglected; a box of mass m and sides a (drive), b (in-plane, across)
+  /// centred on the site has m(a² + b²)/12).
+  double container_rotary_inertia_kg_m2 = 0.0;
   /// Length of the container along its drive, m, >= 0 (0: unknown; rotation_warnings
   /// then says nothing). Only for the rotation check: the beds act at the site.
   double length_along_drive_m = 0.0;
