@@ -176,10 +176,11 @@ namespace {
 struct Prepared {
   CoupledModel coupled;
   Eigen::MatrixXd M, M_inv, B, R;
+  Eigen::MatrixXd T;  ///< modes x dampers: the sites' translation across the drive, t_d = z × n_d
   Eigen::VectorXd w, K, C;
   double omega = 0.0, U = 0.0;
   Eigen::VectorXd exc_shape, base_shape, force_shape;
-  std::vector<double> drive_dot_e, peak_speed;
+  std::vector<double> drive_dot_e, across_dot_e, peak_speed;
   std::vector<std::string> warnings;
 };
 
@@ -267,6 +268,11 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   P.K = model.modal_masses_kg.cwiseProduct(P.w.cwiseAbs2());
   P.C = 2.0 * model.modal_masses_kg.cwiseProduct(model.damping_ratios).cwiseProduct(P.w);
   P.B = P.coupled.drive_shapes;  // modes x dampers
+  P.T = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(dcount));
+  for (std::size_t d = 0; d < dcount; ++d) {
+    const Eigen::Vector2d across(-dampers[d].drive_direction[1], dampers[d].drive_direction[0]);  // z × n
+    P.T.col(static_cast<Eigen::Index>(d)) = model.point(dampers[d].point).translation.transpose() * across;
+  }
   P.R = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(dcount));  // rotation shapes
   for (std::size_t d = 0; d < dcount; ++d) {
     const Eigen::RowVectorXd& rot = model.point(dampers[d].point).rotation;
@@ -286,6 +292,7 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   P.exc_shape = Eigen::VectorXd::Zero(n);    // modal load per unit sin ψ
   P.base_shape = Eigen::VectorXd::Zero(n);   // P_e = (Γ + Σ m_c Φ_dᵀ) e
   P.drive_dot_e.assign(dcount, 0.0);         // n_d · e (base motion of the sites)
+  P.across_dot_e.assign(dcount, 0.0);        // t_d · e
   P.force_shape = Eigen::VectorXd::Zero(n);  // Φ_pᵀ e
   if (exc.kind == CosimulationExcitationKind::kPointForce) {
     P.force_shape = model.point(exc.point).translation.transpose() * exc.direction;
@@ -293,7 +300,10 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   } else if (is_base) {
     P.base_shape = (P.coupled.base_participation + P.coupled.container_participation) * exc.direction;
     P.exc_shape = exc.amplitude * omega * omega * P.base_shape;  // −P_e ü_b, ü_b = −UΩ² sin ψ
-    for (std::size_t d = 0; d < dcount; ++d) P.drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
+    for (std::size_t d = 0; d < dcount; ++d) {
+      P.drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
+      P.across_dot_e[d] = -dampers[d].drive_direction[1] * exc.direction[0] + dampers[d].drive_direction[0] * exc.direction[1];
+    }
   }
   P.U = is_base ? exc.amplitude : 0.0;
 
@@ -477,6 +487,15 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const Eigen::VectorXd& base_shape = P.base_shape;
   const Eigen::VectorXd& force_shape = P.force_shape;
   const std::vector<double>& drive_dot_e = P.drive_dot_e;
+  const Eigen::MatrixXd& T = P.T;
+  const std::vector<double>& across_dot_e = P.across_dot_e;
+  // The container axis that follows t_d = z × n_d: c = k × a (a ↔ n, k ↔ z, right-handed).
+  std::vector<dem::Vec3> across_axis(dcount);
+  for (std::size_t d = 0; d < dcount; ++d) {
+    const dem::Vec3& k = dampers[d].container_rotation_axis;
+    const dem::Vec3& a = dampers[d].container_drive_axis;
+    across_axis[d] = {k[1] * a[2] - k[2] * a[1], k[2] * a[0] - k[0] * a[2], k[0] * a[1] - k[1] * a[0]};
+  }
   result.frequencies_with_containers_hz = natural_frequencies_with_containers_hz(coupled);
   result.time_step_s = dt;
   result.steps_per_period = steps_per_period;
@@ -497,22 +516,25 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const std::int64_t max_samples = planned_steps / sample_every + 1;
 
   // --- Container kinematics of damper d for modal state q at drive time t.
-  std::vector<double> site_y(dcount), site_theta(dcount);
+  std::vector<double> site_y(dcount), site_across(dcount), site_theta(dcount);
   const auto site_state = [&](std::size_t d, const Eigen::VectorXd& qq, double base, double base_velocity,
                               const Eigen::VectorXd& qdot, dem::ContainerState& s) {
     const auto col = static_cast<Eigen::Index>(d);
     const auto& cd = dampers[d];
     const double y = B.col(col).dot(qq) + drive_dot_e[d] * base;
     const double ydot = B.col(col).dot(qdot) + drive_dot_e[d] * base_velocity;
+    const double x = T.col(col).dot(qq) + across_dot_e[d] * base;  // across the drive
+    const double xdot = T.col(col).dot(qdot) + across_dot_e[d] * base_velocity;
     const double theta = R.col(col).dot(qq);
     const double theta_dot = R.col(col).dot(qdot);
     for (int a = 0; a < 3; ++a) {
-      s.position_m[a] = cd.container_drive_axis[a] * y;
-      s.velocity_m_s[a] = cd.container_drive_axis[a] * ydot;
+      s.position_m[a] = cd.container_drive_axis[a] * y + across_axis[d][a] * x;
+      s.velocity_m_s[a] = cd.container_drive_axis[a] * ydot + across_axis[d][a] * xdot;
       s.angular_velocity_rad_s[a] = cd.container_rotation_axis[a] * theta_dot;
     }
     s.orientation = theta == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, theta);
     site_y[d] = y;
+    site_across[d] = x;
     site_theta[d] = theta;
   };
 
@@ -560,10 +582,12 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     }
   }
 
-  // Bed loads on the structure: F_d along a and M_d about k, what the container applies to the bed.
-  std::vector<double> force(dcount, 0.0), moment(dcount, 0.0);
+  // Bed loads on the structure: F_d along a, G_d along c (across) and M_d about k, what the
+  // container applies to the bed.
+  std::vector<double> force(dcount, 0.0), force_across(dcount, 0.0), moment(dcount, 0.0);
   const auto read_load = [&](std::size_t d, const dem::ContainerLoad& load) {
     force[d] = dot3(load.force_n, dampers[d].container_drive_axis);
+    force_across[d] = dot3(load.force_n, across_axis[d]);
     moment[d] = dot3(load.moment_nm, dampers[d].container_rotation_axis);
   };
   for (std::size_t d = 0; d < dcount; ++d) read_load(d, worlds[d].load());
@@ -579,6 +603,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     for (std::size_t d = 0; d < dcount; ++d) {
       const auto col = static_cast<Eigen::Index>(d);
       out -= force[d] * B.col(col);
+      if (force_across[d] != 0.0) out -= force_across[d] * T.col(col);
       if (moment[d] != 0.0) out -= moment[d] * R.col(col);
     }
   };
@@ -613,7 +638,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   // Base reaction power R'·u̇_b = u̇_b (P_eᵀq̈ + Σ F_d n_d·e).
   const auto base_power = [&](const Eigen::VectorXd& accel, double base_velocity) {
     double r = base_shape.dot(accel);
-    for (std::size_t d = 0; d < dcount; ++d) r += force[d] * drive_dot_e[d];
+    for (std::size_t d = 0; d < dcount; ++d) r += force[d] * drive_dot_e[d] + force_across[d] * across_dot_e[d];
     return r * base_velocity;
   };
   const double kinetic0 = structure_kinetic(v, base_velocity0);
@@ -653,11 +678,12 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     const double base_velocity_next = U * omega * cos_at(next);
     // The beds: each container at its new state; the half-step velocities are the Verlet ones.
     for (std::size_t d = 0; d < dcount; ++d) {
-      const double y_old = site_y[d], theta_old = site_theta[d];
+      const double y_old = site_y[d], x_old = site_across[d], theta_old = site_theta[d];
       site_state(d, q_new, base_next, 0.0, vh, states[d]);
-      const double y_rate = (site_y[d] - y_old) / dt, theta_rate = (site_theta[d] - theta_old) / dt;
+      const double y_rate = (site_y[d] - y_old) / dt, x_rate = (site_across[d] - x_old) / dt;
+      const double theta_rate = (site_theta[d] - theta_old) / dt;
       for (int a = 0; a < 3; ++a) {
-        states[d].velocity_m_s[a] = dampers[d].container_drive_axis[a] * y_rate;
+        states[d].velocity_m_s[a] = dampers[d].container_drive_axis[a] * y_rate + across_axis[d][a] * x_rate;
         states[d].angular_velocity_rad_s[a] = dampers[d].container_rotation_axis[a] * theta_rate;
       }
       const dem::ContainerLoad& load = worlds[d].step(states[d]);

@@ -338,6 +338,36 @@ TEST_CASE("a held bed's in-loop complex power gives its mass and no dissipation"
   CHECK(std::abs(ss.bed_reduced_loss_factor[0]) < 0.01);
 }
 
+// Reference: the site's motion across the drive. A mode that moves the site only across the
+// drive (shape (φ, 0), drive along y) with gravity pressing the 4 spheres on the container
+// wall that faces that motion (container −y ↔ structure +x: c = k × a follows t = z × n):
+// the bed moves with the container across the drive, so f = √(k/(m + m_c + m_bed))/2π
+// (1%, as the added-mass test along the drive); a bed that did not see the motion would
+// leave √(k/(m + m_c)), 15% higher.
+TEST_CASE("the site's motion across the drive reaches the bed and its load returns", "[cosimulation]") {
+  const double f = 10.0, m = 0.3, mc = 0.05;
+  ModalModel model = one_dof(f, 0.0, m);
+  model.points[0].translation << 1.0, 0.0;  // along x only; the damper drives along y
+  const dem::WorldOptions world = bed(0.01, {0.0401, 0.03, 0.0401}, {2, 1, 2}, 2e8, {0.0, -9.80665, 0.0},
+                                      dem::InitialPlacement::kCollectedLattice);
+  const CosimulationDamper damper = tip_damper(world, mc);
+  const double k = m * std::pow(2 * kPi * f, 2);
+  const double bed_mass = 4 * 7850.0 * 4.0 / 3.0 * kPi * std::pow(0.01, 3);
+  // The bed's weight along container −y is along structure +x (t = z × n = −x, c = +y ↔ t).
+  const double q_static = bed_mass * 9.80665 / k;
+  CosimulationOptions o;
+  o.initial_modal_displacements = Eigen::VectorXd::Constant(1, q_static + 3e-4);
+  o.duration_s = 1.0;
+  const CosimulationResult r = cosimulate(model, {damper}, o);
+  REQUIRE(r.outcome == dem::Outcome::kCompleted);
+  const double period = mean_period_s(r.history.time_s, r.history.modal_displacements.col(0));
+  const double expected = std::sqrt(k / (m + mc + bed_mass)) / (2 * kPi);
+  INFO("measured " << 1.0 / period << " Hz, added-mass prediction " << expected << " Hz, without bed "
+                   << r.frequencies_with_containers_hz[0] << " Hz");
+  CHECK(1.0 / period == Approx(expected).epsilon(0.01));
+  CHECK(r.energy.relative_error < 0.01);
+}
+
 // Reference: conservation of energy. The DEM's own ledger closes to 2e-4..1e-3 at 50 steps per
 // contact (docs/dem.md); the structure's Verlet adds O((ωdt)²) ≈ 1e-6, and the impulsive bed
 // force over a contact adds the trapezoid's O((dt/t_c)²) ≈ 4e-4 on the exchanged work: 1% holds

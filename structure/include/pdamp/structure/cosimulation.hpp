@@ -22,11 +22,12 @@ namespace pdamp::structure {
 /// A particle damper whose bed is a DEM World. The container is rigid; its body frame is
 /// the World's frame at rest (gravity, compartments and placement as in `world`). The
 /// container's origin is the site: it moves along `container_drive_axis` by the site's
-/// displacement along `drive_direction` (the component across the drive is not passed to
-/// the bed) and, with `rotation`, turns about `container_rotation_axis` by the site's
-/// rotation about the structure's z. The bed's load along the drive (and its moment about
-/// the rotation axis) returns to the structure; the empty container is a point mass in
-/// x and y, as in damper_coupling.hpp (mass_with_containers_kg).
+/// displacement along `drive_direction` n, along c = rotation axis × drive axis by its
+/// displacement across the drive (t = z × n), and, with `rotation`, turns about
+/// `container_rotation_axis` by the site's rotation about the structure's z. The bed's load
+/// along the drive and across it (and its moment about the rotation axis) returns to the
+/// structure; the empty container is a point mass in x and y with its rotary inertia, as in
+/// damper_coupling.hpp (mass_with_containers_kg).
 struct CosimulationDamper {
   std::string name;                           ///< label for reports and messages
   std::string point;                          ///< named point of the ModalModel (the site)
