@@ -19,6 +19,7 @@
 #include <thread>
 #include <chrono>
 #include <exception>
+#include <functional>
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
@@ -54,7 +55,11 @@ const std::vector<FlagSpec> kDemSweepFlags{
     {"--dem-max-frequency", "HZ", "--method dem: highest frequency of the stepped sine, Hz, above the\n"
                                   "                          lowest (default: the task's max_frequency_hz)"},
     {"--dem-sweep", "D", "--method dem: up, down or both (default both: the two directions\n"
-                         "                          run in parallel on a machine of two or more cores)"}};
+                         "                          run in parallel on a machine of two or more cores)"},
+    {"--dem-signal", "S", "--method dem: stepped (a stepped sine, default) or linear (a linear sine\n"
+                          "                          sweep over the band, from the steady state at its start)"},
+    {"--dem-sweep-rate", "HZ/S", "--dem-signal linear: the sweep's rate, Hz/s, > 0 (default: 4 pi zeta^2 f^2 / 100\n"
+                                 "                          at the formulas' resonance: quasi-stationary)"}};
 
 namespace {
 
@@ -399,6 +404,7 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files);
 int run_frf_compare(const ParsedArgs& args, const Case& c);
+int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files);
 
 /// The frf task's excitation, checked against the modal model (exit 2 naming /task/excitation).
 st::Excitation task_excitation(const Case& c, const st::ModalModel& modal) {
@@ -576,6 +582,8 @@ constexpr long long kMaxDemPoints = 1000;
 /// earlier once the period-to-period change of |ŷ| stays below kDemStableTolerance twice.
 constexpr int kDemMaxTransientPeriods = 100;
 constexpr double kDemStableTolerance = 1e-2;
+/// --dem-signal linear: the longest sweep accepted, s (simulated), per direction.
+constexpr double kMaxSweepDuration_s = 1e5;
 /// Decay samples: as the other methods (50 per period of the first mode, 2000..20000).
 
 /// One stderr line per progress report of the co-simulation (about twice a second).
@@ -976,24 +984,31 @@ DemBranch run_dem_branch(const Case& c, const st::ModalModel& modal, const std::
   return branch;
 }
 
-/// The stepped sine of --method dem (and of --compare): up and down in frequency over the
-/// band (--dem-min/max-frequency, default the task's), the two directions on two threads
-/// when the machine has two cores (each DEM world then on one thread).
-DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
-  const auto& task = *c.task.frf;
-  const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
-  const double f_min = args.optional_number("--dem-min-frequency", {0.0, 1e6, true}).value_or(task.min_frequency_hz);
-  const double f_max = args.optional_number("--dem-max-frequency", {0.0, 1e6, true}).value_or(task.max_frequency_hz);
-  if (!(f_max > f_min))
-    throw InputError("--dem-max-frequency", "", format_number(f_max) + " Hz: must exceed the lowest frequency " +
-                                                    format_number(f_min) + " Hz (--dem-min-frequency or the task's)");
+/// The band and the directions of --method dem (--dem-min/max-frequency, default the task's).
+struct DemBand {
+  double f_min = 0.0, f_max = 0.0;
+  std::vector<std::string> directions;  ///< "up", "down" (those asked for, up first)
+};
+DemBand dem_band(const ParsedArgs& args, const case_file::FrfTask& task) {
+  DemBand band;
+  band.f_min = args.optional_number("--dem-min-frequency", {0.0, 1e6, true}).value_or(task.min_frequency_hz);
+  band.f_max = args.optional_number("--dem-max-frequency", {0.0, 1e6, true}).value_or(task.max_frequency_hz);
+  if (!(band.f_max > band.f_min))
+    throw InputError("--dem-max-frequency", "", format_number(band.f_max) + " Hz: must exceed the lowest frequency " +
+                                                    format_number(band.f_min) + " Hz (--dem-min-frequency or the task's)");
   const std::string direction = args.optional_text("--dem-sweep").value_or("both");
   if (direction != "up" && direction != "down" && direction != "both")
     throw InputError("--dem-sweep", "", "'" + direction + "': must be up, down or both");
-  const st::ModalModel& modal = setup.s.modal;
-  auto dampers = dem_dampers(c);
-  const bool base = task.excitation == case_file::FrfTask::Excitation::kBase;
+  if (direction != "down") band.directions.push_back("up");
+  if (direction != "up") band.directions.push_back("down");
+  return band;
+}
 
+/// The frf task's harmonic co-simulation options (excitation, settling to a steady state at
+/// each frequency, the case's DEM settings), the excitation checked (exit 2 naming /task/excitation).
+st::CosimulationOptions dem_frf_options(const Case& c, const st::ModalModel& modal) {
+  const auto& task = *c.task.frf;
+  const bool base = task.excitation == case_file::FrfTask::Excitation::kBase;
   st::CosimulationOptions options;
   options.excitation.kind = base ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
   options.excitation.direction = {task.direction[0], task.direction[1]};
@@ -1008,15 +1023,56 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   // whole periods, so each junction is at the turning point, base (or force) at its
   // amplitude with zero rate on both sides: displacement and velocity of the base continue.
   options.excitation_phase_rad = std::numbers::pi / 2.0;
-  {  // the excitation's own checks first (exit 2 naming /task/excitation)
-    st::Excitation e;
-    e.kind = base ? st::Excitation::Kind::kBaseTranslation : st::Excitation::Kind::kPointForce;
-    e.direction = options.excitation.direction;
-    e.amplitude = options.excitation.amplitude;
-    e.point = options.excitation.point;
-    if (const auto problems = e.validate(modal); !problems.empty()) throw InputError(c.path, "/task/excitation", problems.front());
+  task_excitation(c, modal);  // the excitation's own checks first
+  return options;
+}
+
+/// The co-simulation's step for these options (exit 2 naming /task or /dem).
+double dem_time_step(const Case& c, const st::ModalModel& modal, const std::vector<st::CosimulationDamper>& dampers,
+                     const st::CosimulationOptions& options) {
+  if (const auto problems = options.validate(modal); !problems.empty()) throw InputError(c.path, "/task", problems.front());
+  try {
+    return st::cosimulation_time_step(modal, dampers, options).time_step_s;
+  } catch (const std::invalid_argument& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    throw InputError(c.path, "/dem", what);
   }
-  const auto frequencies = spaced(f_min, f_max, points, false);
+}
+
+/// Runs run(k) for k < count, on one thread each when `parallel`. An exception in a thread
+/// is carried to this one and rethrown after all end (the first one in order).
+void run_directions(std::size_t count, bool parallel, const std::function<void(std::size_t)>& run) {
+  if (!parallel) {
+    for (std::size_t k = 0; k < count; ++k) run(k);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(count);
+  std::vector<std::thread> threads;
+  for (std::size_t k = 0; k < count; ++k)
+    threads.emplace_back([&, k] {
+      try {
+        run(k);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+  for (auto& t : threads) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+/// The stepped sine of --method dem (and of --compare): up and down in frequency over the
+/// band, the two directions on two threads when the machine has two cores (each DEM world
+/// then on one thread).
+DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
+  const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
+  const DemBand band = dem_band(args, *c.task.frf);
+  const st::ModalModel& modal = setup.s.modal;
+  auto dampers = dem_dampers(c);
+  const bool base = c.task.frf->excitation == case_file::FrfTask::Excitation::kBase;
+  const st::CosimulationOptions options = dem_frf_options(c, modal);
+  const auto frequencies = spaced(band.f_min, band.f_max, points, false);
 
   // One step for the whole sweep (the carried worlds keep theirs): the smallest automatic
   // step over the frequencies, each period then the nearest whole number of it.
@@ -1024,18 +1080,11 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   for (const double f : frequencies) {
     st::CosimulationOptions o = options;
     o.excitation.frequency_hz = f;
-    if (const auto problems = o.validate(modal); !problems.empty()) throw InputError(c.path, "/task", problems.front());
-    try {
-      sweep_dt = std::min(sweep_dt, st::cosimulation_time_step(modal, dampers, o).time_step_s);
-    } catch (const std::invalid_argument& e) {
-      std::string what = e.what();
-      std::replace(what.begin(), what.end(), '\n', ' ');
-      throw InputError(c.path, "/dem", what);
-    }
+    sweep_dt = std::min(sweep_dt, dem_time_step(c, modal, dampers, o));
   }
   std::vector<std::pair<std::string, std::vector<double>>> directions;
-  if (direction != "down") directions.push_back({"up", frequencies});
-  if (direction != "up") directions.push_back({"down", std::vector<double>(frequencies.rbegin(), frequencies.rend())});
+  for (const auto& d : band.directions)
+    directions.push_back({d, d == "up" ? frequencies : std::vector<double>(frequencies.rbegin(), frequencies.rend())});
 
   DemSweep out;
   out.frequencies = frequencies;
@@ -1048,28 +1097,9 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
     for (auto& d : dampers) d.world.threads = 1;
   out.branches.resize(directions.size());
   const auto started = std::chrono::steady_clock::now();
-  const auto run = [&](std::size_t k) {
+  run_directions(directions.size(), out.parallel, [&](std::size_t k) {
     out.branches[k] = run_dem_branch(c, modal, dampers, options, directions[k].second, directions[k].first, sweep_dt);
-  };
-  if (out.parallel) {
-    // An exception in a sweep's thread is carried to this one and rethrown after both end
-    // (the first one in order: up before down).
-    std::vector<std::exception_ptr> errors(directions.size());
-    std::vector<std::thread> threads;
-    for (std::size_t k = 0; k < directions.size(); ++k)
-      threads.emplace_back([&, k] {
-        try {
-          run(k);
-        } catch (...) {
-          errors[k] = std::current_exception();
-        }
-      });
-    for (auto& t : threads) t.join();
-    for (const auto& e : errors)
-      if (e) std::rethrow_exception(e);
-  } else {
-    for (std::size_t k = 0; k < directions.size(); ++k) run(k);
-  }
+  });
   out.solve_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   for (const auto& b : out.branches) setup.warnings.add(b.warnings);
   out.dampers = std::move(dampers);
@@ -1110,6 +1140,9 @@ std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
 }
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  const std::string signal = args.optional_text("--dem-signal").value_or("stepped");
+  if (signal == "linear") return run_frf_dem_linear(args, c, files);
+  if (signal != "stepped") throw InputError("--dem-signal", "", "'" + signal + "': must be stepped or linear");
   Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const DemSweep sweep = dem_frf_sweep(args, c, setup);
   const auto& frequencies = sweep.frequencies;
@@ -1242,6 +1275,246 @@ const st::ResponsePeak* first_output_peak(const st::FrequencyResponse& r) {
   for (const auto& p : r.peaks)
     if (p.output == 0 && (!best || p.magnitude > best->magnitude)) best = &p;
   return best;
+}
+
+// ---------------------------------------------------------------- --dem-signal linear
+
+/// The default sweep rate: the quasi-stationary ratio (docs/cosimulation.md §6) — the time
+/// spent in the half-power band over the response time, 4πζ²f²/r — at this value for the
+/// formulas' resonance (f, ζ of its half-power band). The cycles' lag error is first order in
+/// 1/ratio: 2.2% at 63 on a linear mode, halving with the rate
+/// (tests/structure/test_cosimulation_sweep.cpp), so about 1.4% at 100, below the DEM bed's
+/// own cycle-to-cycle scatter (3-4%).
+constexpr double kQuasiStationaryRatio = 100.0;
+/// The peak of a sweep is read off the means of this many consecutive cycles (the window of
+/// amplitudes_settled), their standard error the window's spread over its root.
+constexpr std::size_t kSweepWindowCycles = st::kSettledWindowPeriods;
+
+/// One direction of --dem-signal linear: the steady state at the start frequency, then the
+/// sweep to the other end of the band.
+struct DemLinearSweep {
+  std::string sweep;
+  double start_hz = 0.0, end_hz = 0.0, rate_hz_s = 0.0, duration_s = 0.0;
+  int start_transient_periods = 0;
+  bool start_stable = false;
+  std::vector<st::CosimulationSweepCycle> cycles;
+  double energy_error = 0.0, time_step_s = 0.0, wall = 0.0;
+  std::int64_t steps = 0;
+  std::vector<std::string> warnings;
+  /// Moving means of kSweepWindowCycles cycles of the first output (ascending frequency).
+  std::vector<double> window_frequency_hz, window_magnitude, window_standard_error;
+  st::SampledPeak peak;
+};
+
+/// The windowed means of the first output's cycles and their resonance measures.
+void sweep_peak(DemLinearSweep& s) {
+  std::vector<std::pair<double, double>> fm;
+  for (const auto& c : s.cycles) fm.push_back({c.frequency_hz, c.site_amplitude_per_excitation.front()});
+  std::sort(fm.begin(), fm.end());
+  const std::size_t w = kSweepWindowCycles;
+  for (std::size_t i = 0; i + w <= fm.size(); ++i) {
+    double f = 0.0, m = 0.0, ss = 0.0;
+    for (std::size_t k = i; k < i + w; ++k) f += fm[k].first, m += fm[k].second;
+    f /= static_cast<double>(w);
+    m /= static_cast<double>(w);
+    for (std::size_t k = i; k < i + w; ++k) ss += (fm[k].second - m) * (fm[k].second - m);
+    s.window_frequency_hz.push_back(f);
+    s.window_magnitude.push_back(m);
+    s.window_standard_error.push_back(std::sqrt(ss / static_cast<double>(w - 1)) / std::sqrt(static_cast<double>(w)));
+  }
+  if (!s.window_magnitude.empty())
+    s.peak = st::sampled_peak(s.window_frequency_hz, s.window_magnitude, s.window_standard_error);
+}
+
+/// The default rate from the formulas' harmonic balance (its largest first-output peak), or
+/// from the lightest-damped mode in the band when that peak has no half-power band.
+double default_sweep_rate(const Case& c, Setup& formulas, const DemBand& band, std::string& basis) {
+  const auto response = task_harmonic_balance(c, formulas, task_excitation(c, formulas.s.modal));
+  double f = NAN, zeta = NAN;
+  if (const st::ResponsePeak* p = first_output_peak(response); p && std::isfinite(p->damping_ratio) && p->damping_ratio > 0)
+    f = p->frequency_hz, zeta = p->damping_ratio, basis = "the formulas' resonance";
+  if (!std::isfinite(zeta)) {
+    const auto& modal = formulas.s.modal;
+    for (Eigen::Index j = 0; j < modal.mode_count(); ++j) {
+      const double fj = modal.natural_frequencies_hz[j], zj = std::max(modal.damping_ratios[j], 1e-4);
+      if (fj >= band.f_min && fj <= band.f_max && !(zj >= zeta)) f = fj, zeta = zj;
+    }
+    basis = "the lightest-damped bare mode in the band";
+  }
+  if (!std::isfinite(zeta))
+    throw InputError("--dem-sweep-rate", "", "not given, and neither a resonance of the formulas nor a mode lies in [" +
+                                                 format_number(band.f_min) + ", " + format_number(band.f_max) +
+                                                 "] Hz: give the rate in Hz/s");
+  basis += " (" + format_number(f, 4) + " Hz, zeta " + format_number(zeta, 3) + ")";
+  return 4.0 * std::numbers::pi * zeta * zeta * f * f / kQuasiStationaryRatio;
+}
+
+/// pdamp frf --method dem --dem-signal linear: per direction, the bed settled and the
+/// structure brought to its steady state at the band's start (a stepped-sine point), then a
+/// linear sine sweep to the other end continuing from it; the directions in parallel.
+int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files) {
+  Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
+  const DemBand band = dem_band(args, *c.task.frf);
+  const st::ModalModel& modal = setup.s.modal;
+  auto dampers = dem_dampers(c);
+  const bool base = c.task.frf->excitation == case_file::FrfTask::Excitation::kBase;
+  const st::CosimulationOptions steady = dem_frf_options(c, modal);
+  std::string rate_basis = "--dem-sweep-rate";
+  const auto given_rate = args.optional_number("--dem-sweep-rate", {0.0, 1e6, true});
+  const double rate = given_rate ? *given_rate : default_sweep_rate(c, setup, band, rate_basis);
+  const double duration = (band.f_max - band.f_min) / rate;
+  if (!(duration <= kMaxSweepDuration_s))
+    throw InputError("--dem-sweep-rate", "", format_number(rate) + " Hz/s: the sweep over [" + format_number(band.f_min) +
+                                                 ", " + format_number(band.f_max) + "] Hz would take " +
+                                                 format_number(duration) + " s (at most " +
+                                                 format_number(kMaxSweepDuration_s) + " s): a faster rate or a narrower band");
+  std::vector<DemLinearSweep> sweeps(band.directions.size());
+  for (std::size_t k = 0; k < sweeps.size(); ++k) {
+    auto& s = sweeps[k];
+    s.sweep = band.directions[k];
+    s.start_hz = s.sweep == "up" ? band.f_min : band.f_max;
+    s.end_hz = s.sweep == "up" ? band.f_max : band.f_min;
+    s.rate_hz_s = rate;
+    s.duration_s = duration;
+  }
+  const bool parallel = sweeps.size() > 1 && std::thread::hardware_concurrency() >= 2;
+  if (parallel)
+    for (auto& d : dampers) d.world.threads = 1;
+  const auto started = std::chrono::steady_clock::now();
+  run_directions(sweeps.size(), parallel, [&](std::size_t k) {
+    auto& s = sweeps[k];
+    st::CosimulationOptions sweep = steady;
+    sweep.excitation.frequency_hz = s.start_hz;
+    sweep.sweep_end_frequency_hz = s.end_hz;
+    sweep.duration_s = s.duration_s;
+    st::CosimulationOptions start = steady;  // the steady state at the start, on the sweep's step
+    start.excitation.frequency_hz = s.start_hz;
+    start.time_step_s = dem_time_step(c, modal, dampers, sweep);
+    st::CosimulationState state;
+    const std::string label = "pdamp frf (dem) linear " + s.sweep;
+    const auto first = run_cosimulation(c, modal, dampers, start, label + " start " + format_number(s.start_hz, 5) + " Hz", &state);
+    s.start_transient_periods = first.steady_state.transient_periods;
+    s.start_stable = first.steady_state.stable;
+    const auto r = run_cosimulation(c, modal, dampers, sweep, label + " sweep", &state);
+    for (const auto* run : {&first, &r})
+      for (const auto& w : run->warnings) s.warnings.push_back(s.sweep + " sweep: " + w);
+    s.cycles = r.sweep_cycles;
+    s.energy_error = r.energy.relative_error;
+    s.time_step_s = r.time_step_s;
+    s.steps = first.steps + r.steps;
+    s.wall = first.wall_time_s + r.wall_time_s;
+    for (const auto& cycle : s.cycles)
+      for (double m : cycle.site_amplitude_per_excitation)
+        if (!std::isfinite(m)) throw NumericalError(label + ": a cycle's amplitude is not finite");
+    if (!s.start_stable)
+      s.warnings.push_back(s.sweep + " sweep: the steady state at " + format_number(s.start_hz, 5) +
+                           " Hz was not reached within " + std::to_string(kDemMaxTransientPeriods) +
+                           " periods: the sweep's first cycles may carry the transient");
+    if (s.energy_error > 0.01)
+      s.warnings.push_back(s.sweep + " sweep: the co-simulation's energy ledger closes to " +
+                           format_number(s.energy_error, 3) + " only: a smaller /dem/time_step_s");
+    sweep_peak(s);
+  });
+  const double solve_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  for (const auto& s : sweeps) setup.warnings.add(s.warnings);
+
+  const std::size_t outputs = dampers.size();
+  const std::string first_name = dampers.front().name;
+  std::vector<std::pair<std::string, std::string>> rows = {
+      {"method", "dem, linear sine sweep"},
+      {"sweep rate", format_number(rate, 4) + " Hz/s over [" + format_number(band.f_min, 5) + ", " +
+                         format_number(band.f_max, 5) + "] Hz (" + format_number(duration, 4) + " s; " + rate_basis + ")"}};
+  json peaks = json::array(), list = json::array(), runs = json::array();
+  for (const auto& s : sweeps) {
+    const bool found = !s.window_magnitude.empty();
+    const json peak = {{"output", first_name},
+                       {"sweep", s.sweep},
+                       {"frequency_hz", found ? json(s.peak.frequency_hz) : json(nullptr)},
+                       {"magnitude", found ? json(s.peak.magnitude) : json(nullptr)},
+                       {"magnitude_standard_error", found ? number_or_null(s.window_standard_error[s.peak.index]) : json(nullptr)},
+                       {"band_low_hz", found ? number_or_null(s.peak.band.low_hz) : json(nullptr)},
+                       {"band_high_hz", found ? number_or_null(s.peak.band.high_hz) : json(nullptr)},
+                       {"band_centre_hz", found ? number_or_null(s.peak.band_centre_hz) : json(nullptr)},
+                       {"damping_ratio", nullptr}};
+    peaks.push_back(peak);
+    runs.push_back({{"sweep", s.sweep}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
+                    {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
+                    {"start_transient_periods", s.start_transient_periods}, {"start_stable", s.start_stable},
+                    {"energy_error", s.energy_error}, {"steps", s.steps}, {"time_step_s", s.time_step_s},
+                    {"solve_time_s", s.wall}});
+    rows.push_back({"peak " + s.sweep + " " + first_name,
+                    found ? format_number(s.peak.frequency_hz, 5) + " Hz, |out| = " + format_number(s.peak.magnitude, 4) +
+                                " +- " + format_number(s.window_standard_error[s.peak.index], 2) + ", 0.9 band centre " +
+                                (std::isfinite(s.peak.band_centre_hz) ? format_number(s.peak.band_centre_hz, 5) + " Hz"
+                                                                      : std::string("outside the band"))
+                          : "fewer than " + std::to_string(kSweepWindowCycles) + " cycles"});
+    rows.push_back({s.sweep + " sweep", std::to_string(s.cycles.size()) + " cycles, energy error " +
+                                            format_number(s.energy_error, 2) + ", " + std::to_string(s.steps) +
+                                            " steps of " + format_number(s.time_step_s, 3) + " s"});
+    for (const auto& cycle : s.cycles) {
+      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
+      for (std::size_t d = 0; d < outputs; ++d) {
+        magnitude[dampers[d].name] = cycle.site_amplitude_per_excitation[d];
+        phase[dampers[d].name] = std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
+        eta[dampers[d].name] = number_or_null(cycle.bed_reduced_loss_factor[d]);
+        mass[dampers[d].name] = number_or_null(cycle.bed_apparent_mass_fraction[d]);
+      }
+      list.push_back({{"sweep", s.sweep}, {"time_s", cycle.time_s}, {"frequency_hz", cycle.frequency_hz},
+                      {"magnitude", magnitude}, {"phase_deg", phase}, {"bed_eta_star", eta},
+                      {"bed_apparent_mass_fraction", mass}});
+    }
+  }
+  const std::string magnitude_label = base ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+  if (files) {
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "sweep,time_s,frequency_hz";
+    for (const auto& d : dampers) csv << ",magnitude_" << safe_file_name(d.name) << ",phase_deg_" << safe_file_name(d.name);
+    csv << ",bed_eta_star_" << safe_file_name(first_name) << ",bed_apparent_mass_fraction_" << safe_file_name(first_name)
+        << '\n';
+    for (const auto& s : sweeps)
+      for (const auto& cycle : s.cycles) {
+        csv << s.sweep << ',' << cycle.time_s << ',' << cycle.frequency_hz;
+        for (std::size_t d = 0; d < outputs; ++d)
+          csv << ',' << cycle.site_amplitude_per_excitation[d] << ','
+              << std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
+        csv << ',' << cycle.bed_reduced_loss_factor.front() << ',' << cycle.bed_apparent_mass_fraction.front() << '\n';
+      }
+    files->add("frf_dem_sweep.csv", csv.str());
+    std::vector<std::string> names;
+    for (const auto& d : dampers) names.push_back(d.name);
+    setup.warnings.add(write_frf_dem_sweep_plot(*files, names, magnitude_label, c.name + ": linear-sweep DEM co-simulation"));
+  }
+  json frf = {{"file", file_json(files, "frf_dem_sweep.csv")},
+              {"plot", file_json(files, "frf_dem_sweep.png")},
+              {"method", "dem"},
+              {"signal", "linear_sweep"},
+              {"outputs", [&] { json n = json::array(); for (const auto& d : dampers) n.push_back(d.name); return n; }()},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic "
+                                   "of each drive cycle"
+                                 : "receptance |X/F| in m/N, first harmonic of each drive cycle"},
+              {"excitation", base ? "base" : "force"},
+              {"rate_hz_per_s", rate},
+              {"rate_basis", rate_basis},
+              {"quasi_stationary_ratio_default", kQuasiStationaryRatio},
+              {"sweeps", runs},
+              {"parallel", parallel},
+              {"points", list},
+              {"peaks", peaks},
+              {"peak_note", "the peak is read off moving means of " + std::to_string(kSweepWindowCycles) +
+                                " consecutive cycles (standard error: their spread over the root of the count); a "
+                                "sweep's response lags its drive by about a response time, so an up sweep's peak "
+                                "sits above the steady one and a down sweep's below, by about rate x response time"},
+              {"solve_time_s", solve_time},
+              {"warnings", setup.warnings.list()}};
+  rows.push_back({"DEM wall time", format_number(solve_time, 4) + " s (" +
+                                       (parallel ? "directions in parallel" : "one after the other") + ")"});
+  json result = {{"task", "frf"}, {"case", c.name}, {"method", "dem"}, {"signal", "linear_sweep"}};
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["frf"] = frf;
+  result["frf"]["warnings"] = setup.warnings.list();
+  return finish(args, c, files, "frf.json", result, setup.warnings, rows);
 }
 
 /// Relative differences of a method's largest first-output peak from a DEM branch's, for

@@ -347,6 +347,33 @@ std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<st
   return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
 }
 
+std::vector<std::string> write_frf_dem_sweep_plot(OutputDir& out, const std::vector<std::string>& damper_names,
+                                                  const std::string& magnitude_label, const std::string& title) {
+  // frf_dem_sweep.csv: sweep, time_s, frequency_hz, then magnitude and phase per damper.
+  std::ostringstream gp;
+  gp << "# linear-sweep frequency response of pdamp frf --method dem --dem-signal linear (first harmonic\n"
+     << "# of each drive cycle against its mean frequency; up solid, down dashed); run: gnuplot frf_dem_sweep.gp\n"
+     << "set datafile separator ','\nset grid\n"
+     << "sel(s, c) = (stringcolumn(1) eq s) ? column(c) : 1/0\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'frf_dem_sweep.svg' : 'frf_dem_sweep.png'\n"
+     << "  set title " << gnuplot_string(title) << " noenhanced\n"
+     << "  set logscale y\n  set key top right\n  set xlabel 'frequency / Hz'\n  set ylabel "
+     << gnuplot_string(magnitude_label) << " noenhanced\n  plot ";
+  bool first = true;
+  for (std::size_t d = 0; d < damper_names.size(); ++d)
+    for (const char* sweep : {"up", "down"}) {
+      if (!first) gp << ", \\\n       ";
+      first = false;
+      gp << "'frf_dem_sweep.csv' using 3:(sel('" << sweep << "', " << 4 + 2 * d << ")) with lines lw 1 dt "
+         << (std::string(sweep) == "up" ? 1 : 2) << " lc rgb '" << colour(d) << "' title "
+         << gnuplot_string(damper_names[d] + ", " + sweep) << " noenhanced";
+    }
+  gp << "\n}\n";
+  return out.add_plot("frf_dem_sweep.gp", gp.str(), {"frf_dem_sweep.png", "frf_dem_sweep.svg"});
+}
+
 std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::FrequencyResponse& formulas,
                                                  const st::FrequencyResponse* field,
                                                  const std::vector<CompareDemPoint>& dem,

@@ -59,6 +59,12 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
 std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
                                             const std::string& magnitude_label, const std::string& title);
 
+/// frf_dem_sweep.gp/png/svg for frf_dem_sweep.csv (pdamp frf --method dem --dem-signal
+/// linear: sweep, time_s, frequency_hz, then magnitude_<d>, phase_deg_<d> per damper): each
+/// cycle's |output| against its frequency (log y), up solid and down dashed.
+std::vector<std::string> write_frf_dem_sweep_plot(OutputDir& out, const std::vector<std::string>& damper_names,
+                                                  const std::string& magnitude_label, const std::string& title);
+
 /// One DEM point of pdamp frf --compare: the stepped sine's first harmonic and its spread.
 struct CompareDemPoint {
   double frequency_hz = 0.0;

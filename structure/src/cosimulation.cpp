@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -62,6 +63,26 @@ std::string vec2(const Eigen::Vector2d& v) {
 }
 
 bool harmonic(const CosimulationExcitation& e) { return e.kind != CosimulationExcitationKind::kFreeDecay; }
+bool sweeping(const CosimulationOptions& o) { return harmonic(o.excitation) && o.sweep_end_frequency_hz > 0.0; }
+
+/// Time τ at which a linear sweep from f₀ at rate r (Hz/s) has run `cycles` cycles:
+/// f₀τ + ½rτ² = k, rationalised (τ = 2k/(f₀ + √(f₀² + 2rk))) so that r → 0 needs no case.
+double sweep_cycle_time(double f0, double rate, double cycles) {
+  return 2.0 * cycles / (f0 + std::sqrt(std::max(0.0, f0 * f0 + 2.0 * rate * cycles)));
+}
+
+/// A bed's η* and m_app/m_bed from its force and site amplitudes at ω (the Level II measure,
+/// PHYSICS.md §1): P = ½F̂ conj V̂, V̂ = iωŷ; NaN for an empty bed or a still site.
+void bed_measures(std::complex<double> force_hat, std::complex<double> y, double omega, double m_bed,
+                  std::vector<double>& eta_star, std::vector<double>& apparent_mass_fraction) {
+  const std::complex<double> velocity = std::complex<double>(0.0, omega) * y;
+  const std::complex<double> f_conj_v = force_hat * std::conj(velocity);
+  const double v2 = std::norm(velocity);
+  const bool defined = m_bed > 0.0 && v2 > 0.0;
+  constexpr double undefined = std::numeric_limits<double>::quiet_NaN();
+  eta_star.push_back(defined ? (0.5 * f_conj_v.real() / omega) / (0.5 * m_bed * v2) : undefined);
+  apparent_mass_fraction.push_back(defined ? f_conj_v.imag() / (omega * v2 * m_bed) : undefined);
+}
 
 /// Joins violations into one message.
 std::string join(const std::vector<std::string>& lines) {
@@ -140,8 +161,19 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
       p.push_back(at + "analysed_periods = " + std::to_string(analysed_periods) + ": must be in [1, 100000]");
     if (settle_until_stable && !(stable_tolerance > 0.0 && stable_tolerance < 1.0))
       p.push_back(at + "stable_tolerance = " + number(stable_tolerance) + ": must be in (0, 1)");
-  } else if (!(duration_s > 0.0 && std::isfinite(duration_s))) {
-    p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a free decay");
+    if (sweep_end_frequency_hz != 0.0) {
+      if (!(sweep_end_frequency_hz >= dem::limits::kMinFrequency_hz &&
+            sweep_end_frequency_hz <= dem::limits::kMaxFrequency_hz))
+        p.push_back(at + "sweep_end_frequency_hz = " + number(sweep_end_frequency_hz) +
+                    ": must be 0 (one frequency) or in [0.01, 10000] Hz (a linear sweep)");
+      if (!(duration_s > 0.0 && std::isfinite(duration_s)))
+        p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a linear sweep");
+    }
+  } else {
+    if (!(duration_s > 0.0 && std::isfinite(duration_s)))
+      p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a free decay");
+    if (sweep_end_frequency_hz != 0.0)
+      p.push_back(at + "sweep_end_frequency_hz = " + number(sweep_end_frequency_hz) + ": must be 0 for a free decay");
   }
   const auto check_initial = [&](const Eigen::VectorXd& v, const std::string& name) {
     if (v.size() != 0 && v.size() != modes)
@@ -179,7 +211,9 @@ struct Prepared {
   Eigen::MatrixXd T;  ///< modes x dampers: the sites' translation across the drive, t_d = z × n_d
   Eigen::VectorXd w, K, C;
   double omega = 0.0, U = 0.0;
-  Eigen::VectorXd exc_shape, base_shape, force_shape;
+  /// The modal load per unit drive factor: F·Φ_pᵀe (force, factor sin ψ) or U·P_e (base,
+  /// factor −ü_b/U = ψ̇² sin ψ − ψ̈ cos ψ).
+  Eigen::VectorXd load_shape, base_shape, force_shape;
   std::vector<double> drive_dot_e, across_dot_e, peak_speed;
   std::vector<std::string> warnings;
 };
@@ -286,20 +320,19 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   }
   P.M_inv = P.M.inverse();
 
-  // Excitation: f_exc(t) = amplitude_vector · sin ψ.
+  // Excitation: f_exc(t) = load_shape · (drive factor).
   P.omega = is_harmonic ? kTwoPi * f_hz : 0.0;
-  const double omega = P.omega;
-  P.exc_shape = Eigen::VectorXd::Zero(n);    // modal load per unit sin ψ
+  P.load_shape = Eigen::VectorXd::Zero(n);
   P.base_shape = Eigen::VectorXd::Zero(n);   // P_e = (Γ + Σ m_c Φ_dᵀ) e
   P.drive_dot_e.assign(dcount, 0.0);         // n_d · e (base motion of the sites)
   P.across_dot_e.assign(dcount, 0.0);        // t_d · e
   P.force_shape = Eigen::VectorXd::Zero(n);  // Φ_pᵀ e
   if (exc.kind == CosimulationExcitationKind::kPointForce) {
     P.force_shape = model.point(exc.point).translation.transpose() * exc.direction;
-    P.exc_shape = exc.amplitude * P.force_shape;
+    P.load_shape = exc.amplitude * P.force_shape;
   } else if (is_base) {
     P.base_shape = (P.coupled.base_participation + P.coupled.container_participation) * exc.direction;
-    P.exc_shape = exc.amplitude * omega * omega * P.base_shape;  // −P_e ü_b, ü_b = −UΩ² sin ψ
+    P.load_shape = exc.amplitude * P.base_shape;  // −P_e ü_b
     for (std::size_t d = 0; d < dcount; ++d) {
       P.drive_dot_e[d] = dampers[d].drive_direction.dot(exc.direction);
       P.across_dot_e[d] = -dampers[d].drive_direction[1] * exc.direction[0] + dampers[d].drive_direction[0] * exc.direction[1];
@@ -317,15 +350,33 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
       P.peak_speed[d] = std::sqrt(2.0 * e0 * P.B.col(col).dot(P.M_inv * P.B.col(col)));
     }
     if (is_harmonic) {
-      Eigen::MatrixXcd D;
-      linear_dynamic_stiffness(P.coupled, omega, D);
-      const Eigen::VectorXcd qhat = D.partialPivLu().solve(P.exc_shape.cast<std::complex<double>>());
-      for (std::size_t d = 0; d < dcount; ++d) {
-        const auto col = static_cast<Eigen::Index>(d);
-        const std::complex<double> y = P.B.col(col).cast<std::complex<double>>().dot(qhat) + P.drive_dot_e[d] * P.U;
-        // Twice the linear steady state (the start transient can overshoot it), plus the start.
-        P.peak_speed[d] += 2.0 * std::abs(y) * omega;
+      // The linear steady state at the frequency, or its largest over a sweep's band (a
+      // fine grid and the natural frequencies inside it).
+      std::vector<double> frequencies{f_hz};
+      if (sweeping(options)) {
+        const double lo = std::min(exc.frequency_hz, options.sweep_end_frequency_hz);
+        const double hi = std::max(exc.frequency_hz, options.sweep_end_frequency_hz);
+        constexpr int kGrid = 256;
+        frequencies.clear();
+        for (int k = 0; k <= kGrid; ++k) frequencies.push_back(lo + (hi - lo) * k / kGrid);
+        for (const double w : P.w)
+          if (w / kTwoPi > lo && w / kTwoPi < hi) frequencies.push_back(w / kTwoPi);
       }
+      std::vector<double> linear_speed(dcount, 0.0);
+      Eigen::MatrixXcd D;
+      for (const double f : frequencies) {
+        const double omega = kTwoPi * f;
+        linear_dynamic_stiffness(P.coupled, omega, D);
+        const Eigen::VectorXd load = is_base ? Eigen::VectorXd(omega * omega * P.load_shape) : P.load_shape;
+        const Eigen::VectorXcd qhat = D.partialPivLu().solve(load.cast<std::complex<double>>());
+        for (std::size_t d = 0; d < dcount; ++d) {
+          const auto col = static_cast<Eigen::Index>(d);
+          const std::complex<double> y = P.B.col(col).cast<std::complex<double>>().dot(qhat) + P.drive_dot_e[d] * P.U;
+          linear_speed[d] = std::max(linear_speed[d], std::abs(y) * omega);
+        }
+      }
+      // Twice the linear steady state (the start transient can overshoot it), plus the start.
+      for (std::size_t d = 0; d < dcount; ++d) P.peak_speed[d] += 2.0 * linear_speed[d];
     }
     for (auto& s : P.peak_speed) s = std::min(s, 0.5 * dem::limits::kMaxImpactSpeed_m_s);
   }
@@ -423,6 +474,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   result.continued = continuation;
   const auto& exc = options.excitation;
   const bool is_harmonic = harmonic(exc);
+  const bool is_sweep = sweeping(options);
   const bool is_base = exc.kind == CosimulationExcitationKind::kBaseTranslation;
   const Eigen::Index n = model.mode_count();
   const std::size_t dcount = dampers.size();
@@ -433,12 +485,14 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   // --- Frequency, step and steps per period. A continuation keeps the worlds' step: the
   // period takes the nearest whole number of them (the frequency run is 1/(N dt)).
   double f_run = is_harmonic ? exc.frequency_hz : 0.0;
+  // A sweep plans its step at its highest frequency (the drive's step rule is per period).
+  const double f_plan = is_sweep ? std::max(exc.frequency_hz, options.sweep_end_frequency_hz) : f_run;
   double dt = 0.0;
   std::int64_t steps_per_period = 0;
   std::vector<dem::WorldOptions> world_options;
   if (continuation) {
     dt = state.time_step_s;
-    if (is_harmonic) {
+    if (is_harmonic && !is_sweep) {
       steps_per_period = std::max<std::int64_t>(1, std::llround(1.0 / (exc.frequency_hz * dt)));
       if (steps_per_period < 8)
         throw std::invalid_argument("cosimulation.excitation.frequency_hz = " + number(exc.frequency_hz) +
@@ -458,19 +512,19 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     // The step this frequency would take on its own: a warning if the carried one is longer.
     CosimulationOptions automatic = options;
     automatic.time_step_s = 0.0;
-    const StepPlan own = plan_step(P, dampers, automatic, f_run);
+    const StepPlan own = plan_step(P, dampers, automatic, f_plan);
     if (dt > own.dt * (1.0 + kCarriedStepMargin))
       result.warnings.push_back("the carried-over step " + number(dt) + " s is above the automatic step " +
-                                number(own.dt) + " s" + (is_harmonic ? " at " + number(f_run) + " Hz" : std::string()) +
+                                number(own.dt) + " s" + (is_harmonic ? " at " + number(f_plan) + " Hz" : std::string()) +
                                 ": contacts are resolved more coarsely (plan the sweep's step with "
                                 "cosimulation_time_step at its most demanding frequency)");
     if (P.w.maxCoeff() * dt > kStructureStepLimit)
       throw std::invalid_argument("cosimulation state: time_step_s = " + number(dt) + ": the highest mode needs ω·dt <= 0.2");
   } else {
-    StepPlan plan = plan_step(P, dampers, options, f_run);
+    StepPlan plan = plan_step(P, dampers, options, f_plan);
     for (auto& wline : plan.warnings) result.warnings.push_back(std::move(wline));
     dt = plan.dt;
-    steps_per_period = plan.steps_per_period;
+    steps_per_period = is_sweep ? 0 : plan.steps_per_period;
     world_options = std::move(plan.world_options);
     for (auto& wo : world_options) wo.integration.time_step_s = dt;
   }
@@ -483,7 +537,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const Eigen::MatrixXd& R = P.R;
   const double omega = P.omega;
   const double U = P.U;
-  const Eigen::VectorXd& exc_shape = P.exc_shape;
+  const Eigen::VectorXd& load_shape = P.load_shape;
   const Eigen::VectorXd& base_shape = P.base_shape;
   const Eigen::VectorXd& force_shape = P.force_shape;
   const std::vector<double>& drive_dot_e = P.drive_dot_e;
@@ -506,12 +560,13 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
 
 
   // --- Planned length.
-  const std::int64_t transient_steps = is_harmonic ? options.transient_periods * steps_per_period : 0;
+  const bool periodic = is_harmonic && !is_sweep;  // one frequency, whole periods
+  const std::int64_t transient_steps = periodic ? options.transient_periods * steps_per_period : 0;
   const std::int64_t planned_steps =
-      is_harmonic ? transient_steps + options.analysed_periods * steps_per_period
-                  : static_cast<std::int64_t>(std::llround(options.duration_s / dt));
+      periodic ? transient_steps + options.analysed_periods * steps_per_period
+               : static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   double interval = options.sample_interval_s;
-  if (interval == 0.0) interval = is_harmonic ? 1.0 / (64.0 * exc.frequency_hz) : options.duration_s / 2000.0;
+  if (interval == 0.0) interval = is_harmonic ? 1.0 / (64.0 * f_plan) : options.duration_s / 2000.0;
   const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(interval / dt));
   const std::int64_t max_samples = planned_steps / sample_every + 1;
 
@@ -538,9 +593,9 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     site_theta[d] = theta;
   };
 
-  // sin ψ and cos ψ, ψ = 2πk/N + φ, at the steps of a period (harmonic), tabulated once.
+  // sin ψ and cos ψ, ψ = 2πk/N + φ, at the steps of a period (one frequency), tabulated once.
   std::vector<double> sin_table, cos_table;
-  if (is_harmonic) {
+  if (periodic) {
     sin_table.resize(static_cast<std::size_t>(steps_per_period));
     cos_table.resize(static_cast<std::size_t>(steps_per_period));
     for (std::int64_t k = 0; k < steps_per_period; ++k) {
@@ -549,11 +604,27 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
       cos_table[static_cast<std::size_t>(k)] = std::cos(phase);
     }
   }
-  const auto sin_at = [&](std::int64_t step) {
-    return is_harmonic ? sin_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  // The drive at step k of this run: sin ψ, cos ψ, ψ̇, ψ̈ and ψ − φ (a sweep: ψ = φ +
+  // 2π(f₀τ + ½rτ²), τ = k dt, computed per step; its cost is nothing next to a DEM step).
+  struct Drive {
+    double s = 0.0, c = 0.0, rate = 0.0, acceleration = 0.0, phase = 0.0;
   };
-  const auto cos_at = [&](std::int64_t step) {
-    return is_harmonic ? cos_table[static_cast<std::size_t>(step % steps_per_period)] : 0.0;
+  const double f0 = exc.frequency_hz;
+  const double sweep_rate = is_sweep ? (options.sweep_end_frequency_hz - f0) / options.duration_s : 0.0;  // Hz/s
+  const auto drive_at = [&](std::int64_t k) -> Drive {
+    if (!is_harmonic) return {};
+    if (!is_sweep) {
+      const auto i = static_cast<std::size_t>(k % steps_per_period);
+      return {sin_table[i], cos_table[i], omega, 0.0, 0.0};
+    }
+    const double tau = static_cast<double>(k) * dt;
+    const double phase = kTwoPi * tau * (f0 + 0.5 * sweep_rate * tau);
+    return {std::sin(phase0 + phase), std::cos(phase0 + phase), kTwoPi * (f0 + sweep_rate * tau), kTwoPi * sweep_rate,
+            phase};
+  };
+  // The factor of load_shape: sin ψ for a force, −ü_b/U = ψ̇² sin ψ − ψ̈ cos ψ for the base.
+  const auto load_factor = [&](const Drive& a) {
+    return is_base ? a.rate * a.rate * a.s - a.acceleration * a.c : a.s;
   };
 
   // --- Worlds, built at the start pose, and the beds settled with the structure held;
@@ -563,8 +634,9 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     state.worlds.reserve(dcount);
   }
   std::vector<dem::World>& worlds = state.worlds;
-  const double base0 = U * sin_at(0);                  // u_b = U sin ψ
-  const double base_velocity0 = U * omega * cos_at(0);  // u̇_b = UΩ cos ψ
+  const Drive drive0 = drive_at(0);
+  const double base0 = U * drive0.s;                              // u_b = U sin ψ
+  const double base_velocity0 = U * drive0.rate * drive0.c;  // u̇_b = Uψ̇ cos ψ
   std::vector<dem::ContainerState> states(dcount);
   for (std::size_t d = 0; d < dcount; ++d) {
     site_state(d, q, base0, base_velocity0, v, states[d]);
@@ -598,8 +670,8 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   // --- Preallocated loop state (the step loop allocates nothing).
   Eigen::VectorXd g(n), tmp(n), acc(n), vh(n), q_new(n), v_new(n), acc_new(n), v_half_dt(n);
   const Eigen::MatrixXd A_inv = (M + 0.5 * dt * Eigen::MatrixXd(C.asDiagonal())).inverse();
-  const auto modal_load = [&](double sin_t, const Eigen::VectorXd& qq, Eigen::VectorXd& out) {
-    out = sin_t * exc_shape - K.cwiseProduct(qq);
+  const auto modal_load = [&](double factor, const Eigen::VectorXd& qq, Eigen::VectorXd& out) {
+    out = factor * load_shape - K.cwiseProduct(qq);
     for (std::size_t d = 0; d < dcount; ++d) {
       const auto col = static_cast<Eigen::Index>(d);
       out -= force[d] * B.col(col);
@@ -644,7 +716,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   const double kinetic0 = structure_kinetic(v, base_velocity0);
   const double potential0 = structure_potential(q);
 
-  modal_load(sin_at(0), q, g);
+  modal_load(load_factor(drive0), q, g);
   tmp = g - C.cwiseProduct(v);
   acc.noalias() = M_inv * tmp;
   double power = is_base ? base_power(acc, base_velocity0) : 0.0;
@@ -656,13 +728,18 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   std::vector<std::complex<double>> site_sum(dcount, {0.0, 0.0}), bed_force_sum(dcount, {0.0, 0.0});
   Eigen::VectorXcd modal_sum = Eigen::VectorXcd::Zero(n);
   auto& ss = result.steady_state;
-  if (is_harmonic) ss.period_site_amplitudes_m.reserve(static_cast<std::size_t>(options.transient_periods +
+  if (periodic) ss.period_site_amplitudes_m.reserve(static_cast<std::size_t>(options.transient_periods +
                                                                                 options.analysed_periods));
-  bool analysing = is_harmonic && (options.transient_periods == 0);
+  bool analysing = periodic && (options.transient_periods == 0);
+  // A sweep's current cycle: its first-harmonic sums and the phase ψ − φ where it ends.
+  std::vector<std::complex<double>> cycle_site(dcount, {0.0, 0.0}), cycle_force(dcount, {0.0, 0.0});
+  double cycle_end_phase = kTwoPi;
+  Drive drive_now = drive0;
   std::int64_t analysis_start = analysing ? 0 : -1;
   int calm_periods = 0;
   std::int64_t end_step = planned_steps;
-  const std::string_view decay_stage = "decay", transient_stage = "transient", analysis_stage = "analysis";
+  const std::string_view decay_stage = "decay", transient_stage = "transient", analysis_stage = "analysis",
+                         sweep_stage = "sweep";
 
   auto last_report = Clock::now();
   std::int64_t last_report_step = 0;
@@ -674,8 +751,9 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     q_new = q + dt * vh;
     const std::int64_t next = step + 1;
     const double t_next = t0 + static_cast<double>(next) * dt;
-    const double base_next = U * sin_at(next);
-    const double base_velocity_next = U * omega * cos_at(next);
+    const Drive drive_next = drive_at(next);
+    const double base_next = U * drive_next.s;
+    const double base_velocity_next = U * drive_next.rate * drive_next.c;
     // The beds: each container at its new state; the half-step velocities are the Verlet ones.
     for (std::size_t d = 0; d < dcount; ++d) {
       const double y_old = site_y[d], x_old = site_across[d], theta_old = site_theta[d];
@@ -696,7 +774,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     }
     if (result.outcome != dem::Outcome::kCompleted) break;
     // The closing kick with the new loads: (M + dt/2 C) v_new = M vh + dt/2 g_new.
-    modal_load(sin_at(next), q_new, g);
+    modal_load(load_factor(drive_next), q_new, g);
     tmp.noalias() = M * vh;
     tmp += half_dt * g;
     v_new.noalias() = A_inv * tmp;
@@ -706,7 +784,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     tmp = q_new - q;
     damping += 0.5 * (C.cwiseProduct(v) + C.cwiseProduct(v_new)).dot(tmp);
     if (exc.kind == CosimulationExcitationKind::kPointForce) {
-      work += 0.5 * exc.amplitude * (sin_at(step) + sin_at(next)) * force_shape.dot(tmp);
+      work += 0.5 * exc.amplitude * (drive_now.s + drive_next.s) * force_shape.dot(tmp);
     } else if (is_base) {
       const double power_next = base_power(acc_new, base_velocity_next);
       work += half_dt * (power + power_next);
@@ -717,9 +795,32 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     acc.swap(acc_new);
     step = next;
 
-    if (is_harmonic) {
+    if (is_sweep) {
+      // (1/π)·i·e^{−iψ} dψ over the step, dψ exact; a cycle closes once ψ − φ passes 2π(k + 1).
+      const double dpsi = drive_next.phase - drive_now.phase;
+      const std::complex<double> kernel(drive_next.s * dpsi, drive_next.c * dpsi);
+      for (std::size_t d = 0; d < dcount; ++d) cycle_site[d] += site_y[d] * kernel, cycle_force[d] += force[d] * kernel;
+      if (drive_next.phase >= cycle_end_phase * (1.0 - 1e-14)) {  // the sweep's last step ends a cycle to round-off
+        const double k = cycle_end_phase / kTwoPi;  // cycles ended
+        const double t_a = sweep_cycle_time(f0, sweep_rate, k - 1.0), t_b = sweep_cycle_time(f0, sweep_rate, k);
+        CosimulationSweepCycle cycle;
+        cycle.time_s = t0 + 0.5 * (t_a + t_b);
+        cycle.frequency_hz = 1.0 / (t_b - t_a);
+        for (std::size_t d = 0; d < dcount; ++d) {
+          const std::complex<double> y = cycle_site[d] / std::numbers::pi, force_hat = cycle_force[d] / std::numbers::pi;
+          cycle.site_amplitudes_m.push_back(y);
+          cycle.site_amplitude_per_excitation.push_back(std::abs(y) / exc.amplitude);
+          cycle.bed_force_amplitudes_n.push_back(force_hat);
+          bed_measures(force_hat, y, kTwoPi * cycle.frequency_hz, worlds[d].bed_mass_kg(), cycle.bed_reduced_loss_factor,
+                       cycle.bed_apparent_mass_fraction);
+          cycle_site[d] = cycle_force[d] = {0.0, 0.0};
+        }
+        result.sweep_cycles.push_back(std::move(cycle));
+        cycle_end_phase += kTwoPi;
+      }
+    } else if (is_harmonic) {
       // e^{−iΩt}·i·(2/N): amplitude against sin Ωt.
-      const std::complex<double> kernel(sin_at(step), cos_at(step));  // i·e^{−iΩt} = sin + i cos
+      const std::complex<double> kernel(drive_next.s, drive_next.c);  // i·e^{−iΩt} = sin + i cos
       period_sum += site_y[0] * kernel;
       if (analysing) {
         for (std::size_t d = 0; d < dcount; ++d) site_sum[d] += site_y[d] * kernel, bed_force_sum[d] += force[d] * kernel;
@@ -744,12 +845,14 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
         }
       }
     }
+    drive_now = drive_next;
     if (step % sample_every == 0) record(t_next);
     if (progress && step % kProgressStride == 0) {
       const auto now = Clock::now();
       const double since = std::chrono::duration<double>(now - last_report).count();
       if (since >= options.progress_interval_s) {
-        progress(CosimulationProgress{!is_harmonic ? decay_stage : (analysing ? analysis_stage : transient_stage),
+        progress(CosimulationProgress{!is_harmonic ? decay_stage
+                                                   : (is_sweep ? sweep_stage : (analysing ? analysis_stage : transient_stage)),
                                       static_cast<double>(step) * dt, static_cast<double>(end_step) * dt,
                                       static_cast<double>(step - last_report_step) / since});
         last_report = now;
@@ -769,7 +872,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   h.container_load_n.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
   h.container_moment_nm.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
 
-  if (is_harmonic) {
+  if (periodic) {
     ss.frequency_hz = f_run;
     ss.transient_periods = static_cast<int>(std::max<std::int64_t>(analysis_start, 0) / steps_per_period);
     const std::int64_t analysed_steps = analysis_start >= 0 ? step - analysis_start : 0;
@@ -783,15 +886,8 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
         ss.site_amplitudes_m.push_back(y);
         ss.site_amplitude_per_excitation.push_back(std::abs(y) / exc.amplitude);
         ss.bed_force_amplitudes_n.push_back(force_hat);
-        const double omega_run = kTwoPi * f_run;
-        const std::complex<double> velocity = std::complex<double>(0.0, omega_run) * y;
-        const std::complex<double> f_conj_v = force_hat * std::conj(velocity);
-        const double m_bed = worlds[d].bed_mass_kg(), v2 = std::norm(velocity);
-        const bool defined = m_bed > 0.0 && v2 > 0.0;
-        constexpr double undefined = std::numeric_limits<double>::quiet_NaN();
-        ss.bed_reduced_loss_factor.push_back(defined ? (0.5 * f_conj_v.real() / omega_run) / (0.5 * m_bed * v2)
-                                                     : undefined);
-        ss.bed_apparent_mass_fraction.push_back(defined ? f_conj_v.imag() / (omega_run * v2 * m_bed) : undefined);
+        bed_measures(force_hat, y, kTwoPi * f_run, worlds[d].bed_mass_kg(), ss.bed_reduced_loss_factor,
+                     ss.bed_apparent_mass_fraction);
       }
     }
   }
@@ -799,7 +895,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   auto& e = result.energy;
   e.excitation_work_j = work;
   e.structural_damping_j = damping;
-  const double base_velocity_end = U * omega * cos_at(step);
+  const double base_velocity_end = U * drive_now.rate * drive_now.c;
   e.delta_structure_kinetic_j = structure_kinetic(v, base_velocity_end) - kinetic0;
   e.delta_structure_potential_j = structure_potential(q) - potential0;
   for (std::size_t d = 0; d < dcount; ++d) {
@@ -827,9 +923,12 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   state.steps += step;
   state.time_step_s = dt;
   state.excitation = exc;
-  state.excitation.frequency_hz = f_run;
+  state.excitation.frequency_hz = is_sweep ? drive_now.rate / kTwoPi : f_run;
   state.excitation_phase_rad = 0.0;
-  if (is_harmonic) {
+  if (is_sweep) {
+    const double phase = std::fmod(phase0 + drive_now.phase, kTwoPi);
+    state.excitation_phase_rad = phase < 0.0 ? phase + kTwoPi : phase;
+  } else if (is_harmonic) {
     const double phase = std::fmod(phase0 + kTwoPi * static_cast<double>(step % steps_per_period) /
                                                 static_cast<double>(steps_per_period), kTwoPi);
     state.excitation_phase_rad = phase < 0.0 ? phase + kTwoPi : phase;

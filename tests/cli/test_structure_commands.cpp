@@ -3,10 +3,13 @@
 // Runs the built pdamp binary (support/run_pdamp.hpp); the solvers' physics is tested in
 // tests/structure/.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "cli/cli_support.hpp"
 #include "support/temp_dir.hpp"
@@ -317,4 +320,57 @@ TEST_CASE("pdamp frf --compare: formulas, field and DEM in one figure with the p
   }
   require_files(dir.path, {"frf_compare.csv", "frf_compare.gp", "frf.json", "case_resolved.json"});
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --method dem").exit_code == 2);
+}
+
+// --dem-signal linear: per direction the steady state at the band's start, then a linear sine
+// sweep to the other end; each drive cycle's first harmonic is a point. 0.1 Hz/s over
+// [1.4, 1.8] Hz is 4 s and ∫f dt = 6.4 cycles, so 6 whole cycles per direction.
+TEST_CASE("pdamp frf --method dem --dem-signal linear: a linear sine sweep up and down, a point per cycle",
+          "[cli][structure][dem]") {
+  const TempDir dir("frf_dem_linear");
+  const std::string sweep = "frf " + data("one_mode_dem_frf.json") + " --method dem --dem-signal linear";
+  const auto r = run_pdamp(sweep + " --dem-sweep-rate 0.1 --dem-min-frequency 1.4 --dem-max-frequency 1.8 --json -o " +
+                           dir.path.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  CHECK(out["signal"] == "linear_sweep");
+  const json& frf = out["frf"];
+  REQUIRE(frf["sweeps"].size() == 2);
+  std::map<std::string, std::vector<double>> frequencies;
+  for (const auto& p : frf["points"]) {
+    frequencies[p["sweep"].get<std::string>()].push_back(p["frequency_hz"].get<double>());
+    CHECK(p["magnitude"]["damper_1"].get<double>() > 0.0);
+  }
+  for (const auto& s : frf["sweeps"]) {
+    CHECK(s["cycles"] == 6);
+    CHECK(s["duration_s"].get<double>() == Approx(4.0));
+    CHECK(s["energy_error"].get<double>() < 0.01);
+    CHECK(s["start_stable"] == true);
+  }
+  // Cycle frequencies rise on the up sweep and fall on the down sweep, inside the band.
+  REQUIRE(frequencies["up"].size() == 6);
+  REQUIRE(frequencies["down"].size() == 6);
+  CHECK(std::is_sorted(frequencies["up"].begin(), frequencies["up"].end()));
+  CHECK(std::is_sorted(frequencies["down"].rbegin(), frequencies["down"].rend()));
+  CHECK(frequencies["up"].front() > 1.4);
+  CHECK(frequencies["down"].front() < 1.8);
+  REQUIRE(out["peaks"].size() == 2);
+  require_files(dir.path, {"frf_dem_sweep.csv", "frf_dem_sweep.gp", "frf.json"});
+
+  // The default rate: 4πζ²f²/100 at the formulas' largest peak (pdamp frf's own figures).
+  const json formulas = json::parse(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --json").out);
+  const double f = formulas["peaks"][0]["frequency_hz"].get<double>(), zeta = formulas["peaks"][0]["damping_ratio"].get<double>();
+  const auto slow = run_pdamp(sweep + " --dem-sweep up --dem-min-frequency 1.55 --dem-max-frequency 1.551 --json");
+  INFO(slow.err);
+  REQUIRE(slow.exit_code == 0);
+  const json slow_out = json::parse(slow.out);
+  CHECK(slow_out["frf"]["rate_hz_per_s"].get<double>() == Approx(4 * 3.14159265358979 * zeta * zeta * f * f / 100).epsilon(1e-9));
+  CHECK_THAT(slow_out["frf"]["rate_basis"].get<std::string>(), Catch::Contains("formulas"));
+
+  // Bad input is exit 2 with one line.
+  require_one_line_error(run_pdamp(sweep.substr(0, sweep.size() - 6) + "chirp"),
+                         "--dem-signal: 'chirp': must be stepped or linear");
+  CHECK(run_pdamp(sweep + " --dem-sweep-rate 0").exit_code == 2);
+  require_one_line_error(run_pdamp(sweep + " --dem-sweep-rate 1e-9"), "would take");
 }

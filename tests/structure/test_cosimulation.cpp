@@ -169,9 +169,14 @@ TEST_CASE("two dampers on two modes: coupled frequencies, per-site kinematics an
   model.base_participation = Eigen::MatrixXd(2, 2);
   model.base_participation << 0.0, 0.4, 0.0, -0.2;
   const double mc_a = 0.2, mc_b = 0.1;
-  CosimulationDamper at_a = tip_damper(lone_sphere(), mc_a), at_b = tip_damper(lone_sphere(), mc_b);
-  at_a.name = "at_a", at_a.point = "a";
-  at_b.name = "at_b", at_b.point = "b";
+  // Names moved in (GCC 12 flags assigning a literal here with a false -Wrestrict).
+  const auto at = [](CosimulationDamper d, std::string name, std::string point) {
+    d.name = std::move(name);
+    d.point = std::move(point);
+    return d;
+  };
+  CosimulationDamper at_a = at(tip_damper(lone_sphere(), mc_a), "at_a", "a");
+  CosimulationDamper at_b = at(tip_damper(lone_sphere(), mc_b), "at_b", "b");
 
   SECTION("no contact: the coupled 2-DOF") {
     CosimulationOptions o;

@@ -71,8 +71,18 @@ struct CosimulationOptions {
   /// mode, finite. A free decay needs one of them non-zero.
   Eigen::VectorXd initial_modal_displacements;
   Eigen::VectorXd initial_modal_velocities;
-  /// Free decay: simulated time, s, > 0. Harmonic kinds: ignored (periods below).
+  /// Free decay: simulated time, s, > 0. Linear sweep: the sweep's time, s, > 0. Harmonic
+  /// kinds at one frequency: ignored (periods below).
   double duration_s = 0.0;
+  /// Harmonic kinds: 0 (default) drives at excitation.frequency_hz; > 0 makes the drive a
+  /// linear sine sweep whose instantaneous frequency runs from excitation.frequency_hz at the
+  /// run's start to this, Hz, in [0.01, 10000], over duration_s: ψ(τ) = φ + 2π(f₀τ + ½rτ²),
+  /// r = (f₁ − f₀)/duration_s (up or down). The base then moves as U sin ψ (its acceleration
+  /// U(ψ̈ cos ψ − ψ̇² sin ψ) loads the modes), a force as F sin ψ. The periods and the
+  /// steady-state test below are ignored; the run reports each drive cycle's first harmonic
+  /// (CosimulationResult::sweep_cycles) instead of steady_state. The step is planned at the
+  /// sweep's highest frequency, the peak site speed from the linear response over the band.
+  double sweep_end_frequency_hz = 0.0;
   /// Harmonic kinds: periods run before the analysis, >= 0; with settle_until_stable the
   /// largest number allowed (the run stops settling earlier once stable).
   int transient_periods = 0;
@@ -150,6 +160,21 @@ struct CosimulationSteadyState {
   std::vector<double> bed_apparent_mass_fraction;
 };
 
+/// One drive cycle of a linear sweep (ψ from φ + 2πk to φ + 2π(k + 1)): first harmonics
+/// against sin ψ over the cycle, Ŷ = (i/π) ∫ y e^{−iψ} dψ (the steady-state convention above,
+/// weighted by dψ = ψ̇ dt so that the cycle's varying rate is accounted for), and the bed
+/// measures of CosimulationSteadyState from them. A sweep slow enough to be quasi-stationary
+/// (docs/cosimulation.md §6) gives the steady-state FRF cycle by cycle.
+struct CosimulationSweepCycle {
+  double time_s = 0.0;       ///< the cycle's middle, s (the history's clock)
+  double frequency_hz = 0.0; ///< the cycle's mean frequency, 1/(its duration), Hz
+  std::vector<std::complex<double>> site_amplitudes_m;  ///< ŷ_d along n, m
+  std::vector<double> site_amplitude_per_excitation;    ///< |ŷ_d| / U or / F
+  std::vector<std::complex<double>> bed_force_amplitudes_n;
+  std::vector<double> bed_reduced_loss_factor;
+  std::vector<double> bed_apparent_mass_fraction;
+};
+
 /// Energy over the coupled run in one inertial frame, J (docs/cosimulation.md §4).
 /// For base motion the rigid carried-mass term ½m_rigid u̇_b² is left out of both sides
 /// (a truncated modal model does not know m_rigid; it cancels exactly).
@@ -190,7 +215,8 @@ struct CosimulationResult {
   Eigen::VectorXd final_modal_displacements;  ///< q at the last step (relative for base motion)
   Eigen::VectorXd final_modal_velocities;     ///< q̇ at the last step
   CosimulationHistory history;
-  CosimulationSteadyState steady_state;  ///< harmonic kinds only
+  CosimulationSteadyState steady_state;  ///< harmonic kinds at one frequency only
+  std::vector<CosimulationSweepCycle> sweep_cycles;  ///< linear sweep only: the whole cycles run
   CosimulationEnergy energy;
   std::vector<dem_reference::WorldStatus> world_status;            ///< per damper
   std::vector<dem_reference::ContainerState> final_container_states;  ///< per damper
@@ -216,9 +242,10 @@ struct CosimulationState {
   double time_s = 0.0;                       ///< coupled time since the first run's start, s
   std::int64_t steps = 0;                    ///< coupled steps since the first run's start
   double time_step_s = 0.0;                  ///< the worlds' step, s (fixed for all continuations)
-  CosimulationExcitation excitation;         ///< the excitation of the last run
-  /// Harmonic: the drive's phase ψ at the end, rad, in [0, 2π). Runs end on whole periods,
-  /// so this is the last run's start phase; the next run starts its sine there.
+  /// The excitation of the last run (after a sweep: its frequency the sweep's end frequency).
+  CosimulationExcitation excitation;
+  /// Harmonic: the drive's phase ψ at the end, rad, in [0, 2π). Runs at one frequency end on
+  /// whole periods, so this is their start phase; the next run starts its sine there.
   double excitation_phase_rad = 0.0;
   /// true once a run has filled the state (worlds built, beds settled).
   bool started() const { return !worlds.empty(); }
