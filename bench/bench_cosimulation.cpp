@@ -1,10 +1,15 @@
 // Co-simulation benchmark (issue 11 §5): particle-steps per second of the DEM bed in the
-// loop (structure::cosimulate, one mode, base excitation) against the bare DEM stepping
-// the same bed under a prescribed harmonic drive at the same step, one thread. Prints a
-// table; the target is a ratio of at least 0.9.
+// loop (structure::cosimulate, one mode, base excitation) against the bare DEM stepping the
+// same bed through the coupled run's own container motion (replayed step by step), one
+// thread, best of N. Also the bare DEM under a harmonic drive (another motion, other
+// contacts). Prints a table; the target is a ratio of at least 0.9.
+// Usage: bench_cosimulation [periods = 1] [repeats = 3]
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+
+#include <Eigen/Dense>
 
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/world.hpp"
@@ -52,6 +57,7 @@ st::ModalModel one_mode() {
 
 int main(int argc, char** argv) {
   const int periods = argc > 1 ? std::atoi(argv[1]) : 1;
+  const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
   // The automatic bound of the bed (40 steps per contact at 0.3 m/s, as bench_dem), so
   // both runs take the same step.
   const double kStep = dr::time_step_bound(bed()).max_time_step_s;
@@ -74,31 +80,65 @@ int main(int argc, char** argv) {
   options.bed_settling_time_s = 0.0;
   options.time_step_s = kStep;
   options.progress_interval_s = 1e9;
-  const auto result = st::cosimulate(one_mode(), {damper}, options);
-  if (result.outcome != dr::Outcome::kCompleted) {
-    std::fprintf(stderr, "bench_cosimulation: %s\n", result.message.c_str());
+
+  // The coupled run's container trajectory, every step (an untimed run: the timed ones keep
+  // the default sampling). The runs are deterministic, so each timed run moves the bed the same.
+  st::CosimulationOptions traced = options;
+  traced.sample_interval_s = kStep;
+  const auto trace = st::cosimulate(one_mode(), {damper}, traced);
+  if (trace.outcome != dr::Outcome::kCompleted) {
+    std::fprintf(stderr, "bench_cosimulation: %s\n", trace.message.c_str());
     return 3;
   }
-  const double site_amplitude = std::abs(result.steady_state.site_amplitudes_m.front());
+  const Eigen::VectorXd y = trace.history.site_displacement_m.col(0);
+  const double site_amplitude = std::abs(trace.steady_state.site_amplitudes_m.front());
 
-  // The bare DEM: the same bed driven harmonically at the site's amplitude.
-  const dr::HarmonicMotion motion(dr::Vec3{1.0, 0.0, 0.0}, site_amplitude, kFrequency);
-  dr::WorldOptions bare = bed();
-  bare.integration.time_step_s = kStep;
-  dr::World world(bare, dr::ContainerState{});
-  const auto start = Clock::now();
-  for (long k = 0; k < steps; ++k) world.step(motion);
-  const double bare_s = std::chrono::duration<double>(Clock::now() - start).count();
+  // Best of `repeats` for each run (the machine's other load only ever slows a run down).
+  double coupled_s = 1e300, replay_s = 1e300, harmonic_s = 1e300, energy_error = 0.0;
+  long coupled_steps = 0;
+  int particles = 0;
+  for (int k = 0; k < repeats; ++k) {
+    const auto result = st::cosimulate(one_mode(), {damper}, options);
+    coupled_s = std::min(coupled_s, result.wall_time_s);
+    coupled_steps = result.steps;
+    energy_error = result.energy.relative_error;
 
-  const double n = world.particle_count();
-  const double bare_rate = static_cast<double>(steps) * n / bare_s;
-  const double coupled_rate = static_cast<double>(result.steps) * n / result.wall_time_s;
-  std::printf("# bench_cosimulation: %d spheres, step %.3g s, %ld steps (%d period(s) at %.3g Hz), 1 thread\n",
-              world.particle_count(), kStep, steps, periods, kFrequency);
-  std::printf("%-32s %16s\n", "run", "Mparticle-steps/s");
-  std::printf("%-32s %16.2f\n", "bare DEM, harmonic drive", bare_rate / 1e6);
-  std::printf("%-32s %16.2f\n", "DEM in the loop (1 mode)", coupled_rate / 1e6);
-  std::printf("%-32s %16.3f\n", "ratio (target >= 0.9)", coupled_rate / bare_rate);
-  std::printf("site amplitude %.4g m, energy error %.2e\n", site_amplitude, result.energy.relative_error);
+    // The bare DEM replaying the coupled run's own site motion through the same World::step
+    // (position along the drive axis x, velocity the step's difference, as the loop passes
+    // them): the same contacts, so the ratio is the coupling's own cost.
+    dr::WorldOptions bare = bed();
+    bare.integration.time_step_s = kStep;
+    dr::ContainerState state;
+    state.position_m[0] = y[0];
+    dr::World replay(bare, state);
+    auto start = Clock::now();
+    for (Eigen::Index i = 1; i < y.size(); ++i) {
+      state.velocity_m_s[0] = (y[i] - y[i - 1]) / kStep;
+      state.position_m[0] = y[i];
+      replay.step(state);
+    }
+    replay_s = std::min(replay_s, std::chrono::duration<double>(Clock::now() - start).count());
+    particles = replay.particle_count();
+
+    // The bare DEM under a prescribed harmonic drive at the site's steady amplitude (a
+    // different motion: for reference).
+    const dr::HarmonicMotion motion(dr::Vec3{1.0, 0.0, 0.0}, site_amplitude, kFrequency);
+    dr::World world(bare, dr::ContainerState{});
+    start = Clock::now();
+    for (long i = 0; i < steps; ++i) world.step(motion);
+    harmonic_s = std::min(harmonic_s, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  const double n = particles;
+  const double coupled_rate = static_cast<double>(coupled_steps) * n / coupled_s;
+  const double replay_rate = static_cast<double>(y.size() - 1) * n / replay_s;
+  const double harmonic_rate = static_cast<double>(steps) * n / harmonic_s;
+  std::printf("# bench_cosimulation: %d spheres, step %.3g s, %ld steps (%d period(s) at %.3g Hz), 1 thread, best of %d\n",
+              particles, kStep, coupled_steps, periods, kFrequency, repeats);
+  std::printf("%-44s %16s\n", "run", "Mparticle-steps/s");
+  std::printf("%-44s %16.2f\n", "bare DEM, the coupled run's motion replayed", replay_rate / 1e6);
+  std::printf("%-44s %16.2f\n", "bare DEM, harmonic drive (another motion)", harmonic_rate / 1e6);
+  std::printf("%-44s %16.2f\n", "DEM in the loop (1 mode)", coupled_rate / 1e6);
+  std::printf("%-44s %16.3f\n", "ratio to the replay (target >= 0.9)", coupled_rate / replay_rate);
+  std::printf("site amplitude %.4g m, energy error %.2e\n", site_amplitude, energy_error);
   return 0;
 }

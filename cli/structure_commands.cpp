@@ -906,20 +906,23 @@ struct DemSweep {
 };
 
 /// The points of one branch in ascending frequency, and its resonance measures
-/// (sampled_response.hpp) of the first output.
+/// (sampled_response.hpp) of one output. The standard errors are the first output's (its
+/// per-period amplitudes are recorded); the others' peaks have none.
 struct DemBranchPeak {
   std::vector<const DemPoint*> ascending;
   st::SampledPeak peak;
+  std::size_t output = 0;
 };
-DemBranchPeak dem_branch_peak(const DemBranch& branch) {
+DemBranchPeak dem_branch_peak(const DemBranch& branch, std::size_t output = 0) {
   DemBranchPeak out;
+  out.output = output;
   for (const auto& p : branch.points) out.ascending.push_back(&p);
   std::sort(out.ascending.begin(), out.ascending.end(), [](const DemPoint* a, const DemPoint* b) { return a->f < b->f; });
   std::vector<double> f, m, se;
   for (const DemPoint* p : out.ascending) {
     f.push_back(p->f);
-    m.push_back(p->magnitude.front());
-    se.push_back(std::isfinite(p->standard_error) ? p->standard_error : 0.0);
+    m.push_back(p->magnitude.at(output));
+    se.push_back(output == 0 && std::isfinite(p->standard_error) ? p->standard_error : 0.0);
   }
   out.peak = st::sampled_peak(f, m, se);
   return out;
@@ -1114,7 +1117,7 @@ json dem_peak_json(const std::string& output, const DemBranch& branch, const Dem
           {"frequency_hz", bp.peak.frequency_hz},
           {"largest_point_frequency_hz", top.f},
           {"magnitude", bp.peak.magnitude},
-          {"magnitude_standard_error", number_or_null(top.standard_error)},
+          {"magnitude_standard_error", bp.output == 0 ? number_or_null(top.standard_error) : json(nullptr)},
           {"band_low_hz", number_or_null(bp.peak.band.low_hz)},
           {"band_high_hz", number_or_null(bp.peak.band.high_hz)},
           {"band_centre_hz", number_or_null(bp.peak.band_centre_hz)},
@@ -1133,7 +1136,7 @@ std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
   const DemPoint& top = *bp.ascending[bp.peak.index];
   return format_number(bp.peak.frequency_hz, 5) + " Hz (largest of " + std::to_string(points) + " points at " +
          format_number(top.f, 5) + " Hz), |out| = " + format_number(bp.peak.magnitude, 4) +
-         (std::isfinite(top.standard_error) ? " +- " + format_number(top.standard_error, 2) : "") +
+         (bp.output == 0 && std::isfinite(top.standard_error) ? " +- " + format_number(top.standard_error, 2) : "") +
          ", 0.9 band centre " + format_number(bp.peak.band_centre_hz, 5) + " Hz, argmax within [" +
          format_number(bp.peak.indistinguishable_low_hz, 4) + ", " + format_number(bp.peak.indistinguishable_high_hz, 4) +
          "] Hz";
@@ -1154,16 +1157,11 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   std::vector<std::pair<std::string, std::string>> rows = {{"method", "dem"}};
   json list = json::array();
   for (const auto& branch : sweep.branches) {
-    const DemBranchPeak bp = dem_branch_peak(branch);
-    peaks.push_back(dem_peak_json(dampers.front().name, branch, bp));
-    for (std::size_t d = 1; d < outputs; ++d) {  // the other outputs: their largest point
-      std::size_t best = 0;
-      for (std::size_t i = 1; i < branch.points.size(); ++i)
-        if (branch.points[i].magnitude[d] > branch.points[best].magnitude[d]) best = i;
-      peaks.push_back({{"output", dampers[d].name}, {"sweep", branch.sweep}, {"frequency_hz", branch.points[best].f},
-                       {"magnitude", branch.points[best].magnitude[d]}, {"damping_ratio", nullptr}});
+    for (std::size_t d = 0; d < outputs; ++d) {
+      const DemBranchPeak bp = dem_branch_peak(branch, d);
+      peaks.push_back(dem_peak_json(dampers[d].name, branch, bp));
+      rows.push_back({"peak " + branch.sweep + " " + dampers[d].name, dem_peak_row(bp, branch.points.size())});
     }
-    rows.push_back({"peak " + branch.sweep + " " + dampers.front().name, dem_peak_row(bp, branch.points.size())});
     for (const auto& p : branch.points) {
       json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
       for (std::size_t d = 0; d < outputs; ++d) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -373,4 +374,30 @@ TEST_CASE("pdamp frf --method dem --dem-signal linear: a linear sine sweep up an
                          "--dem-signal: 'chirp': must be stepped or linear");
   CHECK(run_pdamp(sweep + " --dem-sweep-rate 0").exit_code == 2);
   require_one_line_error(run_pdamp(sweep + " --dem-sweep-rate 1e-9"), "would take");
+}
+
+// Two dampers: every output gets the stepped sine's resonance measures (the second without
+// standard errors: only the first site's per-period amplitudes are kept).
+TEST_CASE("pdamp frf --method dem with two dampers gives each output its peak", "[cli][structure][dem]") {
+  const TempDir dir("frf_dem_two");
+  std::ifstream in(data("one_mode_dem_frf.json"));
+  json c = json::parse(in);
+  c["structure"]["file"] = data("one_mode_dem.json");
+  c["dampers"].push_back(c["dampers"][0]);
+  c["dampers"][1]["container_mass_kg"] = 0.1;
+  const std::string path = (dir.path / "two.json").string();
+  std::ofstream(path) << c.dump(2);
+  const auto r = run_pdamp("frf " + path + " --method dem --dem-sweep up --dem-points 3 --json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  REQUIRE(out["peaks"].size() == 2);
+  CHECK(out["peaks"][0]["output"] == "damper_1");
+  CHECK(out["peaks"][1]["output"] == "damper_2");
+  for (const auto& peak : out["peaks"]) {
+    CHECK(peak["magnitude"].get<double>() > 0.0);
+    CHECK(peak.contains("band_centre_hz"));
+    CHECK(peak["largest_point_frequency_hz"].get<double>() > 0.0);
+  }
+  CHECK(out["peaks"][1]["magnitude_standard_error"].is_null());
 }
