@@ -1123,14 +1123,15 @@ json dem_peak_json(const std::string& output, const DemBranch& branch, const Dem
           {"band_centre_hz", number_or_null(bp.peak.band_centre_hz)},
           {"indistinguishable_low_hz", bp.peak.indistinguishable_low_hz},
           {"indistinguishable_high_hz", bp.peak.indistinguishable_high_hz},
-          {"damping_ratio", nullptr}};
+          {"damping_ratio", number_or_null(bp.peak.damping_ratio)}};
 }
 
 const char* const kDemPeakNote =
     "frequency_hz: vertex of the parabola through the largest point and its neighbours; band: where the points "
     "stay >= 0.9 of the largest (linear between points), its centre a flat top's better-conditioned resonance "
     "frequency; indistinguishable: the points within two standard errors of the largest (the argmax lies among "
-    "them); standard error = spread/sqrt(analysed periods)";
+    "them); standard error = spread/sqrt(analysed periods); damping_ratio: half-power width (f2 - f1)/(2 f) "
+    "between the points (null where a side does not fall to 1/sqrt(2) of the largest)";
 
 std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
   const DemPoint& top = *bp.ascending[bp.peak.index];
@@ -1139,7 +1140,7 @@ std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
          (bp.output == 0 && std::isfinite(top.standard_error) ? " +- " + format_number(top.standard_error, 2) : "") +
          ", 0.9 band centre " + format_number(bp.peak.band_centre_hz, 5) + " Hz, argmax within [" +
          format_number(bp.peak.indistinguishable_low_hz, 4) + ", " + format_number(bp.peak.indistinguishable_high_hz, 4) +
-         "] Hz";
+         "] Hz, half-power zeta " + format_number(bp.peak.damping_ratio, 3);
 }
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
@@ -1433,7 +1434,7 @@ int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files) 
                        {"band_low_hz", found ? number_or_null(s.peak.band.low_hz) : json(nullptr)},
                        {"band_high_hz", found ? number_or_null(s.peak.band.high_hz) : json(nullptr)},
                        {"band_centre_hz", found ? number_or_null(s.peak.band_centre_hz) : json(nullptr)},
-                       {"damping_ratio", nullptr}};
+                       {"damping_ratio", found ? number_or_null(s.peak.damping_ratio) : json(nullptr)}};
     peaks.push_back(peak);
     runs.push_back({{"sweep", s.sweep}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
                     {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
@@ -1526,6 +1527,8 @@ json agreement_json(const st::ResponsePeak* peak, const st::SampledPeak& dem) {
           {"frequency_relative_difference", relative(peak->frequency_hz, dem.frequency_hz)},
           {"band_centre_relative_difference", relative(peak->band_centre_hz, dem.band_centre_hz)},
           {"magnitude_relative_difference", relative(peak->magnitude, dem.magnitude)},
+          {"damping_ratio", number_or_null(peak->damping_ratio)},
+          {"dem_damping_ratio", number_or_null(dem.damping_ratio)},
           {"frequency_within_dem_indistinguishable",
            peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz}};
 }
@@ -1572,7 +1575,11 @@ int run_frf_compare(const ParsedArgs& args, const Case& c) {
                               format_number(a["magnitude"].get<double>(), 4) + " (vs dem: f " +
                               percent(a["frequency_relative_difference"]) + "%, 0.9 band centre " +
                               percent(a["band_centre_relative_difference"]) + "%, |out| " +
-                              percent(a["magnitude_relative_difference"]) + "%)"});
+                              percent(a["magnitude_relative_difference"]) + "%; zeta " +
+                              (a["damping_ratio"].is_null() ? std::string("-") : format_number(a["damping_ratio"].get<double>(), 3)) +
+                              " vs " +
+                              (a["dem_damping_ratio"].is_null() ? std::string("-") : format_number(a["dem_damping_ratio"].get<double>(), 3)) +
+                              ")"});
   };
   for (const auto& branch : sweep.branches) {
     const DemBranchPeak bp = dem_branch_peak(branch);

@@ -80,6 +80,8 @@ SampledPeak sampled_peak(const std::vector<double>& f, const std::vector<double>
   }
   peak.band = outer_level_crossings(f, c, k, kResonanceBandFraction * c[k]);
   peak.band_centre_hz = 0.5 * (peak.band.low_hz + peak.band.high_hz);
+  const LevelCrossings half_power = level_crossings(f, c, k, k, c[k] / std::sqrt(2.0));
+  peak.damping_ratio = (half_power.high_hz - half_power.low_hz) / (2.0 * peak.frequency_hz);
   peak.indistinguishable_low_hz = peak.indistinguishable_high_hz = f[k];
   if (!standard_errors.empty()) {
     const double floor = c[k] - 2.0 * standard_errors[k];

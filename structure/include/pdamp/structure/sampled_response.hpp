@@ -56,6 +56,10 @@ struct SampledPeak {
   /// within two standard errors (m_i + 2 se_i ≥ m_max − 2 se_max): the argmax is only
   /// known to lie among them. Without standard errors, the peak sample's frequency.
   double indistinguishable_low_hz = 0.0, indistinguishable_high_hz = 0.0;
+  /// Half-power damping ratio (f₂ − f₁)/(2 frequency_hz), f₁, f₂ where the curve first falls
+  /// below magnitude/√2 on either side of the largest sample (level_crossings), as the
+  /// harmonic balance's ResponsePeak; NaN where a side does not fall that low in the samples.
+  double damping_ratio = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Throws std::invalid_argument unless f is strictly increasing, c finite and of f's size
