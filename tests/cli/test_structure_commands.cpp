@@ -26,8 +26,10 @@ constexpr double kPi = 3.14159265358979323846;
 std::string data(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/" + name; }
 
 /// Runs `args` with --json, requires exit 0 and returns the one JSON object on stdout.
-json run_json(const std::string& args) {
-  const auto r = run_pdamp(args + " --json");
+json run_json(const std::string& args, double time_limit_s = 120.0) {
+  RunOptions options;
+  options.time_limit_s = time_limit_s;
+  const auto r = run_pdamp(args + " --json", options);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   return json::parse(r.out);
@@ -400,4 +402,50 @@ TEST_CASE("pdamp frf --method dem with two dampers gives each output its peak", 
     CHECK(peak["largest_point_frequency_hz"].get<double>() > 0.0);
   }
   CHECK(out["peaks"][1]["magnitude_standard_error"].is_null());
+}
+
+/// The [long] runs' time limit, s: a minute or two on an idle 2-core machine, several times
+/// that on a loaded one.
+constexpr double kLongTimeLimit_s = 900.0;
+
+// Issue 11's cross-method agreement on the shipped cases, the reduced version CI runs.
+// Beam: the shipped case (E/100; the full-stiffness sweep gives the same plateau within the
+// bed's chaos, docs/structure_cli.md), 10 points over 1.3-2.2 Hz up and down (about a minute
+// on two cores). The DEM's top is a plateau flat within its scatter, so its argmax is only
+// known to lie among the points within two standard errors of the largest: the harmonic
+// balance's peak frequency must lie in that range (the DEM cannot place it closer), its
+// magnitude within 20% of the DEM's (the issue's bound; measured −4% to +6% for the formulas,
+// −8% to −17% for the field at full stiffness).
+TEST_CASE("shipped beam: the harmonic balance's peaks agree with the DEM stepped sine", "[cli][structure][dem][long]") {
+  const std::string cases = std::string(PDAMP_SOURCE_DIR) + "/cases/";
+  const json out = run_json("frf " + cases + "beam_base_excited.json --compare --dem-points 10 --dem-min-frequency 1.3 "
+                            "--dem-max-frequency 2.2", kLongTimeLimit_s);
+  const json& agreement = out["compare"]["agreement"];
+  REQUIRE(agreement.size() == 2);
+  for (const auto& a : agreement) {
+    for (const char* method : {"formulas", "field"}) {
+      INFO(a["reference"] << " " << method << ": " << a[method].dump());
+      REQUIRE(a[method].is_object());
+      CHECK(std::abs(a[method]["magnitude_relative_difference"].get<double>()) < 0.2);
+      CHECK(a[method]["frequency_within_dem_indistinguishable"] == true);
+    }
+  }
+}
+
+// Link: the decay by averaging on the layers' DEM fields against the DEM in the loop, at full
+// stiffness as shipped (about a minute): settling time within the issue's 25% (measured
+// +23%). The closed forms settle later (+60% measured): below their rolling onset (0.376 h)
+// they see no dissipation where the packed 2 × 4 lattices already collect and collide at
+// 0.27-0.29 h (docs/structure_cli.md) — the known bias this checks the sign of.
+TEST_CASE("shipped link: decay by averaging on the DEM fields agrees with the DEM in the loop", "[cli][structure][dem][long]") {
+  const std::string link = std::string(PDAMP_SOURCE_DIR) + "/cases/manipulator_link_decay.json";
+  const json dem = run_json("decay " + link + " --method dem", kLongTimeLimit_s);
+  const json field = run_json("decay " + link + " --method field");
+  const json formulas = run_json("decay " + link);
+  const double t_dem = dem["settling_time_s"].get<double>(), t_field = field["settling_time_s"].get<double>();
+  const double t_formulas = formulas["settling_time_s"].get<double>();
+  INFO("settling: DEM " << t_dem << " s, field " << t_field << " s, formulas " << t_formulas << " s");
+  CHECK(dem["decay"]["energy_error"].get<double>() < 0.01);
+  CHECK(std::abs(t_field - t_dem) < 0.25 * t_dem);
+  CHECK(t_formulas > t_dem);
 }
