@@ -1289,6 +1289,15 @@ constexpr double kQuasiStationaryRatio = 100.0;
 /// amplitudes_settled), their standard error the window's spread over its root.
 constexpr std::size_t kSweepWindowCycles = st::kSettledWindowPeriods;
 
+/// One output's resonance measures over a sweep, read off the moving means of
+/// kSweepWindowCycles consecutive cycles (ascending frequency); none with fewer cycles.
+struct SweepPeak {
+  std::vector<double> window_frequency_hz, window_magnitude, window_standard_error;
+  st::SampledPeak peak;
+  bool found() const { return !window_magnitude.empty(); }
+  double standard_error() const { return found() ? window_standard_error[peak.index] : NAN; }
+};
+
 /// One direction of --dem-signal linear: the steady state at the start frequency, then the
 /// sweep to the other end of the band.
 struct DemLinearSweep {
@@ -1300,15 +1309,13 @@ struct DemLinearSweep {
   double energy_error = 0.0, time_step_s = 0.0, wall = 0.0;
   std::int64_t steps = 0;
   std::vector<std::string> warnings;
-  /// Moving means of kSweepWindowCycles cycles of the first output (ascending frequency).
-  std::vector<double> window_frequency_hz, window_magnitude, window_standard_error;
-  st::SampledPeak peak;
+  std::vector<SweepPeak> peaks;  ///< per output
 };
 
-/// The windowed means of the first output's cycles and their resonance measures.
-void sweep_peak(DemLinearSweep& s) {
+SweepPeak sweep_peak(const std::vector<st::CosimulationSweepCycle>& cycles, std::size_t output) {
+  SweepPeak out;
   std::vector<std::pair<double, double>> fm;
-  for (const auto& c : s.cycles) fm.push_back({c.frequency_hz, c.site_amplitude_per_excitation.front()});
+  for (const auto& c : cycles) fm.push_back({c.frequency_hz, c.site_amplitude_per_excitation.at(output)});
   std::sort(fm.begin(), fm.end());
   const std::size_t w = kSweepWindowCycles;
   for (std::size_t i = 0; i + w <= fm.size(); ++i) {
@@ -1317,12 +1324,12 @@ void sweep_peak(DemLinearSweep& s) {
     f /= static_cast<double>(w);
     m /= static_cast<double>(w);
     for (std::size_t k = i; k < i + w; ++k) ss += (fm[k].second - m) * (fm[k].second - m);
-    s.window_frequency_hz.push_back(f);
-    s.window_magnitude.push_back(m);
-    s.window_standard_error.push_back(std::sqrt(ss / static_cast<double>(w - 1)) / std::sqrt(static_cast<double>(w)));
+    out.window_frequency_hz.push_back(f);
+    out.window_magnitude.push_back(m);
+    out.window_standard_error.push_back(std::sqrt(ss / static_cast<double>(w - 1)) / std::sqrt(static_cast<double>(w)));
   }
-  if (!s.window_magnitude.empty())
-    s.peak = st::sampled_peak(s.window_frequency_hz, s.window_magnitude, s.window_standard_error);
+  if (out.found()) out.peak = st::sampled_peak(out.window_frequency_hz, out.window_magnitude, out.window_standard_error);
+  return out;
 }
 
 /// The default rate from the formulas' harmonic balance (its largest first-output peak), or
@@ -1412,7 +1419,7 @@ int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files) 
     if (s.energy_error > 0.01)
       s.warnings.push_back(s.sweep + " sweep: the co-simulation's energy ledger closes to " +
                            format_number(s.energy_error, 3) + " only: a smaller /dem/time_step_s");
-    sweep_peak(s);
+    for (std::size_t d = 0; d < dampers.size(); ++d) s.peaks.push_back(sweep_peak(s.cycles, d));
   });
   const double solve_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   for (const auto& s : sweeps) setup.warnings.add(s.warnings);
@@ -1425,28 +1432,32 @@ int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files) 
                          format_number(band.f_max, 5) + "] Hz (" + format_number(duration, 4) + " s; " + rate_basis + ")"}};
   json peaks = json::array(), list = json::array(), runs = json::array();
   for (const auto& s : sweeps) {
-    const bool found = !s.window_magnitude.empty();
-    const json peak = {{"output", first_name},
+    for (std::size_t d = 0; d < outputs; ++d) {
+      const SweepPeak& sp = s.peaks[d];
+      const auto value = [&](double v) { return sp.found() ? number_or_null(v) : json(nullptr); };
+      peaks.push_back({{"output", dampers[d].name},
                        {"sweep", s.sweep},
-                       {"frequency_hz", found ? json(s.peak.frequency_hz) : json(nullptr)},
-                       {"magnitude", found ? json(s.peak.magnitude) : json(nullptr)},
-                       {"magnitude_standard_error", found ? number_or_null(s.window_standard_error[s.peak.index]) : json(nullptr)},
-                       {"band_low_hz", found ? number_or_null(s.peak.band.low_hz) : json(nullptr)},
-                       {"band_high_hz", found ? number_or_null(s.peak.band.high_hz) : json(nullptr)},
-                       {"band_centre_hz", found ? number_or_null(s.peak.band_centre_hz) : json(nullptr)},
-                       {"damping_ratio", found ? number_or_null(s.peak.damping_ratio) : json(nullptr)}};
-    peaks.push_back(peak);
+                       {"frequency_hz", value(sp.peak.frequency_hz)},
+                       {"magnitude", value(sp.peak.magnitude)},
+                       {"magnitude_standard_error", value(sp.standard_error())},
+                       {"band_low_hz", value(sp.peak.band.low_hz)},
+                       {"band_high_hz", value(sp.peak.band.high_hz)},
+                       {"band_centre_hz", value(sp.peak.band_centre_hz)},
+                       {"damping_ratio", value(sp.peak.damping_ratio)}});
+      rows.push_back(
+          {"peak " + s.sweep + " " + dampers[d].name,
+           sp.found() ? format_number(sp.peak.frequency_hz, 5) + " Hz, |out| = " + format_number(sp.peak.magnitude, 4) +
+                            " +- " + format_number(sp.standard_error(), 2) + ", 0.9 band centre " +
+                            (std::isfinite(sp.peak.band_centre_hz) ? format_number(sp.peak.band_centre_hz, 5) + " Hz"
+                                                                   : std::string("outside the band")) +
+                            ", half-power zeta " + format_number(sp.peak.damping_ratio, 3)
+                      : "fewer than " + std::to_string(kSweepWindowCycles) + " cycles"});
+    }
     runs.push_back({{"sweep", s.sweep}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
                     {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
                     {"start_transient_periods", s.start_transient_periods}, {"start_stable", s.start_stable},
                     {"energy_error", s.energy_error}, {"steps", s.steps}, {"time_step_s", s.time_step_s},
                     {"solve_time_s", s.wall}});
-    rows.push_back({"peak " + s.sweep + " " + first_name,
-                    found ? format_number(s.peak.frequency_hz, 5) + " Hz, |out| = " + format_number(s.peak.magnitude, 4) +
-                                " +- " + format_number(s.window_standard_error[s.peak.index], 2) + ", 0.9 band centre " +
-                                (std::isfinite(s.peak.band_centre_hz) ? format_number(s.peak.band_centre_hz, 5) + " Hz"
-                                                                      : std::string("outside the band"))
-                          : "fewer than " + std::to_string(kSweepWindowCycles) + " cycles"});
     rows.push_back({s.sweep + " sweep", std::to_string(s.cycles.size()) + " cycles, energy error " +
                                             format_number(s.energy_error, 2) + ", " + std::to_string(s.steps) +
                                             " steps of " + format_number(s.time_step_s, 3) + " s"});
