@@ -60,10 +60,13 @@ ParsedArgs::ParsedArgs(const CommandSpec& spec, const std::vector<std::string>& 
     }
     positional_.push_back(arg);
   }
-  if (!help_ && static_cast<int>(positional_.size()) != spec.positional) {
-    if (positional_.size() > static_cast<std::size_t>(spec.positional))
-      throw InputError(positional_[spec.positional], "", "unexpected argument (usage: " + spec.usage + ")");
-    throw InputError("pdamp " + spec.name, "", "missing the case file (usage: " + spec.usage + ")");
+  const auto wanted = static_cast<std::size_t>(spec.positional);
+  if (!help_ && (positional_.size() < wanted || (positional_.size() > wanted && !spec.more_positional))) {
+    if (positional_.size() > wanted)
+      throw InputError(positional_[wanted], "", "unexpected argument (usage: " + spec.usage + ")");
+    throw InputError("pdamp " + spec.name, "",
+                     std::string(positional_.empty() ? "missing the case file" : "missing arguments") +
+                         " (usage: " + spec.usage + ")");
   }
 }
 

@@ -23,6 +23,7 @@ struct CommandSpec {
   std::string summary;      ///< one paragraph
   std::vector<FlagSpec> flags;
   int positional = 0;       ///< number of positional arguments (a case file)
+  bool more_positional = false;  ///< `positional` is the least number, more may follow (shard files)
 };
 
 std::string help_text(const CommandSpec& spec);

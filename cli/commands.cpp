@@ -694,6 +694,54 @@ std::string check_dem_field(const Case& c, std::size_t damper, const surrogate::
 
 /// The DEM sweep's results log, written point by point into the output folder (resume).
 constexpr const char* kSweepLog = "field_sweep.jsonl";
+/// What a `pdamp field --shard` run writes beside its log (the log is its result).
+constexpr const char* kShardSummary = "shard.json";
+/// The case file a shard ran, copied into its folder: pdamp field merge DIR... reads it back.
+constexpr const char* kShardCase = "shard_case.json";
+
+/// `--shard I/N`: this run's part of the sweep, {0, 1} (the whole grid) when absent.
+std::pair<int, int> shard_flag(const ParsedArgs& args) {
+  const auto text = args.optional_text("--shard");
+  if (!text) return {0, 1};
+  const std::string allowed = "'" + *text + "': must be I/N with whole numbers 0 <= I < N <= " +
+                              std::to_string(surrogate::kMaxShards) + " (e.g. 3/8 for task 3 of an array of 8)";
+  const auto whole = [&](const std::string& part) {
+    // Digits only (no sign, no exponent), and few enough that stoll cannot overflow.
+    if (part.empty() || part.size() > 6 || part.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError("--shard", "", allowed);
+    return std::stoll(part);
+  };
+  const std::size_t slash = text->find('/');
+  if (slash == std::string::npos) throw InputError("--shard", "", allowed);
+  const long long index = whole(text->substr(0, slash)), count = whole(text->substr(slash + 1));
+  if (count < 1 || count > surrogate::kMaxShards || index >= count) throw InputError("--shard", "", allowed);
+  return {static_cast<int>(index), static_cast<int>(count)};
+}
+
+/// The sweep identity of the case's field for `source` (formulas or dem): what guards
+/// the results log, so run_field and run_field_merge must agree on it.
+surrogate::SweepOptions field_sweep_options(const Case& c, const std::string& source) {
+  const SingleDamper single = single_damper(c, "pdamp field");
+  const bool dem = source == "dem";
+  surrogate::SweepOptions sweep;
+  sweep.source = dem ? surrogate::FieldSource::kDem : surrogate::FieldSource::kFormulas;
+  sweep.case_hash = case_file::physics_hash(c, source);
+  sweep.model_version = dem ? surrogate::dem_model_version() : 0;
+  sweep.clearance_m = single.layer.clearance_m;
+  sweep.bed_mass_kg = single.layer.bed_mass_kg;
+  sweep.threads = dem ? c.field.threads : 1;
+  return sweep;
+}
+
+/// The default output folder of a field: one safe path component under out/, as the
+/// case name must not steer it elsewhere ("../x", "/etc/x").
+std::string default_field_dir(const Case& c, const std::string& source) {
+  const std::string safe = safe_file_name(c.name);
+  if (safe != c.name)
+    print_warnings({"case name '" + strict_json::printable(c.name) + "' is not a safe folder name: writing to out/" +
+                    safe + "_field_" + source});
+  return "out/" + safe + "_field_" + source;
+}
 
 int run_field(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
@@ -703,17 +751,15 @@ int run_field(const ParsedArgs& args) {
     throw InputError("--source", "", "'" + source + "': must be formulas, dem or measured");
   const bool dem = source == "dem";
   if (source != "measured" && args.has("--measured")) throw InputError("--measured", "", "goes with --source measured");
+  if (source == "measured" && args.has("--shard"))
+    throw InputError("--shard", "", "goes with --source dem or formulas (a measured field is imported whole)");
+  const auto [shard_index, shard_count] = shard_flag(args);
+  const bool sharded = args.has("--shard");
   std::string dir;
   if (const auto given = args.optional_text("-o")) {
     dir = *given;
   } else {
-    // The default folder is built from the case name, which must not steer it
-    // elsewhere ("../x", "/etc/x"): one safe path component under out/.
-    const std::string safe = safe_file_name(c.name);
-    if (safe != c.name)
-      print_warnings({"case name '" + strict_json::printable(c.name) + "' is not a safe folder name: writing to out/" +
-                      safe + "_field_" + source});
-    dir = "out/" + safe + "_field_" + source;
+    dir = default_field_dir(c, source);
   }
   if (source == "measured") {
     OutputDir files(dir);
@@ -721,24 +767,28 @@ int run_field(const ParsedArgs& args) {
   }
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
 
-  surrogate::SweepOptions sweep;
-  sweep.source = dem ? surrogate::FieldSource::kDem : surrogate::FieldSource::kFormulas;
-  sweep.case_hash = case_file::physics_hash(c, source);
-  sweep.model_version = dem ? surrogate::dem_model_version() : 0;
-  sweep.clearance_m = single.layer.clearance_m;
-  sweep.bed_mass_kg = single.layer.bed_mass_kg;
-  sweep.threads = dem ? c.field.threads : 1;
+  surrogate::SweepOptions sweep = field_sweep_options(c, source);
+  sweep.shard_index = shard_index;
+  sweep.shard_count = shard_count;
   std::mutex progress_mutex;
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   std::string estimate;
+  // A shard's log is its result (pdamp field merge reads it), so a sharded formulas
+  // sweep keeps one too; it also makes a rerun of the same shard command resume.
+  if (dem || sharded) sweep.results_path = std::filesystem::path(dir) / kSweepLog;
   if (dem) {
-    sweep.results_path = std::filesystem::path(dir) / kSweepLog;
     estimate = check_dem_field(c, 0, grid, &sweep);
+  } else {
+    try {
+      (void)surrogate::pending_sweep_points(grid, sweep);  // a stale log: exit 2 before any work
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.path, "/field", e.what());
+    }
   }
   OutputDir files(dir);
+  if (!sweep.results_path.empty()) files.in_place(kSweepLog);
   if (dem) {
-    files.in_place(kSweepLog);
-    std::cerr << "pdamp field: " << estimate << std::endl;
+    std::cerr << "pdamp field: " << estimate << (sharded ? " (shard " + args.text("--shard") + ")" : "") << std::endl;
     sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
       std::lock_guard lock(progress_mutex);
       std::cerr << (tty ? "\r" : "") << "pdamp field: " << done << "/" << total << " points";
@@ -759,6 +809,93 @@ int run_field(const ParsedArgs& args) {
   if (dem && tty) std::cerr << "\n";
 
   json out = {{"sweep", result.summary.brief_report()}, {"warnings", result.summary.warnings}};
+  if (!sharded) return write_field_outputs(args, c, result.field, files, out);
+  // A shard has no field of its own: its log waits for pdamp field merge.
+  const std::string shard = std::to_string(shard_index) + "/" + std::to_string(shard_count);
+  out.update({{"source", source}, {"shard", shard}, {"points", result.summary.points_total},
+              {"points_in_grid", grid.size()}, {"file", (files.dir() / kSweepLog).string()}});
+  files.add_json(kShardSummary, out);
+  {  // the case as given, which pdamp field merge DIR... reads back (its physics hash is the shards')
+    std::ifstream in(c.path, std::ios::binary);
+    files.add(kShardCase, std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+  }
+  out["files"] = files.commit();
+  print_warnings(result.summary.warnings);
+  std::vector<std::pair<std::string, std::string>> rows = {
+      {"source", source}, {"shard", shard}, {"sweep", out["sweep"].get<std::string>()},
+      {"next", "pdamp field merge SHARD_DIR... -o DIR (all " + std::to_string(shard_count) + " shards)"}};
+  for (const auto& path : out["files"]) rows.push_back({"wrote", path.get<std::string>()});
+  return emit(args, out, rows, false);
+}
+
+/// The "source" of a shard log's header line (formulas or dem), for a merge not told it.
+std::string shard_log_source(const std::filesystem::path& log) {
+  std::ifstream in(log);
+  std::string header;
+  if (!in || !std::getline(in, header))
+    throw InputError(log.string(), "", "cannot be read (a shard's field_sweep.jsonl, or its folder)");
+  try {
+    const json h = json::parse(header);
+    const std::string source = h.at("source").get<std::string>();
+    if (source == "formulas" || source == "dem") return source;
+  } catch (const std::exception&) {
+  }
+  throw InputError(log.string(), "line 1", "is not the header of a pdamp field sweep log (source formulas or dem)");
+}
+
+/// `pdamp field merge SHARD...` (INTERFACE.md): the shards' logs joined into the field a
+/// serial `pdamp field` writes. The case, which gives the identity every shard must carry
+/// and the damper that write_field_outputs needs (scattered fit, pictures), is the first
+/// shard folder's shard_case.json (the case file the shard ran, copied), the source its log's; `pdamp field merge CASE.json
+/// [--source SRC] SHARD...` names them instead.
+int run_field_merge(const ParsedArgs& args) {
+  const auto& positional = args.positional();
+  std::error_code error;
+  const auto shard_log = [&](const std::filesystem::path& given) {  // a folder is what a job array leaves
+    return std::filesystem::is_directory(given, error) ? given / kSweepLog : given;
+  };
+  const std::filesystem::path first = positional.at(0);
+  const bool case_given = first.extension() == ".json" && std::filesystem::is_regular_file(first, error);
+  const std::size_t first_shard = case_given ? 1 : 0;
+  if (first_shard >= positional.size())
+    throw InputError("pdamp field merge", "", "no shard given: pdamp field merge SHARD_DIR... (or CASE.json SHARD...)");
+  std::filesystem::path case_path = first;
+  if (!case_given) {
+    case_path = shard_log(first).parent_path() / kShardCase;
+    if (!std::filesystem::is_regular_file(case_path, error))
+      throw InputError(first.string(), "", std::string("holds no ") + kShardCase + " (a folder of pdamp field --shard I/N has one): "
+                                           "give the case first, pdamp field merge CASE.json SHARD...");
+  }
+  const Case c = case_file::load_case(case_path.string());
+  (void)single_damper(c, "pdamp field merge");
+  const std::string source = args.optional_text("--source").value_or(shard_log_source(shard_log(positional.at(first_shard))));
+  if (source != "formulas" && source != "dem")
+    throw InputError("--source", "", "'" + source + "': must be formulas or dem (the source the shards ran)");
+  const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
+  const std::string dir = args.optional_text("-o").value_or(default_field_dir(c, source));
+  std::vector<std::filesystem::path> logs;
+  const auto out_dir = std::filesystem::weakly_canonical(dir, error);
+  for (std::size_t k = first_shard; k < positional.size(); ++k) {
+    const std::filesystem::path log = shard_log(positional[k]);
+    // Committing into a shard's folder would replace that shard's files (OutputDir
+    // drops what the previous run wrote), the log included.
+    if (!out_dir.empty() && std::filesystem::weakly_canonical(log, error).parent_path() == out_dir)
+      throw InputError("-o", "", "'" + dir + "' holds the shard file " + log.string() +
+                                     ": merge into another folder (the merge would replace the shard's files)");
+    logs.push_back(log);
+  }
+  OutputDir files(dir);
+  surrogate::SweepResult result;
+  try {
+    result = surrogate::merge_sweep_shards(grid, field_sweep_options(c, source), logs, c.path);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());  // names the files already
+  }
+  json out = {{"sweep", "merged " + std::to_string(logs.size()) + " shard files: " +
+                            std::to_string(result.summary.points_total) + " points (" +
+                            std::to_string(result.summary.points_failed) + " failed)"},
+              {"shards", logs.size()},
+              {"warnings", result.summary.warnings}};
   return write_field_outputs(args, c, result.field, files, out);
 }
 
@@ -888,11 +1025,24 @@ const std::vector<Command>& commands() {
                              "                          measured (a test-rig CSV, see --measured)"},
          {"--measured", "FILE", "CSV with columns frequency_hz, amplitude_m, eta_star [, eta_star_stderr,\n"
                                 "                          apparent_mass_kg, motion_mode] on a full grid"},
+         {"--shard", "I/N", "compute only shard I of N (grid nodes k with k % N == I), for job\n"
+                            "                          arrays; writes field_sweep.jsonl and shard.json, no field:\n"
+                            "                          join the N shards with pdamp field merge"},
          {"-o", "DIR", "output folder (default out/<case name>_field_<source>): field.json,\n"
                        "                          field_table.csv, heat map and cuts (PNG, SVG); dem: also\n"
                        "                          field_sweep.jsonl (resume) and scattered_fit.json"},
          kJsonFlag}, 1},
        run_field},
+      {{"field merge", "pdamp field merge SHARD_DIR... [-o DIR] [--json]  (or CASE.json [--source SRC] SHARD...)",
+        "join the shards of one pdamp field --shard I/N sweep into its field (the same\n"
+        "values as one serial run); refuses shards of another case, model version or grid.\n"
+        "SHARD: a shard's folder or its field_sweep.jsonl; the case is the first folder's\n"
+        "shard_case.json (the case the shard ran) unless given first",
+        {{"--source", "SRC", "formulas or dem: the source the shards ran (default: the first shard log's)"},
+         {"-o", "DIR", "output folder (default out/<case name>_field_<source>), not a shard's:\n"
+                       "                          the outputs of pdamp field (field.json, pictures, ...)"},
+         kJsonFlag}, 1, true},
+       run_field_merge},
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",

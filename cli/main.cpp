@@ -1,4 +1,5 @@
 // pdamp command-line front end: dispatch to a subcommand, map errors to exit codes.
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <exception>
@@ -19,7 +20,7 @@ void print_overview() {
             << "usage: pdamp <command> [options]   (pdamp <command> --help for its options)\n\ncommands:\n";
   for (const auto& command : pdamp::cli::commands()) {
     std::string name = "  " + command.spec.name;
-    name.resize(12, ' ');
+    name.resize(std::max<std::size_t>(name.size() + 1, 12), ' ');
     std::cout << name << command.spec.summary.substr(0, command.spec.summary.find('\n')) << "\n";
   }
   std::cout << "\nUnits are SI (m, s, kg, Hz, Pa). Exit codes: 0 success, 1 other failure,\n"
@@ -67,16 +68,27 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   try {
+    // A two-word command ("field merge") before its one-word prefix ("field").
+    const Command* match = nullptr;
+    std::size_t words = 0;
     for (const auto& command : commands()) {
-      if (command.spec.name != args[0]) continue;
-      const ParsedArgs parsed(command.spec, std::vector<std::string>(args.begin() + 1, args.end()));
-      if (parsed.help_requested()) {
-        std::cout << help_text(command.spec);
-        return finished(kExitOk);
+      const std::string& name = command.spec.name;
+      const auto space = name.find(' ');
+      const bool two = space != std::string::npos;
+      if (two ? (args.size() >= 2 && name == args[0] + " " + args[1]) : name == args[0]) {
+        if (!match || (two ? 2u : 1u) > words) {
+          match = &command;
+          words = two ? 2 : 1;
+        }
       }
-      return finished(command.run(parsed));
     }
-    throw InputError(args[0], "", "unknown command (see pdamp --help)");
+    if (match == nullptr) throw InputError(args[0], "", "unknown command (see pdamp --help)");
+    const ParsedArgs parsed(match->spec, std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(words), args.end()));
+    if (parsed.help_requested()) {
+      std::cout << help_text(match->spec);
+      return finished(kExitOk);
+    }
+    return finished(match->run(parsed));
   } catch (const InputError& e) {
     return report(e.what(), kExitBadInput);
   } catch (const pdamp::case_file::CaseError& e) {  // "<case file>: <pointer>: <rule>"

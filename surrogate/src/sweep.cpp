@@ -48,7 +48,7 @@ json nullable(double value) { return std::isfinite(value) ? json(value) : json(n
 
 /// The header line that identifies a sweep; a results file resumes only if its header is equal.
 json sweep_header(const Grid& grid, const SweepOptions& options) {
-  return {{"format", kSweepFormat},
+  json header = {{"format", kSweepFormat},
           {"format_version", kSweepFormatVersion},
           {"source", to_string(options.source)},
           {"case_hash", options.case_hash},
@@ -56,6 +56,19 @@ json sweep_header(const Grid& grid, const SweepOptions& options) {
           {"clearance_m", options.clearance_m},
           {"bed_mass_kg", options.bed_mass_kg},
           {"axes", json::array({json(detail::axis_json(grid.axis0)), json(detail::axis_json(grid.axis1))})}};
+  // Only a sharded sweep records its shard: the whole grid's header stays as it was
+  // before shards existed, so that such logs still resume.
+  if (options.shard_count > 1) header["shard"] = {{"index", options.shard_index}, {"count", options.shard_count}};
+  return header;
+}
+
+/// The nodes of options' shard, in grid order.
+std::vector<std::size_t> shard_nodes(const Grid& grid, const SweepOptions& options) {
+  std::vector<std::size_t> nodes;
+  for (std::size_t k = static_cast<std::size_t>(options.shard_index); k < grid.size();
+       k += static_cast<std::size_t>(options.shard_count))
+    nodes.push_back(k);
+  return nodes;
 }
 
 std::string point_line(std::size_t index, const DrivePoint& drive, const FieldPoint& p, double wall_time_s) {
@@ -216,6 +229,10 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       const long long index = object.integer("index", 0, static_cast<long long>(grid.size()) - 1);
       const auto k = static_cast<std::size_t>(index);
       if (done[k]) object.fail("index", std::to_string(index) + " appears twice");
+      if (!in_shard(k, options.shard_index, options.shard_count)) {
+        object.fail("index", std::to_string(index) + " is not a node of shard " + std::to_string(options.shard_index) +
+                                 "/" + std::to_string(options.shard_count));
+      }
       const DrivePoint node = drive_point(grid, k, options.clearance_m);
       strict_json::StrictObject drive(object.required("drive"), "/drive", context);
       const double f = drive.number("frequency_hz", true, "Hz");
@@ -293,6 +310,13 @@ std::vector<std::string> SweepOptions::validate() const {
     problems.push_back("threads = " + std::to_string(threads) + ": must be in [1, " + std::to_string(kMaxThreads) +
                        "]");
   }
+  if (shard_count < 1 || shard_count > kMaxShards) {
+    problems.push_back("shard_count = " + std::to_string(shard_count) + ": must be in [1, " +
+                       std::to_string(kMaxShards) + "]");
+  } else if (shard_index < 0 || shard_index >= shard_count) {
+    problems.push_back("shard_index = " + std::to_string(shard_index) + ": must be in [0, " +
+                       std::to_string(shard_count - 1) + "]");
+  }
   return problems;
 }
 
@@ -309,10 +333,11 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
   detail::throw_if_any(options.validate(), "sweep options");
   if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   const auto start = Clock::now();
-  const std::size_t total = grid.size();
+  const std::vector<std::size_t> nodes = shard_nodes(grid, options);
+  const std::size_t total = nodes.size();
 
-  std::vector<FieldPoint> points(total);
-  std::vector<bool> done(total, false);
+  std::vector<FieldPoint> points(grid.size());
+  std::vector<bool> done(grid.size(), false);
   std::optional<ResultsFile> file;
   std::size_t resumed = 0;
   std::vector<std::string> warnings;
@@ -321,7 +346,7 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
     resumed = resume(*file, options.results_path, grid, options, points, done, warnings);
   }
   std::vector<std::size_t> pending;
-  for (std::size_t k = 0; k < total; ++k) {
+  for (const std::size_t k : nodes) {
     if (!done[k]) pending.push_back(k);
   }
 
@@ -400,17 +425,171 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
 std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options) {
   detail::throw_if_any(grid.validate(), "sweep grid");
   detail::throw_if_any(options.validate(), "sweep options");
-  if (options.results_path.empty()) return grid.size();
+  const std::size_t total = shard_nodes(grid, options).size();
+  if (options.results_path.empty()) return total;
   std::error_code error;
   // exists() follows links: a dangling link is "nothing saved yet", as run_sweep creates its target.
-  if (!std::filesystem::exists(options.results_path, error)) return grid.size();
+  if (!std::filesystem::exists(options.results_path, error)) return total;
   std::vector<FieldPoint> points(grid.size());
   std::vector<bool> done(grid.size(), false);
   // Read only, without the lock: a sweep running now may append meanwhile, which at worst
   // makes the count a little high (a cut last line is dropped, as on resume).
   const SavedPoints saved = read_saved_points(detail::read_text_file(options.results_path),
                                               detail::file_label(options.results_path), grid, options, points, done);
-  return grid.size() - saved.resumed;
+  return total - saved.resumed;
+}
+
+namespace {
+
+/// One shard's results file as merge_sweep_shards reads it.
+struct ShardLog {
+  std::string label;  ///< file_label of its path
+  std::string text;   ///< the whole file
+  json header;        ///< line 1
+  int index = 0;      ///< its shard (0/1 for a log of the whole grid)
+  int count = 1;
+};
+
+ShardLog read_shard_log(const std::filesystem::path& path) {
+  ShardLog log;
+  log.label = detail::file_label(path);
+  log.text = detail::read_text_file(path);
+  const std::string context = log.label + ": line 1";
+  const std::size_t newline = log.text.find('\n');
+  if (newline == std::string::npos)
+    throw std::invalid_argument(context + ": no complete sweep header (an empty or cut file); not a shard's results file");
+  log.header = strict_json::parse_json_document(log.text.substr(0, newline), context);
+  if (!log.header.is_object() || log.header.value("format", json()) != kSweepFormat)
+    throw std::invalid_argument(context + ": not a sweep results file (format must be \"" + std::string(kSweepFormat) +
+                                "\")");
+  if (const auto shard = log.header.find("shard"); shard != log.header.end()) {
+    const auto part = [&](const char* key) {
+      const json& v = shard->is_object() ? shard->value(key, json()) : json();
+      if (!v.is_number_integer()) throw std::invalid_argument(context + ": /shard/" + key + ": must be a whole number");
+      return v.get<long long>();
+    };
+    const long long index = part("index"), count = part("count");
+    if (count < 2 || count > kMaxShards || index < 0 || index >= count)
+      throw std::invalid_argument(context + ": /shard: " + std::to_string(index) + "/" + std::to_string(count) +
+                                  ": must be i/n with 0 <= i < n, 2 <= n <= " + std::to_string(kMaxShards));
+    log.index = static_cast<int>(index);
+    log.count = static_cast<int>(count);
+    log.header.erase("shard");  // what remains is the sweep's identity
+  }
+  return log;
+}
+
+std::string shard_name(int index, int count) { return std::to_string(index) + "/" + std::to_string(count); }
+
+/// How two identity headers differ, key by key, each value named by its source.
+std::string identity_difference(const json& a, const std::string& a_label, const json& b, const std::string& b_label) {
+  std::string text;
+  json keys = a;
+  keys.update(b);
+  for (const auto& [key, unused] : keys.items()) {
+    const auto ia = a.find(key), ib = b.find(key);
+    const bool in_a = ia != a.end(), in_b = ib != b.end();
+    if (in_a && in_b && *ia == *ib) continue;
+    const auto shown = [&](bool present, json::const_iterator it) {
+      if (!present) return std::string("absent");
+      return key == "axes" ? std::string("other axes") : it->dump();
+    };
+    text += (text.empty() ? "" : "; ") + key + ": " + a_label + " " + shown(in_a, ia) + ", " + b_label + " " +
+            shown(in_b, ib);
+  }
+  return text;
+}
+
+}  // namespace
+
+SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
+                               const std::vector<std::filesystem::path>& shard_logs,
+                               const std::string& expected_label) {
+  SweepOptions wanted = options;
+  wanted.results_path.clear();
+  wanted.shard_index = 0;
+  wanted.shard_count = 1;
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  detail::throw_if_any(wanted.validate(), "sweep options");
+  if (shard_logs.empty()) throw std::invalid_argument("merge: no shard results files given");
+  const auto start = Clock::now();
+
+  std::vector<ShardLog> logs;
+  for (const auto& path : shard_logs) logs.push_back(read_shard_log(path));
+  // printable(): the differences quote the files' values (see read_saved_points).
+  const ShardLog& first = logs.front();
+  for (std::size_t i = 1; i < logs.size(); ++i) {
+    if (logs[i].header != first.header) {
+      throw std::invalid_argument(strict_json::printable(
+          first.label + " and " + logs[i].label + ": are not shards of one sweep (" +
+          identity_difference(first.header, first.label, logs[i].header, logs[i].label) +
+          "); merge only the shards of one pdamp field command"));
+    }
+  }
+  const json expected = sweep_header(grid, wanted);
+  if (first.header != expected) {
+    throw std::invalid_argument(strict_json::printable(
+        first.label + ": line 1: is a shard of another sweep than " + expected_label + " (" +
+        identity_difference(first.header, first.label, expected, expected_label) + ")"));
+  }
+  // Which file holds which shard: every shard of one count exactly once.
+  std::vector<const ShardLog*> by_index(static_cast<std::size_t>(first.count), nullptr);
+  for (const auto& log : logs) {
+    if (log.count != first.count) {
+      throw std::invalid_argument(first.label + " is shard " + shard_name(first.index, first.count) + " but " +
+                                  log.label + " is shard " + shard_name(log.index, log.count) +
+                                  ": the shard counts differ");
+    }
+    const ShardLog*& slot = by_index[static_cast<std::size_t>(log.index)];
+    if (slot != nullptr) {
+      throw std::invalid_argument(slot->label + " and " + log.label + ": both are shard " +
+                                  shard_name(log.index, log.count) + "; give each shard once");
+    }
+    slot = &log;
+  }
+  std::string missing;
+  std::size_t missing_count = 0;
+  for (std::size_t i = 0; i < by_index.size(); ++i) {
+    if (by_index[i] != nullptr) continue;
+    if (++missing_count <= 10) missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+  }
+  if (missing_count > 0) {
+    throw std::invalid_argument(std::string(missing_count == 1 ? "shard " : "shards ") + missing +
+                                (missing_count > 10 ? ", ..." : "") + " of " + std::to_string(first.count) +
+                                (missing_count == 1 ? " is" : " are") + " missing (" + std::to_string(logs.size()) +
+                                " of " + std::to_string(first.count) + " shard files given)");
+  }
+
+  std::vector<FieldPoint> points(grid.size());
+  std::vector<bool> done(grid.size(), false);
+  SweepResult result;
+  for (const auto& log : logs) {
+    SweepOptions shard = wanted;
+    shard.shard_index = log.index;
+    shard.shard_count = log.count;
+    // The same strict reader as a resume: a damaged line is refused with its number,
+    // and a node of another shard (so also a point in two files) is refused.
+    const SavedPoints saved = read_saved_points(log.text, log.label, grid, shard, points, done);
+    if (!saved.warning.empty()) result.summary.warnings.push_back(saved.warning);
+    const std::size_t nodes = shard_nodes(grid, shard).size();
+    if (saved.resumed != nodes) {
+      throw std::invalid_argument(log.label + ": shard " + shard_name(log.index, log.count) + " is incomplete (" +
+                                  std::to_string(saved.resumed) + " of " + std::to_string(nodes) +
+                                  " points saved); rerun its command, it resumes, then merge");
+    }
+  }
+  result.field.grid = grid;
+  result.field.points = std::move(points);
+  result.field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
+  result.field.clearance_m = options.clearance_m;
+  result.field.bed_mass_kg = options.bed_mass_kg;
+  result.summary.points_total = grid.size();
+  result.summary.points_resumed = grid.size();
+  for (const auto& p : result.field.points) {
+    if (p.status == PointStatus::kFailed) ++result.summary.points_failed;
+  }
+  result.summary.wall_time_s = seconds_since(start);
+  return result;
 }
 
 }  // namespace pdamp::surrogate

@@ -468,3 +468,186 @@ TEST_CASE("a directory or a FIFO given as the results file is refused at once, n
         fifo.string() + ": is a FIFO (named pipe), not a file");
   CHECK(never.calls() == 0);
 }
+
+// ---------------------------------------------------------------- shards (job arrays)
+
+namespace {
+
+/// Runs shard `index` of `count` of the test sweep into `results` and returns it.
+SweepResult run_shard(RecordingEvaluator& evaluator, const fs::path& results, int index, int count) {
+  SweepOptions options = sweep_options(results);
+  options.shard_index = index;
+  options.shard_count = count;
+  return run_sweep(sweep_grid(), by_reference(evaluator), options);
+}
+
+/// The three shard logs of the test sweep, each run to the end, in dir/s<i>.jsonl.
+std::vector<fs::path> three_shards(const fs::path& dir) {
+  std::vector<fs::path> logs;
+  for (int i = 0; i < 3; ++i) {
+    RecordingEvaluator evaluator;
+    logs.push_back(dir / ("s" + std::to_string(i) + ".jsonl"));
+    run_shard(evaluator, logs.back(), i, 3);
+  }
+  return logs;
+}
+
+/// `path` with every occurrence of `from` in its first line replaced by `to`.
+void edit_header(const fs::path& path, const std::string& from, const std::string& to) {
+  std::string text = read_text(path);
+  const std::size_t at = text.find(from);
+  REQUIRE(at < text.find('\n'));
+  text.replace(at, from.size(), to);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+}
+
+}  // namespace
+
+TEST_CASE("shards partition the grid: every node in exactly one, interleaved", "[surrogate]") {
+  TempDir dir("sweep_shards");
+  std::set<std::pair<double, double>> seen;
+  std::size_t evaluated = 0;
+  for (int i = 0; i < 4; ++i) {  // 18 nodes over 4 shards: 5, 5, 4, 4
+    RecordingEvaluator evaluator;
+    const SweepResult result = run_shard(evaluator, dir.path / ("s" + std::to_string(i) + ".jsonl"), i, 4);
+    CHECK(result.summary.points_total == (i < 2 ? 5u : 4u));
+    CHECK(static_cast<std::size_t>(evaluator.calls()) == result.summary.points_total);
+    evaluated += evaluator.finished().size();
+    for (const auto& point : evaluator.finished()) CHECK(seen.insert(point).second);  // disjoint
+    for (std::size_t k = 0; k < 18; ++k) {
+      // The shard's nodes are filled, the others left missing (not a full field).
+      CHECK((result.field.points[k].status == PointStatus::kMissing) == !in_shard(k, i, 4));
+    }
+  }
+  CHECK(evaluated == 18);
+  CHECK(seen.size() == 18);  // the union is the grid
+}
+
+TEST_CASE("merging the shard logs gives the serial sweep's field point for point", "[surrogate]") {
+  TempDir dir("sweep_merge");
+  std::vector<fs::path> logs = three_shards(dir.path);
+  std::reverse(logs.begin(), logs.end());  // any order
+  const SweepResult merged = merge_sweep_shards(sweep_grid(), sweep_options({}), logs);
+  CHECK(merged.field.points == reference_field().points);
+  CHECK(merged.field.validate().empty());
+  CHECK(merged.field.provenance.case_hash == "feedc0ffee123456");
+  CHECK(merged.field.provenance.model_version == 4);
+  CHECK(merged.summary.points_total == 18);
+  CHECK(merged.summary.points_computed == 0);
+  // A log of the whole grid is a merge of one shard (0/1).
+  RecordingEvaluator whole;
+  run_sweep(sweep_grid(), by_reference(whole), sweep_options(dir.path / "whole.jsonl"));
+  CHECK(merge_sweep_shards(sweep_grid(), sweep_options({}), {dir.path / "whole.jsonl"}).field.points ==
+        reference_field().points);
+}
+
+TEST_CASE("a stopped shard resumes as the same shard only", "[surrogate]") {
+  TempDir dir("sweep_shard_resume");
+  const fs::path log = dir.path / "s1.jsonl";
+  RecordingEvaluator dying(4);
+  CHECK_THROWS_WITH(run_shard(dying, log, 1, 3), "simulated kill");
+  const std::size_t saved = dying.finished().size();
+  CHECK(saved >= 3);
+  // Another shard, or the whole grid, on its log is refused: its points are not theirs.
+  RecordingEvaluator never;
+  CHECK_THROWS_WITH(run_shard(never, log, 2, 3), Catch::Contains("belongs to another sweep") && Catch::Contains("shard"));
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(log)), Catch::Contains("shard"));
+  CHECK(never.calls() == 0);
+  SweepOptions options = sweep_options(log);
+  options.shard_index = 1;
+  options.shard_count = 3;
+  CHECK(pending_sweep_points(sweep_grid(), options) == 6 - saved);
+  RecordingEvaluator second;
+  const SweepResult resumed = run_shard(second, log, 1, 3);
+  CHECK(resumed.summary.points_resumed == saved);
+  CHECK(static_cast<std::size_t>(second.calls()) == 6 - saved);
+}
+
+TEST_CASE("shard options outside their range are refused", "[surrogate]") {
+  SweepOptions options = sweep_options({});
+  options.shard_count = 3;
+  options.shard_index = 3;
+  CHECK_THAT(options.validate().at(0), Catch::Contains("shard_index = 3: must be in [0, 2]"));
+  options.shard_count = 0;
+  CHECK_THAT(options.validate().at(0), Catch::Contains("shard_count = 0: must be in [1, 100000]"));
+  options.shard_count = kMaxShards + 1;
+  CHECK(options.validate().size() == 1);
+}
+
+TEST_CASE("merge refuses shards of different sweeps naming both files", "[surrogate]") {
+  TempDir dir("sweep_merge_mismatch");
+  const std::vector<fs::path> logs = three_shards(dir.path);
+  const std::string a = logs[0].string(), b = logs[1].string(), c = logs[2].string();
+
+  SECTION("model version") {
+    edit_header(logs[1], "\"model_version\":4", "\"model_version\":5");
+    CHECK_THROWS_WITH(merge_sweep_shards(sweep_grid(), sweep_options({}), logs),
+                      Catch::StartsWith(a + " and " + b + ": are not shards of one sweep") &&
+                          Catch::Contains("model_version: " + a + " 4, " + b + " 5"));
+  }
+  SECTION("case hash") {
+    edit_header(logs[2], "feedc0ffee123456", "0000000000000000");
+    CHECK_THROWS_WITH(merge_sweep_shards(sweep_grid(), sweep_options({}), logs),
+                      Catch::Contains(a + " and " + c) && Catch::Contains("case_hash"));
+  }
+  SECTION("grid") {
+    RecordingEvaluator evaluator;
+    SweepOptions options = sweep_options(dir.path / "other_grid.jsonl");
+    options.shard_index = 1;
+    options.shard_count = 3;
+    const Grid other = Grid::from_ranges(GridAxes::kFrequencyAmplitude, {1.0, 3.5, 3, AxisSpacing::kLinear},
+                                         {0.005, 0.04, 6, AxisSpacing::kLog});
+    run_sweep(other, by_reference(evaluator), options);
+    CHECK_THROWS_WITH(merge_sweep_shards(sweep_grid(), sweep_options({}), {logs[0], options.results_path, logs[2]}),
+                      Catch::Contains(a + " and " + options.results_path.string()) &&
+                          Catch::Contains("axes: " + a + " other axes"));
+  }
+  SECTION("the expected sweep") {
+    SweepOptions expected = sweep_options({});
+    expected.case_hash = "1111111111111111";
+    CHECK_THROWS_WITH(merge_sweep_shards(sweep_grid(), expected, logs, "case.json"),
+                      Catch::StartsWith(a + ": line 1: is a shard of another sweep than case.json") &&
+                          Catch::Contains("case_hash: " + a + " \"feedc0ffee123456\", case.json \"1111111111111111\""));
+  }
+}
+
+TEST_CASE("merge refuses a missing, repeated, foreign-count, incomplete or damaged shard", "[surrogate]") {
+  TempDir dir("sweep_merge_shards");
+  const std::vector<fs::path> logs = three_shards(dir.path);
+  const auto merge = [](const std::vector<fs::path>& files) {
+    return merge_sweep_shards(sweep_grid(), sweep_options({}), files);
+  };
+  CHECK_THROWS_WITH(merge({logs[0], logs[2]}), "shard 1 of 3 is missing (2 of 3 shard files given)");
+  CHECK_THROWS_WITH(merge({logs[0], logs[1], logs[1], logs[2]}),
+                    logs[1].string() + " and " + logs[1].string() + ": both are shard 1/3; give each shard once");
+  RecordingEvaluator evaluator;
+  const fs::path quarter = dir.path / "q.jsonl";
+  run_shard(evaluator, quarter, 1, 4);
+  CHECK_THROWS_WITH(merge({logs[0], quarter}), logs[0].string() + " is shard 0/3 but " + quarter.string() +
+                                                   " is shard 1/4: the shard counts differ");
+  SECTION("incomplete") {
+    fs::resize_file(logs[1], fs::file_size(logs[1]) - 25);  // a cut last line: that point is not saved
+    CHECK_THROWS_WITH(merge(logs), Catch::StartsWith(logs[1].string() + ": shard 1/3 is incomplete (5 of 6 points saved)"));
+  }
+  SECTION("damaged line") {
+    std::string text = read_text(logs[2]);
+    const std::size_t third_line = text.find('\n', text.find('\n') + 1) + 1;
+    text.replace(third_line, 1, "[");
+    std::ofstream(logs[2], std::ios::binary | std::ios::trunc) << text;
+    CHECK_THROWS_WITH(merge(logs), Catch::StartsWith(logs[2].string() + ": line 3"));
+  }
+  SECTION("a node of another shard") {
+    // Shard 1's first point (node 1) copied into shard 0's log.
+    const std::string one = read_text(logs[1]);
+    const std::size_t begin = one.find('\n') + 1;
+    std::ofstream(logs[0], std::ios::binary | std::ios::app) << one.substr(begin, one.find('\n', begin) + 1 - begin);
+    CHECK_THROWS_WITH(merge(logs), Catch::StartsWith(logs[0].string() + ": line 8") &&
+                                       Catch::Contains("is not a node of shard 0/3"));
+  }
+  SECTION("not a sweep log") {
+    std::ofstream(logs[0], std::ios::trunc) << "{\"format\": \"pdamp.effective_field\"}\n";
+    CHECK_THROWS_WITH(merge(logs), Catch::StartsWith(logs[0].string() + ": line 1: not a sweep results file"));
+    std::ofstream(logs[0], std::ios::trunc) << "";
+    CHECK_THROWS_WITH(merge(logs), Catch::Contains("no complete sweep header"));
+  }
+}

@@ -39,13 +39,27 @@ struct SweepOptions {
   double clearance_m = 0.0;                ///< damper clearance h, m, > 0 (turns (Γ, X/h) nodes into drives)
   double bed_mass_kg = 0.0;  ///< m_bed, kg, > 0 (E_diss and m_app/m_bed where the evaluator leaves them NaN)
   int threads = 2;           ///< points evaluated at once, [1, 256]
+  /// Job arrays (Slurm): this sweep evaluates only the grid nodes k with
+  /// k % shard_count == shard_index (in_shard). Interleaved rather than in blocks, so
+  /// that the expensive nodes (high strokes of every frequency) spread over the shards.
+  /// shard_count in [1, kMaxShards], shard_index in [0, shard_count); 0/1 is the whole grid.
+  int shard_index = 0;
+  int shard_count = 1;
   SweepProgress progress;    ///< optional
   /// One line per violated rule ("threads = 0: must be in [1, 256]"); empty if valid.
   std::vector<std::string> validate() const;
 };
 
+/// Most shards a sweep may be split into (a Slurm array holds up to a few 10^4 tasks).
+inline constexpr int kMaxShards = 100000;
+
+/// True if grid node `index` belongs to shard shard_index of shard_count (see SweepOptions).
+inline bool in_shard(std::size_t index, int shard_index, int shard_count) {
+  return index % static_cast<std::size_t>(shard_count) == static_cast<std::size_t>(shard_index);
+}
+
 struct SweepSummary {
-  std::size_t points_total = 0;     ///< nodes in the grid
+  std::size_t points_total = 0;     ///< nodes of this sweep's shard (the whole grid unless sharded)
   std::size_t points_resumed = 0;   ///< read back from the results file
   std::size_t points_computed = 0;  ///< evaluated in this run (ok or failed)
   std::size_t points_failed = 0;    ///< status kFailed among all points
@@ -58,23 +72,28 @@ struct SweepSummary {
 };
 
 struct SweepResult {
-  EffectiveField field;  ///< every node filled (ok or failed), provenance stamped now
+  /// Every node of the shard filled (ok or failed), provenance stamped now; nodes of
+  /// other shards keep status kMissing (all NaN), so a shard's field is not a full one.
+  EffectiveField field;
   SweepSummary summary;
 };
 
-/// Evaluates every grid node not yet in the results file, options.threads at a time, and
-/// returns the full field (the caller writes it with write_effective_field).
+/// Evaluates every grid node of options' shard not yet in the results file,
+/// options.threads at a time, and returns the field (the caller writes it with
+/// write_effective_field; a shard's field is written by merge_sweep_shards instead).
 ///
 /// Results file: line 1 is a header {format "pdamp.field_sweep", format_version, source,
-/// case_hash, model_version, clearance_m, bed_mass_kg, axes}; every further line is one
+/// case_hash, model_version, clearance_m, bed_mass_kg, axes}, plus shard {index, count}
+/// for a sharded sweep (shard_count > 1; absent for the whole grid, so that logs written
+/// before shards existed still resume); every further line is one
 /// finished point {index, drive {frequency_hz, amplitude_m}, values, status, wall_time_s},
 /// written and fsynced under a mutex as soon as the point is done. Resuming re-reads the
 /// file: a header that differs from this sweep's (another case, model version, source,
-/// clearance, bed mass or grid) throws std::invalid_argument telling the user to delete
+/// clearance, bed mass, grid or shard) throws std::invalid_argument telling the user to delete
 /// or move the file, so stale points are never mixed in; a last line without its newline
 /// (a write cut by SIGTERM or a crash) is truncated away, recomputed and reported in
 /// SweepSummary::warnings; any other damaged line (bad JSON, a repeated key, a value
-/// out of range) throws std::invalid_argument naming the line. A results path that is a
+/// out of range, a node of another shard) throws std::invalid_argument naming the line. A results path that is a
 /// directory, FIFO or device throws std::invalid_argument at once. A second sweep on the
 /// same file at the same time is refused (std::runtime_error; the file is locked with flock).
 ///
@@ -88,14 +107,34 @@ struct SweepResult {
 /// Throws std::invalid_argument for an invalid grid or options, std::runtime_error for I/O.
 SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options);
 
-/// Grid nodes a run_sweep(grid, evaluator, options) would evaluate now: grid.size()
-/// minus the points already saved in options.results_path (0 saved if the path is
+/// Grid nodes a run_sweep(grid, evaluator, options) would evaluate now: the nodes of
+/// options' shard (grid.size() unless sharded) minus the points already saved in options.results_path (0 saved if the path is
 /// empty or does not exist; a cut last line counts as not saved). Reads the file without
 /// writing or locking it, so a caller can estimate the run time (the CLI multiplies by
 /// its time per point) before starting. Throws what run_sweep would throw before its
 /// first point: std::invalid_argument for an invalid grid or options (kMaxGridNodes
 /// included), a results file of another sweep, a damaged line, a directory or FIFO.
 std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options);
+
+/// Joins the results files of the shards of one sweep (run_sweep with shard_count = n
+/// and shard_index 0..n-1, in any order) into the field a serial run_sweep(grid, ...,
+/// options) returns: the same values point for point, provenance stamped now.
+/// options.results_path, shard_index and shard_count are ignored; the other identity
+/// fields (source, case_hash, model_version, clearance_m, bed_mass_kg) and the grid say
+/// which sweep is expected, `expected_label` names where they come from in messages
+/// (e.g. the case file). Reads the files without writing or locking them. Throws
+/// std::invalid_argument, naming the files involved, for: a file that cannot be read or
+/// whose header is not a sweep header ("<file>: line 1: ..."); two files whose headers
+/// differ in anything but the shard ("<a> and <b>: are not shards of one sweep (key: a
+/// .., b ..)"); a header that differs from the expected one ("<file>: line 1: is a shard
+/// of another sweep than <expected_label> (key: file .., expected ..)"); shard counts
+/// that differ, a shard given twice, a shard missing; a damaged line or a node of another
+/// shard (as run_sweep, with the line number); a shard whose points are not all saved
+/// (its sweep was stopped: rerun it, it resumes). SweepSummary: points_total =
+/// points_resumed = grid.size(), nothing computed; warnings for cut last lines.
+SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
+                               const std::vector<std::filesystem::path>& shard_logs,
+                               const std::string& expected_label = "this sweep");
 
 /// Evaluator of the closed forms (formulas::reduced_loss_factor) for one damper: η*,
 /// stderr 0 (exact), E_diss = η*·½ m_bed (XΩ)², apparent mass not given (NaN; the closed
