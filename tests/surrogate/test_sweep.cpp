@@ -481,12 +481,20 @@ SweepResult run_shard(RecordingEvaluator& evaluator, const fs::path& results, in
   return run_sweep(sweep_grid(), by_reference(evaluator), options);
 }
 
+/// "s<i>.jsonl", built with += (GCC 12 warns falsely, -Wrestrict, on "s" + to_string(i)).
+std::string shard_log_name(int i) {
+  std::string name = "s";
+  name += std::to_string(i);
+  name += ".jsonl";
+  return name;
+}
+
 /// The three shard logs of the test sweep, each run to the end, in dir/s<i>.jsonl.
 std::vector<fs::path> three_shards(const fs::path& dir) {
   std::vector<fs::path> logs;
   for (int i = 0; i < 3; ++i) {
     RecordingEvaluator evaluator;
-    logs.push_back(dir / ("s" + std::to_string(i) + ".jsonl"));
+    logs.push_back(dir / shard_log_name(i));
     run_shard(evaluator, logs.back(), i, 3);
   }
   return logs;
@@ -509,7 +517,7 @@ TEST_CASE("shards partition the grid: every node in exactly one, interleaved", "
   std::size_t evaluated = 0;
   for (int i = 0; i < 4; ++i) {  // 18 nodes over 4 shards: 5, 5, 4, 4
     RecordingEvaluator evaluator;
-    const SweepResult result = run_shard(evaluator, dir.path / ("s" + std::to_string(i) + ".jsonl"), i, 4);
+    const SweepResult result = run_shard(evaluator, dir.path / shard_log_name(i), i, 4);
     CHECK(result.summary.points_total == (i < 2 ? 5u : 4u));
     CHECK(static_cast<std::size_t>(evaluator.calls()) == result.summary.points_total);
     evaluated += evaluator.finished().size();
