@@ -328,15 +328,23 @@ double onset_stroke_m(double inertia_factor, double clearance_m) {
 }
 double onset_reduced_loss_factor(double inertia_factor) { return onset_eta_star(inertia_factor); }
 
-LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
-                               double frequency_hz, const ModelOptions& options) {
+namespace {
+
+/// reduced_loss_factor's body. kSentences: write the warning sentences (else only count
+/// them: no allocation, no formatting). Options are checked by the callers.
+template <bool kSentences>
+LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, double frequency_hz,
+                       const ModelOptions& options) {
   require_positive("clearance_m", clearance_m);
   require_positive("stroke_m", stroke_m);
   require_positive("frequency_hz", frequency_hz);
-  require_valid(options);
 
   const double omega = kTwoPi * frequency_hz;
   LossResult result;
+  const auto warn = [&result](auto&& sentence) {
+    ++result.warning_count;
+    if constexpr (kSentences) result.warnings.push_back(sentence());
+  };
   result.model_requested = model;
   result.velocity_amplitude_m_s = stroke_m * omega;
   result.intensity = result.velocity_amplitude_m_s * omega / kStandardGravity;
@@ -367,57 +375,59 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
     result.impact_phase_rad = kNaN;
     result.eta_star = fit.jump_fraction * onset_eta_star(inertia_factor) * std::pow(s, fit.exponent);
     if (explicit_family) {
-      result.warnings.push_back(
+      warn([&] { return std::string(
           std::string(family_name) + " model at stroke X = " + format(stroke_m) +
           " m below its onset X_onset = " + format(onset_m) + " m (s = " + format(s) +
           "): the collect-and-collide orbit does not exist there, so eta* comes from the "
-          "scattered-state fit");
+          "scattered-state fit"); });
     }
     if (s < fit.s_min || s > fit.s_max || s >= 1.0) {
       // Between s_max and the cliff (s = 1) the law is extrapolated toward the jump,
       // where the DEM shows the largest scatter: say so with the fit's quality.
-      std::string quality;
-      if (fit.points > 0)
-        quality = " (fitted on " + std::to_string(fit.points) + " points, reduced chi^2 = " +
-                  format(fit.reduced_chi_squared) + ", jump_fraction = " + format(fit.jump_fraction) + " +- " +
-                  format(fit.jump_fraction_stderr) + ")";
-      result.warnings.push_back("scattered-state fit evaluated at s = X/X_onset = " + format(s) +
-                                ", outside the range it was fitted on [" + format(fit.s_min) + ", " +
-                                format(fit.s_max) + "]: extrapolated" + quality);
+      warn([&] {
+        std::string quality;
+        if (fit.points > 0)
+          quality = " (fitted on " + std::to_string(fit.points) + " points, reduced chi^2 = " +
+                    format(fit.reduced_chi_squared) + ", jump_fraction = " + format(fit.jump_fraction) + " +- " +
+                    format(fit.jump_fraction_stderr) + ")";
+        return std::string("scattered-state fit evaluated at s = X/X_onset = " + format(s) +
+                           ", outside the range it was fitted on [" + format(fit.s_min) + ", " +
+                           format(fit.s_max) + "]: extrapolated" + quality);
+      });
     }
     if (fit.provisional) {
-      result.warnings.push_back(
+      warn([&] { return std::string(
           "scattered-state fit is provisional (jump_fraction = " + format(fit.jump_fraction) +
           ", exponent = " + format(fit.exponent) + ", source: " + fit.source +
           "): the scattered-state eta* = " + format(result.eta_star) +
-          " is a placeholder until the fit is made on DEM points");
+          " is a placeholder until the fit is made on DEM points"); });
     }
   }
 
   if (model == DamperModel::kRolling && !options.gravity_across_drive) {
-    result.warnings.push_back("rolling model without gravity across the drive: no base carries the spheres, so they "
-                              "fly rather than roll (the bouncing model describes that)");
+    warn([&] { return std::string("rolling model without gravity across the drive: no base carries the spheres, so they "
+                              "fly rather than roll (the bouncing model describes that)"); });
   } else if (model == DamperModel::kRolling && !rolls) {
-    result.warnings.push_back(
+    warn([&] { return std::string(
         "rolling model at intensity Gamma = " + format(result.intensity) + ": rolling without slip needs a base "
         "friction mu >= kappa Gamma/(1+kappa) = " + format(rolling_no_slip_friction(inertia_factor, result.intensity)) +
         ", more than mu = " + format(options.base_friction) + ", so the spheres slide (auto then moves toward "
-        "free flight)");
+        "free flight)"); });
   }
   if (model == DamperModel::kBouncing && rolls) {
-    result.warnings.push_back(
+    warn([&] { return std::string(
         "bouncing model at intensity Gamma = " + format(result.intensity) + " <= " + format(slip) +
         ": the base friction mu = " + format(options.base_friction) + " keeps the spheres rolling there, and "
-        "the rolling model describes a bed rolling on its base");
+        "the rolling model describes a bed rolling on its base"); });
   }
   if (!explicit_family && options.gravity_across_drive && !rolls &&
       result.intensity < kFreeFlightFrictionRatio * options.base_friction) {
-    result.warnings.push_back(
+    warn([&] { return std::string(
         "auto at intensity Gamma = " + format(result.intensity) + ": the spheres slide on the base (rolling holds up "
         "to Gamma = " + format(slip) + " with mu = " + format(options.base_friction) + "), and friction still takes " +
         format(100.0 * options.base_friction / result.intensity) + "% of the drive's acceleration: eta* = " +
         format(result.eta_star) + " uses the relative acceleration 1 - mu/Gamma (kappa_eff = " + format(inertia_factor) +
-        "), between rolling and free flight, an approximation: check with pdamp dem");
+        "), between rolling and free flight, an approximation: check with pdamp dem"); });
   }
   if (result.model_used == DamperModel::kBouncing && options.gravity_across_drive && stroke_m < clearance_m &&
       model != DamperModel::kScattered) {
@@ -425,29 +435,44 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
     // case with gravity across the drive sits in the decoupled state with eta* ~ 0.02
     // from X = 0.45 h to 0.8 h, where the orbit gives ~1. No closed form says when the
     // bed is thrown off its base instead, so the whole range X < h is flagged.
-    result.warnings.push_back(
+    warn([&] { return std::string(
         "bouncing model with gravity across the drive at X/h = " + format(stroke_m / clearance_m) +
         " < 1: the bed can stay nearly at rest on the base while the container moves around it (the decoupled "
         "state; the shipped cylinder case with gravity gives eta* ~ 0.02 from 0.45 h to 0.8 h), so eta* = " +
-        format(result.eta_star) + " holds only if the bed is thrown off its base: check with pdamp dem");
+        format(result.eta_star) + " holds only if the bed is thrown off its base: check with pdamp dem"); });
   }
   if (options.gravity_along_drive) {
-    result.warnings.push_back(
+    warn([&] { return std::string(
         "gravity along the drive is not in the ideal models (PHYSICS.md section 2): it moves "
         "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
-        " is an optimistic estimate");
+        " is an optimistic estimate"); });
   }
   if (stroke_m > kMaxStrokeOverClearance * clearance_m) {
-    const std::string impact =
-        std::isfinite(result.impact_phase_rad)
-            ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
-            : std::string();
-    result.warnings.push_back("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
-                              " > " + format(kMaxStrokeOverClearance) +
-                              ": the bed barely separates from the wall" + impact +
-                              ", where the one-block model is outside its range");
+    warn([&] {
+      const std::string impact =
+          std::isfinite(result.impact_phase_rad)
+              ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
+              : std::string();
+      return std::string("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
+                         " > " + format(kMaxStrokeOverClearance) +
+                         ": the bed barely separates from the wall" + impact +
+                         ", where the one-block model is outside its range");
+    });
   }
   return result;
+}
+
+}  // namespace
+
+LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
+                               double frequency_hz, const ModelOptions& options) {
+  require_valid(options);
+  return loss_factor<true>(model, clearance_m, stroke_m, frequency_hz, options);
+}
+
+LossResult reduced_loss_factor_counted(DamperModel model, double clearance_m, double stroke_m,
+                                       double frequency_hz, const ModelOptions& validated_options) {
+  return loss_factor<false>(model, clearance_m, stroke_m, frequency_hz, validated_options);
 }
 
 double dissipated_energy_measure(double eta_star, double bed_mass_kg,

@@ -90,7 +90,9 @@ ClosedFormLossModel::ClosedFormLossModel(formulas::DamperModel model, double cle
 }
 
 DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_m) const {
-  const auto loss = formulas::reduced_loss_factor(model_, clearance_m_, stroke_m, frequency_hz, options_);
+  // options_ were validated by the constructor; only the number of warnings is used here
+  // (warning_messages writes the sentences).
+  const auto loss = formulas::reduced_loss_factor_counted(model_, clearance_m_, stroke_m, frequency_hz, options_);
   DamperResponse response;
   response.eta_star = loss.eta_star;
   response.regime = formulas::to_string(loss.regime);
@@ -113,7 +115,7 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
     std::size_t expected = (explicit_family ? 1u : 0u) + (options_.scattered.provisional ? 1u : 0u);
     const double s = loss.stroke_over_onset;
     if (s < options_.scattered.s_min || s > options_.scattered.s_max || s >= 1.0) ++expected;
-    if (loss.warnings.size() > expected) response.warnings |= kLossOutsideClosedForm;
+    if (loss.warning_count > expected) response.warnings |= kLossOutsideClosedForm;
     return response;
   }
   // On an orbit: η* = η_b(r)/(1+κ), m_app/m = (κ + m_b(r))/(1+κ), r = (1+κ)h/X, so
@@ -126,7 +128,7 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
   response.d_eta_star_d_stroke_1_m = block.d_eta_d_r * dr / scale - loss.eta_star * d_kappa / scale;
   response.d_apparent_mass_fraction_d_stroke_1_m =
       block.d_apparent_d_r * dr / scale + (1.0 - block.apparent_mass_fraction) * d_kappa / (scale * scale);
-  if (!loss.warnings.empty()) response.warnings |= kLossOutsideClosedForm;
+  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
   return response;
 }
 

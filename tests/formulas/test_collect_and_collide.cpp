@@ -716,6 +716,38 @@ TEST_CASE("validity warnings name the violated range with numbers, and none appe
   REQUIRE(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.5 * h, 60.0, weightless).warnings.empty());
 }
 
+TEST_CASE("reduced_loss_factor_counted gives the same numbers and warning count without the sentences",
+          "[formulas]") {
+  const double h = 0.05;
+  fm::ModelOptions vertical;
+  vertical.gravity_along_drive = true;
+  fm::ModelOptions weightless;
+  weightless.gravity_across_drive = false;
+  const fm::ModelOptions defaults;
+  for (const fm::ModelOptions* options : std::vector<const fm::ModelOptions*>{&defaults, &vertical, &weightless})
+    for (const fm::DamperModel model : {fm::DamperModel::kRolling, fm::DamperModel::kBouncing,
+                                        fm::DamperModel::kScattered, fm::DamperModel::kAuto})
+      for (const double x_over_h : {0.05, 0.2, 0.37, 0.4, 1.0 / kPi, 1.5, 12.0})
+        for (const double f : {2.0, 4.0, 60.0}) {
+          const fm::LossResult full = fm::reduced_loss_factor(model, h, x_over_h * h, f, *options);
+          const fm::LossResult counted = fm::reduced_loss_factor_counted(model, h, x_over_h * h, f, *options);
+          REQUIRE(full.warning_count == full.warnings.size());
+          REQUIRE(counted.warnings.empty());
+          REQUIRE(counted.warning_count == full.warnings.size());
+          REQUIRE(counted.model_used == full.model_used);
+          REQUIRE(counted.regime == full.regime);
+          // Bit for bit: the same code computes both.
+          REQUIRE(counted.eta_star == full.eta_star);
+          REQUIRE(counted.inertia_factor == full.inertia_factor);
+          REQUIRE(counted.intensity == full.intensity);
+          REQUIRE(counted.stroke_over_onset == full.stroke_over_onset);
+          REQUIRE((counted.impact_phase_rad == full.impact_phase_rad ||
+                   (std::isnan(counted.impact_phase_rad) && std::isnan(full.impact_phase_rad))));
+        }
+  REQUIRE_THROWS_AS(fm::reduced_loss_factor_counted(fm::DamperModel::kRolling, 0.0, 0.01, 2.0, defaults),
+                    std::invalid_argument);
+}
+
 TEST_CASE("bad inputs throw std::invalid_argument naming the quantity, value and range",
           "[formulas]") {
   using M = fm::DamperModel;

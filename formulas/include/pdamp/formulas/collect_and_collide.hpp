@@ -154,6 +154,9 @@ struct LossResult {
   double impact_phase_rad = 0.0;  ///< NaN in the scattered state
   double stroke_over_onset = 0.0; ///< s = X/X_onset of the family used
   std::vector<std::string> warnings;  ///< validity-range violations (INTERFACE.md)
+  /// How many warnings apply (warnings.size(), also when reduced_loss_factor_counted
+  /// leaves `warnings` empty).
+  std::size_t warning_count = 0;
 };
 /// The inertia factor auto gives a bed at intensity Γ (docs/collect_and_collide.md §6):
 /// with gravity across the drive the spheres roll without slip while the base friction
@@ -182,6 +185,12 @@ double onset_reduced_loss_factor(double inertia_factor);
 /// provisional or outside [s_min, 1), X/h > 10. No allocation when there is no warning.
 LossResult reduced_loss_factor(DamperModel model, double clearance_m, double stroke_m,
                                double frequency_hz, const ModelOptions& options = {});
+/// reduced_loss_factor for inner loops (surrogate::ClosedFormLossModel::evaluate, called
+/// per RK4 stage and per harmonic-balance root): the same numbers and warning_count, but
+/// the sentences are not written (`warnings` stays empty) and the options are not
+/// re-validated (they must be valid: ModelOptions::validate() empty). Never allocates.
+LossResult reduced_loss_factor_counted(DamperModel model, double clearance_m, double stroke_m,
+                                       double frequency_hz, const ModelOptions& validated_options);
 
 /// Energy measures from η* (PHYSICS.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
 /// η* >= 0, m_bed > 0, |V*| >= 0, all finite (std::invalid_argument otherwise).
