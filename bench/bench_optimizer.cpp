@@ -6,8 +6,10 @@
 #include <numbers>
 #include <string>
 
-#include "../tests/optimizer/cliff_problem.hpp"  // the tests' problem, not a copy
+#include "../tests/optimizer/beam_problem.hpp"   // the tests' problems, not copies
+#include "../tests/optimizer/cliff_problem.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/optimizer/clearance_on_structure.hpp"
 #include "pdamp/optimizer/filling_ratios.hpp"
@@ -60,46 +62,18 @@ BENCHMARK_CAPTURE(BM_RobustSizing, nlopt, opt::Backend::kNlopt)->Unit(benchmark:
 BENCHMARK_CAPTURE(BM_RobustSizing, ipopt, opt::Backend::kIpopt)->Unit(benchmark::kMillisecond);
 
 /// The optimiser's inputs for cases/manipulator_link_optimize.json as `pdamp optimize`
-/// builds them (cli/optimize_command.cpp, make_problem: the first damper's layers as
-/// candidates, released from rest, step_log_change 0.2).
+/// builds them (case_file::filling_ratio_problem), with the task's evaluation budgets.
 struct FillingProblem {
-  pdamp::structure::ModalModel modal;
-  opt::FillingRatioOptions options;
+  pdamp::case_file::FillingRatioProblem problem;
   opt::Options solver;
 };
 
 FillingProblem manipulator_link_problem() {
   namespace cf = pdamp::case_file;
   const cf::Case c = cf::load_case(std::string(PDAMP_SOURCE_DIR) + "/cases/manipulator_link_optimize.json");
-  const cf::FillingRatiosTask& task = *c.task.filling_ratios;
-  const cf::StructureSetup setup = cf::structure_setup(c, cf::LossMethod::kFormulas);
-  const cf::DamperSpec& spec = c.dampers.front();
-  FillingProblem p;
-  p.modal = setup.modal;
-  p.options.damper = setup.dampers.front();
-  p.options.fixed_dampers.assign(setup.dampers.begin() + 1, setup.dampers.end());
-  p.options.model = spec.model;
-  p.options.model_options = spec.model_options;
-  p.options.mass_budget_kg = task.mass_budget_kg;
-  for (std::size_t k = 0; k < spec.layers.size(); ++k) {
-    const cf::LayerSpec& layer = spec.layers[k];
-    const double r = layer.particle_radius_m;
-    opt::LayerCandidate l;
-    l.name = layer.name;
-    l.inner_length_m = layer.container.inner_length(spec.drive_axis);
-    l.slab_length_m = 2.0 * r;
-    l.spheres_per_slab = task.spheres_per_slab.at(k);
-    l.sphere_mass_kg = layer.bed_mass_kg / layer.particle_count;
-    l.sphere_volume_m3 = 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    l.initial_slabs = std::min(layer.particle_count / l.spheres_per_slab, l.max_slabs());
-    p.options.layers.push_back(l);
-  }
-  p.options.decay.initial_modal_amplitudes = cf::initial_modal_amplitudes(c, setup, task.decay).cwiseAbs();
-  p.options.decay.duration_s = task.decay.duration_s;
-  p.options.decay.threshold_fraction = task.decay.settling_threshold;
-  p.options.decay.step_log_change = 0.2;
-  p.solver.global_evaluations = task.global_evaluations;
-  p.solver.max_evaluations = task.max_evaluations;
+  FillingProblem p{cf::filling_ratio_problem(c), {}};
+  p.solver.global_evaluations = c.task.filling_ratios->global_evaluations;
+  p.solver.max_evaluations = c.task.filling_ratios->max_evaluations;
   return p;
 }
 
@@ -112,7 +86,7 @@ void BM_FillingRatios(benchmark::State& state, opt::Backend backend) {
   int evaluations = 0;
   double settling = 0.0;
   for (auto _ : state) {
-    const opt::FillingRatioResult r = opt::optimize_filling_ratios(p.modal, p.options, p.solver);
+    const opt::FillingRatioResult r = opt::optimize_filling_ratios(p.problem.modal, p.problem.options, p.solver);
     evaluations = r.decay_evaluations;
     settling = r.chosen.settling_time_s;
     benchmark::DoNotOptimize(r.chosen.objective);  // the const overload: "+m,r" on a double miscompiles here
@@ -123,40 +97,12 @@ void BM_FillingRatios(benchmark::State& state, opt::Backend backend) {
 BENCHMARK_CAPTURE(BM_FillingRatios, nlopt, opt::Backend::kNlopt)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_FillingRatios, ipopt, opt::Backend::kIpopt)->Unit(benchmark::kMillisecond)->Iterations(3);
 
-/// The base-excited beam of cases/beam_base_excited.json (as tests/optimizer/
-/// test_clearance_on_structure.cpp builds it): 3 modes, the damper's weight on the
+/// The base-excited beam of cases/beam_base_excited.json (tests/optimizer/beam_problem.hpp):
+/// 3 modes, the damper's weight on the
 /// geometric stiffness, rolling, 0.148 kg bed, 0.3 kg container, U = 1.33 mm, 1.2-2.4 Hz.
 void BM_ClearanceOnStructure(benchmark::State& state, opt::ClearanceObjective objective) {
-  namespace st = pdamp::structure;
-  st::BeamModel beam;
-  st::BeamSegment segment;
-  segment.length_m = 0.6;
-  segment.section.shape = st::SectionShape::kSolidRectangle;
-  segment.section.width_m = 0.03;
-  segment.section.depth_m = 0.002;
-  segment.material = {206e9, 7850.0};
-  segment.elements = 24;
-  beam.segments.push_back(segment);
-  beam.supports.push_back({st::Support::Kind::kClamped, 0.0, 0.0, 0.0, 0.0});
-  beam.points.push_back({"tip", 0.6});
-  beam.points.push_back({"middle", 0.3});
-  beam.carried_weights.push_back({0.6, 0.3 + 0.148});
-  beam.axial_gravity_m_s2 = -9.80665;
-  beam.geometric_stiffness = true;
-  st::ModalDamping damping;
-  damping.ratios = {0.002};
-  const st::ModalModel model = st::beam_modal_model(beam, 3, damping).modal;
-  opt::ClearanceOnStructureOptions o;
-  o.site = "tip";
-  o.drive_direction = {0.0, 1.0};
-  o.base_direction = {0.0, 1.0};
-  o.container_mass_kg = 0.3;
-  o.bed_mass_kg = 0.148;
-  o.model = pdamp::formulas::DamperModel::kRolling;
-  o.base_amplitude_m = 1.33e-3;
-  o.frequency_min_hz = 1.2;
-  o.frequency_max_hz = 2.4;
-  o.frequency_points = 200;
+  const pdamp::structure::ModalModel model = pdamp::test::beam_model();
+  opt::ClearanceOnStructureOptions o = pdamp::test::beam_options();
   o.objective = objective;
   int evaluations = 0;
   for (auto _ : state) {

@@ -22,6 +22,7 @@
 #include "output.hpp"
 #include "report.hpp"
 #include "structure_commands.hpp"
+#include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/optimizer/filling_ratios.hpp"
@@ -54,65 +55,9 @@ const FlagSpec kBackendFlag{"--backend", "NAME",
 json number_or_null(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 
-/// The optimiser's description of the case: candidates from the first damper's layers.
-struct Problem {
-  st::ModalModel modal;
-  opt::FillingRatioOptions options;
-  Eigen::VectorXd initial_modal_displacements;  ///< q(0), signed (the DEM verification releases from it)
-  std::vector<std::string> warnings;
-};
-
-Problem make_problem(const Case& c) {
-  const FillingRatiosTask& task = *c.task.filling_ratios;
-  Problem p;
-  case_file::StructureSetup setup = case_file::structure_setup(c, case_file::LossMethod::kFormulas);
-  const case_file::DamperSpec& spec = c.dampers.front();
-  p.modal = setup.modal;
-  p.options.damper = setup.dampers.front();
-  p.options.fixed_dampers.assign(setup.dampers.begin() + 1, setup.dampers.end());
-  p.options.model = spec.model;
-  p.options.model_options = spec.model_options;
-  p.options.mass_budget_kg = task.mass_budget_kg;
-  p.options.objective = task.objective == FillingRatiosTask::Objective::kIntegralSquare
-                            ? opt::FillingObjective::kIntegralSquare
-                            : opt::FillingObjective::kSettlingTime;
-  for (std::size_t k = 0; k < spec.layers.size(); ++k) {
-    const case_file::LayerSpec& layer = spec.layers[k];
-    const double r = layer.particle_radius_m;
-    opt::LayerCandidate l;
-    l.name = layer.name;
-    l.inner_length_m = layer.container.inner_length(spec.drive_axis);
-    l.slab_length_m = 2.0 * r;
-    l.spheres_per_slab = task.spheres_per_slab.at(k);
-    l.sphere_mass_kg = layer.bed_mass_kg / layer.particle_count;
-    l.sphere_volume_m3 = 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    l.cross_section_m2 = 1.0;
-    for (int axis = 0; axis < 3; ++axis)
-      if (axis != spec.drive_axis) l.cross_section_m2 *= layer.container.box_inner_size_m[static_cast<std::size_t>(axis)];
-    const int whole = layer.particle_count / l.spheres_per_slab;
-    if (layer.particle_count % l.spheres_per_slab != 0)
-      p.warnings.push_back("layer " + layer.name + ": " + std::to_string(layer.particle_count) +
-                           " particles are not whole slabs of " + std::to_string(l.spheres_per_slab) +
-                           ": the starting design takes " + std::to_string(whole) + " slabs");
-    l.initial_slabs = std::min(whole, l.max_slabs());
-    p.options.layers.push_back(l);
-  }
-  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup, task.decay);
-  p.initial_modal_displacements = q0;
-  p.options.decay.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
-  if (!(p.options.decay.initial_modal_amplitudes.maxCoeff() > 0.0))
-    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
-  p.options.decay.duration_s = task.decay.duration_s;
-  p.options.decay.threshold_fraction = task.decay.settling_threshold;
-  // The coarsest RK4 rule free_decay allows (ln a changes <= 0.2 a step: local error about
-  // 3e-6 of ln a): the search runs hundreds of decays; the comparison files use the same.
-  p.options.decay.step_log_change = 0.2;
-  if (const auto problems = p.options.validate(); !problems.empty()) throw InputError(c.path, "/task", problems.front());
-  if (setup.beam)
-    p.warnings.push_back("the beam's modes are those of the case's starting design (its bed weights load the beam's "
-                         "geometric stiffness); designs of other bed masses reuse them");
-  return p;
-}
+/// The optimiser's description of the case (case_file::filling_ratio_problem).
+using Problem = case_file::FillingRatioProblem;
+Problem make_problem(const Case& c) { return case_file::filling_ratio_problem(c); }
 
 std::vector<double> slabs_of(const opt::FillingDesign& d) {
   std::vector<double> n;

@@ -12,12 +12,15 @@
 
 #include "pdamp/optimizer/clearance_on_structure.hpp"
 #include "pdamp/structure/beam.hpp"
+#include "optimizer/beam_problem.hpp"
 
 namespace {
 
 namespace opt = pdamp::optimizer;
 namespace fm = pdamp::formulas;
 namespace st = pdamp::structure;
+using pdamp::test::beam_model;
+using pdamp::test::beam_options;
 
 /// A 2 kg oscillator on a base at 3 Hz, ζ = 0.5 %, as a mass-normalised mode:
 /// φ = 1/√m, Γ = √m (x direction).
@@ -47,45 +50,6 @@ opt::ClearanceOnStructureOptions one_mode_options(fm::DamperModel damper_model) 
   o.base_amplitude_m = 1e-3;
   o.frequency_min_hz = 2.4;
   o.frequency_max_hz = 3.6;
-  o.frequency_points = 200;
-  return o;
-}
-
-/// cases/beam_base_excited.json: a standing 0.6 m spring-steel cantilever, 30 x 2 mm,
-/// clamped at its foot, gravity compressing it, the damper (0.3 kg container, 36 spheres
-/// of 5 mm = 0.148 kg) at the tip, whose weight loads the geometric stiffness.
-st::ModalModel beam_model() {
-  st::BeamModel beam;
-  st::BeamSegment segment;
-  segment.length_m = 0.6;
-  segment.section.shape = st::SectionShape::kSolidRectangle;
-  segment.section.width_m = 0.03;
-  segment.section.depth_m = 0.002;
-  segment.material = {206e9, 7850.0};
-  segment.elements = 24;
-  beam.segments.push_back(segment);
-  beam.supports.push_back({st::Support::Kind::kClamped, 0.0, 0.0, 0.0, 0.0});
-  beam.points.push_back({"tip", 0.6});
-  beam.points.push_back({"middle", 0.3});
-  beam.carried_weights.push_back({0.6, 0.3 + 0.148});
-  beam.axial_gravity_m_s2 = -9.80665;
-  beam.geometric_stiffness = true;
-  st::ModalDamping damping;
-  damping.ratios = {0.002};
-  return st::beam_modal_model(beam, 3, damping).modal;
-}
-
-opt::ClearanceOnStructureOptions beam_options() {
-  opt::ClearanceOnStructureOptions o;
-  o.site = "tip";
-  o.drive_direction = {0.0, 1.0};
-  o.base_direction = {0.0, 1.0};
-  o.container_mass_kg = 0.3;
-  o.bed_mass_kg = 0.148;
-  o.model = fm::DamperModel::kRolling;
-  o.base_amplitude_m = 1.33e-3;
-  o.frequency_min_hz = 1.2;
-  o.frequency_max_hz = 2.4;
   o.frequency_points = 200;
   return o;
 }

@@ -10,6 +10,7 @@
 #include <new>
 
 #include "pdamp/structure/cosimulation.hpp"
+#include "structure/cosimulation_support.hpp"
 
 // Allocation counter for the "no allocation in the step loop" test: the global operator
 // new/delete are replaced by malloc/free. GCC pairs the standard allocation functions it
@@ -31,6 +32,8 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace {
 
 using namespace pdamp::structure;
+using pdamp::test::bed;
+using pdamp::test::tip_damper;
 namespace dem = pdamp::dem_reference;
 using cd = std::complex<double>;
 constexpr double kPi = 3.14159265358979323846;
@@ -50,36 +53,8 @@ ModalModel one_dof(double f_hz, double zeta, double mass_kg, double phi = 1.0, d
   return m;
 }
 
-/// A box compartment with `count` spheres (lattice counts x, y, z), softened steel.
-dem::WorldOptions bed(double radius_m, const dem::Vec3& box_m, std::vector<int> lattice, double youngs_pa,
-                      dem::Vec3 gravity, dem::InitialPlacement placement) {
-  dem::WorldOptions w;
-  w.materials[0].material.youngs_modulus_pa = youngs_pa;
-  w.gravity_m_s2 = gravity;
-  auto& c = w.compartments[0];
-  c.container.box_inner_size_m = box_m;
-  c.placement = placement;
-  c.lattice_counts = lattice;
-  c.particles[0].radius_m = radius_m;
-  c.particles[0].count = lattice[0] * lattice[1] * lattice[2];
-  c.particles[0].lot_diameter_variation_m = 0.0;
-  return w;
-}
-
-CosimulationDamper tip_damper(const dem::WorldOptions& world, double container_mass_kg) {
-  CosimulationDamper d;
-  d.name = "tip";
-  d.point = "tip";
-  d.drive_direction = {0.0, 1.0};
-  d.container_mass_kg = container_mass_kg;
-  d.world = world;
-  return d;
-}
-
 /// A single sphere floating in the middle of a long box without gravity: it never touches.
-dem::WorldOptions lone_sphere() {
-  return bed(0.005, {0.12, 0.03, 0.03}, {1, 1, 1}, 2e7, {0.0, 0.0, 0.0}, dem::InitialPlacement::kCentredLattice);
-}
+dem::WorldOptions lone_sphere() { return pdamp::test::lone_sphere(0.12); }
 
 /// Mean period from the up-crossings of y − mean(y) (linear interpolation), s.
 double mean_period_s(const std::vector<double>& t, const Eigen::VectorXd& y) {

@@ -10,10 +10,13 @@
 #include <complex>
 
 #include "pdamp/structure/cosimulation.hpp"
+#include "structure/cosimulation_support.hpp"
 
 namespace {
 
 using namespace pdamp::structure;
+using pdamp::test::bed;
+using pdamp::test::tip_damper;
 namespace dem = pdamp::dem_reference;
 using cd = std::complex<double>;
 constexpr double kPi = 3.14159265358979323846;
@@ -34,38 +37,10 @@ ModalModel base_oscillator(double f_hz, double zeta, double mass_kg) {
   return m;
 }
 
-/// A box compartment with a lattice of spheres (softened steel).
-dem::WorldOptions bed(double radius_m, const dem::Vec3& box_m, std::vector<int> lattice, double youngs_pa,
-                      dem::Vec3 gravity, dem::InitialPlacement placement) {
-  dem::WorldOptions w;
-  w.materials[0].material.youngs_modulus_pa = youngs_pa;
-  w.gravity_m_s2 = gravity;
-  auto& c = w.compartments[0];
-  c.container.box_inner_size_m = box_m;
-  c.placement = placement;
-  c.lattice_counts = lattice;
-  c.particles[0].radius_m = radius_m;
-  c.particles[0].count = lattice[0] * lattice[1] * lattice[2];
-  c.particles[0].lot_diameter_variation_m = 0.0;
-  return w;
-}
-
 /// A single sphere floating in a long box without gravity: it keeps the container's start
 /// velocity u̇(0) (< 5 mm/s here), so it travels < 0.2 m in 30 s and never touches a wall 0.5 m
 /// away; the modes see no bed force (checked by the container work).
-dem::WorldOptions lone_sphere() {
-  return bed(0.005, {1.0, 0.03, 0.03}, {1, 1, 1}, 2e7, {0.0, 0.0, 0.0}, dem::InitialPlacement::kCentredLattice);
-}
-
-CosimulationDamper tip_damper(const dem::WorldOptions& world, double container_mass_kg) {
-  CosimulationDamper d;
-  d.name = "tip";
-  d.point = "tip";
-  d.drive_direction = {0.0, 1.0};
-  d.container_mass_kg = container_mass_kg;
-  d.world = world;
-  return d;
-}
+dem::WorldOptions lone_sphere() { return pdamp::test::lone_sphere(1.0); }
 
 CosimulationOptions base_sweep(double amplitude_m, double f0_hz, double f1_hz, double duration_s) {
   CosimulationOptions o;
