@@ -13,7 +13,6 @@ namespace pdamp::surrogate {
 namespace {
 
 constexpr double kPi = formulas::kPi;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Scan range of the closed forms relative to the clearance: above 10 h they warn (X/h > 10).
 constexpr double kMinStrokeOverClearance = 1e-3;
 constexpr double kMaxStrokeOverClearance = 10.0;

@@ -486,7 +486,8 @@ std::string identity_difference(const json& a, const std::string& a_label, const
   std::string text;
   json keys = a;
   keys.update(b);
-  for (const auto& [key, unused] : keys.items()) {
+  for (const auto& item : keys.items()) {
+    const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
     const auto ia = a.find(key), ib = b.find(key);
     const bool in_a = ia != a.end(), in_b = ib != b.end();
     if (in_a && in_b && *ia == *ib) continue;
