@@ -40,7 +40,7 @@ namespace fs = std::filesystem;
 
 /// One reader of a user's file. `name` is the fuzz target's suffix (fuzz_<name>) and the
 /// folder of its corpus and regressions; `file_name` is what the bytes are saved as.
-enum class Reader { kCaseFile, kFieldFile, kMeasuredCsv, kImpactCsv, kScatteredFit, kModalData, kSweepLog };
+enum class Reader { kCaseFile, kFieldFile, kMeasuredCsv, kImpactCsv, kScatteredFit, kModalData, kSweepLog, kShardLog };
 
 struct ReaderInfo {
   Reader reader;
@@ -59,6 +59,7 @@ inline constexpr ReaderInfo kReaders[] = {
     {Reader::kScatteredFit, "scattered_fit", "scattered_fit.json", true},
     {Reader::kModalData, "modal_data", "modal.json", true},
     {Reader::kSweepLog, "sweep_log", "field_sweep.jsonl", true},
+    {Reader::kShardLog, "shard_log", "field_sweep.jsonl", true},
 };
 
 inline const ReaderInfo& info(Reader reader) {
@@ -172,6 +173,9 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
         break;
       }
       case Reader::kSweepLog: (void)surrogate::pending_sweep_points(sweep_grid(), sweep_options(path)); break;
+      case Reader::kShardLog:  // pdamp field merge of one shard file: its header checks, then the lines
+        (void)surrogate::merge_sweep_shards(sweep_grid(), sweep_options(path), {path}, "the fuzzed sweep");
+        break;
     }
     outcome.accepted = true;
   } catch (const std::invalid_argument& e) {
