@@ -16,7 +16,8 @@ using namespace pdamp::test;
 
 namespace {
 
-/// The shipped low-intensity case on an 18-node grid (3 frequencies x 6 strokes), with `edit`.
+/// The shipped low-intensity case on an 18-node grid (3 frequencies x 6 strokes), with `edit`,
+/// written to the temp folder as `name`: one name per test case, as ctest -j2 runs them at once.
 std::string shard_case(const std::string& name, const std::function<void(json&)>& edit = {}) {
   return edited_case(name, [&](json& c) {
     c["field"] = {{"axis0", {{"min", 1.5}, {"max", 2.5}, {"count", 3}}},
@@ -64,7 +65,7 @@ fs::path run_shard(const std::string& case_file, const fs::path& dir, int i, int
 
 TEST_CASE("pdamp field --shard writes only its log, and merge equals the serial field bit for bit", "[cli]") {
   TempDir tmp("field_shards_merge");
-  const std::string c = shard_case("pdamp_shards_case.json");
+  const std::string c = shard_case("pdamp_shards_merge.json");
   REQUIRE(run_pdamp({"field", c, "--source", "formulas", "-o", (tmp.path / "serial").string()}).exit_code == 0);
 
   std::vector<std::string> shards;
@@ -111,7 +112,7 @@ TEST_CASE("pdamp field --shard writes only its log, and merge equals the serial 
 
 TEST_CASE("pdamp field merge refuses shards of another case, grid or model version naming both files", "[cli]") {
   TempDir tmp("field_shards_mismatch");
-  const std::string c = shard_case("pdamp_shards_case.json");
+  const std::string c = shard_case("pdamp_shards_mismatch.json");
   const fs::path s0 = run_shard(c, tmp.path, 0, 2);
   const std::string log0 = (s0 / "field_sweep.jsonl").string();
   const auto merge = [&](const fs::path& other) {
@@ -150,7 +151,7 @@ TEST_CASE("pdamp field merge refuses shards of another case, grid or model versi
 
 TEST_CASE("pdamp field merge refuses a missing, repeated or damaged shard and a shard's folder as output", "[cli]") {
   TempDir tmp("field_shards_refused");
-  const std::string c = shard_case("pdamp_shards_case.json");
+  const std::string c = shard_case("pdamp_shards_missing.json");
   std::vector<std::string> s;
   for (int i = 0; i < 3; ++i) s.push_back(run_shard(c, tmp.path, i, 3).string());
   const std::string out = (tmp.path / "merged").string();
@@ -179,9 +180,9 @@ TEST_CASE("pdamp field merge refuses a missing, repeated or damaged shard and a 
   require_one_line_error(run_pdamp({"field", "merge", c, "--source", "formulas"}), "no shard given");
 }
 
-TEST_CASE("rerunning a shard resumes its log; a log of another shard is refused", "[cli]") {
+TEST_CASE("rerunning a shard resumes its log, and a log of another shard is refused", "[cli]") {
   TempDir tmp("field_shards_resume");
-  const std::string c = shard_case("pdamp_shards_case.json");
+  const std::string c = shard_case("pdamp_shards_resume.json");
   const fs::path s1 = run_shard(c, tmp.path, 1, 3);
   const fs::path log = s1 / "field_sweep.jsonl";
   // Drop the last point, as a killed job would leave it: the rerun computes only that one.
@@ -197,7 +198,7 @@ TEST_CASE("rerunning a shard resumes its log; a log of another shard is refused"
 }
 
 TEST_CASE("bad --shard values are refused with the allowed range", "[cli]") {
-  const std::string c = shard_case("pdamp_shards_case.json");
+  const std::string c = shard_case("pdamp_shards_bad_flag.json");
   for (const char* bad : {"3/3", "-1/3", "1/0", "0/100001", "a/b", "1", "1/2/3", "/3", "1/", " 1/3", "1.0/3", "+1/3"}) {
     INFO(bad);
     require_one_line_error(run_pdamp({"field", c, "--source", "formulas", "--shard", bad, "-o",

@@ -185,7 +185,7 @@ TEST_CASE("the output directory is checked before any work", "[cli]") {
   CHECK(field.err.find("pdamp field:") == std::string::npos);
 }
 
-TEST_CASE("a reused output folder holds one run's set; stale staging folders are removed", "[cli]") {
+TEST_CASE("a reused output folder holds one run's set, and stale staging folders are removed", "[cli]") {
   TempDir tmp("reuse");
   const fs::path out = tmp.path / "out";
   fs::create_directories(out);
