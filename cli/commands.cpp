@@ -394,7 +394,8 @@ int run_run(const ParsedArgs& args) {
       throw InputError("--method", "", "applies to the structure tasks (modes, frf, decay); this case's task is damper_design");
     return run_damper_design(args, c);
   }
-  if (c.task.kind == case_file::TaskKind::kFillingRatios) return run_optimize_task(args, c);
+  if (c.task.kind == case_file::TaskKind::kFillingRatios || c.task.kind == case_file::TaskKind::kPlacement)
+    return run_optimize_task(args, c);
   // modes, frf, decay: exactly as pdamp modes, frf and decay (structure_commands.cpp).
   return run_structure_task(args, c);
 }
@@ -961,7 +962,7 @@ const std::vector<Command>& commands() {
       {{"run", "pdamp run CASE.json [--method formulas|field|dem] [--dem-points N] [--dem-sweep D] [-o DIR] [--json]",
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
-        "as pdamp modes, frf and decay, --method only for these; filling_ratios: as pdamp optimize)",
+        "as pdamp modes, frf and decay; filling_ratios and placement: as pdamp optimize)",
         concat_flags({kMethodFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, kDemSweepFlags), 1},
        run_run},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",

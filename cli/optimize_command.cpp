@@ -20,6 +20,7 @@
 
 #include "errors.hpp"
 #include "output.hpp"
+#include "placement_command.hpp"
 #include "report.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/case_file/filling_ratio_problem.hpp"
@@ -438,12 +439,13 @@ std::vector<std::pair<std::string, std::string>> verification_rows(const Problem
 }  // namespace
 
 int run_optimize_task(const ParsedArgs& args, const Case& c) {
+  if (c.task.kind == case_file::TaskKind::kPlacement && c.task.placement) return run_placement_task(args, c);
   if (c.task.kind != case_file::TaskKind::kFillingRatios || !c.task.filling_ratios)
     throw InputError(c.path, "/task",
-                     "pdamp optimize needs a task of kind filling_ratios (this case's task is '" +
+                     "pdamp optimize needs a task of kind filling_ratios or placement (this case's task is '" +
                          std::string(case_file::to_string(c.task.kind)) +
                          "'): give \"task\": {\"kind\": \"filling_ratios\", \"mass_budget_kg\", \"initial_state\", "
-                         "\"duration_s\"} (docs/cases.md, Format 2)");
+                         "\"duration_s\"} or {\"kind\": \"placement\", \"targets\"} (docs/cases.md, Format 2)");
   if (args.has("--method"))
     throw InputError("--method", "", "task kind filling_ratios uses the closed forms of each layer (formulas) only");
   const FillingRatiosTask& task = *c.task.filling_ratios;
@@ -576,15 +578,21 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
 }
 
 Command optimize_command() {
-  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--verify|--no-verify] [-o DIR] [--json]",
+  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field] [--verify|--no-verify] [-o DIR] [--json]",
            "optimise the case's task (kind filling_ratios: whole slabs per layer of the first damper\n"
            "for the fastest free decay under a particle-mass budget; relaxed solve, rounded\n"
-           "neighbours, single-layer baseline; docs/optimizer.md); with the task's verify block\n"
-           "or --verify, the DEM-in-the-loop check of the chosen and baseline designs",
-           {kBackendFlag, kVerifyFlag, kNoVerifyFlag,
+           "neighbours, single-layer baseline; with the task's verify block or --verify, the\n"
+           "DEM-in-the-loop check of the chosen and baseline designs. Kind placement: the site\n"
+           "along a beam, or among named points, where the damper adds the most damping to the\n"
+           "target modes; docs/optimizer.md)",
+           {kBackendFlag,
+            {"--method", "M", "placement only: each layer's eta*(f, X) from formulas (the closed forms;\n"
+                              "                          default) or field (its field_file); filling_ratios uses formulas"},
+            kVerifyFlag, kNoVerifyFlag,
             {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg,\n"
                           "                          case_resolved.json and with the verification verify_decay.csv,\n"
-                          "                          verify_decay.gp/png/svg into DIR, atomically"},
+                          "                          verify_decay.gp/png/svg into DIR, atomically (placement:\n"
+                          "                          placement.json, placement.csv, placement.gp/png/svg)"},
             {"--json", "", "print exactly one JSON object on stdout"}},
            1},
           [](const ParsedArgs& args) { return run_optimize_task(args, case_file::load_case(args.positional().at(0))); }};

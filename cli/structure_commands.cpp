@@ -61,6 +61,16 @@ const std::vector<FlagSpec> kDemSweepFlags{
     {"--dem-sweep-rate", "HZ/S", "--dem-signal linear: the sweep's rate, Hz/s, > 0 (default: 4 pi zeta^2 f^2 / 100\n"
                                  "                          at the formulas' resonance: quasi-stationary)"}};
 
+case_file::LossMethod loss_method(const ParsedArgs& args) {
+  const std::string name = args.optional_text("--method").value_or("formulas");
+  if (name == "formulas") return case_file::LossMethod::kFormulas;
+  if (name == "field") return case_file::LossMethod::kField;
+  if (name == "dem")
+    throw InputError("--method", "", "'dem': pdamp modes takes formulas or field (the DEM co-simulation runs in "
+                                     "pdamp frf and pdamp decay)");
+  throw InputError("--method", "", "'" + name + "': must be formulas, field or dem");
+}
+
 namespace {
 
 using nlohmann::json;
@@ -111,15 +121,6 @@ json number_or_null(double value) { return std::isfinite(value) ? json(value) : 
 /// `--method dem`: the DEM co-simulation (pdamp frf and decay only).
 bool dem_method(const ParsedArgs& args) { return args.optional_text("--method").value_or("") == "dem"; }
 
-case_file::LossMethod loss_method(const ParsedArgs& args) {
-  const std::string name = args.optional_text("--method").value_or("formulas");
-  if (name == "formulas") return case_file::LossMethod::kFormulas;
-  if (name == "field") return case_file::LossMethod::kField;
-  if (name == "dem")
-    throw InputError("--method", "", "'dem': pdamp modes takes formulas or field (the DEM co-simulation runs in "
-                                     "pdamp frf and pdamp decay)");
-  throw InputError("--method", "", "'" + name + "': must be formulas, field or dem");
-}
 
 std::unique_ptr<OutputDir> output_dir(const ParsedArgs& args) {
   if (const auto dir = args.optional_text("-o")) return std::make_unique<OutputDir>(*dir);
@@ -1747,7 +1748,8 @@ int run_structure_task(const ParsedArgs& args, const Case& c) {
     case TaskKind::kFrf: return run_frf_case(args, c);
     case TaskKind::kDecay: return run_decay_case(args, c);
     case TaskKind::kDamperDesign:
-    case TaskKind::kFillingRatios: break;
+    case TaskKind::kFillingRatios:
+    case TaskKind::kPlacement: break;
   }
   throw std::logic_error("run_structure_task: not a structure task");
 }

@@ -11,6 +11,7 @@
 #include "args.hpp"
 #include "commands.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/modal_model.hpp"
@@ -24,6 +25,9 @@ extern const FlagSpec kMethodFlag;
 /// on an frf task (without them, run uses the defaults).
 extern const std::vector<FlagSpec> kDemSweepFlags;
 
+/// The loss models `--method` asks for (formulas, the default, or field); InputError for
+/// dem (a co-simulation, not a loss model) and anything else.
+case_file::LossMethod loss_method(const ParsedArgs& args);
 /// pdamp modes, frf and decay, in the order `pdamp --help` lists them.
 std::vector<Command> structure_commands();
 

@@ -72,6 +72,21 @@ class ObjectReader {
     resolved_[key] = values;
     return values;
   }
+  /// An array of at least min_size strings.
+  std::vector<std::string> text_array(const std::string& key, std::size_t min_size) {
+    strict_.optional(key);
+    if (!has(key) || !object_.at(key).is_array()) fail(key, "required (an array of strings)");
+    if (object_.at(key).size() < min_size)
+      fail(key, "has " + std::to_string(object_.at(key).size()) + " entries: needs at least " + std::to_string(min_size));
+    std::vector<std::string> values;
+    for (std::size_t i = 0; i < object_.at(key).size(); ++i) {
+      const json& item = object_.at(key)[i];
+      if (!item.is_string()) fail(key + "/" + std::to_string(i), "must be a string, got " + json_type_name(item));
+      values.push_back(item.get<std::string>());
+    }
+    resolved_[key] = values;
+    return values;
+  }
   /// An array of objects; the callback reads each element with its own reader.
   template <typename Fn>
   void array(const std::string& key, Fn&& read) {

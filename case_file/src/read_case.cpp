@@ -152,6 +152,7 @@ std::string_view to_string(TaskKind kind) {
     case TaskKind::kDecay: return "decay";
     case TaskKind::kModes: return "modes";
     case TaskKind::kFillingRatios: return "filling_ratios";
+    case TaskKind::kPlacement: return "placement";
   }
   return "unknown";
 }

@@ -9,6 +9,12 @@ namespace pdamp::case_file::detail {
 
 namespace {
 
+/// The number of modes the structure keeps (a beam's mode_count, or the modal file's).
+int available_modes(const Case& c) {
+  return c.structure->kind == StructureSpec::Kind::kBeam ? c.structure->mode_count
+                                                         : static_cast<int>(c.structure->modal_data->mode_count());
+}
+
 FrfTask read_frf(ObjectReader& r, const Case& c) {
   FrfTask t;
   t.min_frequency_hz = r.number("min_frequency_hz", std::nullopt, limits::kFrequency, " Hz");
@@ -56,9 +62,7 @@ DecayTask read_decay(ObjectReader& r, const Case& c) {
 
 ModesTask read_modes(ObjectReader& r, const Case& c) {
   ModesTask t;
-  const int available = c.structure->kind == StructureSpec::Kind::kBeam
-                            ? c.structure->mode_count
-                            : static_cast<int>(c.structure->modal_data->mode_count());
+  const int available = available_modes(c);
   t.mode_count = r.integer("mode_count", available, 1, available);
   t.backbone_min_amplitude_m = r.number("backbone_min_amplitude_m", std::nullopt, limits::kStroke, " m");
   t.backbone_max_amplitude_m = r.number("backbone_max_amplitude_m", std::nullopt, limits::kStroke, " m");
@@ -142,9 +146,57 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
   return t;
 }
 
+PlacementTask read_placement(ObjectReader& r, const Case& c) {
+  PlacementTask t;
+  std::vector<std::string> damper_names;
+  for (const auto& d : c.dampers) damper_names.push_back(d.name);
+  const std::string damper = r.text("damper", c.dampers.front().name, damper_names);
+  t.damper_index = static_cast<std::size_t>(std::find(damper_names.begin(), damper_names.end(), damper) - damper_names.begin());
+  t.objective = r.text("objective", std::string("weighted_mean"), {"weighted_mean", "worst_mode"}) == "worst_mode"
+                    ? optimizer::PlacementObjective::kWorstMode
+                    : optimizer::PlacementObjective::kWeightedMean;
+  t.backend = r.text("backend", std::string("nlopt"), {"nlopt", "ipopt"});
+  const int modes = available_modes(c);
+  r.array("targets", [&](ObjectReader& e) {
+    optimizer::PlacementTarget target;
+    target.mode = e.integer("mode", std::nullopt, 1, modes) - 1;  // counted from 1 in the case
+    for (const auto& other : t.targets)
+      if (other.mode == target.mode) e.fail("mode", "= " + std::to_string(target.mode + 1) + ": given twice");
+    target.weight = e.number("weight", 1.0, {0.0, 1e6});
+    target.reference_point = read_point_name(e, "reference_point", c);
+    target.reference_amplitude_m = e.number("reference_amplitude_m", std::nullopt, limits::kStroke, " m");
+    t.targets.push_back(target);
+  });
+  if (t.targets.empty()) r.fail("targets", "required: at least one {\"mode\", \"reference_point\", \"reference_amplitude_m\"}");
+  if (t.objective == optimizer::PlacementObjective::kWeightedMean) {
+    double weights = 0.0;
+    for (const auto& target : t.targets) weights += target.weight;
+    if (!(weights > 0.0)) r.fail("targets", "the weights sum to 0: at least one must be > 0");
+  }
+  if (r.has("candidate_points")) {
+    t.candidate_points = r.text_array("candidate_points", 1);
+    const auto& names = c.structure->point_names;
+    for (std::size_t i = 0; i < t.candidate_points.size(); ++i)
+      if (std::find(names.begin(), names.end(), t.candidate_points[i]) == names.end())
+        r.fail("candidate_points/" + std::to_string(i), "'" + t.candidate_points[i] + "' is no named point of the structure");
+  }
+  if (c.structure->kind == StructureSpec::Kind::kBeam && t.candidate_points.empty()) {
+    const double length = c.structure->beam.length_m();
+    const Range along{0.0, length};
+    t.min_position_m = r.number("min_position_m", 0.0, along, " m (along the beam)");
+    t.max_position_m = r.number("max_position_m", length, along, " m (along the beam)");
+    if (!(t.max_position_m > t.min_position_m)) r.fail("max_position_m", "must be > min_position_m");
+    t.positions = r.integer("positions", PlacementTask{}.positions, 3, 100000);
+  } else if (t.candidate_points.empty()) {
+    r.fail("candidate_points", "required for modal data (its shapes are known at the named points only)");
+  }
+  t.rotation_warning_fraction = r.number("rotation_warning_fraction", PlacementTask{}.rotation_warning_fraction, {0.0, 10.0, true});
+  return t;
+}
+
 void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
-  const std::string kind =
-      r.text("kind", std::string("damper_design"), {"damper_design", "frf", "decay", "modes", "filling_ratios"});
+  const std::string kind = r.text("kind", std::string("damper_design"),
+                                  {"damper_design", "frf", "decay", "modes", "filling_ratios", "placement"});
   if (kind == "frf") {
     task.kind = TaskKind::kFrf;
     task.frf = read_frf(r, c);
@@ -157,6 +209,9 @@ void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
   } else if (kind == "filling_ratios") {
     task.kind = TaskKind::kFillingRatios;
     task.filling_ratios = read_filling_ratios(r, c);
+  } else if (kind == "placement") {
+    task.kind = TaskKind::kPlacement;
+    task.placement = read_placement(r, c);
   }
 }
 

@@ -61,22 +61,30 @@ std::string_view to_string(LossMethod method) {
   return method == LossMethod::kFormulas ? "formulas" : "field";
 }
 
+st::BeamModel loaded_beam(const Case& c, std::optional<std::size_t> without_damper) {
+  // The dampers' containers and beds hang on the beam: their weight loads its geometric
+  // stiffness (a standing beam with a tip damper), their inertia enters through the coupling.
+  const st::BeamModel& beam = c.structure->beam;
+  st::BeamModel loaded = beam;
+  for (std::size_t i = 0; i < c.dampers.size(); ++i) {
+    if (without_damper == i) continue;
+    const DamperSpec& d = c.dampers[i];
+    double mass = d.container_mass_kg;
+    for (const LayerSpec& layer : d.layers) mass += layer.bed_mass_kg;
+    for (const auto& p : beam.points)
+      if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
+    for (const auto& p : beam.point_masses)
+      if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
+  }
+  return loaded;
+}
+
 StructureSetup structure_setup(const Case& c, LossMethod method) {
   if (!c.structure) throw CaseError(c.path, "/structure", "required: pdamp modes, frf and decay need a format-2 case");
   StructureSetup out;
   const StructureSpec& s = *c.structure;
   if (s.kind == StructureSpec::Kind::kBeam) {
-    // The dampers' containers and beds hang on the beam: their weight loads its geometric
-    // stiffness (a standing beam with a tip damper), their inertia enters through the coupling.
-    st::BeamModel loaded = s.beam;
-    for (const DamperSpec& d : c.dampers) {
-      double mass = d.container_mass_kg;
-      for (const LayerSpec& layer : d.layers) mass += layer.bed_mass_kg;
-      for (const auto& p : s.beam.points)
-        if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
-      for (const auto& p : s.beam.point_masses)
-        if (p.name == d.site) loaded.carried_weights.push_back({p.position_m, mass});
-    }
+    st::BeamModel loaded = loaded_beam(c);
     st::BeamModalResult beam;
     try {
       beam = st::beam_modal_model(loaded, s.mode_count, s.damping);

@@ -21,6 +21,13 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr Eigen::Index kDofsPerNode = 3;
 /// Positions closer than this fraction of the beam length share one node.
 constexpr double kMergeFraction = 1e-9;
+/// A feature (support, mass, point, carried weight) closer than this fraction of the
+/// finest nominal element (segment length / elements) to another key position shares its
+/// node: a sliver element of length s between them adds EI/s³ terms that dwarf the rest of
+/// K (at s = 1e-5 of an element the eigensolver returned a negative ω²). The feature then
+/// sits at most 1% of an element from where it was asked, which moves its shape by about
+/// 1% of an element times the shape's slope.
+constexpr double kSliverFraction = 1e-2;
 /// A computed eigenvalue below −kNegativeEigenvalueFraction·λ_max is truly negative (an
 /// unstable, buckled beam): the eigenvalues of L⁻¹KL⁻ᵀ (M = LLᵀ) carry an absolute
 /// round-off of about ε·λ_max ≈ 2e-16·λ_max, so the zero eigenvalues of rigid modes stay
@@ -118,31 +125,39 @@ struct Mesh {
   }
 };
 
-/// Nodes at every segment boundary, support, point mass and named point (merged within
-/// kMergeFraction·L); each piece between two such positions gets its segment's element
-/// count in proportion to its length (at least one), so no sliver elements appear.
+/// Nodes at every segment boundary, support, point mass and named point. Segment
+/// boundaries stay where they are; a feature within the merge tolerance (the larger of
+/// kMergeFraction·L and kSliverFraction of the finest nominal element) of a key already
+/// placed shares its node. Each piece between two keys gets its segment's element count in
+/// proportion to its length (at least one), so no sliver elements appear.
 Mesh build_mesh(const BeamModel& beam) {
   const double length = beam.length_m();
   Mesh mesh;
-  mesh.merge_tolerance_m = kMergeFraction * length;
+  double finest_element_m = length;
+  for (const auto& segment : beam.segments)
+    finest_element_m = std::min(finest_element_m, segment.length_m / std::max(1, segment.elements));
+  mesh.merge_tolerance_m = std::max(kMergeFraction * length, kSliverFraction * finest_element_m);
 
   std::vector<double> segment_end_m;
-  std::vector<double> key_positions{0.0};
+  std::vector<double> keys{0.0};
   double end = 0.0;
   for (const auto& segment : beam.segments) {
     end += segment.length_m;
     segment_end_m.push_back(end);
-    key_positions.push_back(end);
+    keys.push_back(end);
   }
-  const auto add_key = [&](double x) { key_positions.push_back(std::clamp(x, 0.0, length)); };
-  for (const auto& s : beam.supports) add_key(s.position_m);
-  for (const auto& m : beam.point_masses) add_key(m.position_m);
-  for (const auto& p : beam.points) add_key(p.position_m);
-  for (const auto& w : beam.carried_weights) add_key(w.position_m);
-  std::sort(key_positions.begin(), key_positions.end());
-  std::vector<double> keys;
-  for (double x : key_positions) {
-    if (keys.empty() || x - keys.back() > mesh.merge_tolerance_m) keys.push_back(x);
+  std::vector<double> features;
+  const auto add_feature = [&](double x) { features.push_back(std::clamp(x, 0.0, length)); };
+  for (const auto& s : beam.supports) add_feature(s.position_m);
+  for (const auto& m : beam.point_masses) add_feature(m.position_m);
+  for (const auto& p : beam.points) add_feature(p.position_m);
+  for (const auto& w : beam.carried_weights) add_feature(w.position_m);
+  std::sort(features.begin(), features.end());
+  for (double x : features) {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), x);
+    const bool near_next = it != keys.end() && *it - x <= mesh.merge_tolerance_m;
+    const bool near_previous = it != keys.begin() && x - *(it - 1) <= mesh.merge_tolerance_m;
+    if (!near_next && !near_previous) keys.insert(it, x);
   }
 
   mesh.node_x_m.push_back(keys.front());
@@ -640,6 +655,34 @@ BeamModalResult beam_modal_model(const BeamModel& beam, int mode_count, const Mo
   modal.base_participation = modes.transpose() * a.matrices.mass_kg * rigid_translation;
   modal.mode_shapes = std::move(modes);
   return result;
+}
+
+PointModeShape beam_point_shape(const BeamModel& beam, const ModalModel& modal, const std::string& name,
+                                double position_m) {
+  throw_if_any(beam.validate(), "beam point shape: beam model");
+  const Mesh mesh = build_mesh(beam);
+  if (modal.mode_shapes.rows() != mesh.dofs())
+    throw std::invalid_argument("beam point shape: modal.mode_shapes has " + std::to_string(modal.mode_shapes.rows()) +
+                                " rows, the beam has " + std::to_string(mesh.dofs()) +
+                                " DOFs: pass the modal model of this beam");
+  const double length = beam.length_m();
+  if (!std::isfinite(position_m) || position_m < -kMergeFraction * length || position_m > (1.0 + kMergeFraction) * length)
+    throw std::invalid_argument("beam point shape: position_m = " + number(position_m) + ": must be in [0, " +
+                                number(length) + "] m");
+  const auto [element, xi] = mesh.element_at(std::clamp(position_m, 0.0, length));
+  const HermiteAt h = hermite(xi, element->length_m);
+  const Eigen::Index first = kDofsPerNode * element->first_node;
+  const Eigen::MatrixXd& modes = modal.mode_shapes;
+  PointModeShape shape;
+  shape.name = name;
+  shape.translation = Eigen::MatrixXd::Zero(2, modes.cols());
+  shape.rotation = Eigen::RowVectorXd::Zero(modes.cols());
+  shape.translation.row(0) = (1.0 - xi) * modes.row(first) + xi * modes.row(first + kDofsPerNode);
+  for (int i = 0; i < 4; ++i) {
+    shape.translation.row(1) += h.value[i] * modes.row(first + kBendingDofs[i]);
+    shape.rotation += h.slope[i] * modes.row(first + kBendingDofs[i]);
+  }
+  return shape;
 }
 
 Eigen::VectorXd static_deflection_modal_amplitudes(const BeamModel& beam, const ModalModel& modal,

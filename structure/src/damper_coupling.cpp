@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -77,22 +78,29 @@ std::vector<std::string> Damper::validate(const ModalModel& model) const {
   return problems;
 }
 
+double rotation_ratio(const PointModeShape& site, Eigen::Index mode, const Eigen::Vector2d& drive_direction,
+                      double length_along_drive_m) {
+  const double end_motion = std::abs(site.rotation[mode]) * 0.5 * length_along_drive_m;
+  if (!(length_along_drive_m > 0.0) || end_motion == 0.0) return 0.0;
+  const double translation = std::abs(site.translation.col(mode).dot(drive_direction));
+  return translation > 0.0 ? end_motion / translation : std::numeric_limits<double>::infinity();
+}
+
 std::vector<std::string> rotation_warnings(const ModalModel& model, const std::vector<Damper>& dampers,
                                            double fraction) {
   std::vector<std::string> warnings;
   for (const Damper& d : dampers) {
     const PointModeShape* site = find_point(model, d.point);
-    if (!site || !(d.length_along_drive_m > 0.0)) continue;
+    if (!site) continue;
     for (Eigen::Index j = 0; j < model.mode_count(); ++j) {
-      const double translation = std::abs(site->translation.col(j).dot(d.drive_direction));
-      const double end_motion = std::abs(site->rotation[j]) * 0.5 * d.length_along_drive_m;
-      if (!(end_motion > fraction * translation)) continue;
+      const double ratio = rotation_ratio(*site, j, d.drive_direction, d.length_along_drive_m);
+      if (!(ratio > fraction)) continue;
       std::ostringstream out;
       out.precision(3);
       out << "damper " << d.name << " at '" << d.point << "': in mode " << j + 1 << " (" << model.natural_frequencies_hz[j]
           << " Hz) the site rotates, so the container's ends move by ";
-      if (translation > 0.0) {
-        out << 100.0 * end_motion / translation << "%";
+      if (std::isfinite(ratio)) {
+        out << 100.0 * ratio << "%";
       } else {
         out << "more than 100%";
       }

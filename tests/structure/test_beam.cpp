@@ -453,6 +453,51 @@ TEST_CASE("segments of one section and nodes placed at features leave the freque
   CHECK(result.modal.points.size() == 3);
 }
 
+// Reference: the uniform cantilever (β₁L = 1.875104, β₂L = 4.694091). A named point 1e-5
+// of an element from the tip used to get its own node, a sliver element whose EI/s³ terms
+// made the eigensolver return a negative ω²; within 1% of the finest element it now shares
+// the tip's node, so the frequencies stay the cantilever's and the point moves as the tip.
+TEST_CASE("a point next to another feature shares its node instead of making a sliver element", "[structure]") {
+  BeamModel beam = uniform_beam(20, {support(Support::Kind::kClamped, 0.0)});
+  const double element = kLengthM / 20;
+  beam.points = {{"tip", kLengthM}, {"almost tip", kLengthM - 1e-5 * element}, {"near", 0.5 - 0.005 * element},
+                 {"apart", 0.5 + 0.02 * element}};
+  const auto result = beam_modal_model(beam, 2, no_damping());
+  CHECK(result.modal.natural_frequencies_hz[0] == Approx(bending_frequency_hz(1.875104)).epsilon(1e-4));
+  CHECK(result.modal.natural_frequencies_hz[1] == Approx(bending_frequency_hz(4.694091)).epsilon(1e-4));
+  CHECK(result.modal.point("almost tip").translation == result.modal.point("tip").translation);
+  // "near" (0.5% of an element off) merges with the node at 0.5; "apart" (2%) gets its own.
+  CHECK(beam_matrices(beam).node_positions_m.size() == 22);
+}
+
+// Reference: at a node the interpolated shape is the node's own (exactly); inside an element
+// it is the analytic cantilever mode φ = cosh βx − cos βx − σ(sinh βx − sin βx) scaled to the
+// FE tip value, to 1e-5 (20 Hermite elements: the cubic interpolation error of mode 2 is
+// O((βh)⁴/384) ~ 1e-6 of its amplitude, the eigenvector error smaller still).
+TEST_CASE("a mode shape interpolated between nodes follows the analytic cantilever mode", "[structure]") {
+  const BeamModel beam = uniform_beam(20, {support(Support::Kind::kClamped, 0.0)});
+  const ModalModel modal = beam_modal_model(beam, 2, no_damping()).modal;
+  const PointModeShape tip = beam_point_shape(beam, modal, "tip shape", kLengthM);
+  CHECK(tip.translation == modal.point("tip").translation);
+  CHECK(tip.rotation == modal.point("tip").rotation);
+  for (int j = 0; j < 2; ++j) {
+    const double bl = j == 0 ? 1.875104068711961 : 4.694091132974175;
+    const double sigma = (std::cosh(bl) + std::cos(bl)) / (std::sinh(bl) + std::sin(bl));
+    const auto phi = [&](double x) {
+      const double b = bl * x / kLengthM;
+      return std::cosh(b) - std::cos(b) - sigma * (std::sinh(b) - std::sin(b));
+    };
+    const double scale = tip.translation(1, j) / phi(kLengthM);
+    for (double x : {0.1234, 0.5555, 0.9876}) {
+      const PointModeShape p = beam_point_shape(beam, modal, "p", x);
+      INFO("mode " << j << ", x = " << x);
+      CHECK(p.translation(1, j) == Approx(scale * phi(x)).margin(1e-5 * std::abs(tip.translation(1, j))));
+      CHECK(p.translation(0, j) == Approx(0.0).margin(1e-12));
+    }
+  }
+  CHECK_THROWS_WITH(beam_point_shape(beam, modal, "p", 1.5), Catch::Contains("position_m = 1.5: must be in [0, 1] m"));
+}
+
 TEST_CASE("damping ratios repeat the last value or follow Rayleigh damping", "[structure]") {
   const BeamModel beam = uniform_beam(10, {support(Support::Kind::kClamped, 0.0)});
   ModalDamping listed;

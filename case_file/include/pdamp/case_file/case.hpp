@@ -18,6 +18,7 @@
 #include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
+#include "pdamp/optimizer/placement.hpp"
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/modal_model.hpp"
 #include "pdamp/surrogate/grid.hpp"
@@ -118,7 +119,7 @@ struct StructureSpec {
   std::vector<std::string> point_names;
 };
 
-enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes, kFillingRatios };
+enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes, kFillingRatios, kPlacement };
 
 /// `task` kind frf: the frequency response over a band.
 struct FrfTask {
@@ -192,6 +193,24 @@ struct FillingRatiosTask {
   std::vector<int> spheres_per_slab;  ///< spheres in one full slab of the layer's lattice
 };
 
+/// `task` kind placement (issue 12 §1.4): where one damper adds the most damping to chosen
+/// modes (docs/optimizer.md, "Placement"). On a beam the site moves continuously over
+/// [min_position_m, max_position_m]; on modal data (or with candidate_points on a beam) the
+/// named candidate points are compared.
+struct PlacementTask {
+  std::size_t damper_index = 0;  ///< `damper`: the damper placed, by name (default the first)
+  optimizer::PlacementObjective objective = optimizer::PlacementObjective::kWeightedMean;
+  std::string backend = "nlopt";  ///< local refinement on a beam: "nlopt" (COBYLA) or "ipopt"
+  /// Modes 0-based here (the case counts them from 1), each with its weight and the
+  /// amplitude of its reference point.
+  std::vector<optimizer::PlacementTarget> targets;
+  double min_position_m = 0.0;    ///< beam: search range along the axis, m (default the whole beam)
+  double max_position_m = 0.0;
+  int positions = 101;            ///< beam: positions of the scan, [3, 100000]
+  std::vector<std::string> candidate_points;  ///< named points compared instead (required for modal data)
+  double rotation_warning_fraction = 0.1;     ///< (0, 10]: optimizer::PlacementOptions
+};
+
 /// What `pdamp run` does; the settings of the kind given (format 1: damper_design only).
 struct TaskSpec {
   TaskKind kind = TaskKind::kDamperDesign;
@@ -199,6 +218,7 @@ struct TaskSpec {
   std::optional<DecayTask> decay;
   std::optional<ModesTask> modes;
   std::optional<FillingRatiosTask> filling_ratios;
+  std::optional<PlacementTask> placement;
 };
 
 struct Case {

@@ -32,6 +32,10 @@ struct StructureSetup {
   std::vector<std::string> warnings;         ///< one sentence each (a field reused at another clearance)
 };
 
+/// The case's beam with the weight (container and beds) of every damper except
+/// `without_damper` carried at its site: what loads the geometric stiffness.
+structure::BeamModel loaded_beam(const Case& c, std::optional<std::size_t> without_damper = {});
+
 /// Builds the structure and its dampers; CaseError (exit 2) for a case without a
 /// structure, a layer without `field_file` under kField, or an unreadable field file.
 StructureSetup structure_setup(const Case& c, LossMethod method);

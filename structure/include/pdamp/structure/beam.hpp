@@ -123,6 +123,13 @@ struct BeamMatrices {
 /// Throws std::invalid_argument if the beam does not validate.
 BeamMatrices beam_matrices(const BeamModel& beam);
 
+/// The shape of every mode of `modal` (the modal model of this beam) at position x (m)
+/// along the axis, as the finite elements interpolate it: linear in u, Hermite cubics in w
+/// and θ = dw/dx inside the element holding x. Exact for the FE model wherever x lies, with
+/// no node there (a node placed next to another would make a sliver element). Throws
+/// std::invalid_argument when modal.mode_shapes does not fit the beam's mesh or x is off it.
+PointModeShape beam_point_shape(const BeamModel& beam, const ModalModel& modal, const std::string& name,
+                                double position_m);
 /// Modal amplitudes of the static deflection under a force (x, y) and moment (about z)
 /// at position x_m along the beam: q0 = Φᵀ M u_static, the initial state of a release.
 Eigen::VectorXd static_deflection_modal_amplitudes(const BeamModel& beam, const ModalModel& modal,

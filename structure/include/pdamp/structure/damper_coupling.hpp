@@ -56,6 +56,12 @@ struct Damper {
 /// `fraction` of |b_dj| (0.1 by default: the beds' ends then see 10% more or less stroke).
 std::vector<std::string> rotation_warnings(const ModalModel& model, const std::vector<Damper>& dampers,
                                            double fraction = 0.1);
+/// The ratio rotation_warnings tests, θ_j·(L/2) / |b_dj| with b_dj = Φ_j(site)·n: the
+/// container ends' extra motion from the site's rotation against its translation along
+/// the drive, dimensionless; 0 when L <= 0 (unknown) or θ_j = 0, +infinity at a node of
+/// the translation where the site still rotates.
+double rotation_ratio(const PointModeShape& site, Eigen::Index mode, const Eigen::Vector2d& drive_direction,
+                      double length_along_drive_m);
 
 /// How the coupling treats answers a loss model cannot give.
 struct CouplingOptions {
