@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/summary.hpp"
 #include "pdamp/dem_reference/world_options.hpp"
@@ -135,6 +136,22 @@ class World {
   std::size_t memory_bytes() const;
   /// FNV-1a hash of positions, velocities and angular velocities (determinism tests).
   std::uint64_t state_hash() const;
+
+  /// Writes the world's whole mutable state (checkpoint.hpp, docs/dem.md "Checkpoints"):
+  /// particles (positions, half-step velocities, forces and torques, positions at the last
+  /// list rebuild, internal numbering), neighbour rows and contact histories, the work
+  /// partitions, the container, the energy account and the counters (not the stage times:
+  /// a resumed run times its own steps). What the options determine (radii, masses,
+  /// materials, walls, time step) is not written.
+  void save_state(StateWriter& out) const;
+  /// Continues from what save_state wrote on a World built from the same options: the
+  /// steps that follow are bit for bit those the saved world would have taken (same
+  /// thread count: the partitions are part of the state). std::invalid_argument naming the
+  /// field when the state is of another world (particle, compartment, wall or partition
+  /// count, time step, rolling resistance) or inconsistent (a numbering that is no
+  /// permutation, a list entry pointing outside, a non-finite value); the world is then
+  /// unchanged.
+  void restore_state(StateReader& in);
 
  private:
   struct Impl;
