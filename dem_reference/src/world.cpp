@@ -1412,6 +1412,7 @@ void World::add_velocity(const Vec3& velocity_m_s) {
   w.refresh_bound();
 }
 
+const WorldOptions& World::options() const { return impl_->options; }
 double World::time_step_s() const { return impl_->dt; }
 double World::time_s() const { return impl_->time; }
 std::int64_t World::step_count() const { return impl_->steps; }

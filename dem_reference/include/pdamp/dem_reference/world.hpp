@@ -98,6 +98,8 @@ class World {
   /// leaves contacts unchanged (run_harmonic starts the bed moving with the container).
   void add_velocity(const Vec3& velocity_m_s);
 
+  /// The options the world was built with (integration.time_step_s as given, 0 = automatic).
+  const WorldOptions& options() const;
   double time_step_s() const;
   double time_s() const;
   std::int64_t step_count() const;

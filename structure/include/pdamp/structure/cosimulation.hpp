@@ -11,6 +11,7 @@
 
 #include <Eigen/Dense>
 
+#include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/summary.hpp"
 #include "pdamp/dem_reference/world.hpp"
@@ -280,6 +281,33 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
 CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                               const CosimulationOptions& options, CosimulationState& state,
                               const CosimulationProgressCallback& progress = {});
+
+/// Checkpoints of a co-simulation run in segments (issue 13 §4, docs/cosimulation.md §7).
+/// save_cosimulation_state writes a started state: each world's integration settings and
+/// whole state (World::save_state), q, q̇, the time, steps, step and the excitation with its
+/// phase. restore_cosimulation_state builds the worlds from `dampers` (their World options
+/// with the saved integration settings) and restores them, so that continuing the restored
+/// state is bit for bit continuing the saved one. std::invalid_argument naming the field when
+/// the state does not fit the model and dampers (mode or damper count, another bed) or is
+/// damaged.
+void save_cosimulation_state(const CosimulationState& state, dem_reference::StateWriter& out);
+CosimulationState restore_cosimulation_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                             dem_reference::StateReader& in);
+
+/// A free decay's result so far, for a checkpoint: the histories, the energy account, the
+/// counters, the frequencies with the containers and the warnings (harmonic results are not
+/// written: only a free decay is run in segments). restore_cosimulation_result refuses a
+/// result of another shape (modes, dampers) naming the field.
+void save_cosimulation_result(const CosimulationResult& result, dem_reference::StateWriter& out);
+CosimulationResult restore_cosimulation_result(dem_reference::StateReader& in, Eigen::Index modes, std::size_t dampers);
+
+/// Appends the result of a continuation to the result of the runs before it (a free decay
+/// run in segments, each continuing the state the last one left): the histories without the
+/// continuation's first sample (the last one's final sample again), the energy terms and the
+/// counters summed, the relative error of the summed ledger, the continuation's outcome,
+/// final states and warnings not yet listed. Segments of whole sample intervals
+/// (options.sample_interval_s fixed) give the histories a single run records.
+void append_continuation(CosimulationResult& total, const CosimulationResult& next);
 
 /// The common step a fresh cosimulate() would take for these inputs, s, and its whole steps
 /// per period (harmonic, else 0), without building worlds (a stepped sine takes the smallest
