@@ -959,11 +959,11 @@ const FlagSpec kModelOverrides[] = {
 const std::vector<Command>& commands() {
   static const std::vector<Command> all = [] {
     std::vector<Command> list = {
-      {{"run", "pdamp run CASE.json [--method formulas|field|dem] [--dem-points N] [--dem-sweep D] [-o DIR] [--json]",
+      {{"run", "pdamp run CASE.json [--method formulas|field|dem] [--dem-points N] [--dem-sweep D] [--resume] [-o DIR] [--json]",
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
         "as pdamp modes, frf and decay; filling_ratios and placement: as pdamp optimize)",
-        concat_flags({kMethodFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, kDemSweepFlags), 1},
+        concat_flags(concat_flags({kMethodFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, kDemSweepFlags), kCheckpointFlags), 1},
        run_run},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",

@@ -31,8 +31,9 @@ class NumericalError : public std::runtime_error {
 /// staged files are removed and pdamp ends by the signal (its default action).
 class Interrupted : public std::runtime_error {
  public:
-  explicit Interrupted(int signal_number)
-      : std::runtime_error("interrupted by signal " + std::to_string(signal_number) + "; no result was written"),
+  /// `what_happened`: what was kept (a checkpoint and how to resume), else "no result was written".
+  explicit Interrupted(int signal_number, const std::string& what_happened = "no result was written")
+      : std::runtime_error("interrupted by signal " + std::to_string(signal_number) + "; " + what_happened),
         signal_number_(signal_number) {}
   int signal_number() const { return signal_number_; }
 

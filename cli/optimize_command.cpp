@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <future>
 #include <iostream>
 #include <memory>
@@ -234,7 +235,7 @@ bool ahead(double objective_a, double end_a, double objective_b, double end_b) {
 }
 
 DesignCheck check_design(const Case& c, const Problem& p, const case_file::VerifySpec& verify, const std::string& name,
-                         const opt::FillingDesign& design) {
+                         const opt::FillingDesign& design, const ParsedArgs& args) {
   DesignCheck out;
   out.name = name;
   out.design = &design;
@@ -251,8 +252,18 @@ DesignCheck check_design(const Case& c, const Problem& p, const case_file::Verif
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
   case_file::DecayTask decay = c.task.filling_ratios->decay;
   decay.duration_s = verify.duration_s;
+  DemCheckpoint checkpoint = dem_checkpoint(args, "verify_" + name, "verify_" + name);
+  std::ostringstream design_text;
+  for (double n : slabs) design_text << ' ' << n;
+  design_text << "; softening " << verify.stiffness_softening;
+  checkpoint.settings = "design" + design_text.str();
+  // A design that completed before the interruption left no checkpoint: it runs again.
+  if (checkpoint.resume && !std::filesystem::exists(checkpoint.file)) {
+    checkpoint.resume = false;
+    std::cerr << "pdamp: warning: no checkpoint of the " + name + " design's verification: it runs from the start\n";
+  }
   out.dem = run_dem_decay(dc, p.modal, containers, dem_dampers, p.initial_modal_displacements, decay,
-                          "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s");
+                          "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s", checkpoint);
   const auto& settle = out.dem.settling;
   out.dem_end_envelope_m = settle.envelope_m.empty() ? NAN : settle.envelope_m.back();
   out.dem_objective = settling_objective(p) ? settle.settling_time_s
@@ -347,15 +358,15 @@ json verification_json(const Problem& p, const case_file::VerifySpec& verify, do
 }
 
 Verification verify_designs(const Case& c, const Problem& p, const opt::FillingRatioResult& r,
-                            const case_file::VerifySpec& verify) {
+                            const case_file::VerifySpec& verify, const ParsedArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   Verification v;
   // The two DEM runs are independent (one World each, single-threaded by default): run
   // them at once, the baseline on a second thread; its exceptions come back through get().
-  auto baseline = std::async(std::launch::async, [&] { return check_design(c, p, verify, "baseline", r.baseline); });
+  auto baseline = std::async(std::launch::async, [&] { return check_design(c, p, verify, "baseline", r.baseline, args); });
   DesignCheck chosen;
   try {
-    chosen = check_design(c, p, verify, "chosen", r.chosen);
+    chosen = check_design(c, p, verify, "chosen", r.chosen, args);
   } catch (...) {
     baseline.wait();  // the thread uses c, p and r: let it end before they go
     throw;
@@ -478,8 +489,11 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
   }
   if (args.has("--no-verify")) verify.reset();
   std::optional<Verification> verification;
+  if (!verify)
+    for (const auto& flag : kCheckpointFlags)
+      if (args.has(flag.name)) throw InputError(flag.name, "", "applies to the DEM verification (--verify)");
   if (verify) {
-    verification = verify_designs(c, p, r, *verify);
+    verification = verify_designs(c, p, r, *verify, args);
     for (const auto& d : verification->designs)
       for (const auto& w : d.dem.warnings) warnings.push_back("verify (" + d.name + "): " + w);
     if (!verification->passed)
@@ -578,22 +592,23 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
 }
 
 Command optimize_command() {
-  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field] [--verify|--no-verify] [-o DIR] [--json]",
+  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field] [--verify|--no-verify] [--resume] [-o DIR] [--json]",
            "optimise the case's task (kind filling_ratios: whole slabs per layer of the first damper\n"
            "for the fastest free decay under a particle-mass budget; relaxed solve, rounded\n"
            "neighbours, single-layer baseline; with the task's verify block or --verify, the\n"
            "DEM-in-the-loop check of the chosen and baseline designs. Kind placement: the site\n"
            "along a beam, or among named points, where the damper adds the most damping to the\n"
            "target modes; docs/optimizer.md)",
-           {kBackendFlag,
+           concat_flags({kBackendFlag,
             {"--method", "M", "placement only: each layer's eta*(f, X) from formulas (the closed forms;\n"
                               "                          default) or field (its field_file); filling_ratios uses formulas"},
             kVerifyFlag, kNoVerifyFlag,
             {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg,\n"
                           "                          case_resolved.json and with the verification verify_decay.csv,\n"
                           "                          verify_decay.gp/png/svg into DIR, atomically (placement:\n"
-                          "                          placement.json, placement.csv, placement.gp/png/svg)"},
-            {"--json", "", "print exactly one JSON object on stdout"}},
+                          "                          placement.json, placement.csv, placement.gp/png/svg; the verification's\n"
+                          "                          verify_chosen.checkpoint, verify_baseline.checkpoint while running)"},
+            {"--json", "", "print exactly one JSON object on stdout"}}, kCheckpointFlags),
            1},
           [](const ParsedArgs& args) { return run_optimize_task(args, case_file::load_case(args.positional().at(0))); }};
 }

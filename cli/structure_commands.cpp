@@ -19,14 +19,18 @@
 #include <thread>
 #include <chrono>
 #include <exception>
+#include <filesystem>
 #include <functional>
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
 #include "errors.hpp"
+#include "external_program.hpp"
 #include "output.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/dem_reference/checkpoint.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/beam.hpp"
@@ -724,10 +728,195 @@ SimulatedSettling simulated_settling(const std::vector<double>& t, const Eigen::
 
 }  // namespace
 
+// ------------------------------------------------------------------ checkpointed decays
+
+const std::vector<FlagSpec> kCheckpointFlags{
+    {"--resume", "", "continue the DEM run from its checkpoint in the -o folder (left by a run that\n"
+                     "                          was interrupted or killed; same case, settings and thread count)"},
+    {"--checkpoint-interval", "S", "wall-clock seconds between checkpoints of a DEM run in the -o folder,\n"
+                                   "                          >= 0 (default 60; 0: after every segment of about 2 s); one is\n"
+                                   "                          also written when SIGINT, SIGTERM or SIGHUP arrives"}};
+
+DemCheckpoint dem_checkpoint(const ParsedArgs& args, const std::string& name, const std::string& kind) {
+  DemCheckpoint out;
+  out.kind = kind;
+  out.resume = args.has("--resume");
+  if (args.has("--checkpoint-interval")) {
+    out.interval_s = args.number("--checkpoint-interval", Range{0.0, 1e9});
+  }
+  const auto dir = args.optional_text("-o");
+  if (!dir) {
+    if (out.resume) throw InputError("--resume", "", "needs -o DIR: the checkpoint is in the output folder");
+    return out;
+  }
+  out.file = std::filesystem::path(*dir) / (name + ".checkpoint");
+  return out;
+}
+
+namespace {
+
+/// Wall-clock seconds a segment aims at: short enough that an interrupted run stops soon,
+/// long enough that its start (no allocation, a few vector copies) costs nothing.
+constexpr double kSegmentWallSeconds = 2.0;
+/// The first segment (settling included, no rate known yet): this fraction of the run.
+constexpr double kFirstSegmentFraction = 0.01;
+/// A segment is at most this many times the last one.
+constexpr std::int64_t kSegmentGrowth = 4;
+
+/// What must match for a resume besides the case's physics: the structure, the task, the
+/// run's own settings (duration, sampling, q0, step) and the caller's (a design).
+std::string decay_settings(const Case& c, const st::CosimulationOptions& o, double dt, const std::string& own) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "structure " << surrogate::case_hash(c.resolved.value("structure", json())) << "; task "
+    << surrogate::case_hash(c.resolved.value("task", json())) << "; duration_s " << o.duration_s
+    << "; sample_interval_s " << o.sample_interval_s << "; time_step_s " << dt << "; q0";
+  for (Eigen::Index j = 0; j < o.initial_modal_displacements.size(); ++j) s << ' ' << o.initial_modal_displacements[j];
+  if (!own.empty()) s << "; " << own;
+  return s.str();
+}
+
+void write_checkpoint(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header,
+                      const st::CosimulationState& state, const st::CosimulationResult& sum) {
+  dem_reference::StateWriter out;
+  st::save_cosimulation_state(state, out);
+  st::save_cosimulation_result(sum, out);
+  write_file_atomically(cp.file, dem_reference::encode_checkpoint(header, out.bytes()));
+}
+
+/// The decay of `options` in segments, checkpointed (DemCheckpoint).
+st::CosimulationResult run_checkpointed_decay(const Case& c, const st::ModalModel& modal,
+                                              const std::vector<st::CosimulationDamper>& dampers,
+                                              const st::CosimulationOptions& options, const std::string& label,
+                                              const DemCheckpoint& cp) {
+  double dt = 0.0;
+  try {
+    dt = st::cosimulation_time_step(modal, dampers, options).time_step_s;
+  } catch (const std::invalid_argument& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    throw InputError(c.path, "/dem", what);
+  }
+  const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(options.sample_interval_s / dt));
+  const std::int64_t total = std::llround(options.duration_s / dt);
+  dem_reference::CheckpointHeader header;
+  header.kind = cp.kind;
+  header.case_hash = case_file::physics_hash(c, "dem");
+  header.physics_model_version = dem_reference::kPhysicsModelVersion;
+  header.settings = decay_settings(c, options, dt, cp.settings);
+  header.end_time_s = static_cast<double>(total) * dt;
+  const std::string shown = strict_json::printable(cp.file.string());
+
+  st::CosimulationState state;
+  st::CosimulationResult sum;
+  std::int64_t done = 0;
+  if (cp.resume) {
+    if (!std::filesystem::exists(cp.file))
+      throw InputError("--resume", "", "no checkpoint " + shown + " to continue (the run completed, or never started)");
+    const auto decoded = dem_reference::decode_checkpoint(
+        strict_json::read_input_file(cp.file.string(), dem_reference::kMaxCheckpointBytes), cp.file.string());
+    const auto& h = decoded.header;
+    const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& here) {
+      throw InputError(cp.file.string(), "/" + key,
+                       "'" + saved + "' in the checkpoint, '" + here + "' for this run: it belongs to another " +
+                           (key == "kind" ? "command" : key == "physics_model_version" ? "pdamp version" : "case or settings") +
+                           " (run without --resume to start again)");
+    };
+    if (h.kind != header.kind) refuse("kind", h.kind, header.kind);
+    if (h.case_hash != header.case_hash) refuse("case_hash", h.case_hash, header.case_hash);
+    if (h.physics_model_version != header.physics_model_version)
+      refuse("physics_model_version", std::to_string(h.physics_model_version), std::to_string(header.physics_model_version));
+    if (h.settings != header.settings) refuse("settings", h.settings, header.settings);
+    try {
+      dem_reference::StateReader in(decoded.payload, "checkpoint state");
+      state = st::restore_cosimulation_state(modal, dampers, in);
+      sum = st::restore_cosimulation_result(in, modal.mode_count(), dampers.size());
+      in.finish();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(cp.file.string(), "", e.what());
+    }
+    done = sum.steps;
+    if (done <= 0 || done > total || state.steps != done)
+      throw InputError(cp.file.string(), "", "its step count " + std::to_string(done) + " does not fit this run's " +
+                                                 std::to_string(total) + " steps");
+    std::cerr << label << ": resuming at t = " << format_number(static_cast<double>(done) * dt, 6) << " s of "
+              << format_number(header.end_time_s, 6) << " s from " << shown << "\n";
+  } else if (std::filesystem::exists(cp.file)) {
+    std::cerr << "pdamp: warning: " << shown << " of an earlier run is replaced (--resume continues it)\n";
+  }
+
+  // Signals wait for the segment's end: the checkpoint is written, then pdamp ends by them.
+  begin_output_phase();
+  struct EndPhase {
+    ~EndPhase() { end_output_phase(); }
+  } end_phase;
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  std::int64_t segment = sample_every * std::max<std::int64_t>(1, std::llround(kFirstSegmentFraction *
+                                                                                static_cast<double>(total / sample_every)));
+  while (done < total) {
+    const std::int64_t steps = std::min(segment, total - done);
+    st::CosimulationOptions o = options;
+    o.duration_s = static_cast<double>(steps) * dt;
+    if (state.started()) o.initial_modal_displacements.resize(0), o.initial_modal_velocities.resize(0);
+    const std::int64_t offset = done;
+    const auto report = [&](const st::CosimulationProgress& p) {
+      st::CosimulationProgress whole = p;
+      whole.simulated_time_s += static_cast<double>(offset) * dt;
+      whole.end_time_s = header.end_time_s;
+      print_cosim_progress(label, whole);
+    };
+    const auto started = std::chrono::steady_clock::now();
+    st::CosimulationResult part;
+    try {
+      part = st::cosimulate(modal, dampers, o, state, report);
+    } catch (const std::invalid_argument& e) {
+      std::string what = e.what();
+      std::replace(what.begin(), what.end(), '\n', ' ');
+      throw InputError(c.path, "/dem", what);
+    }
+    if (part.outcome == dem_reference::Outcome::kUnstable)
+      throw NumericalError(label + ": DEM unstable: " + part.message +
+                           " (a smaller /dem/time_step_s, a larger /dem/steps_per_contact or /dem/max_impact_speed_m_s)");
+    if (part.outcome != dem_reference::Outcome::kCompleted) throw NumericalError(label + ": DEM failed: " + part.message);
+    if (done == 0 && !cp.resume) {
+      sum = std::move(part);
+    } else {
+      st::append_continuation(sum, part, state);
+    }
+    done += steps;
+    // The next segment: about kSegmentWallSeconds at this segment's rate, whole sample
+    // intervals, at most kSegmentGrowth times this one (a short first segment, settling and
+    // all, measures its rate poorly).
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double rate = static_cast<double>(steps) / std::max(wall, 1e-3);
+    segment = std::min(kSegmentGrowth * steps,
+                       sample_every * std::max<std::int64_t>(1, std::llround(kSegmentWallSeconds * rate /
+                                                                             static_cast<double>(sample_every))));
+    segment = std::max(segment, sample_every);
+    const int signal = pending_interrupt();
+    const bool due = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >= cp.interval_s;
+    // At the end a signal still gets a checkpoint: the results are not written yet.
+    if (signal != 0 || (done < total && due)) {
+      header.simulated_time_s = static_cast<double>(done) * dt;
+      write_checkpoint(cp, header, state, sum);
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
+    if (signal != 0)
+      throw Interrupted(signal, "the run stopped at t = " + format_number(header.simulated_time_s, 6) + " of " +
+                                    format_number(header.end_time_s, 6) + " s and wrote " + shown +
+                                    ": run the same command with --resume to continue");
+  }
+  std::error_code ignored;
+  std::filesystem::remove(cp.file, ignored);  // complete: the results follow
+  return sum;
+}
+
+}  // namespace
+
 DemDecay run_dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
                        const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                        const case_file::DecayTask& task, const std::string& label,
-                       const std::string& duration_pointer) {
+                       const std::string& duration_pointer, const DemCheckpoint& checkpoint) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -750,7 +939,8 @@ DemDecay run_dem_decay(const Case& c, const st::ModalModel& modal, std::vector<s
                                     kDecayMinSamples, kDecayMaxSamples);
   options.sample_interval_s = task.duration_s / samples;
   DemDecay out;
-  out.cosimulation = run_cosimulation(c, modal, dampers, options, label);
+  out.cosimulation = checkpoint.file.empty() ? run_cosimulation(c, modal, dampers, options, label)
+                                             : run_checkpointed_decay(c, modal, dampers, options, label, checkpoint);
   const auto& r = out.cosimulation;
   out.warnings = r.warnings;
 
@@ -786,7 +976,8 @@ int run_decay_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   if (!(q0.cwiseAbs().maxCoeff() > 0.0))
     throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
   const auto dampers = dem_dampers(c);
-  const DemDecay decay = run_dem_decay(c, modal, setup.s.dampers, dampers, q0, task, "pdamp decay (dem)", "/task/duration_s");
+  const DemDecay decay = run_dem_decay(c, modal, setup.s.dampers, dampers, q0, task, "pdamp decay (dem)",
+                                       "/task/duration_s", dem_checkpoint(args, "decay_dem", "decay_dem"));
   setup.warnings.add(decay.warnings);
   const auto& r = decay.cosimulation;
   const auto& h = r.history;
@@ -1641,6 +1832,8 @@ int run_decay_case(const ParsedArgs& args, const Case& c) {
     auto dem_files = output_dir(args);
     return run_decay_dem(args, c, dem_files.get());
   }
+  for (const auto& flag : kCheckpointFlags)
+    if (args.has(flag.name)) throw InputError(flag.name, "", "applies to --method dem (the DEM runs checkpoint)");
   const auto method = loss_method(args);
   auto files = output_dir(args);
   Setup setup = make_setup(c, method);
@@ -1775,13 +1968,14 @@ std::vector<Command> structure_commands() {
                        "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, kDemSweepFlags), 1},
        run_frf},
-      {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [-o DIR] [--json]",
+      {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [--resume] [--checkpoint-interval S] [-o DIR] [--json]",
         "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"
         "equivalent damping ratio and the energy each layer dissipates",
-        {kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg (dem: decay_dem.csv,\n"
-                                    "                          decay_dem.gp/png/svg), decay.json and case_resolved.json\n"
-                                    "                          into DIR, atomically"},
-         kJsonFlag}, 1},
+        concat_flags({kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg (dem: decay_dem.csv,\n"
+                                                  "                          decay_dem.gp/png/svg), decay.json and case_resolved.json\n"
+                                                  "                          into DIR, atomically (dem: decay_dem.checkpoint while running)"},
+                      kJsonFlag},
+                     kCheckpointFlags), 1},
        run_decay},
   };
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -60,15 +61,36 @@ struct DemDecay {
   std::vector<std::string> warnings;   ///< the co-simulation's, not settled, energy ledger above 1%
 };
 
+/// Checkpoints of a DEM-in-the-loop decay (issue 13 §4, docs/cosimulation.md §7): the run
+/// goes in segments of whole sample intervals (about 2 s of wall time each) and writes its
+/// state (worlds, modes, the history so far) to `file` every `interval_s` of wall time and
+/// when SIGINT, SIGTERM or SIGHUP arrives (then it ends by the signal, saying how to resume).
+/// With `resume` it continues from `file`, refusing a checkpoint of another kind, case,
+/// model version or settings; a completed run removes the file. Empty `file`: one
+/// uninterrupted run, no checkpoints.
+struct DemCheckpoint {
+  std::filesystem::path file;
+  std::string kind = "decay_dem";  ///< what the checkpoint continues ("verify_chosen", ...)
+  std::string settings;            ///< the caller's own settings (a design): part of the match
+  bool resume = false;
+  double interval_s = 60.0;        ///< wall-clock seconds between checkpoints, >= 0 (0: every segment)
+};
+/// `--resume` and `--checkpoint-interval` (pdamp decay --method dem, optimize --verify, run).
+extern const std::vector<FlagSpec> kCheckpointFlags;
+/// The checkpoint of a DEM run named `name` in the -o folder of `args` (InputError for
+/// --resume without -o, or a bad --checkpoint-interval); no file without -o.
+DemCheckpoint dem_checkpoint(const ParsedArgs& args, const std::string& name, const std::string& kind);
+
 /// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds,
 /// structure::cosimulate) from rest at q0 over task.duration_s, and measures its settling
-/// against task.settling_threshold. `containers`: the same dampers as the structure sees
+/// against task.settling_threshold; with a checkpoint file, in segments (DemCheckpoint). `containers`: the same dampers as the structure sees
 /// them (their layers are ignored; drive shapes and the static offset of the case's beds).
 /// Progress lines on stderr start with `label`; `duration_pointer` is named in the
 /// not-settled warning. Exit 2 (InputError) for refused options, 3 for a World that stops.
 DemDecay run_dem_decay(const case_file::Case& c, const structure::ModalModel& modal,
                        std::vector<structure::Damper> containers,
                        const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
-                       const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer);
+                       const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
+                       const DemCheckpoint& checkpoint = {});
 
 }  // namespace pdamp::cli

@@ -743,6 +743,14 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
   acc.noalias() = M_inv * tmp;
   double power = is_base ? base_power(acc, base_velocity0) : 0.0;
   double work = 0.0, damping = 0.0;
+  // The same sums since the first run's start (CosimulationState::energy_since_start).
+  double work_since_start = continuation ? state.energy_since_start.excitation_work_j : 0.0;
+  double damping_since_start = continuation ? state.energy_since_start.structural_damping_j : 0.0;
+  if (!continuation) {
+    state.start_structure_kinetic_j = kinetic0;
+    state.start_structure_potential_j = potential0;
+    state.start_world_energy = opening;
+  }
   record(t0);
 
   // DFT accumulators: per period (first damper's site, for the stability test) and analysed.
@@ -806,14 +814,19 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     acc_new.noalias() = M_inv.lazyProduct(tmp);
     // Ledger, trapezoidal over the step (the worlds account their work the same way).
     tmp = q_new - q;
-    damping += 0.5 * (C.cwiseProduct(v) + C.cwiseProduct(v_new)).dot(tmp);
+    const double damped = 0.5 * (C.cwiseProduct(v) + C.cwiseProduct(v_new)).dot(tmp);
+    damping += damped;
+    damping_since_start += damped;
+    double worked = 0.0;
     if (exc.kind == CosimulationExcitationKind::kPointForce) {
-      work += 0.5 * exc.amplitude * (drive_now.s + drive_next.s) * force_shape.dot(tmp);
+      worked = 0.5 * exc.amplitude * (drive_now.s + drive_next.s) * force_shape.dot(tmp);
     } else if (is_base) {
       const double power_next = base_power(acc_new, base_velocity_next);
-      work += half_dt * (power + power_next);
+      worked = half_dt * (power + power_next);
       power = power_next;
     }
+    work += worked;
+    work_since_start += worked;
     q.swap(q_new);
     v.swap(v_new);
     acc.swap(acc_new);
@@ -916,25 +929,36 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
     }
   }
 
-  auto& e = result.energy;
-  e.excitation_work_j = work;
-  e.structural_damping_j = damping;
   const double base_velocity_end = U * drive_now.rate * drive_now.c;
-  e.delta_structure_kinetic_j = structure_kinetic(v, base_velocity_end) - kinetic0;
-  e.delta_structure_potential_j = structure_potential(q) - potential0;
+  const double kinetic_end = structure_kinetic(v, base_velocity_end), potential_end = structure_potential(q);
+  // The ledger from the given start: this run's (kinetic0, opening) or the first run's.
+  const auto ledger = [&](double w, double damped, double kinetic_start, double potential_start,
+                          const std::vector<dem::EnergyAccount>& start) {
+    CosimulationEnergy e;
+    e.excitation_work_j = w;
+    e.structural_damping_j = damped;
+    e.delta_structure_kinetic_j = kinetic_end - kinetic_start;
+    e.delta_structure_potential_j = potential_end - potential_start;
+    for (std::size_t d = 0; d < dcount; ++d) {
+      const dem::EnergyAccount now = worlds[d].energy();
+      e.dem_normal_damping_j += now.normal_damping_j - start[d].normal_damping_j;
+      e.dem_friction_j += now.friction_j - start[d].friction_j;
+      e.dem_rolling_j += now.rolling_j - start[d].rolling_j;
+      e.delta_bed_kinetic_j += now.kinetic_j - start[d].kinetic_j;
+      e.delta_bed_potential_j += now.potential_j - start[d].potential_j;
+      e.delta_bed_elastic_j += now.elastic_j - start[d].elastic_j;
+      e.container_work_j += now.container_work_j - start[d].container_work_j;
+    }
+    e.relative_error = ledger_error(e);
+    return e;
+  };
+  result.energy = ledger(work, damping, kinetic0, potential0, opening);
+  state.energy_since_start = ledger(work_since_start, damping_since_start, state.start_structure_kinetic_j,
+                                    state.start_structure_potential_j, state.start_world_energy);
   for (std::size_t d = 0; d < dcount; ++d) {
-    const dem::EnergyAccount now = worlds[d].energy();
-    e.dem_normal_damping_j += now.normal_damping_j - opening[d].normal_damping_j;
-    e.dem_friction_j += now.friction_j - opening[d].friction_j;
-    e.dem_rolling_j += now.rolling_j - opening[d].rolling_j;
-    e.delta_bed_kinetic_j += now.kinetic_j - opening[d].kinetic_j;
-    e.delta_bed_potential_j += now.potential_j - opening[d].potential_j;
-    e.delta_bed_elastic_j += now.elastic_j - opening[d].elastic_j;
-    e.container_work_j += now.container_work_j - opening[d].container_work_j;
     result.world_status.push_back(worlds[d].status());
     result.final_container_states.push_back(worlds[d].container());
   }
-  e.relative_error = ledger_error(e);
   // --- The state for the next run.
   state.modal_displacements = q;
   state.modal_velocities = v;
@@ -1019,6 +1043,14 @@ void save_cosimulation_state(const CosimulationState& state, dem::StateWriter& o
   out.f64(e.frequency_hz);
   out.text(e.point);
   out.f64(state.excitation_phase_rad);
+  CosimulationEnergy e_since = state.energy_since_start;
+  for (double* v : energy_terms(e_since)) out.f64(*v);
+  out.f64(state.start_structure_kinetic_j);
+  out.f64(state.start_structure_potential_j);
+  for (const auto& a : state.start_world_energy)
+    for (double v : {a.container_work_j, a.normal_damping_j, a.friction_j, a.rolling_j, a.kinetic_j, a.potential_j,
+                     a.elastic_j})
+      out.f64(v);
   out.tag("end of cosimulation state");
 }
 
@@ -1062,6 +1094,15 @@ CosimulationState restore_cosimulation_state(const ModalModel& model, const std:
   e.frequency_hz = in.finite("excitation.frequency_hz");
   e.point = in.text("excitation.point", 4096);
   state.excitation_phase_rad = in.finite("excitation_phase_rad");
+  for (double* v : energy_terms(state.energy_since_start)) *v = in.finite("energy_since_start");
+  state.energy_since_start.relative_error = ledger_error(state.energy_since_start);
+  state.start_structure_kinetic_j = in.finite("start_structure_kinetic_j");
+  state.start_structure_potential_j = in.finite("start_structure_potential_j");
+  state.start_world_energy.resize(worlds);
+  for (auto& a : state.start_world_energy)
+    for (double* v : {&a.container_work_j, &a.normal_damping_j, &a.friction_j, &a.rolling_j, &a.kinetic_j, &a.potential_j,
+                      &a.elastic_j})
+      *v = in.finite("start_world_energy");
   in.expect_tag("end of cosimulation state");
   return state;
 }
@@ -1084,8 +1125,6 @@ void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out
   for (const auto* m : {&h.modal_displacements, &h.site_displacement_m, &h.site_rotation_rad, &h.container_load_n,
                         &h.container_moment_nm})
     write_matrix(out, *m);
-  CosimulationEnergy e = r.energy;
-  for (double* v : energy_terms(e)) out.f64(*v);
   out.i64(static_cast<std::int64_t>(r.warnings.size()));
   for (const auto& w : r.warnings) out.text(w);
   out.tag("end of cosimulation result");
@@ -1117,15 +1156,13 @@ CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Inde
   h.site_rotation_rad = read_matrix(in, "history.site_rotation_rad", samples, dampers);
   h.container_load_n = read_matrix(in, "history.container_load_n", samples, dampers);
   h.container_moment_nm = read_matrix(in, "history.container_moment_nm", samples, dampers);
-  for (double* v : energy_terms(r.energy)) *v = in.finite("energy");
-  r.energy.relative_error = ledger_error(r.energy);
   const std::size_t warnings = in.count("warnings", 10000, 8);
   for (std::size_t k = 0; k < warnings; ++k) r.warnings.push_back(in.text("warnings", kMaxWarningBytes));
   in.expect_tag("end of cosimulation result");
   return r;
 }
 
-void append_continuation(CosimulationResult& total, const CosimulationResult& next) {
+void append_continuation(CosimulationResult& total, const CosimulationResult& next, const CosimulationState& state) {
   auto& h = total.history;
   const auto& g = next.history;
   const Eigen::Index have = static_cast<Eigen::Index>(h.time_s.size());
@@ -1139,11 +1176,7 @@ void append_continuation(CosimulationResult& total, const CosimulationResult& ne
     to->conservativeResize(have + add, from->cols());
     if (add > 0) to->bottomRows(add) = from->bottomRows(add);
   }
-  CosimulationEnergy e = next.energy;
-  const auto sums = energy_terms(total.energy);
-  const auto adds = energy_terms(e);
-  for (std::size_t k = 0; k < sums.size(); ++k) *sums[k] += *adds[k];
-  total.energy.relative_error = ledger_error(total.energy);
+  total.energy = state.energy_since_start;
   total.steps += next.steps;
   total.simulated_time_s += next.simulated_time_s;
   total.wall_time_s += next.wall_time_s;

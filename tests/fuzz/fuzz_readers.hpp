@@ -27,6 +27,8 @@
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/dem_reference/checkpoint.hpp"
+#include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/imported_modal_data.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/surrogate/grid.hpp"
@@ -40,7 +42,17 @@ namespace fs = std::filesystem;
 
 /// One reader of a user's file. `name` is the fuzz target's suffix (fuzz_<name>) and the
 /// folder of its corpus and regressions; `file_name` is what the bytes are saved as.
-enum class Reader { kCaseFile, kFieldFile, kMeasuredCsv, kImpactCsv, kScatteredFit, kModalData, kSweepLog, kShardLog };
+enum class Reader {
+  kCaseFile,
+  kFieldFile,
+  kMeasuredCsv,
+  kImpactCsv,
+  kScatteredFit,
+  kModalData,
+  kSweepLog,
+  kShardLog,
+  kCheckpoint
+};
 
 struct ReaderInfo {
   Reader reader;
@@ -60,6 +72,7 @@ inline constexpr ReaderInfo kReaders[] = {
     {Reader::kModalData, "modal_data", "modal.json", true},
     {Reader::kSweepLog, "sweep_log", "field_sweep.jsonl", true},
     {Reader::kShardLog, "shard_log", "field_sweep.jsonl", true},
+    {Reader::kCheckpoint, "checkpoint", "decay_dem.checkpoint", true},
 };
 
 inline const ReaderInfo& info(Reader reader) {
@@ -92,6 +105,40 @@ inline surrogate::SweepOptions sweep_options(const fs::path& results) {
   options.bed_mass_kg = 0.74;
   options.threads = 1;
   return options;
+}
+
+/// The structure and bed of the checkpoint reader (its seed, tests/fuzz/corpus/checkpoint/,
+/// is a free decay of this model; tests/fuzz/make_checkpoint_seed.cpp writes it): one mode
+/// at 10 Hz, four spheres in a box at the point "tip".
+inline structure::ModalModel checkpoint_model() {
+  structure::ModalModel m;
+  m.natural_frequencies_hz = Eigen::VectorXd::Constant(1, 10.0);
+  m.damping_ratios = Eigen::VectorXd::Constant(1, 0.01);
+  m.modal_masses_kg = Eigen::VectorXd::Constant(1, 0.1);
+  Eigen::MatrixXd shape(2, 1);
+  shape << 0.0, 1.0;
+  m.points = {{"tip", shape, Eigen::RowVectorXd::Constant(1, 0.0)}};
+  return m;
+}
+
+inline std::vector<structure::CosimulationDamper> checkpoint_dampers() {
+  dem_reference::WorldOptions w;
+  w.materials[0].material.youngs_modulus_pa = 2e8;
+  w.gravity_m_s2 = {0.0, 0.0, -9.80665};
+  auto& c = w.compartments[0];
+  c.container.box_inner_size_m = {0.03, 0.0201, 0.0201};
+  c.placement = dem_reference::InitialPlacement::kCollectedLattice;
+  c.lattice_counts = {1, 2, 2};
+  c.particles[0].radius_m = 0.005;
+  c.particles[0].count = 4;
+  c.particles[0].lot_diameter_variation_m = 0.0;
+  structure::CosimulationDamper d;
+  d.name = "tip";
+  d.point = "tip";
+  d.drive_direction = {0.0, 1.0};
+  d.container_mass_kg = 0.02;
+  d.world = w;
+  return {d};
 }
 
 /// A folder for the inputs of one process (tmpfs when there is one: a fuzzer writes
@@ -176,6 +223,33 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
       case Reader::kShardLog:  // pdamp field merge of one shard file: its header checks, then the lines
         (void)surrogate::merge_sweep_shards(sweep_grid(), sweep_options(path), {path}, "the fuzzed sweep");
         break;
+      case Reader::kCheckpoint: {  // pdamp decay --method dem --resume: the file, then the state it carries
+        const std::string bytes = strict_json::read_input_file(path.string(), dem_reference::kMaxCheckpointBytes);
+        const auto restore = [](std::string_view payload) {
+          dem_reference::StateReader in(payload, "checkpoint state");
+          (void)structure::restore_cosimulation_state(checkpoint_model(), checkpoint_dampers(), in);
+          (void)structure::restore_cosimulation_result(in, 1, 1);
+          in.finish();
+        };
+        // The state reader on whatever follows the header line, as if its hash were right: a
+        // mutation rarely keeps the FNV-1a hash, and the reader behind it must hold anyway.
+        if (const auto header_end = bytes.find('\n', bytes.find('\n') + 1); header_end != std::string::npos) {
+          try {
+            restore(std::string_view(bytes).substr(header_end + 1));
+          } catch (const std::invalid_argument&) {
+            // refused cleanly: the contract of this path (the CLI path below names the file)
+          }
+        }
+        const auto decoded = dem_reference::decode_checkpoint(bytes, path.string());
+        try {
+          restore(decoded.payload);
+        } catch (const strict_json::InputError&) {
+          throw;
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(path.string() + ": " + e.what());  // as the CLI names the file
+        }
+        break;
+      }
     }
     outcome.accepted = true;
   } catch (const std::invalid_argument& e) {

@@ -88,7 +88,7 @@ std::string printable(const std::string& text) {
   return out;
 }
 
-std::string read_input_file(const std::string& path) {
+std::string read_input_file(const std::string& path, std::size_t max_bytes) {
   if (path.empty()) refuse("''", "empty file name");
   // O_NONBLOCK: opening a FIFO for reading with no writer would block forever.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
@@ -106,9 +106,9 @@ std::string read_input_file(const std::string& path) {
   struct stat info {};
   if (::fstat(fd, &info) != 0) refuse(path, std::string("cannot be read (") + std::strerror(errno) + ")");
   if (!S_ISREG(info.st_mode)) refuse(path, std::string("is ") + kind_of(info.st_mode) + ", not a file");
-  if (static_cast<unsigned long long>(info.st_size) > kMaxInputFileBytes)
+  if (static_cast<unsigned long long>(info.st_size) > max_bytes)
     refuse(path, "is " + std::to_string(info.st_size >> 20) + " MiB, larger than the " +
-                     std::to_string(kMaxInputFileBytes >> 20) + " MiB an input file may have");
+                     std::to_string(max_bytes >> 20) + " MiB an input file may have");
   std::string bytes;
   bytes.resize(static_cast<std::size_t>(info.st_size));
   std::size_t done = 0;

@@ -248,6 +248,14 @@ struct CosimulationState {
   /// Harmonic: the drive's phase ψ at the end, rad, in [0, 2π). Runs at one frequency end on
   /// whole periods, so this is their start phase; the next run starts its sine there.
   double excitation_phase_rad = 0.0;
+  /// The energy account since the first run's start (docs/cosimulation.md §4): what one run
+  /// of the combined length reports, to the bit. Its running sums (work, structural damping)
+  /// continue from run to run; its changes are taken from the first start's references below.
+  /// A run split into segments (checkpoints) reports this as its whole.
+  CosimulationEnergy energy_since_start;
+  double start_structure_kinetic_j = 0.0;    ///< T' at the first start, J
+  double start_structure_potential_j = 0.0;  ///< ½qᵀKq at the first start, J
+  std::vector<dem_reference::EnergyAccount> start_world_energy;  ///< each world's account at the first start
   /// true once a run has filled the state (worlds built, beds settled).
   bool started() const { return !worlds.empty(); }
 };
@@ -294,8 +302,8 @@ void save_cosimulation_state(const CosimulationState& state, dem_reference::Stat
 CosimulationState restore_cosimulation_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                                              dem_reference::StateReader& in);
 
-/// A free decay's result so far, for a checkpoint: the histories, the energy account, the
-/// counters, the frequencies with the containers and the warnings (harmonic results are not
+/// A free decay's result so far, for a checkpoint: the histories, the counters, the
+/// frequencies with the containers and the warnings (the energy account is the state's) (harmonic results are not
 /// written: only a free decay is run in segments). restore_cosimulation_result refuses a
 /// result of another shape (modes, dampers) naming the field.
 void save_cosimulation_result(const CosimulationResult& result, dem_reference::StateWriter& out);
@@ -303,11 +311,12 @@ CosimulationResult restore_cosimulation_result(dem_reference::StateReader& in, E
 
 /// Appends the result of a continuation to the result of the runs before it (a free decay
 /// run in segments, each continuing the state the last one left): the histories without the
-/// continuation's first sample (the last one's final sample again), the energy terms and the
-/// counters summed, the relative error of the summed ledger, the continuation's outcome,
-/// final states and warnings not yet listed. Segments of whole sample intervals
-/// (options.sample_interval_s fixed) give the histories a single run records.
-void append_continuation(CosimulationResult& total, const CosimulationResult& next);
+/// continuation's first sample (the last one's final sample again), the counters summed, the
+/// continuation's outcome, final states and warnings not yet listed, and the energy account
+/// of `state` since the first start (CosimulationState::energy_since_start: a sum of the
+/// runs' own accounts would differ from one run's in the last bits). Segments of whole
+/// sample intervals (options.sample_interval_s fixed) give the histories one run records.
+void append_continuation(CosimulationResult& total, const CosimulationResult& next, const CosimulationState& state);
 
 /// The common step a fresh cosimulate() would take for these inputs, s, and its whole steps
 /// per period (harmonic, else 0), without building worlds (a stepped sine takes the smallest

@@ -18,9 +18,9 @@ inline constexpr std::size_t kMaxInputFileBytes = std::size_t{256} << 20;
 
 /// The whole file as bytes. InputError "<path>: <reason>" when the path
 /// does not exist, is not a regular file (directory, FIFO, socket, device), cannot be
-/// read or is larger than kMaxInputFileBytes. The file is opened without blocking, so
+/// read or is larger than max_bytes (kMaxInputFileBytes; a checkpoint allows more). The file is opened without blocking, so
 /// a FIFO swapped in after the check cannot hang the caller either.
-std::string read_input_file(const std::string& path);
+std::string read_input_file(const std::string& path, std::size_t max_bytes = kMaxInputFileBytes);
 
 /// Parses `text` (read from `path`) as one JSON document, refusing what
 /// nlohmann::json would accept silently: a key repeated in one object (the parser keeps

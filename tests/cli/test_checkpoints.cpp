@@ -1,0 +1,170 @@
+// Checkpointed DEM runs from the command line (issue 13 §4): pdamp decay --method dem killed
+// mid-way and resumed gives the uninterrupted run's result to the bit; checkpoints of another
+// case or settings, damaged ones and misplaced flags are exit 2 naming the file or flag.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+
+#include "cli/cli_support.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+/// The shipped link decay, 6 s, contacts softened 1e-3 (about 1 s of work on this machine).
+std::string short_decay(const TempDir& dir, double duration_s = 6.0) {
+  std::ifstream in(case_path("manipulator_link_decay.json"));
+  json c = json::parse(in);
+  c["task"]["duration_s"] = duration_s;
+  c["dem"] = {{"stiffness_softening", 1e-3}};
+  const fs::path path = dir.path / ("link_" + std::to_string(duration_s) + ".json");
+  std::ofstream(path) << c.dump(2);
+  return path.string();
+}
+
+json without_timings(json j) {
+  for (const char* key : {"solve_time_s", "file", "outputs", "wall_time_s", "plot"}) j.erase(key);
+  for (auto& [key, value] : j.items())
+    if (value.is_object()) value = without_timings(value);
+  return j;
+}
+
+}  // namespace
+
+// Reference: the uninterrupted run of the same command. SIGINT arrives once the first
+// checkpoint exists (--checkpoint-interval 0: one after every segment); pdamp writes one more
+// at the segment's end and ends by the signal; --resume completes the run, removes the
+// checkpoint, and its decay_dem.csv and result equal the uninterrupted run's (times,
+// displacements, settling, energy ledger).
+TEST_CASE("pdamp decay --method dem killed mid-way and resumed equals the uninterrupted run", "[cli][cosimulation]") {
+  const TempDir dir("checkpoint_resume");
+  const std::string c = short_decay(dir);
+  const fs::path whole = dir.path / "whole", parts = dir.path / "parts";
+  const auto reference = run_pdamp({"decay", c, "--method", "dem", "-o", whole.string(), "--json"});
+  INFO(reference.err);
+  REQUIRE(reference.exit_code == 0);
+
+  RunOptions options;
+  options.while_running = [&](pid_t pid) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(parts / "decay_dem.checkpoint") && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ::kill(pid, SIGINT);
+  };
+  const auto killed = run_pdamp({"decay", c, "--method", "dem", "-o", parts.string(), "--json", "--checkpoint-interval",
+                                 "0"},
+                                options);
+  INFO(killed.err);
+  REQUIRE(killed.exit_code == 128 + SIGINT);
+  CHECK_THAT(killed.err, Catch::Contains("--resume to continue"));
+  REQUIRE(fs::exists(parts / "decay_dem.checkpoint"));
+  CHECK_FALSE(fs::exists(parts / "decay.json"));
+
+  const auto resumed = run_pdamp({"decay", c, "--method", "dem", "-o", parts.string(), "--json", "--resume"});
+  INFO(resumed.err);
+  REQUIRE(resumed.exit_code == 0);
+  CHECK_THAT(resumed.err, Catch::Contains("resuming at t = "));
+  CHECK_FALSE(fs::exists(parts / "decay_dem.checkpoint"));
+  CHECK(slurp(whole / "decay_dem.csv") == slurp(parts / "decay_dem.csv"));
+  CHECK(without_timings(json::parse(reference.out)) == without_timings(json::parse(resumed.out)));
+}
+
+TEST_CASE("a checkpoint of another case, settings or a damaged one is refused naming the file", "[cli][cosimulation]") {
+  const TempDir dir("checkpoint_refusals");
+  const std::string c = short_decay(dir, 4.0);
+  const fs::path out = dir.path / "out";
+  RunOptions options;
+  options.while_running = [&](pid_t pid) {
+    while (!fs::exists(out / "decay_dem.checkpoint")) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ::kill(pid, SIGTERM);
+  };
+  const auto killed = run_pdamp({"decay", c, "--method", "dem", "-o", out.string(), "--checkpoint-interval", "0"}, options);
+  REQUIRE(killed.exit_code == 128 + SIGTERM);
+  const std::string checkpoint = slurp(out / "decay_dem.checkpoint");
+
+  SECTION("another duration") {
+    require_one_line_error(run_pdamp({"decay", short_decay(dir, 5.0), "--method", "dem", "-o", out.string(), "--resume"}),
+                           "decay_dem.checkpoint: /settings");
+  }
+  SECTION("another bed") {
+    std::ifstream in(c);
+    json other = json::parse(in);
+    other["dem"]["contact"] = {{"friction", 0.2}};
+    const fs::path path = dir.path / "other.json";
+    std::ofstream(path) << other.dump(2);
+    require_one_line_error(run_pdamp({"decay", path.string(), "--method", "dem", "-o", out.string(), "--resume"}),
+                           "decay_dem.checkpoint: /case_hash");
+  }
+  SECTION("a damaged checkpoint") {
+    std::string bad = checkpoint;
+    bad[bad.size() / 2] = static_cast<char>(bad[bad.size() / 2] ^ 0x40);
+    std::ofstream(out / "decay_dem.checkpoint", std::ios::binary) << bad;
+    require_one_line_error(run_pdamp({"decay", c, "--method", "dem", "-o", out.string(), "--resume"}),
+                           "/payload_fnv1a64");
+  }
+  SECTION("a truncated checkpoint") {
+    std::ofstream(out / "decay_dem.checkpoint", std::ios::binary) << checkpoint.substr(0, checkpoint.size() / 3);
+    require_one_line_error(run_pdamp({"decay", c, "--method", "dem", "-o", out.string(), "--resume"}), "truncated");
+  }
+  SECTION("no checkpoint, no folder, another method") {
+    fs::remove(out / "decay_dem.checkpoint");
+    require_one_line_error(run_pdamp({"decay", c, "--method", "dem", "-o", out.string(), "--resume"}),
+                           "--resume: no checkpoint");
+    require_one_line_error(run_pdamp({"decay", c, "--method", "dem", "--resume"}), "--resume: needs -o DIR");
+    require_one_line_error(run_pdamp({"decay", c, "--method", "formulas", "-o", out.string(), "--resume"}),
+                           "--resume: applies to --method dem");
+    require_one_line_error(run_pdamp({"decay", c, "--method", "dem", "-o", out.string(), "--checkpoint-interval", "-1"}),
+                           "--checkpoint-interval");
+  }
+}
+
+// Reference: the uninterrupted verification of the same (cut short) optimisation. Both DEM
+// decays checkpoint on their own (verify_chosen.checkpoint, verify_baseline.checkpoint) and
+// stop at the signal; --resume continues each (or reruns one that had completed) and the
+// verification equals the uninterrupted one.
+TEST_CASE("a killed DEM verification resumes both designs and equals the uninterrupted one", "[cli][optimizer]") {
+  const TempDir dir("checkpoint_verify");
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  json c = json::parse(in);
+  c["task"]["global_evaluations"] = 30;
+  c["task"]["max_evaluations"] = 120;
+  c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}};
+  const fs::path path = dir.path / "case.json";
+  std::ofstream(path) << c.dump(2);
+  const fs::path whole = dir.path / "whole", parts = dir.path / "parts";
+  const auto reference = run_pdamp({"optimize", path.string(), "-o", whole.string(), "--json"});
+  INFO(reference.err);
+  REQUIRE(reference.exit_code == 0);
+
+  RunOptions options;
+  options.while_running = [&](pid_t pid) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(parts / "verify_chosen.checkpoint") && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ::kill(pid, SIGINT);
+  };
+  const auto killed =
+      run_pdamp({"optimize", path.string(), "-o", parts.string(), "--json", "--checkpoint-interval", "0"}, options);
+  INFO(killed.err);
+  REQUIRE(killed.exit_code == 128 + SIGINT);
+  REQUIRE(fs::exists(parts / "verify_chosen.checkpoint"));
+  const auto resumed = run_pdamp({"optimize", path.string(), "-o", parts.string(), "--json", "--resume"});
+  INFO(resumed.err);
+  REQUIRE(resumed.exit_code == 0);
+  CHECK_THAT(resumed.err, Catch::Contains("pdamp optimize --verify (chosen): resuming at t = "));
+  CHECK_FALSE(fs::exists(parts / "verify_chosen.checkpoint"));
+  CHECK_FALSE(fs::exists(parts / "verify_baseline.checkpoint"));
+  const json a = without_timings(json::parse(reference.out)), b = without_timings(json::parse(resumed.out));
+  CHECK(a["verification"] == b["verification"]);
+  CHECK(slurp(whole / "verify_decay.csv") == slurp(parts / "verify_decay.csv"));
+}
