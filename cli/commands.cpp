@@ -319,6 +319,7 @@ DamperDesign damper_design(const Case& c) {
     result = {{"task", case_file::to_string(c.task.kind)}, {"case", c.name}, {"model", fm::to_string(family)},
               {"clearance_m", layer.clearance_m}, {"bed_mass_kg", layer.bed_mass_kg}, {"optimum", optimum_json(out.optimum)}};
     auto& warnings = out.warnings;
+    warnings = case_file::settled_bed_warnings(c);
     const auto design_point = fm::reduced_loss_factor(family, layer.clearance_m, out.optimum.x_opt_m, f, d.model_options);
     out.eta_star_at_design = design_point.eta_star;
     result["optimum"]["eta_star_at_design"] = design_point.eta_star;

@@ -185,7 +185,7 @@ Case design_case(const Case& c, const opt::FillingDesign& d, double softening) {
       throw InputError(c.path, "/dampers/0/layers/" + std::to_string(k) + "/particles",
                        "the verified design's " + std::to_string(layer.particle_count) + " spheres: " + e.what());
     }
-    layer.clearance_m = layer.bed.clearance_m;
+    layer.clearance_m = layer.bed.settled_clearance_m;
     layer.bed_mass_kg = d.layers[k].bed_mass_kg;
     layer.compartment.particles.front().count = layer.particle_count;
     kept.push_back(std::move(layer));

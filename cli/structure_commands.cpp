@@ -889,6 +889,8 @@ st::CosimulationResult run_checkpointed_decay(const Case& c, const st::ModalMode
     // all, measures its rate poorly).
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double rate = static_cast<double>(steps) / std::max(wall, 1e-3);
+    // A progress line per segment (the segments' own lines come only from long ones).
+    print_cosim_progress(label, st::CosimulationProgress{"decay", static_cast<double>(done) * dt, header.end_time_s, rate});
     segment = std::min(kSegmentGrowth * steps,
                        sample_every * std::max<std::int64_t>(1, std::llround(kSegmentWallSeconds * rate /
                                                                              static_cast<double>(sample_every))));

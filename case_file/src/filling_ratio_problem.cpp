@@ -13,6 +13,7 @@ FillingRatioProblem filling_ratio_problem(const Case& c) {
   const FillingRatiosTask& task = *c.task.filling_ratios;
   FillingRatioProblem p;
   StructureSetup setup = structure_setup(c, LossMethod::kFormulas);
+  p.warnings = setup.warnings;
   const DamperSpec& spec = c.dampers.front();
   p.modal = setup.modal;
   p.options.damper = setup.dampers.front();
@@ -31,6 +32,7 @@ FillingRatioProblem filling_ratio_problem(const Case& c) {
     l.inner_length_m = layer.container.inner_length(spec.drive_axis);
     l.slab_length_m = 2.0 * r;
     l.spheres_per_slab = task.spheres_per_slab.at(k);
+    l.spheres_per_lane = task.spheres_per_lane.at(k);
     l.sphere_mass_kg = layer.bed_mass_kg / layer.particle_count;
     l.sphere_volume_m3 = 4.0 / 3.0 * std::numbers::pi * r * r * r;
     l.cross_section_m2 = 1.0;

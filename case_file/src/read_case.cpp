@@ -181,6 +181,27 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
   return options;
 }
 
+std::vector<std::string> settled_bed_warnings(const Case& c) {
+  std::vector<std::string> out;
+  for (const DamperSpec& d : c.dampers) {
+    for (const LayerSpec& layer : d.layers) {
+      const auto& bed = layer.bed;
+      if (bed.settled_clearance_m == bed.clearance_m) continue;
+      std::ostringstream text;
+      text.precision(4);
+      text << d.name << "/" << layer.name << ": the bed is " << bed.spheres_per_lane
+           << " spheres high across gravity and settles onto the base: h = " << bed.settled_clearance_m * 1e3
+           << " mm, not the lattice's " << bed.clearance_m * 1e3 << " mm";
+      if (bed.settled_upper_spheres > 0)
+        text << "; " << bed.settled_upper_spheres
+             << " spheres stay above the bottom rows, which the closed forms (one rolling layer) do not model: "
+                "use the layer's DEM field (docs/collect_and_collide.md §8)";
+      out.push_back(text.str());
+    }
+  }
+  return out;
+}
+
 std::string physics_hash(const Case& c, const std::string& source) {
   // Format 1 hashes exactly what it always hashed (shipped fields carry the value).
   json identity = c.format_version == 1 ? json{{"damper", c.resolved["damper"]}}

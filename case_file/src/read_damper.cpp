@@ -135,30 +135,46 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
     r.fail("particles", e.what());
   }
   const auto explicit_clearance = r.optional_number("clearance_m", limits::kClearance, " m");
-  layer.clearance_m = explicit_clearance.value_or(layer.bed.clearance_m);
+  // The bed's clearance is that of the settled bed: a bed stacked across gravity spreads
+  // its lanes' spheres onto the base (LatticeBed::settled_clearance_m).
+  const double settled = layer.bed.settled_clearance_m;
+  layer.clearance_m = explicit_clearance.value_or(settled);
   // A bed that leaves (nearly) no room is no damper: the derived clearance takes the
   // range of an explicit one.
-  if (!explicit_clearance && !limits::kClearance.contains(layer.bed.clearance_m)) {
+  if (!explicit_clearance && !limits::kClearance.contains(settled)) {
     std::ostringstream out;
     out.precision(10);
-    out << "the collected bed leaves a clearance of " << layer.bed.clearance_m << " m (" << layer.bed.slabs
-        << " slabs of 2r in " << layer.container.inner_length(d.drive_axis) << " m): " << limits::kClearance.text() << " m";
+    if (settled == layer.bed.clearance_m) {
+      out << "the collected bed leaves a clearance of " << layer.bed.clearance_m << " m (" << layer.bed.slabs
+          << " slabs of 2r in " << layer.container.inner_length(d.drive_axis) << " m): " << limits::kClearance.text()
+          << " m";
+    } else {
+      out << "the bed is stacked more than one sphere high across gravity: it settles into bottom rows that leave "
+          << settled << " m of travel along the drive (its lattice of " << layer.bed.slabs << " slabs would leave "
+          << layer.bed.clearance_m << " m; docs/collect_and_collide.md §8): " << limits::kClearance.text()
+          << " m; use fewer spheres, a container one sphere high or a longer one";
+    }
     r.fail("particles", out.str());
   }
   // The bed cannot travel farther than the container is long: an override beyond the
-  // free length (inner length along the drive minus the bed) is a typo, not a design.
-  const double inner_length = layer.container.inner_length(d.drive_axis);
-  if (explicit_clearance && *explicit_clearance > inner_length - layer.bed.bed_extent_m + 1e-12) {
+  // free length (inner length along the drive minus the settled bed) is a typo, not a design.
+  if (explicit_clearance && *explicit_clearance > settled + 1e-12) {
     std::ostringstream out;
     out.precision(10);  // 0.1000001 is not 0.1
-    out << "= " << *explicit_clearance << ": must be <= the free length along the drive, " << inner_length - layer.bed.bed_extent_m
-        << " m (inner length " << inner_length << " m minus the bed's " << layer.bed.bed_extent_m << " m)";
+    out << "= " << *explicit_clearance << ": must be <= the free length along the drive, " << settled
+        << " m (inner length " << layer.container.inner_length(d.drive_axis) << " m minus the settled bed)";
     r.fail("clearance_m", out.str());
   }
   const double volume = 4.0 / 3.0 * fm::kPi * std::pow(layer.particle_radius_m, 3);
   layer.bed_mass_kg = layer.particle_count * volume * c.materials.at(layer.particle_material).density_kg_m3;
   auto& derived = r.resolved()["derived"];
-  derived["bed_clearance_m"] = layer.bed.clearance_m;
+  derived["bed_clearance_m"] = layer.bed.settled_clearance_m;
+  // Only a bed that settles differently from its lattice reports it (a bed one sphere high
+  // keeps the resolved case, and the physics hash of the fields made for it, as it was).
+  if (layer.bed.settled_clearance_m != layer.bed.clearance_m) {
+    derived["lattice_clearance_m"] = layer.bed.clearance_m;
+    derived["settled_upper_spheres"] = layer.bed.settled_upper_spheres;
+  }
   derived["bed_extent_m"] = layer.bed.bed_extent_m;
   derived["bed_slabs"] = layer.bed.slabs;
   derived["clearance_m"] = layer.clearance_m;

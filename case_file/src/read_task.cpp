@@ -135,6 +135,14 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
                       "slabs of 2r = " + number_text(2.0 * layer.particle_radius_m) + " m (one slab and its travel)");
     const int per_slab = spheres_per_slab(layer, damper.drive_axis);
     t.spheres_per_slab.push_back(per_slab);
+    t.spheres_per_lane.push_back(layer.bed.spheres_per_lane);
+    if ((static_cast<int>(std::floor(length / (2.0 * layer.particle_radius_m) * (1.0 + 1e-9))) - 1) /
+            layer.bed.spheres_per_lane < 1)
+      throw CaseError(r.file(), at + "/container/inner_size_m",
+                      "= " + number_text(length) + " m along the drive: a slab stacked " +
+                          std::to_string(layer.bed.spheres_per_lane) +
+                          " high settles into as many rows of 2r on the base; task kind filling_ratios needs room "
+                          "for them and one row of travel");
     const double slab_kg = per_slab * layer.bed_mass_kg / layer.particle_count;
     lightest_slab_kg = k == 0 ? slab_kg : std::min(lightest_slab_kg, slab_kg);
   }

@@ -82,6 +82,7 @@ st::BeamModel loaded_beam(const Case& c, std::optional<std::size_t> without_damp
 StructureSetup structure_setup(const Case& c, LossMethod method) {
   if (!c.structure) throw CaseError(c.path, "/structure", "required: pdamp modes, frf and decay need a format-2 case");
   StructureSetup out;
+  out.warnings = settled_bed_warnings(c);
   const StructureSpec& s = *c.structure;
   if (s.kind == StructureSpec::Kind::kBeam) {
     st::BeamModel loaded = loaded_beam(c);

@@ -130,7 +130,9 @@ InitialBed place_particles(const WorldOptions& options, const std::vector<WallFe
         throw std::invalid_argument(where(ci) + ": " + e.what());
       }
     }
-    bed.clearances_m.push_back(lattice ? lattice->clearance_m : std::numeric_limits<double>::quiet_NaN());
+    // The free travel of the settled bed (a bed stacked across gravity spreads onto the
+    // base in its first period): the h the closed forms and the case take.
+    bed.clearances_m.push_back(lattice ? lattice->settled_clearance_m : std::numeric_limits<double>::quiet_NaN());
     if (c.placement != InitialPlacement::kRandom) {
       const double shift = c.placement == InitialPlacement::kCentredLattice
                                ? -0.5 * static_cast<double>(c.collect_side) * lattice->clearance_m

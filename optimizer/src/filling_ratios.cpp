@@ -58,8 +58,9 @@ std::string_view to_string(FillingObjective objective) {
 }
 
 int LayerCandidate::max_slabs() const {
-  if (!(slab_length_m > 0.0) || !(inner_length_m > 0.0)) return 0;
-  return static_cast<int>(std::floor(inner_length_m / slab_length_m * (1.0 + kFitsTolerance))) - 1;
+  if (!(slab_length_m > 0.0) || !(inner_length_m > 0.0) || spheres_per_lane < 1) return 0;
+  const int rows = static_cast<int>(std::floor(inner_length_m / slab_length_m * (1.0 + kFitsTolerance)));
+  return (rows - 1) / spheres_per_lane;
 }
 
 std::vector<std::string> FillingRatioOptions::validate() const {
@@ -78,11 +79,15 @@ std::vector<std::string> FillingRatioOptions::validate() const {
       problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must be > 0 and finite");
     if (!(l.slab_length_m > 0.0 && std::isfinite(l.slab_length_m)))
       problems.push_back(at + "slab_length_m = " + number(l.slab_length_m) + ": must be > 0 and finite");
-    else if (l.max_slabs() < 1)
-      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must hold at least two slabs of " +
-                         number(l.slab_length_m) + " m (one slab and one slab of travel)");
+    else if (l.spheres_per_lane >= 1 && l.max_slabs() < 1)
+      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must hold the " +
+                         std::to_string(l.spheres_per_lane) + " settled row(s) of one slab and one row of travel, " +
+                         number(l.slab_length_m) + " m each");
     if (l.spheres_per_slab < 1)
       problems.push_back(at + "spheres_per_slab = " + std::to_string(l.spheres_per_slab) + ": must be >= 1");
+    if (l.spheres_per_lane < 1 || l.spheres_per_lane > std::max(l.spheres_per_slab, 1))
+      problems.push_back(at + "spheres_per_lane = " + std::to_string(l.spheres_per_lane) +
+                         ": must be in [1, spheres_per_slab]");
     if (!(l.sphere_mass_kg > 0.0 && std::isfinite(l.sphere_mass_kg)))
       problems.push_back(at + "sphere_mass_kg = " + number(l.sphere_mass_kg) + ": must be > 0 and finite");
     if (!(l.cross_section_m2 >= 0.0 && std::isfinite(l.cross_section_m2)) ||
@@ -125,7 +130,7 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
     layer.name = l.name;
     layer.bed_mass_kg = n * l.slab_mass_kg();
     layer.loss_model = std::make_shared<surrogate::ClosedFormLossModel>(
-        options.model, l.inner_length_m - n * l.slab_length_m, options.model_options);
+        options.model, l.clearance_m(n), options.model_options);
     damper.layers.push_back(std::move(layer));
   }
   return damper;
@@ -141,8 +146,8 @@ FillingDesign evaluate_filling_design(const structure::ModalModel& model, const 
     LayerDesign d;
     d.name = l.name;
     d.slabs = slabs[k];
-    d.filling_ratio = slabs[k] * l.slab_length_m / l.inner_length_m;
-    d.clearance_m = l.inner_length_m - slabs[k] * l.slab_length_m;
+    d.clearance_m = l.clearance_m(slabs[k]);
+    d.filling_ratio = 1.0 - d.clearance_m / l.inner_length_m;
     d.bed_mass_kg = slabs[k] * l.slab_mass_kg();
     d.particles = slabs[k] * l.spheres_per_slab;
     d.volume_fraction = l.cross_section_m2 > 0.0

@@ -370,7 +370,8 @@ TEST_CASE("numbers too large for a double, hexadecimal flags and absurd measured
 TEST_CASE("a DEM run announces its cost first and one that cannot fit in memory is refused", "[cli]") {
   // A million 0.1 mm spheres with 10,000 snapshots: 1e6 x 1e4 x 84 bytes = 840 GB.
   const auto big = edited_case("pdamp_memory.json", [](json& c) {
-    c["damper"]["container"] = {{"shape", "box"}, {"inner_size_m", {0.05, 0.02, 0.02}}};
+    // One sphere high (100 lanes of 10,000 along the 2.5 m drive): a bed stacked high would settle and jam.
+    c["damper"]["container"] = {{"shape", "box"}, {"inner_size_m", {2.5, 0.02, 0.0002}}};
     c["damper"]["particles"] = {{"count", 1000000}, {"radius_m", 1e-4}};
     c["excitation"] = {{"frequency_hz", 50.0}, {"amplitude_m", 0.001}};
     c["dem"] = {{"snapshots", 10000}};

@@ -58,13 +58,16 @@ TEST_CASE("pdamp optimize chooses whole slabs per layer and reports the relaxed,
         CHECK(l.contains(key));
     CHECK(d["total_mass_kg"].get<double>() <= r["mass_budget_kg"].get<double>() * (1.0 + 1e-9));
   }
-  // Whole slabs in the chosen design; h = L − n·2r with 2r = 5 mm.
+  // Whole slabs in the chosen design. A slab is 8 across and 2 high, so its 2 spheres per
+  // lane settle onto the base: h = L − 2n·2r with 2r = 5 mm, and every design keeps its
+  // settled bed one layer with at least 2r of travel (2n <= floor(L/2r) − 1).
   const double lengths[3] = {0.07, 0.04, 0.028};
   for (std::size_t k = 0; k < 3; ++k) {
     const auto& l = r["design"]["layers"][k];
     const double n = l["slabs"].get<double>();
     CHECK(n == std::round(n));
-    CHECK(l["clearance_m"].get<double>() == Approx(lengths[k] - 0.005 * n).margin(1e-12));
+    CHECK(l["clearance_m"].get<double>() == Approx(lengths[k] - 2.0 * 0.005 * n).margin(1e-12));
+    CHECK(2.0 * n <= std::floor(lengths[k] / 0.005 + 1e-9) - 1.0);
   }
   for (const char* name : {"optimize.json", "designs.csv", "decay_compare.csv", "decay_compare.gp", "case_resolved.json"})
     CHECK(fs::is_regular_file(dir.path / name));

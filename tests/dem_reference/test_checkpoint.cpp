@@ -149,7 +149,8 @@ TEST_CASE("a state of another world or a damaged state is refused and leaves the
       refused(good.substr(0, length), "state");
   }
   SECTION("bytes after the world's own are its caller's to refuse") {
-    dr::StateReader in(good + "x", "state");
+    const std::string longer = good + "x";  // the reader views the bytes: they must outlive it
+    dr::StateReader in(longer, "state");
     target.restore_state(in);
     CHECK_THROWS_WITH(in.finish(), Catch::Contains("1 bytes are left over"));
   }

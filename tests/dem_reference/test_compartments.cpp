@@ -136,16 +136,18 @@ TEST_CASE("the load of two compartments is the sum of their loads alone", "[dem_
   CHECK(identical);
 }
 
-// Reference: geometry. The clearance of a collected lattice bed is the container's inner
-// length along the collect axis less the lattice's extent, n·2r (PHYSICS.md "Clearance
-// of a real bed"): 0.06 − 2·0.01 = 0.04 m for A and 0.08 − 3·0.008 = 0.056 m for B,
-// whether the compartment is alone or not.
+// Reference: geometry. The clearance of a collected bed is the container's inner length
+// along the collect axis less the settled bed's extent (PHYSICS.md "Clearance of a real
+// bed", formulas::LatticeBed::settled_clearance_m): A's 2 × 2 × 2 lattice is two high
+// across gravity, so each lane's 4 spheres settle onto the base, 0.06 − 4·0.01 = 0.02 m
+// (its lattice would leave 0.04 m); B is a cylinder, 0.08 − 3·0.008 = 0.056 m; whether
+// the compartment is alone or not.
 TEST_CASE("each compartment reports the clearance of its own bed", "[dem_reference]") {
   const auto a = compartment_a();
   const auto b = compartment_b();
   dr::World world(body_with({a, b}, 0.0));
   REQUIRE(world.compartment_count() == 2);
-  CHECK(world.clearance_m(0) == Approx(0.06 - 2.0 * 0.01).epsilon(1e-12));
+  CHECK(world.clearance_m(0) == Approx(0.06 - 4.0 * 0.01).epsilon(1e-12));
   CHECK(world.clearance_m(1) == Approx(0.08 - 3.0 * 0.008).epsilon(1e-12));
   CHECK(dr::World(body_with({b}, 0.0)).clearance_m(0) == world.clearance_m(1));
   // Particles are numbered compartment by compartment and carry their compartment.

@@ -238,6 +238,52 @@ TEST_CASE("a cylinder driven along its axis holds the square-lattice sites of it
   }
 }
 
+// Reference: counting. A lane (one position across the drive and gravity) of N spheres
+// settles into a bottom row of min(N, floor(L/2r)) spheres; h = L − longest row·2r. The DEM
+// shows the settled state (tests/dem_reference "a bed stacked two high settles ...", and
+// docs/collect_and_collide.md §8): 4 slabs of 8 × 2 in 28 mm settle into 5 bottom rows and
+// 3 mm of travel; 7 slabs in 40 mm into 8 rows, wall to wall. Exact integers and sums of
+// r-multiples: 1e-12 m.
+TEST_CASE("a bed stacked two high settles into longer bottom rows and a smaller clearance", "[formulas]") {
+  const double r = 0.0025;
+  const auto box = [](double length) {
+    fm::Container b;
+    b.box_inner_size_m = {length, 0.041, 0.012};
+    return b;
+  };
+  const fm::LatticePacking packing = along_x_gravity_down();
+  const fm::LatticeBed narrow = fm::collected_lattice(box(0.028), 64, r, packing);
+  CHECK(narrow.slabs == 4);
+  CHECK(narrow.spheres_per_lane == 2);
+  CHECK(narrow.clearance_m == Approx(0.008).margin(kGeometry));
+  CHECK(narrow.settled_clearance_m == Approx(0.003).margin(kGeometry));
+  CHECK(narrow.settled_upper_spheres == 24);
+  const fm::LatticeBed jammed = fm::collected_lattice(box(0.040), 112, r, packing);
+  CHECK(jammed.clearance_m == Approx(0.005).margin(kGeometry));
+  CHECK(jammed.settled_clearance_m == Approx(0.0).margin(kGeometry));
+  CHECK(jammed.settled_upper_spheres == 48);
+  // Two slabs (4 a lane) fit on the base: one layer, h = L − 4·2r.
+  const fm::LatticeBed spread = fm::collected_lattice(box(0.040), 32, r, packing);
+  CHECK(spread.settled_clearance_m == Approx(0.020).margin(kGeometry));
+  CHECK(spread.settled_upper_spheres == 0);
+
+  SECTION("one sphere high, no gravity across the drive, or a cylinder: the lattice's clearance") {
+    fm::Container low = box(0.040);
+    low.box_inner_size_m[2] = 0.006;
+    const fm::LatticeBed single = fm::collected_lattice(low, 56, r, packing);
+    CHECK(single.spheres_per_lane == 1);
+    CHECK(single.settled_clearance_m == single.clearance_m);
+    fm::LatticePacking weightless = packing;
+    weightless.gravity_axis_sign.reset();
+    CHECK(fm::collected_lattice(box(0.028), 64, r, weightless).settled_clearance_m == Approx(0.008).margin(kGeometry));
+    fm::LatticePacking along_drive = packing;
+    along_drive.gravity_axis_sign = std::pair{0, -1};
+    CHECK(fm::collected_lattice(box(0.028), 64, r, along_drive).settled_clearance_m == Approx(0.008).margin(kGeometry));
+    const fm::LatticeBed tube = fm::collected_lattice(cylinder(0.0125, 0.104335, 0), 260, 0.0025, packing);
+    CHECK(tube.settled_clearance_m == tube.clearance_m);
+  }
+}
+
 TEST_CASE("beds that do not fit are rejected with the numbers", "[formulas]") {
   const fm::Container box = level2_box();
   fm::LatticePacking packing = along_x_gravity_down();

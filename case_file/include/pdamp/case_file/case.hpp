@@ -191,6 +191,7 @@ struct FillingRatiosTask {
   std::optional<VerifySpec> verify;
   // Derived on load, one per layer of the first damper:
   std::vector<int> spheres_per_slab;  ///< spheres in one full slab of the layer's lattice
+  std::vector<int> spheres_per_lane;  ///< of a slab, stacked across gravity in one lane (LatticeBed)
 };
 
 /// `task` kind placement (issue 12 §1.4): where one damper adds the most damping to chosen
@@ -258,6 +259,12 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
 /// becomes the JSON pointer of the case key it comes from (/dem/time_step_s,
 /// /dem/inner_structures/pins/0, /dampers/0/layers/1/particles, ...).
 CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::string& problem);
+
+/// One sentence per layer whose bed is stacked across gravity (formulas::LatticeBed): its
+/// clearance is the settled bed's (smaller than its lattice's), and where spheres stay
+/// above the settled bottom rows the closed forms, which model one rolling layer, are
+/// outside their validity (docs/collect_and_collide.md §8).
+std::vector<std::string> settled_bed_warnings(const Case& c);
 
 /// The identity of the physics a field of `source` (formulas, dem, measured) depends
 /// on: dampers, materials and, for dem, the DEM settings; not names or descriptions.

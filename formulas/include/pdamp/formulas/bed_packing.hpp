@@ -61,7 +61,21 @@ struct LatticeBed {
   std::vector<Vec3> centres_m;  ///< container frame, m
   int slabs = 0;                ///< sphere rows along the drive
   double bed_extent_m = 0.0;    ///< slabs·2r: extent of the packed bed along the drive
-  double clearance_m = 0.0;     ///< h = inner length along the drive − bed_extent_m
+  double clearance_m = 0.0;     ///< h = inner length along the drive − bed_extent_m (the lattice as placed)
+  /// The clearance of the bed once it has settled (docs/collect_and_collide.md §8): a box
+  /// with gravity across the drive whose lanes are stacked more than one sphere high does
+  /// not keep its simple cubic lattice. Under the drive the upper spheres fall into the
+  /// grooves or onto the free base, so each lane's bottom row takes min(N_lane, floor(L/2r))
+  /// spheres (N_lane the spheres of that lane at every height) and the bed's extent is the
+  /// longest bottom row: settled_clearance_m = L − max_lane min(N_lane, floor(L/2r))·2r,
+  /// m. It may be 0 (the bottom rows fill the container: the bed jams). Equal to
+  /// clearance_m for a bed one sphere high, a cylinder, or no gravity across the drive.
+  double settled_clearance_m = 0.0;
+  /// Spheres left above the settled bottom rows (0: the bed settles into one layer).
+  int settled_upper_spheres = 0;
+  /// Most spheres one slab puts in one lane, stacked across gravity (1: one sphere high;
+  /// a slab 8 across and 2 high: 2). 1 for a cylinder or without gravity across the drive.
+  int spheres_per_lane = 1;
 };
 
 /// Places `count` (>= 1) spheres of radius r (> 0) on a simple cubic lattice of pitch

@@ -19,22 +19,30 @@ namespace pdamp::optimizer {
 
 /// One candidate layer (a compartment of the container): a box of inner length L along
 /// the drive holding n whole slabs of a lattice. A slab is one sphere row along the drive
-/// (extent 2r) with `spheres_per_slab` spheres, so
-///   m(n) = n·spheres_per_slab·sphere_mass,  h(n) = L − n·2r,  φ(n) = n·2r/L.
+/// (extent 2r) with `spheres_per_slab` spheres in lanes of `spheres_per_lane` stacked
+/// across gravity. A stacked bed settles onto the base (formulas::LatticeBed::
+/// settled_clearance_m): its n·spheres_per_lane spheres per lane lie in one row, so
+///   m(n) = n·spheres_per_slab·sphere_mass,  h(n) = L − n·k·2r,  φ(n) = n·k·2r/L  (k = spheres_per_lane).
 /// Only whole slabs count (a partial last slab is not a design here: it would occupy a
-/// whole 2r of length with less mass). 0 <= n <= max_slabs() keeps h >= 2r > 0.
+/// whole 2r of length with less mass). 0 <= n <= max_slabs() keeps h >= 2r > 0 with every
+/// sphere on the base: the closed forms describe one layer rolling there (a bed that
+/// settles more than one high is outside them; the DEM jams such beds, docs/optimizer.md).
 struct LayerCandidate {
   std::string name;                  ///< unique, non-empty; reports name it
   double inner_length_m = 0.0;       ///< L, inner length along the drive, m, > 0
   double slab_length_m = 0.0;        ///< 2r, extent of one slab along the drive, m, in (0, L/2]
   int spheres_per_slab = 0;          ///< spheres in one full slab, >= 1
+  int spheres_per_lane = 1;          ///< of a slab, stacked across gravity in one lane, in [1, spheres_per_slab]
   double sphere_mass_kg = 0.0;       ///< mass of one sphere, kg, > 0
   /// Inner cross-section normal to the drive, m², for the volume fraction only (0: not reported).
   double cross_section_m2 = 0.0;
   double sphere_volume_m3 = 0.0;     ///< one sphere's volume, m³ (volume fraction only)
   int initial_slabs = 0;             ///< the starting design (the case's counts), in [0, max_slabs()]
-  /// floor(L/2r) − 1 (relative tolerance 1e-9 on "fits"): at least one slab of travel left.
+  /// floor((floor(L/2r) − 1)/spheres_per_lane) (relative tolerance 1e-9 on "fits"): the
+  /// settled bed in one layer with at least 2r of travel left.
   int max_slabs() const;
+  /// h(n) = L − n·spheres_per_lane·2r, m (the settled bed's travel).
+  double clearance_m(double slabs) const { return inner_length_m - slabs * spheres_per_lane * slab_length_m; }
   double slab_mass_kg() const { return spheres_per_slab * sphere_mass_kg; }
 };
 
@@ -74,9 +82,9 @@ struct FillingRatioOptions {
 struct LayerDesign {
   std::string name;
   double slabs = 0.0;             ///< n_k (whole for integer designs, real for the relaxed one)
-  double filling_ratio = 0.0;     ///< φ = n·2r/L
+  double filling_ratio = 0.0;     ///< φ = n·k·2r/L of the settled bed (k = spheres_per_lane)
   double volume_fraction = 0.0;   ///< n·spheres_per_slab·V_sphere/(L·A), 0 if A unknown
-  double clearance_m = 0.0;       ///< h = L − n·2r, m
+  double clearance_m = 0.0;       ///< h = L − n·k·2r, m
   double bed_mass_kg = 0.0;       ///< m = n·spheres_per_slab·m_sphere, kg
   double particles = 0.0;         ///< n·spheres_per_slab
 };
