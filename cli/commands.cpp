@@ -830,6 +830,206 @@ int run_field(const ParsedArgs& args) {
   return emit(args, out, rows, false);
 }
 
+// ---------------------------------------------------------------- sensitivity studies
+
+constexpr const char* kSensitivityLog = "sensitivity_sweep.jsonl";
+
+/// The study's drive: the section's, else the excitation's stroke, else the design stroke.
+std::pair<double, double> sensitivity_drive(const Case& c) {
+  const SingleDamper single = single_damper(c, "pdamp sensitivity");
+  const double f = c.sensitivity ? c.sensitivity->frequency_hz : c.excitation.frequency_hz;
+  double x = c.sensitivity ? c.sensitivity->amplitude_m : c.excitation.amplitude_m.value_or(0.0);
+  if (!(x > 0.0)) {
+    const auto family = single.damper.model == fm::DamperModel::kBouncing ? fm::DamperModel::kBouncing
+                                                                           : fm::DamperModel::kRolling;
+    x = fm::optimum_stroke(family, single.layer.clearance_m, single.damper.model_options).x_opt_m;
+  }
+  return {f, x};
+}
+
+/// sensitivity.csv and the tornado plot: per parameter the lowest and highest η* of its
+/// values, sorted by that range, about the baseline's η*.
+std::vector<std::string> write_sensitivity_files(OutputDir& files, const Case& c, const json& rows, double baseline) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "parameter,value,unit,eta_star,eta_star_stderr,delta_eta_star,motion_mode,apparent_mass_fraction,"
+         "closed_form_eta_star,clearance_m,bed_mass_kg,status\n";
+  const auto num = [](const json& v) { return v.is_number() ? v.get<double>() : NAN; };
+  for (const auto& r : rows)
+    csv << r["parameter"].get<std::string>() << ',' << num(r["value"]) << ',' << r["unit"].get<std::string>() << ','
+        << num(r["eta_star"]) << ',' << num(r["eta_star_stderr"]) << ',' << num(r["delta_eta_star"]) << ','
+        << r["motion_mode"].get<std::string>() << ',' << num(r["apparent_mass_fraction"]) << ','
+        << num(r["closed_form_eta_star"]) << ',' << num(r["clearance_m"]) << ',' << num(r["bed_mass_kg"]) << ','
+        << r["status"].get<std::string>() << '\n';
+  files.add("sensitivity.csv", csv.str());
+
+  struct Bar {
+    std::string parameter;
+    double low = INFINITY, high = -INFINITY, low_value = NAN, high_value = NAN;
+  };
+  std::vector<Bar> bars;
+  for (const auto& r : rows) {
+    const std::string name = r["parameter"].get<std::string>();
+    if (name == "baseline" || !r["eta_star"].is_number()) continue;
+    auto it = std::find_if(bars.begin(), bars.end(), [&](const Bar& b) { return b.parameter == name; });
+    if (it == bars.end()) it = bars.insert(bars.end(), Bar{name});
+    const double eta = r["eta_star"].get<double>(), value = r["value"].get<double>();
+    if (eta < it->low) it->low = eta, it->low_value = value;
+    if (eta > it->high) it->high = eta, it->high_value = value;
+  }
+  std::sort(bars.begin(), bars.end(), [](const Bar& a, const Bar& b) { return a.high - a.low < b.high - b.low; });
+  std::ostringstream tornado;
+  tornado.precision(10);
+  tornado << "parameter,eta_star_low,eta_star_high,value_at_low,value_at_high\n";
+  for (const auto& b : bars) tornado << b.parameter << ',' << b.low << ',' << b.high << ',' << b.low_value << ',' << b.high_value << '\n';
+  files.add("sensitivity_tornado.csv", tornado.str());
+  std::ostringstream gp;
+  gp << "# tornado plot of pdamp sensitivity: eta* over each parameter's values; run: gnuplot sensitivity.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(c.name + ": sensitivity of eta* (one parameter at a time)") << " noenhanced\n"
+     << "set xlabel 'reduced loss factor {/Symbol h}*'\nset ytics noenhanced\nset grid x\nset key bottom right\n"
+     << "set offsets 0, 0, 0.5, 0.5\nset style fill solid 0.6 border -1\n"
+     << "set arrow from " << baseline << ", graph 0 to " << baseline << ", graph 1 nohead lc rgb 'black' dt 2\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900," << 200 + 45 * static_cast<int>(bars.size()) << " enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'sensitivity.svg' : 'sensitivity.png'\n"
+     << "  plot 'sensitivity_tornado.csv' every ::1 using (($2+$3)/2):($0):2:3:($0-0.3):($0+0.3):ytic(1) "
+        "with boxxyerror lc rgb 'steelblue' title 'range over the values', \\\n"
+     << "       NaN with lines dt 2 lc rgb 'black' title " << gnuplot_string("baseline " + format_number(baseline, 4)) << "\n"
+     << "}\n";
+  return files.add_plot("sensitivity.gp", gp.str(), {"sensitivity.png", "sensitivity.svg"});
+}
+
+int run_sensitivity(const ParsedArgs& args) {
+  const Case c = case_file::load_case(args.positional().at(0));
+  (void)single_damper(c, "pdamp sensitivity");  // one damper of one layer, refused otherwise
+  const std::string source = args.optional_text("--source").value_or("dem");
+  if (source != "formulas" && source != "dem") throw InputError("--source", "", "'" + source + "': must be dem or formulas");
+  const bool dem = source == "dem";
+  const auto [f, x] = sensitivity_drive(c);
+  std::vector<std::string> warnings;
+  const auto variants = case_file::sensitivity_variants(c, warnings);
+  const std::string dir = args.optional_text("-o").value_or("out/" + safe_file_name(c.name) + "_sensitivity");
+
+  surrogate::SweepPoints points;
+  points.identity = json::array();
+  for (const auto& v : variants) {
+    points.drives.push_back({f, x});
+    points.identity.push_back({{"parameter", v.parameter}, {"value", v.value}});
+  }
+  surrogate::SweepOptions sweep = field_sweep_options(c, source);
+  sweep.threads = dem ? (c.sensitivity ? c.sensitivity->threads : c.field.threads) : 1;
+  const auto [shard_index, shard_count] = shard_flag(args);
+  sweep.shard_index = shard_index;
+  sweep.shard_count = shard_count;
+  if (dem || args.has("--shard")) sweep.results_path = std::filesystem::path(dir) / kSensitivityLog;
+
+  // Every variant's DEM checked and costed before any work (exit 2 naming its key).
+  std::vector<surrogate::PointEvaluator> evaluators;
+  double wall_time_s = 0.0, particle_steps = 0.0;
+  for (const auto& v : variants) {
+    const SingleDamper d = single_damper(v.variant, "pdamp sensitivity");
+    if (dem) {
+      auto options = case_file::dem_options(v.variant, 0, x, f);
+      options.world.threads = 1;  // the study runs variants in parallel instead
+      const auto e = check_dem_run(v.variant, 0, options);
+      check_dem_placement(v.variant, 0, options);
+      wall_time_s += e.wall_time_s;
+      particle_steps += e.particle_steps;
+      evaluators.push_back(surrogate::dem_evaluator(options));
+    } else {
+      evaluators.push_back(surrogate::formula_evaluator(d.damper.model, d.layer.clearance_m, d.layer.bed_mass_kg,
+                                                        d.damper.model_options));
+    }
+  }
+  std::size_t pending = 0;
+  try {
+    pending = surrogate::pending_point_sweep(points, sweep);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path, "/sensitivity", e.what());
+  }
+  OutputDir files(dir);
+  if (!sweep.results_path.empty()) files.in_place(kSensitivityLog);
+  std::mutex progress_mutex;
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  if (dem) {
+    const double at_once = std::min<double>(sweep.threads, static_cast<double>(variants.size()));
+    std::cerr << "pdamp sensitivity: " << variants.size() << " DEM runs at f = " << format_number(f) << " Hz, X = "
+              << format_number(x) << " m (" << pending << " to run), about "
+              << format_number(particle_steps * static_cast<double>(pending) / static_cast<double>(variants.size()), 3)
+              << " particle-steps, " << format_number(wall_time_s * static_cast<double>(pending) /
+                                                      static_cast<double>(variants.size()) / at_once, 3)
+              << " s on " << at_once << " threads" << std::endl;
+    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
+      std::lock_guard lock(progress_mutex);
+      std::cerr << (tty ? "\r" : "") << "pdamp sensitivity: " << done << "/" << total << " runs";
+      if (std::isfinite(eta_s)) std::cerr << ", ETA " << static_cast<long>(eta_s) << " s";
+      std::cerr << (tty ? "   " : "\n") << std::flush;
+    };
+  }
+  const auto result = surrogate::run_point_sweep(
+      points, [&](std::size_t k) { return evaluators[k](f, x); }, sweep);
+  if (dem && tty) std::cerr << "\n";
+  warnings.insert(warnings.end(), result.summary.warnings.begin(), result.summary.warnings.end());
+
+  const auto nullable = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  const surrogate::FieldPoint& base = result.points.front();
+  json rows = json::array();
+  for (std::size_t k = 0; k < variants.size(); ++k) {
+    const auto& v = variants[k];
+    const auto& p = result.points[k];
+    const SingleDamper d = single_damper(v.variant, "pdamp sensitivity");
+    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, d.damper.model_options);
+    const bool ok = p.status == surrogate::PointStatus::kOk;
+    rows.push_back({{"parameter", v.parameter},
+                    {"value", k == 0 ? json(nullptr) : json(v.value)},
+                    {"unit", v.unit},
+                    {"status", std::string(surrogate::to_string(p.status))},
+                    {"eta_star", ok ? nullable(p.eta_star) : json(nullptr)},
+                    {"eta_star_stderr", ok ? nullable(p.eta_star_stderr) : json(nullptr)},
+                    {"delta_eta_star", ok && base.status == surrogate::PointStatus::kOk ? nullable(p.eta_star - base.eta_star)
+                                                                                         : json(nullptr)},
+                    {"motion_mode", p.motion_mode},
+                    {"apparent_mass_fraction", nullable(p.apparent_mass_fraction)},
+                    {"closed_form_eta_star", nullable(closed.eta_star)},
+                    {"closed_form_regime", std::string(fm::to_string(closed.regime))},
+                    {"clearance_m", d.layer.clearance_m},
+                    {"bed_mass_kg", d.layer.bed_mass_kg},
+                    {"intensity", x * std::pow(2.0 * fm::kPi * f, 2) / fm::kStandardGravity}});
+  }
+  json out = {{"case", c.name},
+              {"source", source},
+              {"frequency_hz", f},
+              {"amplitude_m", x},
+              {"rows", rows},
+              {"sweep", result.summary.brief_report()},
+              {"file", (files.dir() / "sensitivity.json").string()}};
+  if (args.has("--shard")) {
+    out["shard"] = args.text("--shard");
+    out["note"] = "a shard's rows are its own variants; the other shards' are missing";
+  }
+  const double baseline_eta = base.status == surrogate::PointStatus::kOk ? base.eta_star : NAN;
+  for (auto& w : write_sensitivity_files(files, c, rows, baseline_eta)) warnings.push_back(w);
+  out["warnings"] = warnings;
+  files.add_json("case_resolved.json", c.resolved);
+  files.add_json("sensitivity.json", out);
+  out["outputs"] = files.commit();
+  print_warnings(warnings);
+  std::vector<std::pair<std::string, std::string>> table = {
+      {"case", c.name}, {"drive", "f = " + format_number(f) + " Hz, X = " + format_number(x) + " m"},
+      {"sweep", out["sweep"].get<std::string>()}};
+  for (const auto& r : rows) {
+    std::string line = r["eta_star"].is_number() ? format_number(r["eta_star"].get<double>(), 4) : std::string("-");
+    if (r["eta_star_stderr"].is_number()) line += " +- " + format_number(r["eta_star_stderr"].get<double>(), 2);
+    line += "  " + r["motion_mode"].get<std::string>();
+    if (r["closed_form_eta_star"].is_number()) line += "  (closed form " + format_number(r["closed_form_eta_star"].get<double>(), 4) + ")";
+    const std::string name = r["parameter"].get<std::string>();
+    table.push_back({name == "baseline" ? name : name + " = " + format_number(r["value"].get<double>(), 5), line});
+  }
+  for (const auto& path : out["outputs"]) table.push_back({"wrote", path.get<std::string>()});
+  return emit(args, out, table, false);
+}
+
 /// The "source" of a shard log's header line (formulas or dem), for a merge not told it.
 std::string shard_log_source(const std::filesystem::path& log) {
   std::ifstream in(log);
@@ -1035,6 +1235,18 @@ const std::vector<Command>& commands() {
                        "                          field_sweep.jsonl (resume) and scattered_fit.json"},
          kJsonFlag}, 1},
        run_field},
+      {{"sensitivity", "pdamp sensitivity CASE.json [--source dem|formulas] [--shard I/N] [-o DIR] [--json]",
+        "eta* and the motion mode of the damper with one parameter changed at a time (friction,\n"
+        "restitution, rolling friction, particle radius and count, Young's modulus, tilt about\n"
+        "each container axis), the case's `sensitivity` values or defaults; a tornado plot",
+        {{"--source", "SRC", "dem (default: one DEM run per variant, sensitivity.threads at once,\n"
+                             "                          saved as each finishes, resumed after a kill) or formulas"},
+         {"--shard", "I/N", "run only the variants k with k % N == I (job arrays)"},
+         {"-o", "DIR", "output folder (default out/<case name>_sensitivity): sensitivity.json,\n"
+                       "                          sensitivity.csv, sensitivity_tornado.csv, sensitivity.png/svg,\n"
+                       "                          sensitivity_sweep.jsonl (resume)"},
+         kJsonFlag}, 1},
+       run_sensitivity},
       {{"field merge", "pdamp field merge SHARD_DIR... [-o DIR] [--json]  (or CASE.json [--source SRC] SHARD...)",
         "join the shards of one pdamp field --shard I/N sweep into its field (the same\n"
         "values as one serial run); refuses shards of another case, model version or grid.\n"

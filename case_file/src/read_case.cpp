@@ -76,8 +76,27 @@ void read_buffer(ObjectReader& b, Case& c) {
   c.buffer = spec;
 }
 
-Case read_case(const std::string& path) {
-  const json root = strict_json::parse_json_document(strict_json::read_input_file(path), path);
+void read_sensitivity(ObjectReader& r, Case& c) {
+  SensitivitySpec s;
+  s.frequency_hz = r.number("frequency_hz", c.excitation.frequency_hz, limits::kFrequency, " Hz");
+  const auto amplitude = r.optional_number("amplitude_m", limits::kStroke, " m");
+  if (amplitude) s.amplitude_m = *amplitude;
+  else if (c.excitation.amplitude_m) s.amplitude_m = *c.excitation.amplitude_m;
+  r.array("parameters", [&](ObjectReader& p) {
+    SensitivityParameter parameter;
+    parameter.name = p.text("name", std::nullopt,
+                            {"friction", "restitution", "rolling_friction", "particle_radius_m", "particle_count",
+                             "youngs_modulus_factor", "tilt_x_deg", "tilt_y_deg", "tilt_z_deg"});
+    for (const auto& other : s.parameters)
+      if (other.name == parameter.name) p.fail("name", "'" + parameter.name + "' is given twice");
+    parameter.values = p.number_array("values", Range{-1e6, 1e6}, "", 1);
+    s.parameters.push_back(std::move(parameter));
+  });
+  s.threads = r.integer("threads", c.field.threads, 1, 256);
+  c.sensitivity = std::move(s);
+}
+
+Case read_case(const json& root, const std::string& path) {
   // The root's errors carry no pointer ("<file>: must be a JSON object").
   if (!root.is_object()) throw CaseError(path, "", std::string("must be a JSON object, got ") + root.type_name());
   Case c;
@@ -129,20 +148,31 @@ Case read_case(const std::string& path) {
   }
   section_or_defaults(r, "field", [&](ObjectReader& f) { detail::read_field(f, c); });
   r.object("buffer", false, [&](ObjectReader& b) { read_buffer(b, c); });
+  r.object("sensitivity", false, [&](ObjectReader& s) { read_sensitivity(s, c); });
   r.finish();
   return c;
 }
 
 }  // namespace
 
-Case load_case(const std::string& path) {
+Case load_case_document(const json& document, const std::string& path) {
   try {
-    return read_case(path);
+    return read_case(document, path);
   } catch (const CaseError&) {
     throw;
   } catch (const strict_json::InputError& e) {  // the reader's own checks: unknown keys, file, JSON
     throw CaseError(e.file(), e.pointer(), e.rule());
   }
+}
+
+Case load_case(const std::string& path) {
+  json document;
+  try {
+    document = strict_json::parse_json_document(strict_json::read_input_file(path), path);
+  } catch (const strict_json::InputError& e) {
+    throw CaseError(e.file(), e.pointer(), e.rule());
+  }
+  return load_case_document(document, path);
 }
 
 std::string_view to_string(TaskKind kind) {

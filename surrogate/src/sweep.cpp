@@ -1,4 +1,4 @@
-// Parallel, resumable sweeps over a grid with a JSON-lines results file.
+// Parallel, resumable sweeps over a grid or a list of points with a JSON-lines results file.
 #include "pdamp/surrogate/sweep.hpp"
 
 #include <fcntl.h>
@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -46,26 +47,47 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 
 json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
+/// What a sweep visits, by index: a grid's nodes (their drives from the grid and the
+/// clearance) or a list of points (a sensitivity study's variants), and what identifies
+/// them in the results file's header.
+struct Points {
+  std::size_t count = 0;
+  std::function<DrivePoint(std::size_t)> drive;
+  json identity;           ///< header entries: {"axes": [..]} for a grid, {"points": ..} for a list
+  std::string noun;        ///< "grid node" or "point" (messages)
+};
+
+Points grid_points(const Grid& grid, double clearance_m) {
+  return {grid.size(), [&grid, clearance_m](std::size_t k) { return drive_point(grid, k, clearance_m); },
+          json{{"axes", json::array({json(detail::axis_json(grid.axis0)), json(detail::axis_json(grid.axis1))})}},
+          "grid node"};
+}
+
+Points list_points(const SweepPoints& points) {
+  return {points.drives.size(), [&points](std::size_t k) { return points.drives[k]; },
+          json{{"points", points.identity}}, "point"};
+}
+
 /// The header line that identifies a sweep; a results file resumes only if its header is equal.
-json sweep_header(const Grid& grid, const SweepOptions& options) {
+json sweep_header(const Points& points, const SweepOptions& options) {
   json header = {{"format", kSweepFormat},
           {"format_version", kSweepFormatVersion},
           {"source", to_string(options.source)},
           {"case_hash", options.case_hash},
           {"model_version", options.model_version},
           {"clearance_m", options.clearance_m},
-          {"bed_mass_kg", options.bed_mass_kg},
-          {"axes", json::array({json(detail::axis_json(grid.axis0)), json(detail::axis_json(grid.axis1))})}};
+          {"bed_mass_kg", options.bed_mass_kg}};
+  header.update(points.identity);
   // Only a sharded sweep records its shard: the whole grid's header stays as it was
   // before shards existed, so that such logs still resume.
   if (options.shard_count > 1) header["shard"] = {{"index", options.shard_index}, {"count", options.shard_count}};
   return header;
 }
 
-/// The nodes of options' shard, in grid order.
-std::vector<std::size_t> shard_nodes(const Grid& grid, const SweepOptions& options) {
+/// The indices of options' shard, ascending.
+std::vector<std::size_t> shard_nodes(std::size_t count, const SweepOptions& options) {
   std::vector<std::size_t> nodes;
-  for (std::size_t k = static_cast<std::size_t>(options.shard_index); k < grid.size();
+  for (std::size_t k = static_cast<std::size_t>(options.shard_index); k < count;
        k += static_cast<std::size_t>(options.shard_count))
     nodes.push_back(k);
   return nodes;
@@ -184,7 +206,7 @@ struct SavedPoints {
 /// point is computed again. Every complete line is checked strictly: a damaged line
 /// before the end cannot come from a kill, so it throws std::invalid_argument, as does a
 /// header of another sweep.
-SavedPoints read_saved_points(const std::string& text, const std::string& file_name, const Grid& grid,
+SavedPoints read_saved_points(const std::string& text, const std::string& file_name, const Points& nodes,
                               const SweepOptions& options, std::vector<FieldPoint>& points, std::vector<bool>& done) {
   SavedPoints saved;
   const std::size_t last_newline = text.rfind('\n');
@@ -197,7 +219,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
                     " bytes without a newline, the write of a killed run); dropped, " +
                     (complete_lines == 0 ? "the sweep starts again" : "its point is computed again");
   }
-  const json header = sweep_header(grid, options);
+  const json header = sweep_header(nodes, options);
   const std::string damaged = ": the results file is damaged; delete or move it to start the sweep again";
   std::size_t line_number = 0;
   std::size_t begin = 0;
@@ -226,22 +248,24 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
     }
     try {
       strict_json::StrictObject object(value, "", context);
-      const long long index = object.integer("index", 0, static_cast<long long>(grid.size()) - 1);
+      const long long index = object.integer("index", 0, static_cast<long long>(nodes.count) - 1);
       const auto k = static_cast<std::size_t>(index);
       if (done[k]) object.fail("index", std::to_string(index) + " appears twice");
       if (!in_shard(k, options.shard_index, options.shard_count)) {
         object.fail("index", std::to_string(index) + " is not a node of shard " + std::to_string(options.shard_index) +
                                  "/" + std::to_string(options.shard_count));
       }
-      const DrivePoint node = drive_point(grid, k, options.clearance_m);
+      const DrivePoint node = nodes.drive(k);
       strict_json::StrictObject drive(object.required("drive"), "/drive", context);
       const double f = drive.number("frequency_hz", true, "Hz");
       const double x = drive.number("amplitude_m", true, "m");
       drive.finish();
       if (std::abs(f - node.frequency_hz) > kDriveTolerance * node.frequency_hz ||
           std::abs(x - node.amplitude_m) > kDriveTolerance * node.amplitude_m) {
-        object.fail("drive", "(" + number(f) + " Hz, " + number(x) + " m) is not grid node " + std::to_string(k) +
-                                 " (" + number(node.frequency_hz) + " Hz, " + number(node.amplitude_m) + " m)");
+        std::ostringstream what;  // a stream: GCC 12 flags "(" + std::string with a false -Wrestrict
+        what << "(" << number(f) << " Hz, " << number(x) << " m) is not " << nodes.noun << " " << k << " ("
+             << number(node.frequency_hz) << " Hz, " << number(node.amplitude_m) << " m)";
+        object.fail("drive", what.str());
       }
       auto nullable_number = [&](std::string_view key) {
         const json& v = object.required(key);
@@ -280,15 +304,15 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
 
 /// Reads the saved points of a results file (or starts it): fills `points` and `done`,
 /// returns how many were resumed and adds a warning for a dropped partial last line.
-std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Grid& grid, const SweepOptions& options,
+std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Points& nodes, const SweepOptions& options,
                    std::vector<FieldPoint>& points, std::vector<bool>& done, std::vector<std::string>& warnings) {
   // read_text_file (strict_json::read_input_file) again refuses anything but a regular file.
   const std::string text = detail::read_text_file(path);
-  const SavedPoints saved = read_saved_points(text, detail::file_label(path), grid, options, points, done);
+  const SavedPoints saved = read_saved_points(text, detail::file_label(path), nodes, options, points, done);
   if (!saved.warning.empty()) warnings.push_back(saved.warning);
   if (saved.complete_bytes == 0) {  // new file, or only a cut header: start it
     file.truncate_to(0);
-    file.append(sweep_header(grid, options).dump() + "\n");
+    file.append(sweep_header(nodes, options).dump() + "\n");
     detail::sync_parent_folder(path);
     return 0;
   }
@@ -320,6 +344,20 @@ std::vector<std::string> SweepOptions::validate() const {
   return problems;
 }
 
+std::vector<std::string> SweepPoints::validate() const {
+  std::vector<std::string> problems;
+  if (drives.empty()) problems.push_back("drives: must hold at least one point");
+  for (std::size_t k = 0; k < drives.size(); ++k) {
+    if (!positive_finite(drives[k].frequency_hz))
+      problems.push_back("drives[" + std::to_string(k) + "].frequency_hz = " + number(drives[k].frequency_hz) +
+                         ": must be > 0 and finite");
+    if (!positive_finite(drives[k].amplitude_m))
+      problems.push_back("drives[" + std::to_string(k) + "].amplitude_m = " + number(drives[k].amplitude_m) +
+                         ": must be > 0 and finite");
+  }
+  return problems;
+}
+
 std::string SweepSummary::brief_report() const {
   std::ostringstream out;
   out.precision(3);
@@ -328,22 +366,27 @@ std::string SweepSummary::brief_report() const {
   return out.str();
 }
 
-SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options) {
-  detail::throw_if_any(grid.validate(), "sweep grid");
+namespace {
+
+/// The evaluator of one point: its index and drive.
+using IndexEvaluator = std::function<FieldPoint(std::size_t index, const DrivePoint& drive)>;
+
+/// run_sweep and run_point_sweep: every point of options' shard not yet in the results
+/// file, options.threads at a time (the documentation of run_sweep says the rest).
+PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, const SweepOptions& options) {
   detail::throw_if_any(options.validate(), "sweep options");
-  if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   const auto start = Clock::now();
-  const std::vector<std::size_t> nodes = shard_nodes(grid, options);
+  const std::vector<std::size_t> nodes = shard_nodes(all.count, options);
   const std::size_t total = nodes.size();
 
-  std::vector<FieldPoint> points(grid.size());
-  std::vector<bool> done(grid.size(), false);
+  std::vector<FieldPoint> points(all.count);
+  std::vector<bool> done(all.count, false);
   std::optional<ResultsFile> file;
   std::size_t resumed = 0;
   std::vector<std::string> warnings;
   if (!options.results_path.empty()) {
     file.emplace(options.results_path);
-    resumed = resume(*file, options.results_path, grid, options, points, done, warnings);
+    resumed = resume(*file, options.results_path, all, options, points, done, warnings);
   }
   std::vector<std::size_t> pending;
   for (const std::size_t k : nodes) {
@@ -375,9 +418,9 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
       if (slot >= pending.size()) return;
       const std::size_t k = pending[slot];
       try {
-        const DrivePoint drive = drive_point(grid, k, options.clearance_m);
+        const DrivePoint drive = all.drive(k);
         const auto point_start = Clock::now();
-        FieldPoint p = checked_point(evaluator(drive.frequency_hz, drive.amplitude_m), drive, options);
+        FieldPoint p = checked_point(evaluator(k, drive), drive, options);
         const double wall_time_s = seconds_since(point_start);
         std::lock_guard lock(mutex);
         if (file) file->append(point_line(k, drive, p, wall_time_s));
@@ -405,38 +448,75 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
   }
   if (error) std::rethrow_exception(error);
 
-  SweepResult result;
-  result.field.grid = grid;
-  result.field.points = std::move(points);
-  result.field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
-  result.field.clearance_m = options.clearance_m;
-  result.field.bed_mass_kg = options.bed_mass_kg;
+  PointSweepResult result;
+  result.points = std::move(points);
   result.summary.points_total = total;
   result.summary.points_resumed = resumed;
   result.summary.points_computed = computed;
   result.summary.warnings = std::move(warnings);
-  for (const auto& p : result.field.points) {
+  for (const auto& p : result.points) {
     if (p.status == PointStatus::kFailed) ++result.summary.points_failed;
   }
   result.summary.wall_time_s = seconds_since(start);
   return result;
 }
 
-std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options) {
-  detail::throw_if_any(grid.validate(), "sweep grid");
+/// A field of `grid` from the points of a grid sweep, provenance stamped now.
+EffectiveField field_of(const Grid& grid, std::vector<FieldPoint> points, const SweepOptions& options) {
+  EffectiveField field;
+  field.grid = grid;
+  field.points = std::move(points);
+  field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
+  field.clearance_m = options.clearance_m;
+  field.bed_mass_kg = options.bed_mass_kg;
+  return field;
+}
+
+std::size_t pending_points(const Points& all, const SweepOptions& options) {
   detail::throw_if_any(options.validate(), "sweep options");
-  const std::size_t total = shard_nodes(grid, options).size();
+  const std::size_t total = shard_nodes(all.count, options).size();
   if (options.results_path.empty()) return total;
   std::error_code error;
   // exists() follows links: a dangling link is "nothing saved yet", as run_sweep creates its target.
   if (!std::filesystem::exists(options.results_path, error)) return total;
-  std::vector<FieldPoint> points(grid.size());
-  std::vector<bool> done(grid.size(), false);
+  std::vector<FieldPoint> points(all.count);
+  std::vector<bool> done(all.count, false);
   // Read only, without the lock: a sweep running now may append meanwhile, which at worst
   // makes the count a little high (a cut last line is dropped, as on resume).
   const SavedPoints saved = read_saved_points(detail::read_text_file(options.results_path),
-                                              detail::file_label(options.results_path), grid, options, points, done);
+                                              detail::file_label(options.results_path), all, options, points, done);
   return total - saved.resumed;
+}
+
+}  // namespace
+
+SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options) {
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  detail::throw_if_any(options.validate(), "sweep options");
+  if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
+  PointSweepResult r = run_points(
+      grid_points(grid, options.clearance_m),
+      [&evaluator](std::size_t, const DrivePoint& drive) { return evaluator(drive.frequency_hz, drive.amplitude_m); },
+      options);
+  return {field_of(grid, std::move(r.points), options), std::move(r.summary)};
+}
+
+PointSweepResult run_point_sweep(const SweepPoints& points, const PointIndexEvaluator& evaluator,
+                                 const SweepOptions& options) {
+  detail::throw_if_any(points.validate(), "sweep points");
+  if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
+  return run_points(list_points(points), [&evaluator](std::size_t k, const DrivePoint&) { return evaluator(k); },
+                    options);
+}
+
+std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options) {
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  return pending_points(grid_points(grid, options.clearance_m), options);
+}
+
+std::size_t pending_point_sweep(const SweepPoints& points, const SweepOptions& options) {
+  detail::throw_if_any(points.validate(), "sweep points");
+  return pending_points(list_points(points), options);
 }
 
 namespace {
@@ -503,14 +583,14 @@ std::string identity_difference(const json& a, const std::string& a_label, const
 
 }  // namespace
 
-SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
-                               const std::vector<std::filesystem::path>& shard_logs,
-                               const std::string& expected_label) {
+namespace {
+
+PointSweepResult merge_points(const Points& all, const SweepOptions& options,
+                              const std::vector<std::filesystem::path>& shard_logs, const std::string& expected_label) {
   SweepOptions wanted = options;
   wanted.results_path.clear();
   wanted.shard_index = 0;
   wanted.shard_count = 1;
-  detail::throw_if_any(grid.validate(), "sweep grid");
   detail::throw_if_any(wanted.validate(), "sweep options");
   if (shard_logs.empty()) throw std::invalid_argument("merge: no shard results files given");
   const auto start = Clock::now();
@@ -527,7 +607,7 @@ SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
           "); merge only the shards of one pdamp field command"));
     }
   }
-  const json expected = sweep_header(grid, wanted);
+  const json expected = sweep_header(all, wanted);
   if (first.header != expected) {
     throw std::invalid_argument(strict_json::printable(
         first.label + ": line 1: is a shard of another sweep than " + expected_label + " (" +
@@ -561,36 +641,49 @@ SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
                                 " of " + std::to_string(first.count) + " shard files given)");
   }
 
-  std::vector<FieldPoint> points(grid.size());
-  std::vector<bool> done(grid.size(), false);
-  SweepResult result;
+  std::vector<FieldPoint> points(all.count);
+  std::vector<bool> done(all.count, false);
+  PointSweepResult result;
   for (const auto& log : logs) {
     SweepOptions shard = wanted;
     shard.shard_index = log.index;
     shard.shard_count = log.count;
     // The same strict reader as a resume: a damaged line is refused with its number,
     // and a node of another shard (so also a point in two files) is refused.
-    const SavedPoints saved = read_saved_points(log.text, log.label, grid, shard, points, done);
+    const SavedPoints saved = read_saved_points(log.text, log.label, all, shard, points, done);
     if (!saved.warning.empty()) result.summary.warnings.push_back(saved.warning);
-    const std::size_t nodes = shard_nodes(grid, shard).size();
+    const std::size_t nodes = shard_nodes(all.count, shard).size();
     if (saved.resumed != nodes) {
       throw std::invalid_argument(log.label + ": shard " + shard_name(log.index, log.count) + " is incomplete (" +
                                   std::to_string(saved.resumed) + " of " + std::to_string(nodes) +
                                   " points saved); rerun its command, it resumes, then merge");
     }
   }
-  result.field.grid = grid;
-  result.field.points = std::move(points);
-  result.field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
-  result.field.clearance_m = options.clearance_m;
-  result.field.bed_mass_kg = options.bed_mass_kg;
-  result.summary.points_total = grid.size();
-  result.summary.points_resumed = grid.size();
-  for (const auto& p : result.field.points) {
+  result.points = std::move(points);
+  result.summary.points_total = all.count;
+  result.summary.points_resumed = all.count;
+  for (const auto& p : result.points) {
     if (p.status == PointStatus::kFailed) ++result.summary.points_failed;
   }
   result.summary.wall_time_s = seconds_since(start);
   return result;
+}
+
+}  // namespace
+
+SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
+                               const std::vector<std::filesystem::path>& shard_logs,
+                               const std::string& expected_label) {
+  detail::throw_if_any(grid.validate(), "sweep grid");
+  PointSweepResult r = merge_points(grid_points(grid, options.clearance_m), options, shard_logs, expected_label);
+  return {field_of(grid, std::move(r.points), options), std::move(r.summary)};
+}
+
+PointSweepResult merge_point_sweep_shards(const SweepPoints& points, const SweepOptions& options,
+                                          const std::vector<std::filesystem::path>& shard_logs,
+                                          const std::string& expected_label) {
+  detail::throw_if_any(points.validate(), "sweep points");
+  return merge_points(list_points(points), options, shard_logs, expected_label);
 }
 
 }  // namespace pdamp::surrogate

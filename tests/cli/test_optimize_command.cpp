@@ -195,3 +195,27 @@ TEST_CASE("the task's verification is skipped with --no-verify, and --verify wit
   CHECK(run_json({"run", path, "--no-verify"})["verification"].is_null());
   require_one_line_error(run_pdamp({"optimize", path, "--verify", "--no-verify"}), "--verify");
 }
+
+// Reference: the DEM in the loop (issue 12 §5): the shipped optimisation's chosen design must
+// settle faster than the best single layer by the closed forms and by the DEM verification
+// the case asks for (35 s, contacts softened 1e-3: docs/optimizer.md measures 1e-2 alike).
+// The DEM settles the chosen design in 31.0 s and leaves the baseline at 0.66 mm > 0.45 mm.
+TEST_CASE("the shipped optimisation's chosen design settles first by the closed forms and by the DEM", "[cli][optimizer][long]") {
+  const TempDir dir("optimize_shipped_verify");
+  const json r = run_json({"optimize", case_path(kCase), "-o", dir.path.string()});
+  const json& v = r["verification"];
+  REQUIRE(v.is_object());
+  CHECK(v["ranking"]["predicted_chosen_ahead"] == true);
+  CHECK(v["ranking"]["dem_chosen_ahead"] == true);
+  for (const char* name : {"chosen", "baseline"}) {
+    INFO(name);
+    CHECK(v["designs"][name]["dem"]["energy_error"].get<double>() < 0.01);
+  }
+  CHECK(v["designs"]["chosen"]["dem"]["settled"] == true);
+  // The DEM's decay is the closed forms' within a factor of 1.5 in settling time (the
+  // scattered-state tail, docs/optimizer.md): a jamming bed (the previous design) was 6 off.
+  const double predicted = v["designs"]["chosen"]["predicted"]["settling_time_s"].get<double>();
+  const double dem = v["designs"]["chosen"]["dem"]["settling_time_s"].get<double>();
+  CHECK(dem / predicted < 1.5);
+  CHECK(dem / predicted > 1.0 / 1.5);
+}

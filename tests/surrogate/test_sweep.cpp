@@ -659,3 +659,72 @@ TEST_CASE("merge refuses a missing, repeated, foreign-count, incomplete or damag
     CHECK_THROWS_WITH(merge(logs), Catch::Contains("no complete sweep header"));
   }
 }
+
+// A list of points (a sensitivity study's variants) instead of a grid: the same machinery.
+namespace {
+
+SweepPoints five_variants() {
+  SweepPoints points;
+  points.identity = nlohmann::json::array();
+  for (int k = 0; k < 5; ++k) {
+    points.drives.push_back({2.0, 0.04});  // one design drive for every variant
+    points.identity.push_back({{"parameter", "friction"}, {"value", 0.1 * (k + 1)}});
+  }
+  return points;
+}
+
+/// η* = the variant's index, so every saved point names its variant.
+FieldPoint variant_point(std::size_t k) {
+  FieldPoint p;
+  p.eta_star = static_cast<double>(k);
+  p.eta_star_stderr = 0.0;
+  p.motion_mode = "variant " + std::to_string(k);
+  p.status = PointStatus::kOk;
+  return p;
+}
+
+}  // namespace
+
+// Reference: the index itself (variant_point): a killed study resumes without recomputing,
+// its log refuses another list, and its shards merge into the serial result.
+TEST_CASE("a list of points sweeps, resumes, shards and merges like a grid", "[surrogate]") {
+  const TempDir dir("point_sweep");
+  const SweepPoints points = five_variants();
+  SweepOptions options = sweep_options(dir.path / "study.jsonl");
+  std::atomic<int> calls{0};
+  const auto dying = [&](std::size_t k) {
+    if (++calls == 3) throw std::runtime_error("simulated kill");
+    return variant_point(k);
+  };
+  options.threads = 1;
+  CHECK_THROWS_WITH(run_point_sweep(points, dying, options), "simulated kill");
+  CHECK(pending_point_sweep(points, options) == 3);
+  calls = 10;  // no more kills
+  const PointSweepResult r = run_point_sweep(points, dying, options);
+  CHECK(r.summary.points_resumed == 2);
+  CHECK(r.summary.points_computed == 3);
+  REQUIRE(r.points.size() == 5);
+  for (std::size_t k = 0; k < 5; ++k) CHECK(r.points[k].eta_star == static_cast<double>(k));
+
+  // Another list (one value changed) does not resume this log.
+  SweepPoints other = points;
+  other.identity[4]["value"] = 0.55;
+  CHECK_THROWS_WITH(run_point_sweep(other, variant_point, options), Catch::Contains("belongs to another sweep"));
+
+  // Two shards, merged: the serial result.
+  std::vector<fs::path> logs;
+  for (int shard = 0; shard < 2; ++shard) {
+    SweepOptions part = sweep_options(dir.path / ("shard" + std::to_string(shard) + ".jsonl"));
+    part.shard_index = shard;
+    part.shard_count = 2;
+    const PointSweepResult s = run_point_sweep(points, variant_point, part);
+    CHECK(s.summary.points_total == (shard == 0 ? 3u : 2u));
+    logs.push_back(part.results_path);
+  }
+  const PointSweepResult merged = merge_point_sweep_shards(points, sweep_options({}), logs, "the study");
+  for (std::size_t k = 0; k < 5; ++k) CHECK(merged.points[k].eta_star == static_cast<double>(k));
+  CHECK_THROWS_WITH(merge_point_sweep_shards(other, sweep_options({}), logs, "the other study"),
+                    Catch::Contains("is a shard of another sweep than the other study"));
+  SweepPoints empty;
+  CHECK_THROWS_WITH(run_point_sweep(empty, variant_point, options), Catch::Contains("drives: must hold at least one point"));
+}

@@ -222,6 +222,22 @@ struct TaskSpec {
   std::optional<PlacementTask> placement;
 };
 
+/// `sensitivity` (issue 13 §3): the parameters `pdamp sensitivity` varies one at a time
+/// around the damper's operating point, each over the values given (docs/sensitivity.md).
+struct SensitivityParameter {
+  std::string name;            ///< friction, restitution, rolling_friction, particle_radius_m,
+                               ///< particle_count, youngs_modulus_factor, tilt_x_deg, tilt_y_deg, tilt_z_deg
+  std::vector<double> values;  ///< in the parameter's own unit (a factor for youngs_modulus_factor)
+};
+struct SensitivitySpec {
+  double amplitude_m = 0.0;   ///< stroke X of the study, m (default: excitation.amplitude_m, else the design stroke)
+  double frequency_hz = 0.0;  ///< f of the study, Hz (default: excitation.frequency_hz)
+  /// The parameters and their values; empty: every parameter at its default values
+  /// (sensitivity_variants).
+  std::vector<SensitivityParameter> parameters;
+  int threads = 2;            ///< DEM runs at once, [1, 256]
+};
+
 struct Case {
   std::string path;
   int format_version = 1;
@@ -234,6 +250,7 @@ struct Case {
   ExcitationSpec excitation;
   DesignSpec design;
   std::optional<BufferSpec> buffer;
+  std::optional<SensitivitySpec> sensitivity;  ///< `sensitivity`, when the case has one
   DemSpec dem;
   FieldSpec field;
   nlohmann::json resolved;  ///< the case with every default resolved and derived values added
@@ -242,6 +259,28 @@ struct Case {
 /// Reads and validates a case file (format 1 or 2). CaseError names the file, the JSON
 /// pointer and the rule broken (for a modal data file: that file and its pointer).
 Case load_case(const std::string& path);
+/// The same for a document already parsed (a variant of a case's JSON), read as if it were
+/// the file at `path` (relative paths in it resolve against that file's folder).
+Case load_case_document(const nlohmann::json& document, const std::string& path);
+
+/// One case of a sensitivity study: the parameter varied, its value, and the case with it.
+struct SensitivityVariant {
+  std::string parameter;  ///< "baseline" for the case as it is
+  double value = 0.0;     ///< the parameter's value (the baseline's own for "baseline")
+  std::string unit;       ///< of value ("" for dimensionless, "deg", "m", "factor")
+  Case variant;
+};
+/// The baseline and every variant of the case's `sensitivity` study (defaults where it names
+/// no parameters: friction ×0.5 and ×1.5, restitution ±0.1, particle radius ×0.9 and ×1.1,
+/// particle count ×0.9 and ×1.1 (rounded), Young's modulus ×0.5 and ×2, tilts of ±5° about
+/// each container axis). Each variant is the case's JSON with one value changed, read again
+/// by the case reader: CaseError naming /sensitivity/parameters/i/values/j for a value the
+/// case refuses; a default value the case refuses is left out and said in `skipped`.
+/// Single-damper cases of one layer only (CaseError otherwise).
+std::vector<SensitivityVariant> sensitivity_variants(const Case& c, std::vector<std::string>& skipped);
+/// The baseline case's value of a sensitivity parameter (0 for the tilts, 1 for
+/// youngs_modulus_factor), for the rows' reference.
+double sensitivity_baseline_value(const Case& c, const std::string& parameter);
 
 std::string_view to_string(TaskKind kind);
 

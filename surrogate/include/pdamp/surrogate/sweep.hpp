@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/surrogate/grid.hpp"
@@ -135,6 +137,33 @@ std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options);
 SweepResult merge_sweep_shards(const Grid& grid, const SweepOptions& options,
                                const std::vector<std::filesystem::path>& shard_logs,
                                const std::string& expected_label = "this sweep");
+
+/// A sweep over a list of points instead of a grid's nodes: a sensitivity study's variants
+/// of one damper at its design drive. The same machinery as run_sweep (parallel, saved point
+/// by point, resumable, shardable, merged by merge_point_sweep_shards): the results file's
+/// header carries `identity` under "points" where a grid sweep has its axes, so a file of
+/// another list is refused as one of another grid is.
+struct SweepPoints {
+  std::vector<DrivePoint> drives;  ///< one per point (the drive its line records), > 0 and finite
+  nlohmann::json identity;         ///< what the points are (e.g. the variants' names and values)
+  /// One line per violated rule ("drives[2].amplitude_m = 0: must be > 0 and finite").
+  std::vector<std::string> validate() const;
+};
+/// The response of point k (thread-safe, as PointEvaluator).
+using PointIndexEvaluator = std::function<FieldPoint(std::size_t index)>;
+struct PointSweepResult {
+  std::vector<FieldPoint> points;  ///< one per point; of other shards status kMissing
+  SweepSummary summary;
+};
+/// run_sweep over `points` (the same results file, resume, shard, progress and error rules).
+PointSweepResult run_point_sweep(const SweepPoints& points, const PointIndexEvaluator& evaluator,
+                                 const SweepOptions& options);
+/// pending_sweep_points for a list of points.
+std::size_t pending_point_sweep(const SweepPoints& points, const SweepOptions& options);
+/// merge_sweep_shards for a list of points.
+PointSweepResult merge_point_sweep_shards(const SweepPoints& points, const SweepOptions& options,
+                                          const std::vector<std::filesystem::path>& shard_logs,
+                                          const std::string& expected_label = "this sweep");
 
 /// Evaluator of the closed forms (formulas::reduced_loss_factor) for one damper: η*,
 /// stderr 0 (exact), E_diss = η*·½ m_bed (XΩ)², apparent mass not given (NaN; the closed

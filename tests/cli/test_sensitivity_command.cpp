@@ -1,0 +1,87 @@
+// pdamp sensitivity (issue 13 §3): rows per variant, files, the DEM study resumed from its
+// log, a tilt about gravity that changes nothing, and bad input as exit 2.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli/cli_support.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+json run_json(const std::vector<std::string>& args) {
+  auto full = args;
+  full.push_back("--json");
+  const auto r = run_pdamp(full);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return json::parse(r.out);
+}
+
+/// A quick DEM study: the shipped 36-sphere case, 1 transient and 1 analysed period.
+std::string quick_study(const TempDir& dir) {
+  std::ifstream in(case_path("low_intensity_36_spheres.json"));
+  json c = json::parse(in);
+  c["dem"]["transient_periods"] = 1;
+  c["dem"]["analysed_periods"] = 2;
+  c["sensitivity"] = {{"parameters", {{{"name", "friction"}, {"values", {0.15}}},
+                                      {{"name", "tilt_z_deg"}, {"values", {5}}}}}};
+  const fs::path path = dir.path / "study.json";
+  std::ofstream(path) << c.dump(2);
+  return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("pdamp sensitivity --source formulas gives a row per variant and the closed forms", "[cli]") {
+  const TempDir dir("sensitivity_formulas");
+  const json r = run_json({"sensitivity", case_path("low_intensity_36_spheres.json"), "--source", "formulas", "-o",
+                           dir.path.string()});
+  for (const char* key : {"file", "rows", "frequency_hz", "amplitude_m", "source", "warnings", "outputs"})
+    CHECK(r.contains(key));
+  const auto& rows = r["rows"];
+  REQUIRE(rows.size() == 15);  // the default study: 16 values, 2 refused by the 6 x 6 lattice
+  CHECK(rows[0]["parameter"] == "baseline");
+  const double base = rows[0]["closed_form_eta_star"].get<double>();
+  for (const auto& row : rows) {
+    // The closed forms see the clearance only: a smaller radius moves h, nothing else does.
+    INFO(row.dump());
+    CHECK(row["eta_star"] == row["closed_form_eta_star"]);
+    if (row["parameter"] == "particle_radius_m") CHECK(row["closed_form_eta_star"].get<double>() != base);
+    else CHECK(row["closed_form_eta_star"].get<double>() == base);
+  }
+  for (const char* file : {"sensitivity.json", "sensitivity.csv", "sensitivity_tornado.csv", "sensitivity.gp"})
+    CHECK(fs::exists(dir.path / file));
+}
+
+// Reference: a tilt about the container's z axis, along which gravity points, changes no
+// input of the DEM: its η* is the baseline's to the bit. A second run resumes every variant.
+TEST_CASE("a DEM sensitivity study resumes from its log and a tilt about gravity changes nothing", "[cli]") {
+  const TempDir dir("sensitivity_dem");
+  const std::string path = quick_study(dir);
+  const json first = run_json({"sensitivity", path, "-o", dir.path.string()});
+  const auto& rows = first["rows"];
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[2]["parameter"] == "tilt_z_deg");
+  CHECK(rows[2]["eta_star"] == rows[0]["eta_star"]);
+  CHECK(rows[1]["eta_star"] != rows[0]["eta_star"]);  // friction does change the bed
+  CHECK(fs::exists(dir.path / "sensitivity_sweep.jsonl"));
+  const json again = run_json({"sensitivity", path, "-o", dir.path.string()});
+  CHECK_THAT(again["sweep"].get<std::string>(), Catch::Contains("3 resumed, 0 computed"));
+  CHECK(again["rows"] == rows);
+}
+
+TEST_CASE("pdamp sensitivity refuses a bad source, a multi-damper case and a bad shard", "[cli]") {
+  require_one_line_error(run_pdamp({"sensitivity", case_path("low_intensity_36_spheres.json"), "--source", "field"}),
+                         "--source");
+  require_one_line_error(run_pdamp({"sensitivity", case_path("manipulator_link_decay.json")}), "one damper of one layer");
+  require_one_line_error(run_pdamp({"sensitivity", case_path("low_intensity_36_spheres.json"), "--shard", "3/2"}),
+                         "--shard");
+}
