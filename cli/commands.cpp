@@ -25,6 +25,7 @@
 #include "optimize_command.hpp"
 #include "plots.hpp"
 #include "report.hpp"
+#include "external_program.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
@@ -566,14 +567,58 @@ int run_dem(const ParsedArgs& args) {
   const auto estimate = check_dem_run(c, 0, options);
   check_dem_placement(c, 0, options);
   auto files = output_dir(args);
+
+  // Checkpoints in the -o folder at period ends (docs/dem.md "Checkpoints"): every
+  // --checkpoint-interval seconds and when a signal arrives (then pdamp ends by it).
+  const DemCheckpoint cp = dem_checkpoint(args, "dem", "dem");
+  dem_reference::CheckpointHeader header;
+  header.kind = cp.kind;
+  header.case_hash = case_file::physics_hash(c, "dem");
+  header.physics_model_version = dem_reference::kPhysicsModelVersion;
+  {
+    std::ostringstream settings;
+    settings.precision(17);
+    settings << "amplitude_m " << x << "; frequency_hz " << f << "; transient_periods " << options.transient_periods
+             << "; analysed_periods " << options.analysed_periods << "; samples_per_period " << options.samples_per_period
+             << "; snapshots " << options.snapshots << "; threads " << options.world.threads;
+    header.settings = settings.str();
+  }
+  header.end_time_s = (options.transient_periods + options.analysed_periods) / f;
+  dem_reference::HarmonicCheckpoints hook;
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  hook.due = [&] {
+    return pending_interrupt() != 0 ||
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >= cp.interval_s;
+  };
+  hook.stop = [] { return pending_interrupt() != 0; };
+  hook.write = [&](const std::string& state, double t) {
+    header.simulated_time_s = t;
+    write_checkpoint_file(cp, header, state);
+    last_checkpoint = std::chrono::steady_clock::now();
+  };
+  if (cp.resume) hook.resume_state = read_checkpoint_payload(cp, header);  // refused before any output
   std::cerr << estimate_line("pdamp dem", estimate) << std::endl;
+  if (cp.resume) {
+    std::cerr << "pdamp dem: resuming from " << strict_json::printable(cp.file.string()) << std::endl;
+  } else if (!cp.file.empty() && std::filesystem::exists(cp.file)) {
+    print_warnings({strict_json::printable(cp.file.string()) + " of an earlier run is replaced (--resume continues it)"});
+  }
 
   ProgressLine progress("pdamp dem");
   dem_reference::DamperResult result;
-  try {
-    result = dem_reference::run_harmonic(options, [&](const dem_reference::Progress& p) { progress(p); });
-  } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound
-    throw InputError(path, "/dem", e.what());
+  {
+    const std::optional<DeferredSignals> deferred = cp.file.empty() ? std::nullopt : std::make_optional<DeferredSignals>();
+    try {
+      result = dem_reference::run_harmonic(options, [&](const dem_reference::Progress& p) { progress(p); },
+                                           cp.file.empty() ? nullptr : &hook);
+    } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound, a resume that does not fit
+      throw InputError(cp.resume ? cp.file.string() : path, cp.resume ? "" : "/dem", e.what());
+    }
+    if (result.stopped) throw Interrupted(pending_interrupt(), checkpoint_advice(cp, header));
+  }
+  if (!cp.file.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove(cp.file, ignored);  // complete: the results follow
   }
   if (result.summary.outcome == dem_reference::Outcome::kUnstable)
     throw NumericalError("DEM unstable: " + case_key_names(result.summary.message));
@@ -1208,16 +1253,18 @@ const std::vector<Command>& commands() {
          {"--impact-velocity", "M_S", "impact speed, m/s (default 2*X*Omega, the bouncing optimum)"},
          kJsonFlag}},
        run_buffer},
-      {{"dem", "pdamp dem CASE.json [--amplitude M] [--frequency HZ] [-o DIR] [--json]",
+      {{"dem", "pdamp dem CASE.json [--amplitude M] [--frequency HZ] [--resume] [-o DIR] [--json]",
         "reference DEM of the case's damper under harmonic motion x = X sin(2 pi f t): eta*,\n"
         "its standard error, apparent mass, energy balance, motion mode (docs/dem.md)",
-        {{"--amplitude", "M", "stroke X, m (default: the case's excitation.amplitude_m)"},
-         {"--frequency", "HZ", "frequency f, Hz (default: the case's excitation.frequency_hz)"},
-         {"--periods", "N", "analysed periods (default: the case's dem.analysed_periods)"},
-         {"--threads", "N", "OpenMP threads, 0 = all (default: the case's dem.threads)"},
-         {"-o", "DIR", "write summary.json, time_series.csv, particles_*.vtk (ParaView) and\n"
-                       "                          force_velocity.png/.svg into DIR, atomically"},
-         kJsonFlag}, 1},
+        concat_flags({{"--amplitude", "M", "stroke X, m (default: the case's excitation.amplitude_m)"},
+                      {"--frequency", "HZ", "frequency f, Hz (default: the case's excitation.frequency_hz)"},
+                      {"--periods", "N", "analysed periods (default: the case's dem.analysed_periods)"},
+                      {"--threads", "N", "OpenMP threads, 0 = all (default: the case's dem.threads)"},
+                      {"-o", "DIR", "write summary.json, time_series.csv, particles_*.vtk (ParaView) and\n"
+                                    "                          force_velocity.png/.svg into DIR, atomically (and\n"
+                                    "                          dem.checkpoint while the run lasts: --resume)"},
+                      kJsonFlag},
+                     kCheckpointFlags), 1},
        run_dem},
       {{"field", "pdamp field CASE.json --source formulas|dem|measured [--measured FILE] [-o DIR] [--json]",
         "effective field: eta*, E_diss, apparent mass and motion mode over the case's grid\n"

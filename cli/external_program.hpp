@@ -33,6 +33,16 @@ void install_interrupt_handlers();
 void begin_output_phase();
 void end_output_phase();
 
+/// An output phase for its lifetime: a checkpointed run defers signals to its next
+/// checkpoint (structure_commands.hpp, DemCheckpoint).
+class DeferredSignals {
+ public:
+  DeferredSignals() { begin_output_phase(); }
+  ~DeferredSignals() { end_output_phase(); }
+  DeferredSignals(const DeferredSignals&) = delete;
+  DeferredSignals& operator=(const DeferredSignals&) = delete;
+};
+
 /// The signal received during an output phase, or 0.
 int pending_interrupt();
 

@@ -753,6 +753,38 @@ DemCheckpoint dem_checkpoint(const ParsedArgs& args, const std::string& name, co
   return out;
 }
 
+std::string read_checkpoint_payload(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& expected) {
+  const std::string shown = strict_json::printable(cp.file.string());
+  if (!std::filesystem::exists(cp.file))
+    throw InputError("--resume", "", "no checkpoint " + shown + " to continue (the run completed, or never started)");
+  auto decoded = dem_reference::decode_checkpoint(
+      strict_json::read_input_file(cp.file.string(), dem_reference::kMaxCheckpointBytes), cp.file.string());
+  const auto& h = decoded.header;
+  const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& here) {
+    throw InputError(cp.file.string(), "/" + key,
+                     "'" + saved + "' in the checkpoint, '" + here + "' for this run: it belongs to another " +
+                         (key == "kind" ? "command" : key == "physics_model_version" ? "pdamp version" : "case or settings") +
+                         " (run without --resume to start again)");
+  };
+  if (h.kind != expected.kind) refuse("kind", h.kind, expected.kind);
+  if (h.case_hash != expected.case_hash) refuse("case_hash", h.case_hash, expected.case_hash);
+  if (h.physics_model_version != expected.physics_model_version)
+    refuse("physics_model_version", std::to_string(h.physics_model_version), std::to_string(expected.physics_model_version));
+  if (h.settings != expected.settings) refuse("settings", h.settings, expected.settings);
+  return std::move(decoded.payload);
+}
+
+void write_checkpoint_file(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header,
+                           const std::string& payload) {
+  write_file_atomically(cp.file, dem_reference::encode_checkpoint(header, payload));
+}
+
+std::string checkpoint_advice(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header) {
+  return "the run stopped at t = " + format_number(header.simulated_time_s, 6) + " of " +
+         format_number(header.end_time_s, 6) + " s and wrote " + strict_json::printable(cp.file.string()) +
+         ": run the same command with --resume to continue";
+}
+
 namespace {
 
 /// Wall-clock seconds a segment aims at: short enough that an interrupted run stops soon,
@@ -781,7 +813,7 @@ void write_checkpoint(const DemCheckpoint& cp, const dem_reference::CheckpointHe
   dem_reference::StateWriter out;
   st::save_cosimulation_state(state, out);
   st::save_cosimulation_result(sum, out);
-  write_file_atomically(cp.file, dem_reference::encode_checkpoint(header, out.bytes()));
+  write_checkpoint_file(cp, header, out.bytes());
 }
 
 /// The decay of `options` in segments, checkpointed (DemCheckpoint).
@@ -811,24 +843,9 @@ st::CosimulationResult run_checkpointed_decay(const Case& c, const st::ModalMode
   st::CosimulationResult sum;
   std::int64_t done = 0;
   if (cp.resume) {
-    if (!std::filesystem::exists(cp.file))
-      throw InputError("--resume", "", "no checkpoint " + shown + " to continue (the run completed, or never started)");
-    const auto decoded = dem_reference::decode_checkpoint(
-        strict_json::read_input_file(cp.file.string(), dem_reference::kMaxCheckpointBytes), cp.file.string());
-    const auto& h = decoded.header;
-    const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& here) {
-      throw InputError(cp.file.string(), "/" + key,
-                       "'" + saved + "' in the checkpoint, '" + here + "' for this run: it belongs to another " +
-                           (key == "kind" ? "command" : key == "physics_model_version" ? "pdamp version" : "case or settings") +
-                           " (run without --resume to start again)");
-    };
-    if (h.kind != header.kind) refuse("kind", h.kind, header.kind);
-    if (h.case_hash != header.case_hash) refuse("case_hash", h.case_hash, header.case_hash);
-    if (h.physics_model_version != header.physics_model_version)
-      refuse("physics_model_version", std::to_string(h.physics_model_version), std::to_string(header.physics_model_version));
-    if (h.settings != header.settings) refuse("settings", h.settings, header.settings);
+    const std::string payload = read_checkpoint_payload(cp, header);
     try {
-      dem_reference::StateReader in(decoded.payload, "checkpoint state");
+      dem_reference::StateReader in(payload, "checkpoint state");
       state = st::restore_cosimulation_state(modal, dampers, in);
       sum = st::restore_cosimulation_result(in, modal.mode_count(), dampers.size());
       in.finish();
@@ -846,10 +863,7 @@ st::CosimulationResult run_checkpointed_decay(const Case& c, const st::ModalMode
   }
 
   // Signals wait for the segment's end: the checkpoint is written, then pdamp ends by them.
-  begin_output_phase();
-  struct EndPhase {
-    ~EndPhase() { end_output_phase(); }
-  } end_phase;
+  const DeferredSignals deferred;
   auto last_checkpoint = std::chrono::steady_clock::now();
   std::int64_t segment = sample_every * std::max<std::int64_t>(1, std::llround(kFirstSegmentFraction *
                                                                                 static_cast<double>(total / sample_every)));
@@ -903,10 +917,7 @@ st::CosimulationResult run_checkpointed_decay(const Case& c, const st::ModalMode
       write_checkpoint(cp, header, state, sum);
       last_checkpoint = std::chrono::steady_clock::now();
     }
-    if (signal != 0)
-      throw Interrupted(signal, "the run stopped at t = " + format_number(header.simulated_time_s, 6) + " of " +
-                                    format_number(header.end_time_s, 6) + " s and wrote " + shown +
-                                    ": run the same command with --resume to continue");
+    if (signal != 0) throw Interrupted(signal, checkpoint_advice(cp, header));
   }
   std::error_code ignored;
   std::filesystem::remove(cp.file, ignored);  // complete: the results follow

@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/structure/modal_model.hpp"
@@ -77,6 +78,14 @@ struct DemCheckpoint {
 };
 /// `--resume` and `--checkpoint-interval` (pdamp decay --method dem, optimize --verify, run).
 extern const std::vector<FlagSpec> kCheckpointFlags;
+/// The payload of cp.file when its header has `expected`'s kind, case hash, model version and
+/// settings; InputError naming the file and the key that differs, or the damage, otherwise.
+std::string read_checkpoint_payload(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& expected);
+/// cp.file written atomically (a temporary file and a rename) with `header` and `payload`.
+void write_checkpoint_file(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header,
+                           const std::string& payload);
+/// "stopped at t = … of … s and wrote FILE: run the same command with --resume to continue".
+std::string checkpoint_advice(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header);
 /// The checkpoint of a DEM run named `name` in the -o folder of `args` (InputError for
 /// --resume without -o, or a bad --checkpoint-interval); no file without -o.
 DemCheckpoint dem_checkpoint(const ParsedArgs& args, const std::string& name, const std::string& kind);

@@ -7,6 +7,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -269,7 +270,8 @@ void check_initial_placement(const DamperSimulationOptions& options) {
   (void)detail::place_particles(options.world, detail::build_walls(options.world), options.world.gravity_m_s2);
 }
 
-DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress) {
+DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress,
+                          const HarmonicCheckpoints* checkpoints) {
   const auto wall_start = Clock::now();
   const RunPlan plan = plan_run(options);
   const HarmonicMotion motion(options.drive_axis, options.amplitude_m, options.frequency_hz);
@@ -324,6 +326,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   BlockRecorder recorder(recording);
   DriveBinMeasure drive_bin(steps_per_period, options.frequency_hz, m_bed);
 
+  double wall_before_s = 0.0;  // of the runs before a resume (HarmonicCheckpoints)
   const auto finish = [&](Outcome outcome, const std::string& message) {
     auto& s = result.summary;
     s.outcome = outcome;
@@ -334,7 +337,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     s.particles = n;
     s.time_step_s = dt;
     s.simulated_time_s = world.time_s();
-    s.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+    s.wall_time_s = wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count();
     s.stage_times = world.stage_times();
     result.particle_steps_per_s = s.wall_time_s > 0.0 ? static_cast<double>(s.particle_steps) / s.wall_time_s : 0.0;
   };
@@ -352,24 +355,89 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   const auto report_settling = [&](std::int64_t k) {
     reporter.maybe_report("settling", k, total_steps, static_cast<double>(k - settle_steps) * dt);
   };
-  // settle() returns false exactly when the world halted.
-  if (!settle(world, start, settle_steps, report_settling) && halted()) return result;
+  // A resumed run starts where its checkpoint was written; a new one settles first.
+  const bool resuming = checkpoints != nullptr && !checkpoints->resume_state.empty();
+  std::optional<StateReader> saved;
+  std::int64_t first_step = 1;  // the next drive step
+  bool analysing = false;
+  if (resuming) {
+    saved.emplace(checkpoints->resume_state, "harmonic run state");
+    saved->expect_tag("harmonic run");
+    analysing = saved->i32_in("phase", 1, 2) == 2;
+    first_step = saved->i64("step") + 1;
+    // Checkpoints are written at period ends inside the transient (phase 1) or the analysis (phase 2).
+    const std::int64_t done = first_step - 1;
+    if (done < 1 || done >= transient_steps + plan.analysed_steps || done % steps_per_period != 0 ||
+        analysing != (done > transient_steps))
+      saved->fail("step", std::to_string(done) + " in phase " + (analysing ? "2" : "1") +
+                              ": not a checkpoint of this run's " +
+                              std::to_string(transient_steps + plan.analysed_steps) + " drive steps");
+    wall_before_s = saved->finite("wall_time_s");
+    world.restore_state(*saved);
+  } else if (!settle(world, start, settle_steps, report_settling) && halted()) {  // false exactly when the world halted
+    return result;
+  }
   // Built on the settled bed: its base contacts are the rolling criterion's reference.
   MotionModeAccumulator motion_modes(world, plan.step.world, axis);
-  for (std::int64_t k = 1; k <= transient_steps; ++k) {
+  std::optional<EnergyLedger> ledger;
+  if (resuming) {
+    motion_modes.restore(*saved);
+    if (analysing) {
+      EnergyAccount opening;
+      for (double* v : {&opening.container_work_j, &opening.normal_damping_j, &opening.friction_j, &opening.rolling_j,
+                        &opening.kinetic_j, &opening.potential_j, &opening.elastic_j})
+        *v = saved->finite("ledger.opening");
+      ledger.emplace(opening);
+      drive_bin.restore(*saved);
+      recorder.restore(*saved);
+    }
+    saved->expect_tag("end of harmonic run");
+    saved->finish();
+  }
+  // At a period end: a checkpoint when due, and the end of the run when asked.
+  const auto checkpoint = [&](std::int64_t step) {
+    if (checkpoints == nullptr || step % steps_per_period != 0 || !checkpoints->due || !checkpoints->due()) return false;
+    StateWriter out;
+    out.tag("harmonic run");
+    out.i32(analysing ? 2 : 1);
+    out.i64(step);
+    out.f64(wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count());
+    world.save_state(out);
+    motion_modes.save(out);
+    if (analysing) {
+      const EnergyAccount& a = ledger->opening();
+      for (double v : {a.container_work_j, a.normal_damping_j, a.friction_j, a.rolling_j, a.kinetic_j, a.potential_j,
+                       a.elastic_j})
+        out.f64(v);
+      drive_bin.save(out);
+      recorder.save(out);
+    }
+    out.tag("end of harmonic run");
+    checkpoints->write(out.bytes(), static_cast<double>(step) * dt);
+    return checkpoints->stop && checkpoints->stop();
+  };
+  const auto stop_here = [&]() {
+    result.stopped = true;
+    finish(Outcome::kCompleted, "stopped at a checkpoint");
+    return result;
+  };
+  for (std::int64_t k = first_step; k <= transient_steps; ++k) {
     world.step(motion.state(static_cast<double>(k) * dt));
     if (halted()) return result;
     reporter.maybe_report("transient", settle_steps + k, total_steps, static_cast<double>(k) * dt);
+    if (k < transient_steps && checkpoint(k)) return stop_here();
   }
 
-  const EnergyLedger ledger(world.energy());
-  for (std::int64_t step = transient_steps + 1; step <= transient_steps + plan.analysed_steps; ++step) {
+  if (!ledger) ledger.emplace(world.energy());
+  analysing = true;
+  for (std::int64_t step = std::max(transient_steps + 1, first_step); step <= transient_steps + plan.analysed_steps; ++step) {
     const ContainerState state = motion.state(static_cast<double>(step) * dt);
     const ContainerLoad& load = world.step(state);
     if (halted()) return result;
     drive_bin.add(step, dot(load.force_n, axis), dot(state.velocity_m_s, axis));
     if (recorder.record_step(world)) motion_modes.sample_block(world);
     reporter.maybe_report("analysis", settle_steps + step, total_steps, static_cast<double>(step) * dt);
+    if (step < transient_steps + plan.analysed_steps && checkpoint(step)) return stop_here();
   }
 
   DriveBinMeasures measures = drive_bin.result();
@@ -378,7 +446,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   result.e_diss_j = measures.e_diss_j;
   result.energy_per_cycle_j = measures.energy_per_cycle_j;
   result.apparent_mass_kg = measures.apparent_mass_kg;
-  result.energy = ledger.balance(world.energy());
+  result.energy = ledger->balance(world.energy());
   result.energy_balance_error = result.energy.relative_error;
   result.eta_star_energy_balance = (result.energy.dissipated_j() + result.energy.delta_energy_j()) /
                                    (periods * kPi * m_bed * v_amp * v_amp);

@@ -176,6 +176,21 @@ MotionModeAccumulator::MotionModeAccumulator(const World& world, const WorldOpti
                              world.particle_count()),
       fluctuation_sum_(static_cast<std::size_t>(world.particle_count()), 0.0) {}
 
+void MotionModeAccumulator::save(StateWriter& out) const {
+  out.f64(settled_base_fraction_);
+  out.i64(blocks_);
+  for (double v : {base_sum_, airborne_sum_, spread_sum_}) out.f64(v);
+  out.f64s(fluctuation_sum_);
+}
+
+void MotionModeAccumulator::restore(StateReader& in) {
+  settled_base_fraction_ = in.finite("motion_modes.settled_base_fraction");
+  blocks_ = in.i64("motion_modes.blocks");
+  if (blocks_ < 0) in.fail("motion_modes.blocks", "must not be negative");
+  for (double* v : {&base_sum_, &airborne_sum_, &spread_sum_}) *v = in.finite("motion_modes.sums");
+  fluctuation_sum_ = in.finite_f64s("motion_modes.fluctuation_sum", fluctuation_sum_.size());
+}
+
 void MotionModeAccumulator::sample_block(const World& world) {
   const int n = world.particle_count();
   ++blocks_;

@@ -47,6 +47,35 @@ void DriveBinMeasure::add(std::int64_t step, double force_n, double velocity_m_s
   period_bin_.clear();
 }
 
+void DriveBinMeasure::save(StateWriter& out) const {
+  if (period_bin_.samples() != 0) throw std::logic_error("DriveBinMeasure::save: a period is in progress");
+  const auto sums = all_bin_.sums();
+  for (double v : {sums.force.real(), sums.force.imag(), sums.velocity.real(), sums.velocity.imag(), sums.max_abs_velocity})
+    out.f64(v);
+  out.i64(sums.samples);
+  out.f64s(eta_star_per_period_);
+}
+
+void DriveBinMeasure::restore(StateReader& in) {
+  formulas::DriveBinAccumulator::Sums sums;
+  const double fr = in.finite("drive_bin.force"), fi = in.finite("drive_bin.force");
+  const double vr = in.finite("drive_bin.velocity"), vi = in.finite("drive_bin.velocity");
+  sums.force = {fr, fi};
+  sums.velocity = {vr, vi};
+  sums.max_abs_velocity = in.finite("drive_bin.max_abs_velocity");
+  sums.samples = in.i64("drive_bin.samples");
+  if (sums.samples < 0 || sums.samples % steps_per_period_ != 0)
+    in.fail("drive_bin.samples", std::to_string(sums.samples) + ": must be whole periods of " +
+                                     std::to_string(steps_per_period_) + " steps");
+  const auto periods = in.finite_f64s_up_to("drive_bin.eta_star_per_period", 100000);
+  if (static_cast<std::int64_t>(periods.size()) != sums.samples / steps_per_period_)
+    in.fail("drive_bin.eta_star_per_period", "holds " + std::to_string(periods.size()) + " periods, the sums " +
+                                                 std::to_string(sums.samples / steps_per_period_));
+  all_bin_.restore_sums(sums);
+  period_bin_.clear();
+  eta_star_per_period_ = periods;
+}
+
 DriveBinMeasures DriveBinMeasure::result() const {
   if (eta_star_per_period_.empty()) {
     throw std::invalid_argument("DriveBinMeasure::result: no whole period accumulated yet");

@@ -68,6 +68,57 @@ BlockRecorder::BlockRecorder(const BlockRecorderOptions& options) : options_(opt
   snapshots_.reserve(static_cast<std::size_t>(options_.snapshots));
 }
 
+void BlockRecorder::save(StateWriter& out) const {
+  if (step_in_block_ != 0) throw std::logic_error("BlockRecorder::save: a block is in progress");
+  out.i64(step_);
+  for (const auto* v : {&series_.time_s, &series_.container_position_m, &series_.container_velocity_m_s, &series_.force_n,
+                        &series_.bed_relative_position_m, &series_.bed_momentum_kg_m_s, &series_.kinetic_energy_j,
+                        &sample_times_s_})
+    out.f64s(*v);
+  out.i64(next_snapshot_);
+  out.i64(static_cast<std::int64_t>(snapshots_.size()));
+  for (const auto& s : snapshots_) {
+    out.f64(s.time_s);
+    out.i64(static_cast<std::int64_t>(s.radii_m.size()));
+    for (const auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
+      for (const auto& p : *v)
+        for (double x : p) out.f64(x);
+    out.f64s(s.radii_m);
+    out.i32s(s.compartments);
+  }
+}
+
+void BlockRecorder::restore(StateReader& in) {
+  step_ = in.i64("recorder.step");
+  if (step_ < options_.start_step) in.fail("recorder.step", "is before the recorder's start");
+  const auto blocks = static_cast<std::size_t>(block_count(options_));
+  series_.time_s = in.finite_f64s_up_to("recorder.series", blocks);
+  const std::size_t recorded = series_.time_s.size();
+  for (auto* v : {&series_.container_position_m, &series_.container_velocity_m_s, &series_.force_n,
+                  &series_.bed_relative_position_m, &series_.bed_momentum_kg_m_s, &series_.kinetic_energy_j,
+                  &sample_times_s_})
+    *v = in.finite_f64s("recorder.series", recorded);
+  next_snapshot_ = in.i64("recorder.next_snapshot");
+  const std::size_t taken = in.count("recorder.snapshots", static_cast<std::size_t>(options_.snapshots), 8);
+  if (next_snapshot_ != static_cast<std::int64_t>(taken)) in.fail("recorder.next_snapshot", "does not match the snapshots taken");
+  snapshots_.clear();
+  for (std::size_t k = 0; k < taken; ++k) {
+    ParticleSnapshot s;
+    s.time_s = in.finite("recorder.snapshot.time_s");
+    const std::size_t n = in.count("recorder.snapshot.particles", 100000000, 9 * 8);
+    for (auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s}) {
+      v->resize(n);
+      for (auto& p : *v)
+        for (double& x : p) x = in.finite("recorder.snapshot");
+    }
+    s.radii_m = in.finite_f64s("recorder.snapshot.radii_m", n);
+    s.compartments = in.i32s("recorder.snapshot.compartments", n, 0, 1 << 20);
+    snapshots_.push_back(std::move(s));
+  }
+  step_in_block_ = 0;
+  force_sum_ = velocity_sum_ = position_sum_ = 0.0;
+}
+
 bool BlockRecorder::record_step(const World& world) {
   const Vec3& axis = options_.drive_axis;
   const ContainerState& container = world.container();

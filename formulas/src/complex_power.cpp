@@ -278,6 +278,14 @@ void DriveBinAccumulator::merge(const DriveBinAccumulator& other) {
   samples_ += other.samples_;
 }
 
+void DriveBinAccumulator::restore_sums(const Sums& sums) {
+  force_sum_ = sums.force;
+  velocity_sum_ = sums.velocity;
+  max_abs_velocity_ = sums.max_abs_velocity;
+  samples_ = sums.samples;
+  started_ = false;  // the next add() takes its phase from its step index
+}
+
 void DriveBinAccumulator::clear() {
   force_sum_ = velocity_sum_ = {0.0, 0.0};
   max_abs_velocity_ = 0.0;

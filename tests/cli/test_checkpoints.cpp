@@ -168,3 +168,40 @@ TEST_CASE("a killed DEM verification resumes both designs and equals the uninter
   CHECK(a["verification"] == b["verification"]);
   CHECK(slurp(whole / "verify_decay.csv") == slurp(parts / "verify_decay.csv"));
 }
+
+// Reference: the uninterrupted pdamp dem of the shipped case. Its checkpoints come at period
+// ends (--checkpoint-interval 0: every one); SIGTERM after the first, --resume to the end:
+// the same time series and result (η*, its error, apparent mass, energy balance, mode).
+TEST_CASE("pdamp dem killed at a checkpoint and resumed equals the uninterrupted run", "[cli][dem_reference]") {
+  const TempDir dir("checkpoint_dem");
+  const std::string c = case_path("low_intensity_36_spheres.json");
+  const fs::path whole = dir.path / "whole", parts = dir.path / "parts";
+  const auto reference = run_pdamp({"dem", c, "-o", whole.string(), "--json"});
+  INFO(reference.err);
+  REQUIRE(reference.exit_code == 0);
+  RunOptions options;
+  options.while_running = [&](pid_t pid) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(parts / "dem.checkpoint") && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ::kill(pid, SIGTERM);
+  };
+  const auto killed = run_pdamp({"dem", c, "-o", parts.string(), "--json", "--checkpoint-interval", "0"}, options);
+  INFO(killed.err);
+  REQUIRE(killed.exit_code == 128 + SIGTERM);
+  CHECK_THAT(killed.err, Catch::Contains("wrote " + (parts / "dem.checkpoint").string()));
+  const auto resumed = run_pdamp({"dem", c, "-o", parts.string(), "--json", "--resume"});
+  INFO(resumed.err);
+  REQUIRE(resumed.exit_code == 0);
+  CHECK_FALSE(fs::exists(parts / "dem.checkpoint"));
+  CHECK(slurp(whole / "time_series.csv") == slurp(parts / "time_series.csv"));
+  json a = json::parse(reference.out), b = json::parse(resumed.out);
+  for (json* j : {&a, &b})
+    for (const char* key : {"files", "particle_steps_per_s", "run", "wall_time_s"}) j->erase(key);
+  CHECK(a == b);
+  // Another stroke is another run: its checkpoint is not this one's.
+  const auto again = run_pdamp({"dem", c, "-o", parts.string(), "--checkpoint-interval", "0"}, options);
+  REQUIRE(again.exit_code == 128 + SIGTERM);
+  require_one_line_error(run_pdamp({"dem", c, "--amplitude", "0.05", "-o", parts.string(), "--resume"}),
+                         "dem.checkpoint: /settings");
+}

@@ -209,3 +209,64 @@ TEST_CASE("a checkpoint file carries its header and refuses damage", "[dem_refer
   CHECK_THROWS_AS(dr::decode_checkpoint(extra_key, "f"), InputError);
   CHECK_THROWS_WITH(dr::decode_checkpoint("PDAMP-CHECKPOINT 1\n{\"kind\":", "f"), Catch::Contains("f: "));
 }
+
+// Reference: the uninterrupted harmonic run of the same options. Stopped at a checkpoint in
+// its transient and again in its analysis, each time resumed from the bytes written (as a
+// new process would), the run's measures, series, snapshots and counters are the same bits.
+TEST_CASE("a harmonic run stopped at checkpoints and resumed equals the uninterrupted run", "[dem_reference]") {
+  dr::DamperSimulationOptions o = dem_test::shipped_layer(0.5, 0.8, 0.3, 0.0, 1000.0);
+  o.transient_periods = 2;
+  o.analysed_periods = 3;
+  o.samples_per_period = 64;
+  o.snapshots = 4;
+  const dr::DamperResult whole = dr::run_harmonic(o);
+  REQUIRE(whole.summary.outcome == dr::Outcome::kCompleted);
+
+  std::string state;
+  double written_at = 0.0;
+  int checkpoints = 0;
+  dr::HarmonicCheckpoints hook;
+  hook.due = [] { return true; };  // every period end
+  hook.write = [&](const std::string& bytes, double t) {
+    state = bytes;
+    written_at = t;
+    ++checkpoints;
+  };
+  // The first run stops at its first checkpoint (the transient's first period end; none is
+  // written at the transient's end), the second at its second (the analysis' second period
+  // end, after one at its first), the third runs to the end (none at the run's end).
+  int stops_left = 1;
+  hook.stop = [&] { return --stops_left == 0; };
+  const dr::DamperResult first = dr::run_harmonic(o, {}, &hook);
+  CHECK(first.stopped);
+  CHECK(written_at == Approx(1.0 / o.frequency_hz).epsilon(1e-9));
+  hook.resume_state = state;
+  stops_left = 2;
+  const dr::DamperResult second = dr::run_harmonic(o, {}, &hook);
+  CHECK(second.stopped);
+  CHECK(written_at == Approx(4.0 / o.frequency_hz).epsilon(1e-9));  // in the analysis
+  hook.resume_state = state;
+  stops_left = 1000;
+  const dr::DamperResult last = dr::run_harmonic(o, {}, &hook);
+  REQUIRE_FALSE(last.stopped);
+  REQUIRE(last.summary.outcome == dr::Outcome::kCompleted);
+  CHECK(last.eta_star == whole.eta_star);
+  CHECK(last.eta_star_stderr == whole.eta_star_stderr);
+  CHECK(last.e_diss_j == whole.e_diss_j);
+  CHECK(last.apparent_mass_kg == whole.apparent_mass_kg);
+  CHECK(last.energy_balance_error == whole.energy_balance_error);
+  CHECK(last.motion_mode == whole.motion_mode);
+  CHECK(last.eta_star_per_period == whole.eta_star_per_period);
+  CHECK(last.series.force_n == whole.series.force_n);
+  CHECK(last.series.bed_relative_position_m == whole.series.bed_relative_position_m);
+  CHECK(last.summary.steps == whole.summary.steps);
+  REQUIRE(last.snapshots.size() == whole.snapshots.size());
+  CHECK(last.snapshots.back().positions_m == whole.snapshots.back().positions_m);
+  CHECK(checkpoints == 3);
+
+  // A state of other options is refused naming the field.
+  dr::DamperSimulationOptions other = o;
+  other.analysed_periods = 1;
+  hook.resume_state = state;
+  CHECK_THROWS_WITH(dr::run_harmonic(other, {}, &hook), Catch::Contains("step"));
+}

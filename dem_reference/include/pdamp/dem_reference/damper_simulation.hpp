@@ -100,6 +100,23 @@ struct DamperResult {
   TimeSeries series;
   std::vector<ParticleSnapshot> snapshots;
   std::vector<std::string> warnings;   ///< validity-range remarks (INTERFACE.md)
+  /// The checkpoint hook asked the run to stop (HarmonicCheckpoints::stop) after it wrote
+  /// its state: the measures are unset, the run continues from that state.
+  bool stopped = false;
+};
+
+/// Checkpoints of a harmonic run (issue 13 §4, docs/dem.md "Checkpoints"). At the end of
+/// every drive period of the transient and the analysis the run asks `due()`; when it says
+/// so, the run passes its whole state to `write` (the World, the step, the motion-mode sums
+/// and, once analysing, the drive bin, the energy ledger's opening and the recorded series
+/// and snapshots) and then asks `stop()`: true ends the run there (DamperResult::stopped).
+/// With `resume_state` (bytes an earlier run of the same options wrote) the run starts
+/// there instead of settling: its result is bit for bit the uninterrupted run's.
+struct HarmonicCheckpoints {
+  std::function<bool()> due;
+  std::function<bool()> stop;
+  std::function<void(const std::string& state, double simulated_time_s)> write;
+  std::string resume_state;
 };
 
 /// Progress of a run: once at the start ("setup", before the world is built, with the
@@ -167,8 +184,10 @@ void check_initial_placement(const DamperSimulationOptions& options);
 /// line; particles that do not fit name the numbers). A detected instability returns
 /// with summary.outcome = kUnstable and advice in summary.message (measures unset); a
 /// failure during a step (e.g. a restitution model that throws, on any thread) returns
-/// with kFailed and the exception's message.
+/// with kFailed and the exception's message. A resume_state that does not fit the options
+/// throws std::invalid_argument naming the field.
 DamperResult run_harmonic(const DamperSimulationOptions& options,
-                          const ProgressCallback& progress = {});
+                          const ProgressCallback& progress = {},
+                          const HarmonicCheckpoints* checkpoints = nullptr);
 
 }  // namespace pdamp::dem_reference

@@ -95,6 +95,10 @@ class MotionModeAccumulator {
   /// block ends (its whole periods), the measures and the reference drive.
   MotionIndicators indicators(const BlockRecorder& recorder, const DriveBinMeasures& measures,
                               const MotionReference& drive) const;
+  /// Checkpoints (checkpoint.hpp): the settled reference and the sums over the blocks so
+  /// far; restore throws std::invalid_argument for another bed (sphere count) or non-finite sums.
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
 
  private:
   Vec3 axis_;

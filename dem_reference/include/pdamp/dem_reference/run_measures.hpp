@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/formulas/complex_power.hpp"
 
@@ -37,6 +38,7 @@ class EnergyLedger {
   explicit EnergyLedger(const EnergyAccount& opening) : opening_(opening) {}
   /// The balance from the opening to `now` (World::energy() at the window's end).
   EnergyBalance balance(const EnergyAccount& now) const;
+  const EnergyAccount& opening() const { return opening_; }
 
  private:
   EnergyAccount opening_;
@@ -76,6 +78,11 @@ class DriveBinMeasure {
   /// The measures over the completed periods (a period in progress does not count).
   /// Throws std::invalid_argument before the first period is complete.
   DriveBinMeasures result() const;
+  /// Checkpoints at a period's end (checkpoint.hpp): the completed periods' sums and η*.
+  /// restore throws std::invalid_argument for a state that does not fit (a period in
+  /// progress, non-finite sums, a sample count that is not whole periods).
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
 
  private:
   double frequency_hz_;

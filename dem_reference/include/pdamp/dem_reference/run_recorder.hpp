@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/world.hpp"
 
@@ -69,6 +70,11 @@ class BlockRecorder {
   const TimeSeries& series() const { return series_; }
   /// Drive times of the block ends, where the bed's instantaneous samples are taken, s.
   const std::vector<double>& sample_times_s() const { return sample_times_s_; }
+  /// Checkpoints at a block's end (checkpoint.hpp): the step, the series and the snapshots
+  /// so far. restore throws std::invalid_argument for a state of another recorder (more
+  /// blocks or snapshots than its options hold, a block in progress, non-finite values).
+  void save(StateWriter& out) const;
+  void restore(StateReader& in);
   /// Moves the series and the snapshots out (the recorder is spent afterwards).
   TimeSeries take_series() { return std::move(series_); }
   std::vector<ParticleSnapshot> take_snapshots() { return std::move(snapshots_); }

@@ -83,6 +83,17 @@ class DriveBinAccumulator {
   void merge(const DriveBinAccumulator& other);
   void clear();
   std::int64_t samples() const { return samples_; }
+  /// The sums so far (a checkpoint of a run between periods): the step phase is not in
+  /// them, so restore_sums continues exactly only when the next add() starts a new run of
+  /// steps (after clear(), or on an accumulator only merged into).
+  struct Sums {
+    std::complex<double> force{0.0, 0.0};
+    std::complex<double> velocity{0.0, 0.0};
+    double max_abs_velocity = 0.0;
+    std::int64_t samples = 0;
+  };
+  Sums sums() const { return {force_sum_, velocity_sum_, max_abs_velocity_, samples_}; }
+  void restore_sums(const Sums& sums);
   /// The measures at frequency_hz from the sums so far. Throws std::invalid_argument
   /// unless the samples are a positive whole number of periods, are finite, and the
   /// velocity has a component at Ω (the rules of complex_power()).
