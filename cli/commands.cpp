@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "distributed.hpp"
 #include "errors.hpp"
 #include "limits.hpp"
 #include "output.hpp"
@@ -723,7 +724,8 @@ std::string check_dem_field(const Case& c, std::size_t damper, const surrogate::
   const double per_node = static_cast<double>(grid.size()) / static_cast<double>(evaluated);
   wall_time_s *= per_node;
   particle_steps *= per_node;
-  const double at_once = std::min<double>(c.field.threads, static_cast<double>(grid.size()));
+  const double at_once = std::min<double>(distributed::ranks() > 1 ? distributed::ranks() : c.field.threads,
+                                          static_cast<double>(grid.size()));
   const double available = available_memory_bytes();
   if (at_once * static_cast<double>(largest.memory_bytes) > available) refuse_memory(c, damper, largest, at_once, available);
   std::size_t pending = grid.size();
@@ -737,6 +739,11 @@ std::string check_dem_field(const Case& c, std::size_t damper, const surrogate::
          format_number(share * particle_steps, 3) + " particle-steps, about " +
          format_number(share * wall_time_s / at_once, 2) + " s with " + format_number(at_once, 3) +
          " points at once; memory about " + megabytes(at_once * static_cast<double>(largest.memory_bytes));
+}
+
+/// ", spread over N MPI ranks" for a sweep's first line under mpirun, else "".
+std::string distributed_note() {
+  return distributed::ranks() > 1 ? ", spread over " + std::to_string(distributed::ranks()) + " MPI ranks" : "";
 }
 
 /// The DEM sweep's results log, written point by point into the output folder (resume).
@@ -790,6 +797,13 @@ std::string default_field_dir(const Case& c, const std::string& source) {
   return "out/" + safe + "_field_" + source;
 }
 
+/// The case file as given, copied into a shard's folder: the merge reads it back (its
+/// physics hash is the shards').
+void copy_shard_case(OutputDir& files, const Case& c) {
+  std::ifstream in(c.path, std::ios::binary);
+  files.add(kShardCase, std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+}
+
 int run_field(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
   const SingleDamper single = single_damper(c, "pdamp field");
@@ -809,6 +823,7 @@ int run_field(const ParsedArgs& args) {
     dir = default_field_dir(c, source);
   }
   if (source == "measured") {
+    if (distributed::worker()) return kExitOk;  // rank 0 imports it
     OutputDir files(dir);
     return import_measured_field(args, c, files);
   }
@@ -832,17 +847,6 @@ int run_field(const ParsedArgs& args) {
       throw InputError(c.path, "/field", e.what());
     }
   }
-  OutputDir files(dir);
-  if (!sweep.results_path.empty()) files.in_place(kSweepLog);
-  if (dem) {
-    std::cerr << "pdamp field: " << estimate << (sharded ? " (shard " + args.text("--shard") + ")" : "") << std::endl;
-    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
-      std::lock_guard lock(progress_mutex);
-      std::cerr << (tty ? "\r" : "") << "pdamp field: " << done << "/" << total << " points";
-      if (std::isfinite(eta_s)) std::cerr << ", ETA " << static_cast<long>(eta_s) << " s";
-      std::cerr << (tty ? "   " : "\n") << std::flush;
-    };
-  }
   surrogate::PointEvaluator evaluator;
   if (dem) {
     auto options = case_file::dem_options(c, 0, 1.0, 1.0);
@@ -852,20 +856,37 @@ int run_field(const ParsedArgs& args) {
     evaluator = surrogate::formula_evaluator(single.damper.model, single.layer.clearance_m, single.layer.bed_mass_kg,
                                              single.damper.model_options);
   }
-  const auto result = surrogate::run_sweep(grid, evaluator, sweep);
+  distributed::PointFarm farm([&](const distributed::Request& r) { return evaluator(r[0], r[1]); });
+  if (distributed::worker()) {  // every check passed here too: evaluate what rank 0 sends
+    farm.serve();
+    return kExitOk;
+  }
+  sweep.threads = farm.threads(sweep.threads);
+  OutputDir files(dir);
+  if (!sweep.results_path.empty()) files.in_place(kSweepLog);
+  if (dem) {
+    std::cerr << "pdamp field: " << estimate << (sharded ? " (shard " + args.text("--shard") + ")" : "")
+              << distributed_note() << std::endl;
+    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
+      std::lock_guard lock(progress_mutex);
+      std::cerr << (tty ? "\r" : "") << "pdamp field: " << done << "/" << total << " points";
+      if (std::isfinite(eta_s)) std::cerr << ", ETA " << static_cast<long>(eta_s) << " s";
+      std::cerr << (tty ? "   " : "\n") << std::flush;
+    };
+  }
+  const auto result = surrogate::run_sweep(
+      grid, [&](double f, double x) { return farm.evaluate({f, x}); }, sweep);
   if (dem && tty) std::cerr << "\n";
 
   json out = {{"sweep", result.summary.brief_report()}, {"warnings", result.summary.warnings}};
+  if (const json balance = farm.balance(); !balance.is_null()) out["mpi"] = balance;
   if (!sharded) return write_field_outputs(args, c, result.field, files, out);
   // A shard has no field of its own: its log waits for pdamp field merge.
   const std::string shard = std::to_string(shard_index) + "/" + std::to_string(shard_count);
   out.update({{"source", source}, {"shard", shard}, {"points", result.summary.points_total},
               {"points_in_grid", grid.size()}, {"file", (files.dir() / kSweepLog).string()}});
   files.add_json(kShardSummary, out);
-  {  // the case as given, which pdamp field merge DIR... reads back (its physics hash is the shards')
-    std::ifstream in(c.path, std::ios::binary);
-    files.add(kShardCase, std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
-  }
+  copy_shard_case(files, c);
   out["files"] = files.commit();
   print_warnings(result.summary.warnings);
   std::vector<std::pair<std::string, std::string>> rows = {
@@ -945,23 +966,102 @@ std::vector<std::string> write_sensitivity_files(OutputDir& files, const Case& c
   return files.add_plot("sensitivity.gp", gp.str(), {"sensitivity.png", "sensitivity.svg"});
 }
 
+/// A sensitivity study of a case: its drive, its variants and the sweep's points.
+struct SensitivityStudy {
+  double frequency_hz = 0.0, amplitude_m = 0.0;
+  std::vector<case_file::SensitivityVariant> variants;
+  surrogate::SweepPoints points;
+  std::vector<std::string> warnings;
+};
+
+SensitivityStudy sensitivity_study(const Case& c) {
+  (void)single_damper(c, "pdamp sensitivity");  // one damper of one layer, refused otherwise
+  SensitivityStudy study;
+  std::tie(study.frequency_hz, study.amplitude_m) = sensitivity_drive(c);
+  study.variants = case_file::sensitivity_variants(c, study.warnings);
+  study.points.identity = json::array();
+  for (const auto& v : study.variants) {
+    study.points.drives.push_back({study.frequency_hz, study.amplitude_m});
+    study.points.identity.push_back({{"parameter", v.parameter}, {"value", v.value}});
+  }
+  return study;
+}
+
+std::string sensitivity_source(const ParsedArgs& args, const std::string& fallback) {
+  const std::string source = args.optional_text("--source").value_or(fallback);
+  if (source != "formulas" && source != "dem") throw InputError("--source", "", "'" + source + "': must be dem or formulas");
+  return source;
+}
+
+/// The table, CSV, tornado plot and JSON of a study's points (a run's, a shard's or a merge's).
+int write_sensitivity_outputs(const ParsedArgs& args, const Case& c, const SensitivityStudy& study,
+                              const surrogate::PointSweepResult& result, const std::string& source, OutputDir& files,
+                              json out) {
+  const double f = study.frequency_hz, x = study.amplitude_m;
+  std::vector<std::string> warnings = study.warnings;
+  warnings.insert(warnings.end(), result.summary.warnings.begin(), result.summary.warnings.end());
+  const auto nullable = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  const surrogate::FieldPoint& base = result.points.front();
+  json rows = json::array();
+  for (std::size_t k = 0; k < study.variants.size(); ++k) {
+    const auto& v = study.variants[k];
+    const auto& p = result.points[k];
+    const SingleDamper d = single_damper(v.variant, "pdamp sensitivity");
+    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, d.damper.model_options);
+    const bool ok = p.status == surrogate::PointStatus::kOk;
+    rows.push_back({{"parameter", v.parameter},
+                    {"value", k == 0 ? json(nullptr) : json(v.value)},
+                    {"unit", v.unit},
+                    {"status", std::string(surrogate::to_string(p.status))},
+                    {"eta_star", ok ? nullable(p.eta_star) : json(nullptr)},
+                    {"eta_star_stderr", ok ? nullable(p.eta_star_stderr) : json(nullptr)},
+                    {"delta_eta_star", ok && base.status == surrogate::PointStatus::kOk ? nullable(p.eta_star - base.eta_star)
+                                                                                         : json(nullptr)},
+                    {"motion_mode", p.motion_mode},
+                    {"apparent_mass_fraction", nullable(p.apparent_mass_fraction)},
+                    {"closed_form_eta_star", nullable(closed.eta_star)},
+                    {"closed_form_regime", std::string(fm::to_string(closed.regime))},
+                    {"clearance_m", d.layer.clearance_m},
+                    {"bed_mass_kg", d.layer.bed_mass_kg},
+                    {"intensity", x * std::pow(2.0 * fm::kPi * f, 2) / fm::kStandardGravity}});
+  }
+  out.update({{"case", c.name},
+              {"source", source},
+              {"frequency_hz", f},
+              {"amplitude_m", x},
+              {"rows", rows},
+              {"file", (files.dir() / "sensitivity.json").string()}});
+  const double baseline_eta = base.status == surrogate::PointStatus::kOk ? base.eta_star : NAN;
+  for (auto& w : write_sensitivity_files(files, c, rows, baseline_eta)) warnings.push_back(w);
+  out["warnings"] = warnings;
+  files.add_json("case_resolved.json", c.resolved);
+  files.add_json("sensitivity.json", out);
+  out["outputs"] = files.commit();
+  print_warnings(warnings);
+  std::vector<std::pair<std::string, std::string>> table = {
+      {"case", c.name}, {"drive", "f = " + format_number(f) + " Hz, X = " + format_number(x) + " m"},
+      {"sweep", out["sweep"].get<std::string>()}};
+  for (const auto& r : rows) {
+    std::string line = r["eta_star"].is_number() ? format_number(r["eta_star"].get<double>(), 4) : std::string("-");
+    if (r["eta_star_stderr"].is_number()) line += " +- " + format_number(r["eta_star_stderr"].get<double>(), 2);
+    line += "  " + r["motion_mode"].get<std::string>();
+    if (r["closed_form_eta_star"].is_number()) line += "  (closed form " + format_number(r["closed_form_eta_star"].get<double>(), 4) + ")";
+    const std::string name = r["parameter"].get<std::string>();
+    table.push_back({name == "baseline" ? name : name + " = " + format_number(r["value"].get<double>(), 5), line});
+  }
+  for (const auto& path : out["outputs"]) table.push_back({"wrote", path.get<std::string>()});
+  return emit(args, out, table, false);
+}
+
 int run_sensitivity(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
-  (void)single_damper(c, "pdamp sensitivity");  // one damper of one layer, refused otherwise
-  const std::string source = args.optional_text("--source").value_or("dem");
-  if (source != "formulas" && source != "dem") throw InputError("--source", "", "'" + source + "': must be dem or formulas");
+  const std::string source = sensitivity_source(args, "dem");
   const bool dem = source == "dem";
-  const auto [f, x] = sensitivity_drive(c);
-  std::vector<std::string> warnings;
-  const auto variants = case_file::sensitivity_variants(c, warnings);
+  const SensitivityStudy study = sensitivity_study(c);
+  const double f = study.frequency_hz, x = study.amplitude_m;
+  const auto& variants = study.variants;
   const std::string dir = args.optional_text("-o").value_or("out/" + safe_file_name(c.name) + "_sensitivity");
 
-  surrogate::SweepPoints points;
-  points.identity = json::array();
-  for (const auto& v : variants) {
-    points.drives.push_back({f, x});
-    points.identity.push_back({{"parameter", v.parameter}, {"value", v.value}});
-  }
   surrogate::SweepOptions sweep = field_sweep_options(c, source);
   sweep.threads = dem ? (c.sensitivity ? c.sensitivity->threads : c.field.threads) : 1;
   const auto [shard_index, shard_count] = shard_flag(args);
@@ -989,10 +1089,17 @@ int run_sensitivity(const ParsedArgs& args) {
   }
   std::size_t pending = 0;
   try {
-    pending = surrogate::pending_point_sweep(points, sweep);
+    pending = surrogate::pending_point_sweep(study.points, sweep);
   } catch (const std::invalid_argument& e) {
     throw InputError(c.path, "/sensitivity", e.what());
   }
+  distributed::PointFarm farm(
+      [&](const distributed::Request& r) { return evaluators.at(static_cast<std::size_t>(r[0]))(f, x); });
+  if (distributed::worker()) {  // every check passed here too: evaluate what rank 0 sends
+    farm.serve();
+    return kExitOk;
+  }
+  sweep.threads = farm.threads(sweep.threads);
   OutputDir files(dir);
   if (!sweep.results_path.empty()) files.in_place(kSensitivityLog);
   std::mutex progress_mutex;
@@ -1004,7 +1111,7 @@ int run_sensitivity(const ParsedArgs& args) {
               << format_number(particle_steps * static_cast<double>(pending) / static_cast<double>(variants.size()), 3)
               << " particle-steps, " << format_number(wall_time_s * static_cast<double>(pending) /
                                                       static_cast<double>(variants.size()) / at_once, 3)
-              << " s on " << at_once << " threads" << std::endl;
+              << " s on " << at_once << " threads" << distributed_note() << std::endl;
     sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
       std::lock_guard lock(progress_mutex);
       std::cerr << (tty ? "\r" : "") << "pdamp sensitivity: " << done << "/" << total << " runs";
@@ -1013,66 +1120,17 @@ int run_sensitivity(const ParsedArgs& args) {
     };
   }
   const auto result = surrogate::run_point_sweep(
-      points, [&](std::size_t k) { return evaluators[k](f, x); }, sweep);
+      study.points, [&](std::size_t k) { return farm.evaluate({static_cast<double>(k), 0.0}); }, sweep);
   if (dem && tty) std::cerr << "\n";
-  warnings.insert(warnings.end(), result.summary.warnings.begin(), result.summary.warnings.end());
 
-  const auto nullable = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  const surrogate::FieldPoint& base = result.points.front();
-  json rows = json::array();
-  for (std::size_t k = 0; k < variants.size(); ++k) {
-    const auto& v = variants[k];
-    const auto& p = result.points[k];
-    const SingleDamper d = single_damper(v.variant, "pdamp sensitivity");
-    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, d.damper.model_options);
-    const bool ok = p.status == surrogate::PointStatus::kOk;
-    rows.push_back({{"parameter", v.parameter},
-                    {"value", k == 0 ? json(nullptr) : json(v.value)},
-                    {"unit", v.unit},
-                    {"status", std::string(surrogate::to_string(p.status))},
-                    {"eta_star", ok ? nullable(p.eta_star) : json(nullptr)},
-                    {"eta_star_stderr", ok ? nullable(p.eta_star_stderr) : json(nullptr)},
-                    {"delta_eta_star", ok && base.status == surrogate::PointStatus::kOk ? nullable(p.eta_star - base.eta_star)
-                                                                                         : json(nullptr)},
-                    {"motion_mode", p.motion_mode},
-                    {"apparent_mass_fraction", nullable(p.apparent_mass_fraction)},
-                    {"closed_form_eta_star", nullable(closed.eta_star)},
-                    {"closed_form_regime", std::string(fm::to_string(closed.regime))},
-                    {"clearance_m", d.layer.clearance_m},
-                    {"bed_mass_kg", d.layer.bed_mass_kg},
-                    {"intensity", x * std::pow(2.0 * fm::kPi * f, 2) / fm::kStandardGravity}});
-  }
-  json out = {{"case", c.name},
-              {"source", source},
-              {"frequency_hz", f},
-              {"amplitude_m", x},
-              {"rows", rows},
-              {"sweep", result.summary.brief_report()},
-              {"file", (files.dir() / "sensitivity.json").string()}};
+  json out = {{"sweep", result.summary.brief_report()}};
+  if (const json balance = farm.balance(); !balance.is_null()) out["mpi"] = balance;
   if (args.has("--shard")) {
     out["shard"] = args.text("--shard");
-    out["note"] = "a shard's rows are its own variants; the other shards' are missing";
+    out["note"] = "a shard's rows are its own variants; the other shards' are missing (join them with pdamp sensitivity merge)";
+    copy_shard_case(files, c);
   }
-  const double baseline_eta = base.status == surrogate::PointStatus::kOk ? base.eta_star : NAN;
-  for (auto& w : write_sensitivity_files(files, c, rows, baseline_eta)) warnings.push_back(w);
-  out["warnings"] = warnings;
-  files.add_json("case_resolved.json", c.resolved);
-  files.add_json("sensitivity.json", out);
-  out["outputs"] = files.commit();
-  print_warnings(warnings);
-  std::vector<std::pair<std::string, std::string>> table = {
-      {"case", c.name}, {"drive", "f = " + format_number(f) + " Hz, X = " + format_number(x) + " m"},
-      {"sweep", out["sweep"].get<std::string>()}};
-  for (const auto& r : rows) {
-    std::string line = r["eta_star"].is_number() ? format_number(r["eta_star"].get<double>(), 4) : std::string("-");
-    if (r["eta_star_stderr"].is_number()) line += " +- " + format_number(r["eta_star_stderr"].get<double>(), 2);
-    line += "  " + r["motion_mode"].get<std::string>();
-    if (r["closed_form_eta_star"].is_number()) line += "  (closed form " + format_number(r["closed_form_eta_star"].get<double>(), 4) + ")";
-    const std::string name = r["parameter"].get<std::string>();
-    table.push_back({name == "baseline" ? name : name + " = " + format_number(r["value"].get<double>(), 5), line});
-  }
-  for (const auto& path : out["outputs"]) table.push_back({"wrote", path.get<std::string>()});
-  return emit(args, out, table, false);
+  return write_sensitivity_outputs(args, c, study, result, source, files, out);
 }
 
 /// The "source" of a shard log's header line (formulas or dem), for a merge not told it.
@@ -1080,14 +1138,79 @@ std::string shard_log_source(const std::filesystem::path& log) {
   std::ifstream in(log);
   std::string header;
   if (!in || !std::getline(in, header))
-    throw InputError(log.string(), "", "cannot be read (a shard's field_sweep.jsonl, or its folder)");
+    throw InputError(log.string(), "", "cannot be read (a shard's sweep log, or its folder)");
   try {
     const json h = json::parse(header);
     const std::string source = h.at("source").get<std::string>();
     if (source == "formulas" || source == "dem") return source;
   } catch (const std::exception&) {
   }
-  throw InputError(log.string(), "line 1", "is not the header of a pdamp field sweep log (source formulas or dem)");
+  throw InputError(log.string(), "line 1", "is not the header of a pdamp sweep log (source formulas or dem)");
+}
+
+/// The inputs of a merge (pdamp field merge, pdamp sensitivity merge): the case (given
+/// first, else the first shard folder's shard_case.json) and the shards' logs (a folder
+/// stands for the log `log_name` in it).
+struct MergeInputs {
+  std::filesystem::path case_path;
+  std::vector<std::filesystem::path> logs;
+};
+
+MergeInputs merge_inputs(const ParsedArgs& args, const std::string& command, const std::string& log_name) {
+  const auto& positional = args.positional();
+  std::error_code error;
+  const auto shard_log = [&](const std::filesystem::path& given) {  // a folder is what a job array leaves
+    return std::filesystem::is_directory(given, error) ? given / log_name : given;
+  };
+  const std::filesystem::path first = positional.at(0);
+  const bool case_given = first.extension() == ".json" && std::filesystem::is_regular_file(first, error);
+  const std::size_t first_shard = case_given ? 1 : 0;
+  if (first_shard >= positional.size())
+    throw InputError(command, "", "no shard given: " + command + " SHARD_DIR... (or CASE.json SHARD...)");
+  MergeInputs inputs{first, {}};
+  if (!case_given) {
+    inputs.case_path = shard_log(first).parent_path() / kShardCase;
+    if (!std::filesystem::is_regular_file(inputs.case_path, error))
+      throw InputError(first.string(), "", std::string("holds no ") + kShardCase + " (a shard's folder has one): " +
+                                           "give the case first, " + command + " CASE.json SHARD...");
+  }
+  for (std::size_t k = first_shard; k < positional.size(); ++k) inputs.logs.push_back(shard_log(positional[k]));
+  return inputs;
+}
+
+/// Refuses a merge's output folder that holds a shard's log: committing there would
+/// replace that shard's files (OutputDir drops what the previous run wrote), the log included.
+void refuse_output_in_shard(const MergeInputs& inputs, const std::string& dir) {
+  std::error_code error;
+  const auto out_dir = std::filesystem::weakly_canonical(dir, error);
+  for (const auto& log : inputs.logs) {
+    if (!out_dir.empty() && std::filesystem::weakly_canonical(log, error).parent_path() == out_dir)
+      throw InputError("-o", "", "'" + dir + "' holds the shard file " + log.string() +
+                                     ": merge into another folder (the merge would replace the shard's files)");
+  }
+}
+
+/// `pdamp sensitivity merge SHARD...`: the shards of one study joined into the table a
+/// serial pdamp sensitivity writes.
+int run_sensitivity_merge(const ParsedArgs& args) {
+  const auto inputs = merge_inputs(args, "pdamp sensitivity merge", kSensitivityLog);
+  const Case c = case_file::load_case(inputs.case_path.string());
+  const std::string dir = args.optional_text("-o").value_or("out/" + safe_file_name(c.name) + "_sensitivity");
+  refuse_output_in_shard(inputs, dir);
+  const std::string source = sensitivity_source(args, shard_log_source(inputs.logs.front()));
+  const SensitivityStudy study = sensitivity_study(c);
+  OutputDir files(dir);
+  surrogate::PointSweepResult result;
+  try {
+    result = surrogate::merge_point_sweep_shards(study.points, field_sweep_options(c, source), inputs.logs, c.path);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());  // names the files already
+  }
+  json out = {{"sweep", "merged " + std::to_string(inputs.logs.size()) + " shard files: " +
+                            std::to_string(result.summary.points_total) + " variants (" +
+                            std::to_string(result.summary.points_failed) + " failed)"},
+              {"shards", inputs.logs.size()}};
+  return write_sensitivity_outputs(args, c, study, result, source, files, out);
 }
 
 /// `pdamp field merge SHARD...` (INTERFACE.md): the shards' logs joined into the field a
@@ -1096,41 +1219,16 @@ std::string shard_log_source(const std::filesystem::path& log) {
 /// shard folder's shard_case.json (the case file the shard ran, copied), the source its log's; `pdamp field merge CASE.json
 /// [--source SRC] SHARD...` names them instead.
 int run_field_merge(const ParsedArgs& args) {
-  const auto& positional = args.positional();
-  std::error_code error;
-  const auto shard_log = [&](const std::filesystem::path& given) {  // a folder is what a job array leaves
-    return std::filesystem::is_directory(given, error) ? given / kSweepLog : given;
-  };
-  const std::filesystem::path first = positional.at(0);
-  const bool case_given = first.extension() == ".json" && std::filesystem::is_regular_file(first, error);
-  const std::size_t first_shard = case_given ? 1 : 0;
-  if (first_shard >= positional.size())
-    throw InputError("pdamp field merge", "", "no shard given: pdamp field merge SHARD_DIR... (or CASE.json SHARD...)");
-  std::filesystem::path case_path = first;
-  if (!case_given) {
-    case_path = shard_log(first).parent_path() / kShardCase;
-    if (!std::filesystem::is_regular_file(case_path, error))
-      throw InputError(first.string(), "", std::string("holds no ") + kShardCase + " (a folder of pdamp field --shard I/N has one): "
-                                           "give the case first, pdamp field merge CASE.json SHARD...");
-  }
-  const Case c = case_file::load_case(case_path.string());
+  const auto inputs = merge_inputs(args, "pdamp field merge", kSweepLog);
+  const Case c = case_file::load_case(inputs.case_path.string());
   (void)single_damper(c, "pdamp field merge");
-  const std::string source = args.optional_text("--source").value_or(shard_log_source(shard_log(positional.at(first_shard))));
+  const std::string source = args.optional_text("--source").value_or(shard_log_source(inputs.logs.front()));
   if (source != "formulas" && source != "dem")
     throw InputError("--source", "", "'" + source + "': must be formulas or dem (the source the shards ran)");
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
   const std::string dir = args.optional_text("-o").value_or(default_field_dir(c, source));
-  std::vector<std::filesystem::path> logs;
-  const auto out_dir = std::filesystem::weakly_canonical(dir, error);
-  for (std::size_t k = first_shard; k < positional.size(); ++k) {
-    const std::filesystem::path log = shard_log(positional[k]);
-    // Committing into a shard's folder would replace that shard's files (OutputDir
-    // drops what the previous run wrote), the log included.
-    if (!out_dir.empty() && std::filesystem::weakly_canonical(log, error).parent_path() == out_dir)
-      throw InputError("-o", "", "'" + dir + "' holds the shard file " + log.string() +
-                                     ": merge into another folder (the merge would replace the shard's files)");
-    logs.push_back(log);
-  }
+  refuse_output_in_shard(inputs, dir);
+  const auto& logs = inputs.logs;
   OutputDir files(dir);
   surrogate::SweepResult result;
   try {
@@ -1281,7 +1379,7 @@ const std::vector<Command>& commands() {
                        "                          field_table.csv, heat map and cuts (PNG, SVG); dem: also\n"
                        "                          field_sweep.jsonl (resume) and scattered_fit.json"},
          kJsonFlag}, 1},
-       run_field},
+       run_field, true},
       {{"sensitivity", "pdamp sensitivity CASE.json [--source dem|formulas] [--shard I/N] [-o DIR] [--json]",
         "eta* and the motion mode of the damper with one parameter changed at a time (friction,\n"
         "restitution, rolling friction, particle radius and count, Young's modulus, tilt about\n"
@@ -1293,7 +1391,7 @@ const std::vector<Command>& commands() {
                        "                          sensitivity.csv, sensitivity_tornado.csv, sensitivity.png/svg,\n"
                        "                          sensitivity_sweep.jsonl (resume)"},
          kJsonFlag}, 1},
-       run_sensitivity},
+       run_sensitivity, true},
       {{"field merge", "pdamp field merge SHARD_DIR... [-o DIR] [--json]  (or CASE.json [--source SRC] SHARD...)",
         "join the shards of one pdamp field --shard I/N sweep into its field (the same\n"
         "values as one serial run); refuses shards of another case, model version or grid.\n"
@@ -1304,6 +1402,14 @@ const std::vector<Command>& commands() {
                        "                          the outputs of pdamp field (field.json, pictures, ...)"},
          kJsonFlag}, 1, true},
        run_field_merge},
+      {{"sensitivity merge", "pdamp sensitivity merge SHARD_DIR... [-o DIR] [--json]  (or CASE.json [--source SRC] SHARD...)",
+        "join the shards of one pdamp sensitivity --shard I/N study into its table and tornado\n"
+        "plot (the same values as one serial run); refuses shards of another case, model\n"
+        "version or list of variants. SHARD: a shard's folder or its sensitivity_sweep.jsonl",
+        {{"--source", "SRC", "formulas or dem: the source the shards ran (default: the first shard log's)"},
+         {"-o", "DIR", "output folder (default out/<case name>_sensitivity), not a shard's"},
+         kJsonFlag}, 1, true},
+       run_sensitivity_merge},
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",

@@ -12,6 +12,9 @@ namespace pdamp::cli {
 struct Command {
   CommandSpec spec;
   std::function<int(const ParsedArgs&)> run;
+  /// Under mpirun (docs/distributed.md): the command runs on every rank, its sweep spread
+  /// over them by a distributed::PointFarm; otherwise it runs on rank 0 while the others wait.
+  bool every_rank = false;
 };
 
 /// Every subcommand, in the order `pdamp --help` lists them.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "distributed.hpp"
 #include "errors.hpp"
 #include "external_program.hpp"
 #include "pdamp/case_file/case_error.hpp"
@@ -16,7 +17,7 @@
 namespace {
 
 void print_overview() {
-  std::cout << "pdamp " << "0.1.0" << ": design and optimisation of particle dampers\n\n"
+  std::cout << "pdamp " << "0.1.0" << (pdamp::cli::distributed::built_with_mpi() ? " (MPI build)" : "") << ": design and optimisation of particle dampers\n\n"
             << "usage: pdamp <command> [options]   (pdamp <command> --help for its options)\n\ncommands:\n";
   for (const auto& command : pdamp::cli::commands()) {
     std::string name = "  " + command.spec.name;
@@ -30,6 +31,7 @@ void print_overview() {
 /// One error line on stderr (INTERFACE.md); the message is made printable so that a
 /// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
 int report(const char* what, int exit_code) {
+  pdamp::cli::distributed::note_failure(what);  // a worker rank tells rank 0 in its replies
   std::cerr << "pdamp: error: " << pdamp::strict_json::printable(what) << "\n";
   return exit_code;
 }
@@ -56,12 +58,11 @@ int finished(int exit_code) {
   return exit_code;
 }
 
-}  // namespace
 
-int main(int argc, char** argv) {
+
+/// The command `args` names, run; its exit code (INTERFACE.md).
+int run_command(const std::vector<std::string>& args) {
   using namespace pdamp::cli;
-  install_interrupt_handlers();
-  const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) return report("missing the command (usage: pdamp <command> [options]; see pdamp --help)", kExitBadInput);
   if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     print_overview();
@@ -83,6 +84,7 @@ int main(int argc, char** argv) {
       }
     }
     if (match == nullptr) throw InputError(args[0], "", "unknown command (see pdamp --help)");
+    if (distributed::worker() && !match->every_rank) return kExitOk;  // rank 0 runs it; this rank waits
     const ParsedArgs parsed(match->spec, std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(words), args.end()));
     if (parsed.help_requested()) {
       std::cout << help_text(match->spec);
@@ -105,4 +107,17 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return report(e.what(), kExitOther);
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pdamp::cli;
+  const distributed::Session mpi(&argc, &argv);  // under mpirun: until main returns
+  install_interrupt_handlers();
+  const int exit_code = run_command(std::vector<std::string>(argv + 1, argv + argc));
+  // Under mpirun rank 0 speaks for the run: another rank's failure reaches it in that
+  // rank's replies (distributed.hpp), and an exit code here would make mpirun kill rank 0
+  // while it reports the same bad input.
+  return distributed::worker() ? kExitOk : exit_code;
 }

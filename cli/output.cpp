@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "distributed.hpp"
 #include "errors.hpp"
 #include "external_program.hpp"
 #include "pdamp/strict_json/input_file.hpp"
@@ -92,6 +93,9 @@ void write_file_atomically(const fs::path& path, const std::string& content) {
 }
 
 OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
+  // Under mpirun only rank 0 writes (distributed.hpp); a worker reaching here is a bug
+  // that would race rank 0 for the same files.
+  if (distributed::worker()) throw std::logic_error("MPI rank " + std::to_string(distributed::rank()) + " tried to write " + dir_.string());
   const std::string shown = strict_json::printable(dir_.string());
   if (dir_.empty()) throw InputError(flag, "", "'': an empty path is not an output directory");
   std::error_code error;

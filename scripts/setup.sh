@@ -1,13 +1,23 @@
 #!/usr/bin/env bash
 # Install pdamp's build dependencies from Debian's packages (a no-op when all are
-# present), then configure and build into build/. Usage: scripts/setup.sh [build-dir]
+# present), then configure and build into build/. Usage: scripts/setup.sh [build-dir] [--mpi]
+# --mpi: also Open MPI, and a build whose sweeps spread over mpirun's ranks (docs/distributed.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build_dir=${1:-build}
+build_dir=build
+mpi=OFF
+for arg in "$@"; do
+  case "$arg" in
+    --mpi) mpi=ON ;;
+    -*) echo "setup: unknown option $arg (usage: scripts/setup.sh [build-dir] [--mpi])" >&2; exit 2 ;;
+    *) build_dir=$arg ;;
+  esac
+done
 
 packages=(build-essential cmake pkg-config libeigen3-dev libnlopt-cxx-dev
   coinor-libipopt-dev libfftw3-dev catch2 nlohmann-json3-dev libomp-dev
   gnuplot-nox libbenchmark-dev)
+[ "$mpi" = ON ] && packages+=(libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -20,5 +30,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
 
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# Without --mpi the folder keeps what it was configured with (a new one: no MPI).
+mpi_flag=(); [ "$mpi" = ON ] && mpi_flag=(-DPDAMP_MPI=ON)
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${mpi_flag[@]}" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"

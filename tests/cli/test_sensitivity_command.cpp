@@ -85,3 +85,35 @@ TEST_CASE("pdamp sensitivity refuses a bad source, a multi-damper case and a bad
   require_one_line_error(run_pdamp({"sensitivity", case_path("low_intensity_36_spheres.json"), "--shard", "3/2"}),
                          "--shard");
 }
+
+// Job arrays: the shards of a DEM study, merged, are the serial study to the bit (each
+// variant is one deterministic DEM run, wherever it runs).
+TEST_CASE("pdamp sensitivity merge joins the shards of a DEM study into the serial table", "[cli]") {
+  const TempDir dir("sensitivity_merge");
+  const std::string path = quick_study(dir);
+  const json serial = run_json({"sensitivity", path, "-o", (dir.path / "serial").string()});
+  for (const auto& [shard, folder] : {std::pair{"0/2", "s0"}, std::pair{"1/2", "s1"}}) {
+    const json part = run_json({"sensitivity", path, "--shard", shard, "-o", (dir.path / folder).string()});
+    CHECK(part["shard"] == shard);
+    CHECK(fs::exists(dir.path / folder / "shard_case.json"));
+  }
+  const json merged = run_json({"sensitivity", "merge", (dir.path / "s0").string(), (dir.path / "s1").string(), "-o",
+                                (dir.path / "merged").string()});
+  CHECK(merged["rows"] == serial["rows"]);
+  CHECK(merged["shards"] == 2);
+  CHECK(fs::exists(dir.path / "merged" / "sensitivity.png"));
+
+  // One shard missing, a shard's folder as the output, a shard of another study.
+  require_one_line_error(run_pdamp({"sensitivity", "merge", (dir.path / "s0").string(), "-o",
+                                    (dir.path / "m1").string()}), "missing");
+  require_one_line_error(run_pdamp({"sensitivity", "merge", (dir.path / "s0").string(), (dir.path / "s1").string(),
+                                    "-o", (dir.path / "s1").string()}), "holds the shard file");
+  std::ifstream in(path);
+  json other = json::parse(in);
+  other["sensitivity"]["parameters"][0]["values"] = {0.2};
+  const fs::path other_path = dir.path / "other.json";
+  std::ofstream(other_path) << other.dump(2);
+  (void)run_json({"sensitivity", other_path.string(), "--shard", "1/2", "-o", (dir.path / "t1").string()});
+  require_one_line_error(run_pdamp({"sensitivity", "merge", (dir.path / "s0").string(), (dir.path / "t1").string(),
+                                    "-o", (dir.path / "m2").string()}), "t1");
+}

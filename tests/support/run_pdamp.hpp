@@ -32,6 +32,8 @@ struct RunOptions {
   double time_limit_s = 120.0;                     ///< killed (exit_code -2) after this
   /// Called with the child's pid once it runs (e.g. to send it a signal); may be empty.
   std::function<void(pid_t)> while_running;
+  /// Added to the child's environment, "NAME=value" each.
+  std::vector<std::string> environment;
 };
 
 inline std::string slurp(const std::filesystem::path& path) {
@@ -39,14 +41,13 @@ inline std::string slurp(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-/// Runs PDAMP_BINARY with `args` (argv[1..], verbatim).
-inline RunResult run_pdamp(const std::vector<std::string>& args, const RunOptions& options = {}) {
+/// Runs the program argv_text[0] (a path) with argv_text[1..], verbatim.
+inline RunResult run_program(std::vector<std::string> argv_text, const RunOptions& options = {}) {
   static int counter = 0;
   const auto base = std::filesystem::temp_directory_path() /
                     ("pdamp_run_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
   const std::string out_file = base.string() + ".out", err_file = base.string() + ".err";
-  std::vector<std::string> argv_text{PDAMP_BINARY};
-  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<std::string> environment = options.environment;
   std::vector<char*> argv;
   for (auto& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -60,6 +61,7 @@ inline RunResult run_pdamp(const std::vector<std::string>& args, const RunOption
     const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (in < 0 || out < 0 || err < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(err, 2) < 0) ::_exit(126);
     if (!dir.empty() && ::chdir(dir.c_str()) != 0) ::_exit(126);
+    for (auto& variable : environment) ::putenv(variable.data());
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
@@ -87,6 +89,13 @@ inline RunResult run_pdamp(const std::vector<std::string>& args, const RunOption
   std::filesystem::remove(out_file);
   std::filesystem::remove(err_file);
   return result;
+}
+
+/// Runs PDAMP_BINARY with `args` (argv[1..], verbatim).
+inline RunResult run_pdamp(const std::vector<std::string>& args, const RunOptions& options = {}) {
+  std::vector<std::string> argv_text{PDAMP_BINARY};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  return run_program(std::move(argv_text), options);
 }
 
 /// The same with the arguments given as one string split at blanks (for fixed

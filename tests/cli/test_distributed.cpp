@@ -1,0 +1,157 @@
+// Distributed sweeps (issue 13 §1, docs/distributed.md). The unit part runs in every
+// build; the [mpi] part exists in an MPI build (-DPDAMP_MPI=ON) and runs pdamp under
+// mpirun with 2 ranks on this machine (loopback; CTest label `mpi`, run by .ci/run).
+#include <signal.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/cli_support.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace pdamp::test;
+
+namespace {
+
+bool mpi_build() { return run_pdamp(std::vector<std::string>{"--help"}).out.find("(MPI build)") != std::string::npos; }
+
+}  // namespace
+
+// A build without MPI started by mpirun as 2 processes would have both write the same
+// files: it refuses (the launcher's variables are what mpirun sets in each process).
+TEST_CASE("a pdamp built without MPI refuses to run as several mpirun processes", "[cli]") {
+  if (mpi_build()) {
+    WARN("an MPI build: its launch is tested under mpirun by the [mpi] cases");
+    return;
+  }
+  RunOptions two_ranks;
+  two_ranks.environment = {"OMPI_COMM_WORLD_SIZE=2", "OMPI_COMM_WORLD_RANK=0"};
+  require_one_line_error(run_pdamp({"optimum", "--model", "rolling", "--clearance", "0.01"}, two_ranks),
+                         "built without MPI");
+  two_ranks.environment = {"OMPI_COMM_WORLD_SIZE=2", "OMPI_COMM_WORLD_RANK=1"};
+  const auto other = run_pdamp({"optimum", "--model", "rolling", "--clearance", "0.01"}, two_ranks);
+  CHECK(other.exit_code == 2);
+  CHECK(other.err.empty());  // rank 0 says it once
+  two_ranks.environment = {"OMPI_COMM_WORLD_SIZE=1", "OMPI_COMM_WORLD_RANK=0"};
+  CHECK(run_pdamp({"optimum", "--model", "rolling", "--clearance", "0.01"}, two_ranks).exit_code == 0);
+}
+
+#ifdef PDAMP_MPIEXEC
+namespace {
+
+/// mpirun -n RANKS pdamp ARGS on this machine: more ranks than cores allowed, as root too
+/// (CI runs as root; Open MPI refuses root unless told).
+RunResult run_mpi(int ranks, const std::vector<std::string>& args, RunOptions options = {}) {
+  std::vector<std::string> argv{PDAMP_MPIEXEC, "-n", std::to_string(ranks), "--oversubscribe"};
+  if (::geteuid() == 0) argv.push_back("--allow-run-as-root");
+  argv.push_back(PDAMP_BINARY);
+  argv.insert(argv.end(), args.begin(), args.end());
+  if (options.time_limit_s > 90.0) options.time_limit_s = 90.0;  // a hang is a failure
+  return run_program(argv, options);
+}
+
+json parse_result(const RunResult& r) {
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return json::parse(r.out);
+}
+
+/// field.json without its creation time.
+json field_values(const fs::path& dir) {
+  std::ifstream in(dir / "field.json");
+  json field = json::parse(in);
+  field["provenance"].erase("created_utc");
+  return field;
+}
+
+/// The shipped 36-sphere case on a 2 x 4 grid, short runs (about 0.5 s a point: long
+/// enough for the kill below to land mid-sweep, short enough for CI).
+std::string small_dem_field(const TempDir& dir) {
+  return edited_case((dir.path.filename().string() + ".json"), [](json& c) {
+    c["field"] = {{"axis0", {{"min", 1.5}, {"max", 2.5}, {"count", 2}}},
+                  {"axis1", {{"min", 0.015}, {"max", 0.07}, {"count", 4}}},
+                  {"threads", 1}};
+    c["dem"]["transient_periods"] = 1;
+    c["dem"]["analysed_periods"] = 3;
+  });
+}
+
+std::size_t lines_in(const fs::path& file) {
+  std::ifstream in(file);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+}  // namespace
+
+// Reference: the serial sweep of the same case. Each point is one deterministic DEM run
+// from the same inputs (sent as raw doubles), so the fields agree to the bit, not to a tolerance.
+TEST_CASE("a DEM field on 2 ranks equals the serial one point for point, and a killed run resumes", "[mpi]") {
+  const TempDir dir("mpi_field");
+  const std::string c = small_dem_field(dir);
+  const auto serial = run_pdamp({"field", c, "--source", "dem", "-o", (dir.path / "serial").string()});
+  REQUIRE(serial.exit_code == 0);
+
+  const json spread = parse_result(run_mpi(2, {"field", c, "--source", "dem", "-o", (dir.path / "mpi").string(), "--json"}));
+  CHECK(field_values(dir.path / "mpi") == field_values(dir.path / "serial"));
+  REQUIRE(spread.contains("mpi"));
+  CHECK(spread["mpi"]["ranks"] == 2);
+  const auto& points = spread["mpi"]["points"];
+  CHECK(points[0].get<int>() + points[1].get<int>() == 8);
+  CHECK(points[1].get<int>() >= 1);  // rank 1 took part
+  for (const auto& busy : spread["mpi"]["busy_fraction"]) CHECK((busy.get<double>() > 0.0 && busy.get<double>() <= 1.0));
+
+  // Killed (SIGTERM to mpirun, which passes it on) once 2 points are saved, then rerun:
+  // it resumes from the log and ends with the same field.
+  const fs::path killed = dir.path / "killed";
+  RunOptions kill_midway;
+  kill_midway.while_running = [&](pid_t pid) {
+    for (int i = 0; i < 3000 && lines_in(killed / "field_sweep.jsonl") < 3; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ::kill(-pid, SIGTERM);
+  };
+  const auto first = run_mpi(2, {"field", c, "--source", "dem", "-o", killed.string()}, kill_midway);
+  CHECK(first.exit_code != 0);
+  CHECK_FALSE(fs::exists(killed / "field.json"));
+  const std::size_t saved = lines_in(killed / "field_sweep.jsonl") - 1;
+  REQUIRE(saved >= 2);
+  const json resumed = parse_result(run_mpi(2, {"field", c, "--source", "dem", "-o", killed.string(), "--json"}));
+  CHECK_THAT(resumed["sweep"].get<std::string>(), Catch::Contains(std::to_string(saved) + " resumed"));
+  CHECK(field_values(killed) == field_values(dir.path / "serial"));
+}
+
+TEST_CASE("a sensitivity study on 2 ranks equals the serial one", "[mpi]") {
+  const TempDir dir("mpi_sensitivity");
+  const std::string c = case_path("low_intensity_36_spheres.json");
+  const json serial = parse_result(run_pdamp({"sensitivity", c, "--source", "formulas", "-o", (dir.path / "s").string(), "--json"}));
+  const json spread = parse_result(run_mpi(2, {"sensitivity", c, "--source", "formulas", "-o", (dir.path / "m").string(), "--json"}));
+  CHECK(spread["rows"] == serial["rows"]);
+  CHECK(spread["mpi"]["points"][1].get<int>() >= 1);
+}
+
+TEST_CASE("under mpirun, bad input is one error line and a command without a sweep runs once", "[mpi]") {
+  const TempDir dir("mpi_errors");
+  const std::string bad = edited_case("mpi_bad.json", [](json& c) { c["field"]["threads"] = 0; });
+  const auto r = run_mpi(2, {"field", bad, "--source", "dem", "-o", dir.path.string()});
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.empty());
+  std::size_t errors = 0;
+  for (std::size_t at = r.err.find("pdamp: error:"); at != std::string::npos; at = r.err.find("pdamp: error:", at + 1)) ++errors;
+  CHECK(errors == 1);  // the other rank is silent
+  CHECK_THAT(r.err, Catch::Contains("threads"));
+
+  const auto once = run_mpi(2, {"optimum", "--model", "rolling", "--clearance", "0.01", "--json"});
+  REQUIRE(once.exit_code == 0);
+  CHECK(json::parse(once.out)["clearance_m"] == 0.01);  // one JSON document: rank 1 printed nothing
+}
+#endif
