@@ -12,11 +12,15 @@ stamp() { echo "ci_sanitize_fuzz: $1 at +$(( $(date +%s) - start )) s" >&2; }
 
 scripts/setup_ci_extras.sh
 
-# One build serves both: every target is compiled once with -fsanitize=address,undefined
-# and -fsanitize=fuzzer-no-link; the benchmarks are not built.
-CC=clang CXX=clang++ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DPDAMP_BUILD_BENCH=OFF \
+# One build serves both: what it builds is compiled once with -fsanitize=address,undefined
+# and -fsanitize=fuzzer-no-link. To keep .ci/run within its time it builds only what the
+# two jobs run: the fuzz targets, the test programs of the libraries and, of the
+# command-line tests, the hostile-input ones with pdamp (docs/ci.md, "Time").
+CC=clang CXX=clang++ cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DPDAMP_SANITIZE=address,undefined -DPDAMP_FUZZ=ON >/dev/null
-cmake --build "$build_dir" -j2
+mapfile -t targets < <(ninja -C "$build_dir" -t targets all | sed -n 's/^\(test_[a-z_]*\|fuzz_[a-z_]*\): phony$/\1/p' \
+  | grep -v '^test_cli_')
+cmake --build "$build_dir" -j2 --target "${targets[@]}" test_cli_hostile_input pdamp
 stamp "sanitizer and fuzz build done"
 
 # halt_on_error: the first report ends the process, so the test fails; a leak fails too.
@@ -31,34 +35,49 @@ excluded=$(grep -v -e '^#' -e '^[[:space:]]*$' scripts/sanitize_excluded_tests.t
 # (Catch's --list-test-names-only exits with the number of tests it lists.)
 cosimulation=$( (ASAN_OPTIONS=$ASAN_OPTIONS:alloc_dealloc_mismatch=0 "$build_dir/tests/test_structure_cosimulation" \
   '~[long]' --list-test-names-only || true) | grep -v '^$' | sed 's/^/structure:/')
-ctest --test-dir "$build_dir" -L unit -E "$(printf '%s\n%s\n' "$excluded" "$cosimulation" | regex_of)" \
+# The command-line tests ("cli:") but the hostile-input ones are not built here; those run
+# alone below, next to the cosimulation tests.
+ctest --test-dir "$build_dir" -L unit -E "$(printf '%s\n%s\n' "$excluded" "$cosimulation" | regex_of)|^cli:" \
   --output-on-failure -j2 --timeout 600
 ASAN_OPTIONS=$ASAN_OPTIONS:alloc_dealloc_mismatch=0 "$build_dir/tests/test_structure_cosimulation" '~[long]'
+"$build_dir/tests/test_cli_hostile_input" '~[long]'
 stamp "unit tests under ASan+UBSan done"
 
-# Each fuzz target from its seeds (tests/fuzz/corpus/<name>/) for a bounded time; what it
-# finds goes into a scratch corpus in the build folder, never into the source tree.
-# A crash writes crash-* into that folder and exits non-zero, which fails CI.
-for target in "$build_dir"/fuzz/fuzz_*; do
+# Each fuzz target from its seeds (tests/fuzz/corpus/<name>/) for a bounded time, two at
+# a time (libFuzzer runs one process on one core); what it finds goes into a scratch
+# corpus in the build folder, never into the source tree. A crash writes crash-* into
+# that folder and exits non-zero, which fails CI.
+fuzz_one() {
+  local target=$1 name work timeout dict=()
   name=$(basename "$target")
   name=${name#fuzz_}
   work="$build_dir/fuzz-work/$name"
   mkdir -p "$work/corpus"
-  dict=()
   case "$name" in *csv) ;; *) dict=(-dict=tests/fuzz/json.dict) ;; esac
   # A case may ask for an automatic lattice of up to 1e7 sites per slab (formulas'
   # kMaxSlabSites): 0.4 s in a release build, 10-40 s under ASan and coverage
   # (tests/data/fuzz_regressions/case_file/refused_cylinder_slab_of_3e6_sites.json).
   timeout=5
   [ "$name" = case_file ] && timeout=60
-  echo "ci_sanitize_fuzz: fuzz_$name for $fuzz_seconds s" >&2
   if ! "$target" -max_total_time="$fuzz_seconds" -timeout="$timeout" -rss_limit_mb=2048 -max_len=16384 \
       -print_final_stats=1 "${dict[@]}" -artifact_prefix="$work/" "$work/corpus" "tests/fuzz/corpus/$name" \
       >"$work/log.txt" 2>&1; then
     tail -60 "$work/log.txt" >&2
     echo "ci_sanitize_fuzz: fuzz_$name found a crash: $(ls "$work"/crash-* "$work"/timeout-* "$work"/oom-* 2>/dev/null)" >&2
-    exit 1
+    return 1
   fi
   grep -E "stat::number_of_executed_units|stat::new_units_added" "$work/log.txt" | sed "s/^/fuzz_$name: /" >&2
+}
+targets=("$build_dir"/fuzz/fuzz_*)
+echo "ci_sanitize_fuzz: ${#targets[@]} fuzz targets for $fuzz_seconds s each, two at a time" >&2
+failed=0
+for ((i = 0; i < ${#targets[@]}; i += 2)); do
+  pids=()
+  for target in "${targets[@]:i:2}"; do
+    fuzz_one "$target" &
+    pids+=($!)
+  done
+  for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
 done
+[ "$failed" = 0 ] || exit 1
 stamp "fuzzing done"

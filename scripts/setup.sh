@@ -16,7 +16,7 @@ done
 
 packages=(build-essential cmake pkg-config libeigen3-dev libnlopt-cxx-dev
   coinor-libipopt-dev libfftw3-dev catch2 nlohmann-json3-dev libomp-dev
-  gnuplot-nox libbenchmark-dev)
+  gnuplot-nox libbenchmark-dev ninja-build)
 [ "$mpi" = ON ] && packages+=(libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${packages[@]}"; do
@@ -32,5 +32,8 @@ fi
 
 # Without --mpi the folder keeps what it was configured with (a new one: no MPI).
 mpi_flag=(); [ "$mpi" = ON ] && mpi_flag=(-DPDAMP_MPI=ON)
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${mpi_flag[@]}" >/dev/null
+# A new folder is built with Ninja (about 10% faster than make on 2 cores: no recursive
+# make); a folder made by an earlier setup keeps its generator.
+generator=(); [ -f "$build_dir/CMakeCache.txt" ] || generator=(-G Ninja)
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${mpi_flag[@]}" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"

@@ -6,7 +6,7 @@
 # Usage: scripts/setup_ci_extras.sh   (called by .ci/run; see docs/ci.md)
 set -euo pipefail
 
-packages=(clang libclang-rt-14-dev llvm-14)
+packages=(clang libclang-rt-14-dev llvm-14 ninja-build)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
