@@ -14,13 +14,13 @@ scripts/setup_ci_extras.sh
 
 # One build serves both: what it builds is compiled once with -fsanitize=address,undefined
 # and -fsanitize=fuzzer-no-link. To keep .ci/run within its time it builds only what the
-# two jobs run: the fuzz targets, the test programs of the libraries and, of the
-# command-line tests, the hostile-input ones with pdamp (docs/ci.md, "Time").
+# two jobs run: the fuzz targets and the test programs of the libraries, not pdamp and
+# its command-line tests (docs/ci.md, "Time").
 CC=clang CXX=clang++ cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DPDAMP_SANITIZE=address,undefined -DPDAMP_FUZZ=ON >/dev/null
 mapfile -t targets < <(ninja -C "$build_dir" -t targets all | sed -n 's/^\(test_[a-z_]*\|fuzz_[a-z_]*\): phony$/\1/p' \
   | grep -v '^test_cli_')
-cmake --build "$build_dir" -j2 --target "${targets[@]}" test_cli_hostile_input pdamp
+cmake --build "$build_dir" -j2 --target "${targets[@]}"
 stamp "sanitizer and fuzz build done"
 
 # halt_on_error: the first report ends the process, so the test fails; a leak fails too.
@@ -35,12 +35,10 @@ excluded=$(grep -v -e '^#' -e '^[[:space:]]*$' scripts/sanitize_excluded_tests.t
 # (Catch's --list-test-names-only exits with the number of tests it lists.)
 cosimulation=$( (ASAN_OPTIONS=$ASAN_OPTIONS:alloc_dealloc_mismatch=0 "$build_dir/tests/test_structure_cosimulation" \
   '~[long]' --list-test-names-only || true) | grep -v '^$' | sed 's/^/structure:/')
-# The command-line tests ("cli:") but the hostile-input ones are not built here; those run
-# alone below, next to the cosimulation tests.
+# The command-line tests ("cli:") are not built here.
 ctest --test-dir "$build_dir" -L unit -E "$(printf '%s\n%s\n' "$excluded" "$cosimulation" | regex_of)|^cli:" \
   --output-on-failure -j2 --timeout 600
 ASAN_OPTIONS=$ASAN_OPTIONS:alloc_dealloc_mismatch=0 "$build_dir/tests/test_structure_cosimulation" '~[long]'
-"$build_dir/tests/test_cli_hostile_input" '~[long]'
 stamp "unit tests under ASan+UBSan done"
 
 # Each fuzz target from its seeds (tests/fuzz/corpus/<name>/) for a bounded time, two at
