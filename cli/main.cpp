@@ -58,8 +58,6 @@ int finished(int exit_code) {
   return exit_code;
 }
 
-
-
 /// The command `args` names, run; its exit code (INTERFACE.md).
 int run_command(const std::vector<std::string>& args) {
   using namespace pdamp::cli;
