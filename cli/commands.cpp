@@ -391,6 +391,11 @@ int run_damper_design(const ParsedArgs& args, const Case& c) {
 
 int run_run(const ParsedArgs& args) {
   const Case c = case_file::load_case(args.positional().at(0));
+  // Under mpirun the DEM parts of frf and filling_ratios tasks are spread over the ranks
+  // (distributed.hpp); every other task runs on rank 0 alone.
+  if (distributed::worker() && c.task.kind != case_file::TaskKind::kFrf &&
+      c.task.kind != case_file::TaskKind::kFillingRatios)
+    return kExitOk;
   const RunReportScope report;  // with -o DIR, the task also stages DIR/report.html
   if (c.task.kind == case_file::TaskKind::kDamperDesign) {
     if (args.has("--method"))
@@ -1308,7 +1313,7 @@ const std::vector<Command>& commands() {
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
         "as pdamp modes, frf and decay; filling_ratios and placement: as pdamp optimize)",
         concat_flags(concat_flags({kMethodFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, kDemSweepFlags), kCheckpointFlags), 1},
-       run_run},
+       run_run, true},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",
         {{"--model", "MODEL", "rolling (low intensity, A < g) or bouncing (high intensity)"},

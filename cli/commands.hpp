@@ -12,8 +12,9 @@ namespace pdamp::cli {
 struct Command {
   CommandSpec spec;
   std::function<int(const ParsedArgs&)> run;
-  /// Under mpirun (docs/distributed.md): the command runs on every rank, its sweep spread
-  /// over them by a distributed::PointFarm; otherwise it runs on rank 0 while the others wait.
+  /// Under mpirun (docs/distributed.md): the command runs on every rank, its DEM tasks
+  /// spread over them by a distributed::TaskFarm; otherwise it runs on rank 0 while the
+  /// others wait.
   bool every_rank = false;
 };
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <iostream>
 #include <stdexcept>
 #include <streambuf>
@@ -33,21 +34,69 @@ int launcher_rank() {
   return -1;
 }
 
+// A field point as bytes: five doubles, the status, the motion-mode text.
+std::string encode_point(const surrogate::FieldPoint& p) {
+  const double values[5] = {p.eta_star, p.eta_star_stderr, p.e_diss_j, p.apparent_mass_kg, p.apparent_mass_fraction};
+  const auto status = static_cast<std::int32_t>(p.status);
+  std::string bytes(sizeof values + sizeof status, '\0');
+  std::memcpy(bytes.data(), values, sizeof values);
+  std::memcpy(bytes.data() + sizeof values, &status, sizeof status);
+  return bytes + p.motion_mode;
+}
+
+surrogate::FieldPoint decode_point(const std::string& bytes) {
+  double values[5];
+  std::int32_t status = 0;
+  if (bytes.size() < sizeof values + sizeof status)
+    throw std::runtime_error("a field point of " + std::to_string(bytes.size()) + " bytes is too short");
+  std::memcpy(values, bytes.data(), sizeof values);
+  std::memcpy(&status, bytes.data() + sizeof values, sizeof status);
+  surrogate::FieldPoint p;
+  p.eta_star = values[0];
+  p.eta_star_stderr = values[1];
+  p.e_diss_j = values[2];
+  p.apparent_mass_kg = values[3];
+  p.apparent_mass_fraction = values[4];
+  p.status = static_cast<surrogate::PointStatus>(status);
+  p.motion_mode = bytes.substr(sizeof values + sizeof status);
+  return p;
+}
+
 }  // namespace
+
+void run_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& run) {
+  if (!parallel) {
+    for (std::size_t k = 0; k < count; ++k) run(k);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(count);
+  std::vector<std::thread> threads;
+  for (std::size_t k = 0; k < count; ++k)
+    threads.emplace_back([&, k] {
+      try {
+        run(k);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+  for (auto& t : threads) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
 
 int rank() { return g_rank; }
 int ranks() { return g_ranks; }
 void note_failure(const std::string& message) { g_failure = message; }
 
-PointFarm::PointFarm(LocalEvaluator local) : local_(std::move(local)) {
+TaskFarm::TaskFarm(Evaluator local) : local_(std::move(local)) {
   points_.assign(static_cast<std::size_t>(g_ranks), 0);
   busy_s_.assign(static_cast<std::size_t>(g_ranks), 0.0);
   for (int r = g_ranks - 1; r >= 1; --r) free_.push_back(r);
 }
 
-int PointFarm::threads(int serial_threads) const { return g_ranks > 1 ? g_ranks : serial_threads; }
+int TaskFarm::threads(int serial_threads) const { return g_ranks > 1 ? g_ranks : serial_threads; }
 
-void PointFarm::account(int rank, std::chrono::steady_clock::time_point start) {
+void TaskFarm::account(int rank, std::chrono::steady_clock::time_point start) {
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard lock(mutex_);
   ++points_[static_cast<std::size_t>(rank)];
@@ -55,7 +104,12 @@ void PointFarm::account(int rank, std::chrono::steady_clock::time_point start) {
   last_ = std::max(last_, now);
 }
 
-nlohmann::json PointFarm::balance() const {
+PointFarm::PointFarm(LocalEvaluator local)
+    : farm_([local = std::move(local)](const Request& request) { return encode_point(local(request)); }) {}
+
+surrogate::FieldPoint PointFarm::evaluate(const Request& request) { return decode_point(farm_.evaluate(request)); }
+
+nlohmann::json TaskFarm::balance() const {
   std::lock_guard lock(mutex_);
   if (g_ranks == 1) return nullptr;
   const double wall_s = started_ ? std::chrono::duration<double>(last_ - first_).count() : 0.0;
@@ -69,7 +123,7 @@ nlohmann::json PointFarm::balance() const {
 bool built_with_mpi() { return false; }
 
 // One rank: a build without MPI refuses to run as several (each copy would write the same
-// files), and evaluates every point itself.
+// files), and evaluates every task itself.
 Session::Session(int*, char***) {
   const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
   if (size == nullptr) size = std::getenv("PMI_SIZE");
@@ -82,8 +136,8 @@ Session::Session(int*, char***) {
 }
 Session::~Session() = default;
 
-surrogate::FieldPoint PointFarm::evaluate(const Request& request) { return local_(request); }
-void PointFarm::serve() {}
+std::string TaskFarm::evaluate(const Request& request) { return local_(request); }
+void TaskFarm::serve() {}
 
 #else
 
@@ -105,47 +159,26 @@ NullBuffer g_null;
 std::streambuf* g_cout = nullptr;
 std::streambuf* g_cerr = nullptr;
 
-// A reply: one byte kind, then a point (five doubles, the status, the motion-mode text)
-// or an error message. Doubles travel as bytes, so nothing is rounded on the way.
-constexpr char kPoint = 'p';
+// A reply: one byte kind, then the task's result or an error message.
+constexpr char kResult = 'r';
 constexpr char kError = 'e';
 
-std::vector<char> encode_point(const surrogate::FieldPoint& p) {
-  const double values[5] = {p.eta_star, p.eta_star_stderr, p.e_diss_j, p.apparent_mass_kg, p.apparent_mass_fraction};
-  const auto status = static_cast<std::int32_t>(p.status);
-  std::vector<char> bytes(1 + sizeof values + sizeof status + p.motion_mode.size());
-  bytes[0] = kPoint;
-  std::memcpy(bytes.data() + 1, values, sizeof values);
-  std::memcpy(bytes.data() + 1 + sizeof values, &status, sizeof status);
-  std::memcpy(bytes.data() + 1 + sizeof values + sizeof status, p.motion_mode.data(), p.motion_mode.size());
+std::vector<char> encode_reply(char kind, const std::string& payload) {
+  std::vector<char> bytes(1 + payload.size());
+  bytes[0] = kind;
+  std::memcpy(bytes.data() + 1, payload.data(), payload.size());
   return bytes;
 }
+std::vector<char> encode_error(const std::string& message) { return encode_reply(kError, message); }
 
-std::vector<char> encode_error(const std::string& message) {
-  std::vector<char> bytes(1 + message.size());
-  bytes[0] = kError;
-  std::memcpy(bytes.data() + 1, message.data(), message.size());
-  return bytes;
-}
-
-surrogate::FieldPoint decode_reply(const std::vector<char>& bytes, int from) {
+/// The result a reply carries; its error rethrown naming the rank.
+std::string decode_reply(const std::vector<char>& bytes, int from) {
   const std::string who = "MPI rank " + std::to_string(from);
-  if (!bytes.empty() && bytes[0] == kError) throw std::runtime_error(who + ": " + std::string(bytes.begin() + 1, bytes.end()));
-  double values[5];
-  std::int32_t status = 0;
-  if (bytes.size() < 1 + sizeof values + sizeof status || bytes[0] != kPoint)
-    throw std::runtime_error(who + ": sent a reply that is not a point (" + std::to_string(bytes.size()) + " bytes)");
-  std::memcpy(values, bytes.data() + 1, sizeof values);
-  std::memcpy(&status, bytes.data() + 1 + sizeof values, sizeof status);
-  surrogate::FieldPoint p;
-  p.eta_star = values[0];
-  p.eta_star_stderr = values[1];
-  p.e_diss_j = values[2];
-  p.apparent_mass_kg = values[3];
-  p.apparent_mass_fraction = values[4];
-  p.status = static_cast<surrogate::PointStatus>(status);
-  p.motion_mode.assign(bytes.begin() + static_cast<std::ptrdiff_t>(1 + sizeof values + sizeof status), bytes.end());
-  return p;
+  if (bytes.empty() || (bytes[0] != kResult && bytes[0] != kError))
+    throw std::runtime_error(who + ": sent a reply that is not a result (" + std::to_string(bytes.size()) + " bytes)");
+  std::string payload(bytes.begin() + 1, bytes.end());
+  if (bytes[0] == kError) throw std::runtime_error(who + ": " + payload);
+  return payload;
 }
 
 /// Waits for a message from `source` with `tag` (MPI_ANY_TAG for any) and returns its
@@ -239,7 +272,7 @@ Session::~Session() {
   MPI_Finalize();
 }
 
-surrogate::FieldPoint PointFarm::evaluate(const Request& request) {
+std::string TaskFarm::evaluate(const Request& request) {
   const auto start = std::chrono::steady_clock::now();
   int rank = 0;
   {
@@ -248,9 +281,9 @@ surrogate::FieldPoint PointFarm::evaluate(const Request& request) {
     if (!free_.empty()) rank = free_.back(), free_.pop_back();
   }
   if (rank == 0) {
-    auto point = local_(request);
+    auto result = local_(request);
     account(0, start);
-    return point;
+    return result;
   }
   {
     std::lock_guard lock(g_mpi_mutex);
@@ -270,11 +303,11 @@ surrogate::FieldPoint PointFarm::evaluate(const Request& request) {
   return decode_reply(reply, rank);
 }
 
-void PointFarm::serve() {
+void TaskFarm::serve() {
   if (!g_mpi || g_rank == 0) return;
   const auto answer = [&](const Request& request) {
     try {
-      return encode_point(local_(request));
+      return encode_reply(kResult, local_(request));
     } catch (const std::exception& e) {
       return encode_error(e.what());
     } catch (...) {

@@ -44,37 +44,60 @@ inline bool worker() { return rank() != 0; }
 /// Why this rank's command failed (a worker's only way to tell rank 0, in its replies).
 void note_failure(const std::string& message);
 
-/// What a point is asked by: a grid sweep's (frequency Hz, stroke m), a point sweep's
-/// (index, unused). Sent as raw doubles, so a worker evaluates bit for bit what rank 0 would.
+/// What a task is asked by: a grid sweep's (frequency Hz, stroke m), a point sweep's
+/// (index, unused), a command's own task number (index, unused). Sent as raw doubles, so a
+/// worker evaluates bit for bit what rank 0 would.
 using Request = std::array<double, 2>;
-using LocalEvaluator = std::function<surrogate::FieldPoint(const Request&)>;
 
-/// One sweep's evaluator spread over the ranks. Build it on every rank after the same
-/// checks and with the same evaluator; then a worker calls serve() and returns, rank 0
-/// gives evaluate() to the sweep engine with threads() threads.
-class PointFarm {
+/// Runs run(k) for k < count, on a thread each when `parallel`, else one after the other.
+/// An exception in a thread is carried to this one and rethrown after all end (the first
+/// in order).
+void run_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& run);
+
+/// Independent tasks of one command spread over the ranks, their results as bytes (each
+/// command encodes its own; doubles as bytes or CBOR, so nothing is rounded on the way).
+/// Build it on every rank after the same checks and with the same evaluator; then a worker
+/// calls serve() and returns, rank 0 runs its tasks through evaluate() on threads() threads.
+class TaskFarm {
  public:
-  explicit PointFarm(LocalEvaluator local);
-  /// Points in flight at once: one per rank under MPI, `serial_threads` otherwise.
+  using Evaluator = std::function<std::string(const Request&)>;
+  explicit TaskFarm(Evaluator local);
+  /// Tasks in flight at once: one per rank under MPI, `serial_threads` otherwise.
   int threads(int serial_threads) const;
-  /// Rank 0, thread-safe: the point evaluated on a free rank, or here if none is free.
-  /// An exception on the rank that evaluated it is rethrown here, naming that rank.
-  surrogate::FieldPoint evaluate(const Request& request);
+  /// Rank 0, thread-safe: the task's result from a free rank, or from here if none is free.
+  /// An exception on another rank is rethrown here as std::runtime_error naming that rank;
+  /// one here keeps its type.
+  std::string evaluate(const Request& request);
   /// A worker: evaluates what rank 0 sends until it says stop.
   void serve();
-  /// Rank 0 after the sweep: {ranks, points[r], busy_fraction[r]} (time each rank spent
-  /// on points over the sweep's wall time), or null without MPI.
+  /// Rank 0 after the tasks: {ranks, points[r], busy_fraction[r]} (time each rank spent
+  /// on tasks over the wall time from the first to the last), or null without MPI.
   nlohmann::json balance() const;
 
  private:
-  LocalEvaluator local_;
+  Evaluator local_;
   mutable std::mutex mutex_;  // free_, points_, busy_s_, first_, last_
-  std::vector<int> free_;     // ranks > 0 waiting for a point
+  std::vector<int> free_;     // ranks > 0 waiting for a task
   std::vector<std::size_t> points_;
   std::vector<double> busy_s_;
   std::chrono::steady_clock::time_point first_{}, last_{};
   bool started_ = false;
   void account(int rank, std::chrono::steady_clock::time_point start);
+};
+
+/// A sweep's evaluator spread over the ranks (the engine of pdamp field and sensitivity):
+/// a TaskFarm whose results are field points.
+class PointFarm {
+ public:
+  using LocalEvaluator = std::function<surrogate::FieldPoint(const Request&)>;
+  explicit PointFarm(LocalEvaluator local);
+  int threads(int serial_threads) const { return farm_.threads(serial_threads); }
+  surrogate::FieldPoint evaluate(const Request& request);
+  void serve() { farm_.serve(); }
+  nlohmann::json balance() const { return farm_.balance(); }
+
+ private:
+  TaskFarm farm_;
 };
 
 }  // namespace pdamp::cli::distributed

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <future>
 #include <iostream>
 #include <memory>
 #include <numbers>
@@ -19,6 +18,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "distributed.hpp"
 #include "errors.hpp"
 #include "output.hpp"
 #include "placement_command.hpp"
@@ -203,6 +203,73 @@ double half_integral_square(const std::vector<double>& t, const std::vector<doub
   return sum;
 }
 
+/// What the verification keeps of a design's DEM decay (run_dem_decay): what it compares,
+/// reports and plots. Plain data, so that it travels between MPI ranks (encode_decay).
+struct VerifiedDecay {
+  std::vector<double> time_s;               ///< the co-simulation's samples, s
+  std::vector<double> site_displacement_m;  ///< y − y_s at the first damper's site, per sample
+  SimulatedSettling settling;
+  double threshold_m = 0.0, initial_envelope_m = 0.0;
+  double energy_error = 0.0, dem_dissipated_j = 0.0, structural_dissipated_j = 0.0;
+  std::int64_t steps = 0;
+  double time_step_s = 0.0, wall_time_s = 0.0;
+  std::vector<std::string> warnings;
+};
+
+VerifiedDecay verified_decay(const DemDecay& d) {
+  const auto& r = d.cosimulation;
+  VerifiedDecay v;
+  v.time_s = r.history.time_s;
+  for (std::size_t i = 0; i < v.time_s.size(); ++i)
+    v.site_displacement_m.push_back(r.history.site_displacement_m(static_cast<Eigen::Index>(i), 0) - d.static_offset_m);
+  v.settling = d.settling;
+  v.threshold_m = d.threshold_m;
+  v.initial_envelope_m = d.initial_envelope_m;
+  v.energy_error = r.energy.relative_error;
+  v.dem_dissipated_j = r.energy.dem_dissipated_j();
+  v.structural_dissipated_j = r.energy.structural_damping_j;
+  v.steps = r.steps;
+  v.time_step_s = r.time_step_s;
+  v.wall_time_s = r.wall_time_s;
+  v.warnings = d.warnings;
+  return v;
+}
+
+/// A decay as CBOR for the MPI farm (distributed.hpp): doubles exact, NaN kept; read back
+/// only by decode_decay of the same build.
+std::string encode_decay(const VerifiedDecay& v) {
+  const auto& s = v.settling;
+  const auto bytes = json::to_cbor(json{v.time_s, v.site_displacement_m, s.envelope_time_s, s.envelope_m,
+                                        s.sample_envelope_m, s.settling_time_s, s.frequency_hz, s.damping_ratio,
+                                        v.threshold_m, v.initial_envelope_m, v.energy_error, v.dem_dissipated_j,
+                                        v.structural_dissipated_j, v.steps, v.time_step_s, v.wall_time_s, v.warnings});
+  return std::string(bytes.begin(), bytes.end());
+}
+
+VerifiedDecay decode_decay(const std::string& bytes) {
+  const json j = json::from_cbor(bytes);
+  VerifiedDecay v;
+  auto& s = v.settling;
+  j.at(0).get_to(v.time_s);
+  j.at(1).get_to(v.site_displacement_m);
+  j.at(2).get_to(s.envelope_time_s);
+  j.at(3).get_to(s.envelope_m);
+  j.at(4).get_to(s.sample_envelope_m);
+  j.at(5).get_to(s.settling_time_s);
+  j.at(6).get_to(s.frequency_hz);
+  j.at(7).get_to(s.damping_ratio);
+  j.at(8).get_to(v.threshold_m);
+  j.at(9).get_to(v.initial_envelope_m);
+  j.at(10).get_to(v.energy_error);
+  j.at(11).get_to(v.dem_dissipated_j);
+  j.at(12).get_to(v.structural_dissipated_j);
+  j.at(13).get_to(v.steps);
+  j.at(14).get_to(v.time_step_s);
+  j.at(15).get_to(v.wall_time_s);
+  j.at(16).get_to(v.warnings);
+  return v;
+}
+
 /// One design checked by the DEM: the prediction over the verification's duration and the
 /// DEM's decay over the same time.
 struct DesignCheck {
@@ -211,7 +278,7 @@ struct DesignCheck {
   opt::FillingDesign predicted;   ///< the closed forms over verify.duration_s
   double predicted_end_envelope_m = NAN;
   std::vector<double> predicted_envelope_m;  ///< at the DEM's sample times
-  DemDecay dem;
+  VerifiedDecay dem;
   double dem_objective = NAN;     ///< settling time (NaN: not settled) or ½∫e² dt
   double dem_end_envelope_m = NAN;
   std::string compared;           ///< "objective", "end_envelope" or "settled_only_one"
@@ -234,17 +301,11 @@ bool ahead(double objective_a, double end_a, double objective_b, double end_b) {
   return end_a < end_b;
 }
 
-DesignCheck check_design(const Case& c, const Problem& p, const case_file::VerifySpec& verify, const std::string& name,
-                         const opt::FillingDesign& design, const ParsedArgs& args) {
-  DesignCheck out;
-  out.name = name;
-  out.design = &design;
-  for (const auto& l : design.layers) out.particles += static_cast<int>(std::lround(l.particles));
-  const std::vector<double> slabs = slabs_of(design);
-  opt::FillingRatioOptions options = p.options;
-  options.decay.duration_s = verify.duration_s;
-  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
-
+/// The DEM-in-the-loop decay of `design` over the verification's duration (the task's
+/// decay from its initial state, the verification's softening), resumable from its
+/// checkpoint in the -o folder.
+VerifiedDecay verification_decay(const Case& c, const Problem& p, const case_file::VerifySpec& verify,
+                                 const std::string& name, const opt::FillingDesign& design, const ParsedArgs& args) {
   const Case dc = design_case(c, design, verify.stiffness_softening);
   std::vector<st::CosimulationDamper> dem_dampers;
   for (std::size_t d = 0; d < dc.dampers.size(); ++d) dem_dampers.push_back(case_file::cosimulation_damper(dc, d));
@@ -254,7 +315,7 @@ DesignCheck check_design(const Case& c, const Problem& p, const case_file::Verif
   decay.duration_s = verify.duration_s;
   DemCheckpoint checkpoint = dem_checkpoint(args, "verify_" + name, "verify_" + name);
   std::ostringstream design_text;
-  for (double n : slabs) design_text << ' ' << n;
+  for (double n : slabs_of(design)) design_text << ' ' << n;
   design_text << "; softening " << verify.stiffness_softening;
   checkpoint.settings = "design" + design_text.str();
   // A design that completed before the interruption left no checkpoint: it runs again.
@@ -262,16 +323,30 @@ DesignCheck check_design(const Case& c, const Problem& p, const case_file::Verif
     checkpoint.resume = false;
     std::cerr << "pdamp: warning: no checkpoint of the " + name + " design's verification: it runs from the start\n";
   }
-  out.dem = run_dem_decay(dc, p.modal, containers, dem_dampers, p.initial_modal_displacements, decay,
-                          "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s", checkpoint);
+  return verified_decay(run_dem_decay(dc, p.modal, containers, dem_dampers, p.initial_modal_displacements, decay,
+                                      "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s", checkpoint));
+}
+
+/// The design against its DEM decay `dem`.
+DesignCheck check_design(const Problem& p, const case_file::VerifySpec& verify, const std::string& name,
+                         const opt::FillingDesign& design, VerifiedDecay dem) {
+  DesignCheck out;
+  out.name = name;
+  out.design = &design;
+  for (const auto& l : design.layers) out.particles += static_cast<int>(std::lround(l.particles));
+  const std::vector<double> slabs = slabs_of(design);
+  opt::FillingRatioOptions options = p.options;
+  options.decay.duration_s = verify.duration_s;
+  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
+  out.dem = std::move(dem);
   const auto& settle = out.dem.settling;
   out.dem_end_envelope_m = settle.envelope_m.empty() ? NAN : settle.envelope_m.back();
   out.dem_objective = settling_objective(p) ? settle.settling_time_s
-                                            : half_integral_square(out.dem.cosimulation.history.time_s, settle.sample_envelope_m);
+                                            : half_integral_square(out.dem.time_s, settle.sample_envelope_m);
 
   // The prediction at the DEM's instants (its envelope for the plot and the end value).
   st::FreeDecayOptions at_samples = options.decay;
-  at_samples.sample_times_s = out.dem.cosimulation.history.time_s;
+  at_samples.sample_times_s = out.dem.time_s;
   at_samples.sample_times_s.front() = 0.0;
   for (auto& t : at_samples.sample_times_s) t = std::clamp(t, 0.0, verify.duration_s);
   at_samples.sample_times_s.back() = verify.duration_s;
@@ -312,7 +387,6 @@ struct Verification {
 json verification_json(const Problem& p, const case_file::VerifySpec& verify, double dem_softening, const Verification& v) {
   json designs = json::object();
   for (const auto& d : v.designs) {
-    const auto& r = d.dem.cosimulation;
     designs[d.name] = {
         {"slabs", slabs_of(*d.design)},
         {"particles", d.particles},
@@ -329,12 +403,12 @@ json verification_json(const Problem& p, const case_file::VerifySpec& verify, do
                  {"damping_ratio", number_or_null(d.dem.settling.damping_ratio)},
                  {"threshold_m", d.dem.threshold_m},
                  {"initial_envelope_m", d.dem.initial_envelope_m},
-                 {"energy_error", r.energy.relative_error},
-                 {"dem_dissipated_energy_j", r.energy.dem_dissipated_j()},
-                 {"structural_dissipated_energy_j", r.energy.structural_damping_j},
-                 {"steps", r.steps},
-                 {"time_step_s", r.time_step_s},
-                 {"solve_time_s", r.wall_time_s}}},
+                 {"energy_error", d.dem.energy_error},
+                 {"dem_dissipated_energy_j", d.dem.dem_dissipated_j},
+                 {"structural_dissipated_energy_j", d.dem.structural_dissipated_j},
+                 {"steps", d.dem.steps},
+                 {"time_step_s", d.dem.time_step_s},
+                 {"solve_time_s", d.dem.wall_time_s}}},
         {"compared", d.compared},
         {"relative_difference", number_or_null(d.relative_difference)},
         {"passed", d.passed}};
@@ -357,22 +431,40 @@ json verification_json(const Problem& p, const case_file::VerifySpec& verify, do
           {"wall_time_s", v.wall_time_s}};
 }
 
-Verification verify_designs(const Case& c, const Problem& p, const opt::FillingRatioResult& r,
-                            const case_file::VerifySpec& verify, const ParsedArgs& args) {
+/// The design's slabs as one number, exact for up to five layers of < 1000 slabs: an MPI
+/// worker checks that its own optimisation chose the design rank 0 asks it to verify.
+double design_fingerprint(const opt::FillingDesign& design) {
+  double fingerprint = 0.0, place = 1.0;
+  for (const double n : slabs_of(design)) fingerprint += n * place, place *= 1000.0;
+  return fingerprint;
+}
+
+/// The DEM verification of the chosen and baseline designs; nothing on an MPI worker rank,
+/// which runs the decay rank 0 sends it.
+std::optional<Verification> verify_designs(const Case& c, const Problem& p, const opt::FillingRatioResult& r,
+                                           const case_file::VerifySpec& verify, const ParsedArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-  Verification v;
-  // The two DEM runs are independent (one World each, single-threaded by default): run
-  // them at once, the baseline on a second thread; its exceptions come back through get().
-  auto baseline = std::async(std::launch::async, [&] { return check_design(c, p, verify, "baseline", r.baseline, args); });
-  DesignCheck chosen;
-  try {
-    chosen = check_design(c, p, verify, "chosen", r.chosen, args);
-  } catch (...) {
-    baseline.wait();  // the thread uses c, p and r: let it end before they go
-    throw;
+  const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
+  // The two DEM runs are independent (one World each, single-threaded by default): on two
+  // threads, or on two ranks under mpirun (distributed.hpp). Every rank optimised the same
+  // way (NLopt's seed is fixed), which the fingerprint in the request confirms.
+  distributed::TaskFarm farm([&](const distributed::Request& request) {
+    const auto& [name, design] = designs[static_cast<std::size_t>(request[0])];
+    if (design_fingerprint(*design) != request[1])
+      throw std::runtime_error("its optimisation chose another " + name + " design than rank 0's: the ranks differ");
+    return encode_decay(verification_decay(c, p, verify, name, *design, args));
+  });
+  if (distributed::worker()) {
+    farm.serve();
+    return std::nullopt;
   }
-  v.designs.push_back(std::move(chosen));
-  v.designs.push_back(baseline.get());
+  std::vector<VerifiedDecay> decays(2);
+  distributed::run_concurrently(2, true, [&](std::size_t k) {
+    decays[k] = decode_decay(farm.evaluate({static_cast<double>(k), design_fingerprint(*designs[k].second)}));
+  });
+  Verification v;
+  for (std::size_t k = 0; k < 2; ++k)
+    v.designs.push_back(check_design(p, verify, designs[k].first, *designs[k].second, std::move(decays[k])));
   const DesignCheck& a = v.designs[0];
   const DesignCheck& b = v.designs[1];
   v.predicted_chosen_ahead = ahead(predicted_objective(p, a), a.predicted_end_envelope_m, predicted_objective(p, b),
@@ -382,6 +474,7 @@ Verification verify_designs(const Case& c, const Problem& p, const opt::FillingR
   v.passed = a.passed && b.passed && (!verify.require_ranking || v.ranking_passed);
   v.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   v.result = verification_json(p, verify, c.dem.stiffness_softening, v);
+  if (const json balance = farm.balance(); !balance.is_null()) v.result["mpi"] = balance;
   return v;
 }
 
@@ -395,11 +488,9 @@ std::vector<std::string> write_verification_files(OutputDir& files, const Case& 
   csv << "design,time_s,site_displacement_m,dem_envelope_m,predicted_envelope_m,threshold_m\n";
   for (std::size_t k = 0; k < v.designs.size(); ++k) {
     const auto& d = v.designs[k];
-    const auto& h = d.dem.cosimulation.history;
     if (k > 0) csv << "\n\n";
-    for (std::size_t i = 0; i < h.time_s.size(); ++i)
-      csv << d.name << ',' << h.time_s[i] << ',' << h.site_displacement_m(static_cast<Eigen::Index>(i), 0) - d.dem.static_offset_m
-          << ',' << d.dem.settling.sample_envelope_m[i] << ','
+    for (std::size_t i = 0; i < d.dem.time_s.size(); ++i)
+      csv << d.name << ',' << d.dem.time_s[i] << ',' << d.dem.site_displacement_m[i] << ',' << d.dem.settling.sample_envelope_m[i] << ','
           << (i < d.predicted_envelope_m.size() ? d.predicted_envelope_m[i] : NAN) << ',' << d.dem.threshold_m << '\n';
   }
   files.add("verify_decay.csv", csv.str());
@@ -431,7 +522,7 @@ std::vector<std::pair<std::string, std::string>> verification_rows(const Problem
                                 : "predicted " + format_number(pred, 4) + " m2 s, DEM " + format_number(d.dem_objective, 4) + " m2 s";
     line += "; end envelope predicted " + format_number(d.predicted_end_envelope_m * 1e3, 4) + " mm, DEM " +
             format_number(d.dem_end_envelope_m * 1e3, 4) + " mm; energy error " +
-            format_number(d.dem.cosimulation.energy.relative_error, 2) + "; " +
+            format_number(d.dem.energy_error, 2) + "; " +
             (d.compared == "settled_only_one" ? std::string("only one settled")
                                               : "difference " + format_number(100.0 * d.relative_difference, 3) + " %") +
             ": " + (d.passed ? "pass" : "FAIL");
@@ -450,6 +541,8 @@ std::vector<std::pair<std::string, std::string>> verification_rows(const Problem
 }  // namespace
 
 int run_optimize_task(const ParsedArgs& args, const Case& c) {
+  // Under mpirun only the verification's DEM runs are spread over the ranks.
+  if (distributed::worker() && c.task.kind != case_file::TaskKind::kFillingRatios) return kExitOk;
   if (c.task.kind == case_file::TaskKind::kPlacement && c.task.placement) return run_placement_task(args, c);
   if (c.task.kind != case_file::TaskKind::kFillingRatios || !c.task.filling_ratios)
     throw InputError(c.path, "/task",
@@ -460,8 +553,8 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
   if (args.has("--method"))
     throw InputError("--method", "", "task kind filling_ratios uses the closed forms of each layer (formulas) only");
   const FillingRatiosTask& task = *c.task.filling_ratios;
-  std::unique_ptr<OutputDir> files;
-  if (const auto dir = args.optional_text("-o")) files = std::make_unique<OutputDir>(*dir);
+  std::unique_ptr<OutputDir> files;  // none on an MPI worker rank: rank 0 writes
+  if (const auto dir = args.optional_text("-o"); dir && !distributed::worker()) files = std::make_unique<OutputDir>(*dir);
   Problem p = make_problem(c);
 
   opt::Options solver;
@@ -492,8 +585,10 @@ int run_optimize_task(const ParsedArgs& args, const Case& c) {
   if (!verify)
     for (const auto& flag : kCheckpointFlags)
       if (args.has(flag.name)) throw InputError(flag.name, "", "applies to the DEM verification (--verify)");
+  if (distributed::worker() && !verify) return kExitOk;  // rank 0 alone
   if (verify) {
     verification = verify_designs(c, p, r, *verify, args);
+    if (!verification) return kExitOk;  // an MPI worker: rank 0 reports
     for (const auto& d : verification->designs)
       for (const auto& w : d.dem.warnings) warnings.push_back("verify (" + d.name + "): " + w);
     if (!verification->passed)
@@ -610,7 +705,8 @@ Command optimize_command() {
                           "                          verify_chosen.checkpoint, verify_baseline.checkpoint while running)"},
             {"--json", "", "print exactly one JSON object on stdout"}}, kCheckpointFlags),
            1},
-          [](const ParsedArgs& args) { return run_optimize_task(args, case_file::load_case(args.positional().at(0))); }};
+          [](const ParsedArgs& args) { return run_optimize_task(args, case_file::load_case(args.positional().at(0))); },
+          true};
 }
 
 }  // namespace pdamp::cli

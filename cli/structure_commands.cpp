@@ -25,6 +25,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "distributed.hpp"
 #include "errors.hpp"
 #include "external_program.hpp"
 #include "output.hpp"
@@ -126,7 +127,10 @@ json number_or_null(double value) { return std::isfinite(value) ? json(value) : 
 bool dem_method(const ParsedArgs& args) { return args.optional_text("--method").value_or("") == "dem"; }
 
 
+/// The -o folder, or none; none on an MPI worker rank, which writes nothing (rank 0 checks
+/// the folder and writes the results, distributed.hpp).
 std::unique_ptr<OutputDir> output_dir(const ParsedArgs& args) {
+  if (distributed::worker()) return nullptr;
   if (const auto dir = args.optional_text("-o")) return std::make_unique<OutputDir>(*dir);
   return nullptr;
 }
@@ -450,6 +454,7 @@ int run_frf_case(const ParsedArgs& args, const Case& c) {
     auto dem_files = output_dir(args);
     return run_frf_dem(args, c, dem_files.get());
   }
+  if (distributed::worker()) return kExitOk;  // the harmonic balance: rank 0 alone
   const auto method = loss_method(args);
   auto files = output_dir(args);
   Setup setup = make_setup(c, method);
@@ -1100,6 +1105,7 @@ struct DemBranch {
   double solve_time = 0.0;
 };
 struct DemSweep {
+  bool worker = false;              ///< an MPI worker rank that ran its part: it reports nothing
   std::vector<DemBranch> branches;  ///< up first, then down (those asked for)
   std::vector<double> frequencies;  ///< requested, ascending
   std::vector<st::CosimulationDamper> dampers;
@@ -1108,6 +1114,7 @@ struct DemSweep {
   int analysed_periods = 0;
   double solve_time = 0.0;  ///< wall time of the whole sweep (both directions)
   double time_step_s = 0.0;
+  json mpi;  ///< the farm's balance under mpirun (ranks, directions per rank), else null
 };
 
 /// The points of one branch in ascending frequency, and its resonance measures
@@ -1192,6 +1199,45 @@ DemBranch run_dem_branch(const Case& c, const st::ModalModel& modal, const std::
   return branch;
 }
 
+/// A branch as CBOR for the MPI farm (distributed.hpp): doubles exact, NaN kept. The
+/// layout is this file's own, read back only by decode_branch of the same build.
+std::string encode_branch(const DemBranch& branch) {
+  json points = json::array();
+  for (const auto& p : branch.points)
+    points.push_back({p.sweep, p.f, p.requested_f, p.magnitude, p.phase_deg, p.bed_eta_star, p.bed_apparent_mass_fraction,
+                      p.spread, p.standard_error, p.energy_error, p.transient, p.stable, p.steps, p.dt, p.wall});
+  const auto bytes = json::to_cbor(json{branch.sweep, points, branch.warnings, branch.solve_time});
+  return std::string(bytes.begin(), bytes.end());
+}
+
+DemBranch decode_branch(const std::string& bytes) {
+  const json j = json::from_cbor(bytes);
+  DemBranch branch;
+  j.at(0).get_to(branch.sweep);
+  for (const auto& q : j.at(1)) {
+    DemPoint p;
+    q.at(0).get_to(p.sweep);
+    q.at(1).get_to(p.f);
+    q.at(2).get_to(p.requested_f);
+    q.at(3).get_to(p.magnitude);
+    q.at(4).get_to(p.phase_deg);
+    q.at(5).get_to(p.bed_eta_star);
+    q.at(6).get_to(p.bed_apparent_mass_fraction);
+    q.at(7).get_to(p.spread);
+    q.at(8).get_to(p.standard_error);
+    q.at(9).get_to(p.energy_error);
+    q.at(10).get_to(p.transient);
+    q.at(11).get_to(p.stable);
+    q.at(12).get_to(p.steps);
+    q.at(13).get_to(p.dt);
+    q.at(14).get_to(p.wall);
+    branch.points.push_back(std::move(p));
+  }
+  j.at(2).get_to(branch.warnings);
+  j.at(3).get_to(branch.solve_time);
+  return branch;
+}
+
 /// The band and the directions of --method dem (--dem-min/max-frequency, default the task's).
 struct DemBand {
   double f_min = 0.0, f_max = 0.0;
@@ -1248,31 +1294,11 @@ double dem_time_step(const Case& c, const st::ModalModel& modal, const std::vect
   }
 }
 
-/// Runs run(k) for k < count, on one thread each when `parallel`. An exception in a thread
-/// is carried to this one and rethrown after all end (the first one in order).
-void run_directions(std::size_t count, bool parallel, const std::function<void(std::size_t)>& run) {
-  if (!parallel) {
-    for (std::size_t k = 0; k < count; ++k) run(k);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(count);
-  std::vector<std::thread> threads;
-  for (std::size_t k = 0; k < count; ++k)
-    threads.emplace_back([&, k] {
-      try {
-        run(k);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    });
-  for (auto& t : threads) t.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
-
 /// The stepped sine of --method dem (and of --compare): up and down in frequency over the
 /// band, the two directions on two threads when the machine has two cores (each DEM world
-/// then on one thread).
+/// then on one thread), or under mpirun on two ranks (distributed.hpp; a direction is one
+/// task: each frequency continues from the previous one's state, so a direction cannot be
+/// split). On an MPI worker rank it runs what rank 0 sends and returns {worker = true}.
 DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   const int points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(kDefaultDemPoints));
   const DemBand band = dem_band(args, *c.task.frf);
@@ -1299,16 +1325,30 @@ DemSweep dem_frf_sweep(const ParsedArgs& args, const Case& c, Setup& setup) {
   out.base = base;
   out.analysed_periods = options.analysed_periods;
   out.time_step_s = sweep_dt;
-  out.parallel = directions.size() > 1 && std::thread::hardware_concurrency() >= 2;
+  out.parallel = directions.size() > 1 && (distributed::ranks() > 1 || std::thread::hardware_concurrency() >= 2);
   // Two sweeps on two cores: one thread each (the worlds' own OpenMP would oversubscribe).
+  // Under MPI too, so that a rank's branch is the serial run's bit for bit.
   if (out.parallel)
     for (auto& d : dampers) d.world.threads = 1;
+  distributed::TaskFarm farm([&](const distributed::Request& r) {
+    const auto k = static_cast<std::size_t>(r[0]);
+    return encode_branch(run_dem_branch(c, modal, dampers, options, directions.at(k).second, directions.at(k).first, sweep_dt));
+  });
+  if (distributed::worker()) {  // every check passed here too: run the direction rank 0 sends
+    farm.serve();
+    out.worker = true;
+    return out;
+  }
+  if (distributed::ranks() > 1)
+    std::cerr << "pdamp frf (dem): " << directions.size() << " sweep direction(s) over " << distributed::ranks()
+              << " MPI ranks; progress lines only of a direction run on rank 0" << std::endl;
   out.branches.resize(directions.size());
   const auto started = std::chrono::steady_clock::now();
-  run_directions(directions.size(), out.parallel, [&](std::size_t k) {
-    out.branches[k] = run_dem_branch(c, modal, dampers, options, directions[k].second, directions[k].first, sweep_dt);
+  distributed::run_concurrently(directions.size(), out.parallel, [&](std::size_t k) {
+    out.branches[k] = decode_branch(farm.evaluate({static_cast<double>(k), 0.0}));
   });
   out.solve_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  out.mpi = farm.balance();
   for (const auto& b : out.branches) setup.warnings.add(b.warnings);
   out.dampers = std::move(dampers);
   return out;
@@ -1350,10 +1390,11 @@ std::string dem_peak_row(const DemBranchPeak& bp, std::size_t points) {
 
 int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   const std::string signal = args.optional_text("--dem-signal").value_or("stepped");
-  if (signal == "linear") return run_frf_dem_linear(args, c, files);
+  if (signal == "linear") return distributed::worker() ? kExitOk : run_frf_dem_linear(args, c, files);  // rank 0 alone
   if (signal != "stepped") throw InputError("--dem-signal", "", "'" + signal + "': must be stepped or linear");
   Setup setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const DemSweep sweep = dem_frf_sweep(args, c, setup);
+  if (sweep.worker) return kExitOk;  // rank 0 reports
   const auto& frequencies = sweep.frequencies;
   const auto& dampers = sweep.dampers;
   const bool base = sweep.base;
@@ -1454,6 +1495,7 @@ int run_frf_dem(const ParsedArgs& args, const Case& c, OutputDir* files) {
   result["bed_carried_over"] = true;
   result["frf"] = frf;
   result["frf"]["warnings"] = setup.warnings.list();
+  if (!sweep.mpi.is_null()) result["mpi"] = sweep.mpi;
   return finish(args, c, files, "frf.json", result, setup.warnings, rows);
 }
 
@@ -1592,7 +1634,7 @@ int run_frf_dem_linear(const ParsedArgs& args, const Case& c, OutputDir* files) 
   if (parallel)
     for (auto& d : dampers) d.world.threads = 1;
   const auto started = std::chrono::steady_clock::now();
-  run_directions(sweeps.size(), parallel, [&](std::size_t k) {
+  distributed::run_concurrently(sweeps.size(), parallel, [&](std::size_t k) {
     auto& s = sweeps[k];
     st::CosimulationOptions sweep = steady;
     sweep.excitation.frequency_hz = s.start_hz;
@@ -1771,6 +1813,7 @@ int run_frf_compare(const ParsedArgs& args, const Case& c) {
 
   Setup dem_setup = make_setup(c, case_file::LossMethod::kFormulas, false);
   const DemSweep sweep = dem_frf_sweep(args, c, dem_setup);
+  if (sweep.worker) return kExitOk;  // rank 0 reports
   warnings.add(dem_setup.warnings.list(), "dem: ");
   if (sweep.branches.empty() || sweep.branches.front().points.empty())
     throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
@@ -1980,7 +2023,7 @@ std::vector<Command> structure_commands() {
                        "                          frf_dem.gp/png/svg; --compare: frf_compare.csv/gp/png/svg), frf.json\n"
                        "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, kDemSweepFlags), 1},
-       run_frf},
+       run_frf, true},
       {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [--resume] [--checkpoint-interval S] [-o DIR] [--json]",
         "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"
         "equivalent damping ratio and the energy each layer dissipates",

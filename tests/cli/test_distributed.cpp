@@ -138,6 +138,53 @@ TEST_CASE("a sensitivity study on 2 ranks equals the serial one", "[mpi]") {
   CHECK(spread["mpi"]["points"][1].get<int>() >= 1);
 }
 
+// The stepped sine's two directions (up, down) are two tasks: serially they run on two
+// threads, under mpirun on two ranks, each the same deterministic co-simulation from the
+// same inputs, so the points agree to the bit (frf_dem.csv has no wall times).
+TEST_CASE("a stepped-sine DEM FRF on 2 ranks equals the serial one", "[mpi]") {
+  const TempDir dir("mpi_frf");
+  const std::string c = std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/one_mode_dem_frf.json";
+  const auto frf = [&](const std::string& out) {
+    return std::vector<std::string>{"frf", c, "--method", "dem", "--dem-points", "3", "-o", (dir.path / out).string(), "--json"};
+  };
+  const json serial = parse_result(run_pdamp(frf("serial")));
+  const auto spread = run_mpi(2, frf("mpi"));
+  const json result = parse_result(spread);
+  CHECK_THAT(spread.err, Catch::Contains("2 sweep direction(s) over 2 MPI ranks"));
+  CHECK(slurp(dir.path / "mpi" / "frf_dem.csv") == slurp(dir.path / "serial" / "frf_dem.csv"));
+  REQUIRE(result["frf"]["points"].size() == 6);
+  CHECK(result["peaks"] == serial["peaks"]);
+  CHECK(result["mpi"]["points"] == json::array({1, 1}));  // a direction each
+  CHECK_FALSE(serial.contains("mpi"));
+}
+
+// The optimisation runs on every rank (NLopt's seed is fixed), each rank checks that it chose
+// rank 0's design, and the chosen and baseline DEM decays run on the two ranks: the same
+// deterministic runs as the serial two threads, so verify_decay.csv agrees to the bit.
+TEST_CASE("the DEM verification of an optimisation on 2 ranks equals the serial one", "[mpi]") {
+  const TempDir dir("mpi_verify");
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  json edited = json::parse(in);
+  edited["task"]["global_evaluations"] = 30;
+  edited["task"]["max_evaluations"] = 120;
+  edited["task"]["verify"] = {{"duration_s", 0.7}, {"stiffness_softening", 1e-4}, {"tolerance_relative", 0.3}};
+  const fs::path c = dir.path / "case.json";
+  std::ofstream(c) << edited.dump(2);
+  const auto optimize = [&](const std::string& out) {
+    return std::vector<std::string>{"optimize", c.string(), "-o", (dir.path / out).string(), "--json"};
+  };
+  const json serial = parse_result(run_pdamp(optimize("serial")));
+  const json spread = parse_result(run_mpi(2, optimize("mpi")));
+  CHECK(slurp(dir.path / "mpi" / "verify_decay.csv") == slurp(dir.path / "serial" / "verify_decay.csv"));
+  for (const char* name : {"chosen", "baseline"}) {
+    json a = spread["verification"]["designs"][name], b = serial["verification"]["designs"][name];
+    a["dem"].erase("solve_time_s"), b["dem"].erase("solve_time_s");
+    CHECK(a == b);
+  }
+  CHECK(spread["design"] == serial["design"]);
+  CHECK(spread["verification"]["mpi"]["points"] == json::array({1, 1}));  // a design each
+}
+
 TEST_CASE("under mpirun, bad input is one error line and a command without a sweep runs once", "[mpi]") {
   const TempDir dir("mpi_errors");
   const std::string bad = edited_case("mpi_bad.json", [](json& c) { c["field"]["threads"] = 0; });
@@ -153,5 +200,10 @@ TEST_CASE("under mpirun, bad input is one error line and a command without a swe
   const auto once = run_mpi(2, {"optimum", "--model", "rolling", "--clearance", "0.01", "--json"});
   REQUIRE(once.exit_code == 0);
   CHECK(json::parse(once.out)["clearance_m"] == 0.01);  // one JSON document: rank 1 printed nothing
+  // A command that spreads only its DEM part (frf) runs its harmonic balance once.
+  const auto frf = run_mpi(2, {"frf", std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/one_mode_dem_frf.json", "--json"});
+  INFO(frf.err);
+  REQUIRE(frf.exit_code == 0);
+  CHECK(json::parse(frf.out)["method"] == "formulas");
 }
 #endif
