@@ -2,14 +2,17 @@
 # Install pdamp's build dependencies from Debian's packages (a no-op when all are
 # present), then configure and build into build/. Usage: scripts/setup.sh [build-dir] [--mpi]
 # --mpi: also Open MPI, and a build whose sweeps spread over mpirun's ranks (docs/distributed.md).
+# --list-packages: print the packages it would install (with --mpi, Open MPI's too) and stop.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=build
 mpi=OFF
+list=no
 for arg in "$@"; do
   case "$arg" in
     --mpi) mpi=ON ;;
-    -*) echo "setup: unknown option $arg (usage: scripts/setup.sh [build-dir] [--mpi])" >&2; exit 2 ;;
+    --list-packages) list=yes ;;
+    -*) echo "setup: unknown option $arg (usage: scripts/setup.sh [build-dir] [--mpi] [--list-packages])" >&2; exit 2 ;;
     *) build_dir=$arg ;;
   esac
 done
@@ -18,6 +21,10 @@ packages=(build-essential cmake pkg-config libeigen3-dev libnlopt-cxx-dev
   coinor-libipopt-dev libfftw3-dev catch2 nlohmann-json3-dev libomp-dev
   gnuplot-nox libbenchmark-dev ninja-build)
 [ "$mpi" = ON ] && packages+=(libopenmpi-dev openmpi-bin)
+if [ "$list" = yes ]; then
+  echo "${packages[*]}"
+  exit 0
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -3,12 +3,22 @@
 # clang, the compiler-rt runtimes of ASan/UBSan/libFuzzer (libclang-rt-14-dev: only a
 # Recommends of clang, which --no-install-recommends skips, so it is named here) and
 # llvm-symbolizer (llvm-14) for readable reports. A no-op when all are present.
-# Usage: scripts/setup_ci_extras.sh   (called by .ci/run; see docs/ci.md)
+# With --all, first everything scripts/setup.sh and scripts/ci_mpi.sh install too, in the
+# same apt-get call: .ci/run starts with it on a fresh machine, so there is one
+# `apt-get update` and one install instead of three, and the later scripts find their
+# packages present.
+# Usage: scripts/setup_ci_extras.sh [--all]   (called by .ci/run; see docs/ci.md)
 set -euo pipefail
+cd "$(dirname "$0")/.."
 
 packages=(clang libclang-rt-14-dev llvm-14 ninja-build)
+if [ "${1:-}" = --all ]; then
+  read -r -a base <<<"$(scripts/setup.sh --list-packages --mpi)"
+  packages=("${base[@]}" "${packages[@]}")
+fi
 missing=()
 for p in "${packages[@]}"; do
+  [[ " ${missing[*]} " == *" $p "* ]] && continue  # named by both lists
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
@@ -16,7 +26,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   sudo_cmd=()
   [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+  # --force-unsafe-io: dpkg without an fsync per unpacked file, most of an install's time
+  # on a slow disk. Only here: CI's machine is thrown away after the run, while a power
+  # cut during an install on a user's machine (scripts/setup.sh) must not corrupt it.
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
+    -o Dpkg::Options::=--force-unsafe-io "${missing[@]}" >&2
 fi
 
 # The runtimes must really be there: a clang without them fails only at link time.

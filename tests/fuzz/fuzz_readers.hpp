@@ -24,6 +24,7 @@
 #include <typeinfo>
 #include <vector>
 
+#include "reader_kind.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/strict_json/input_file.hpp"
@@ -40,19 +41,6 @@ namespace pdamp::fuzz {
 
 namespace fs = std::filesystem;
 
-/// One reader of a user's file. `name` is the fuzz target's suffix (fuzz_<name>) and the
-/// folder of its corpus and regressions; `file_name` is what the bytes are saved as.
-enum class Reader {
-  kCaseFile,
-  kFieldFile,
-  kMeasuredCsv,
-  kImpactCsv,
-  kScatteredFit,
-  kModalData,
-  kSweepLog,
-  kShardLog,
-  kCheckpoint
-};
 
 struct ReaderInfo {
   Reader reader;
@@ -265,7 +253,8 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
   return outcome;
 }
 
-/// The body of every fuzz target: a broken contract aborts, so libFuzzer saves the input.
+/// The body of every fuzz target (fuzz_one_input.cpp): a broken contract aborts, so
+/// libFuzzer saves the input.
 inline void fuzz_one(Reader reader, const std::uint8_t* data, std::size_t size) {
   static const InputFolder folder(info(reader).name);
   const Outcome outcome = feed(reader, folder.path(), {reinterpret_cast<const char*>(data), size});

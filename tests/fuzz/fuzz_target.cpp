@@ -3,9 +3,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "fuzz_readers.hpp"
+#include "reader_kind.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  pdamp::fuzz::fuzz_one(pdamp::fuzz::Reader::PDAMP_FUZZ_READER, data, size);
+  pdamp::fuzz::fuzz_one_input(pdamp::fuzz::Reader::PDAMP_FUZZ_READER, data, size);
   return 0;
 }
