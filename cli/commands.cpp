@@ -24,9 +24,9 @@
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 #include "optimize_command.hpp"
-#include "plots.hpp"
-#include "report.hpp"
-#include "external_program.hpp"
+#include "output.hpp"
+#include "output.hpp"
+#include "output.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
@@ -1208,8 +1208,8 @@ int run_sensitivity_merge(const ParsedArgs& args) {
   surrogate::PointSweepResult result;
   try {
     result = surrogate::merge_point_sweep_shards(study.points, field_sweep_options(c, source), inputs.logs, c.path);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(e.what());  // names the files already
+  } catch (const std::invalid_argument&) {
+    throw;  // std::invalid_argument naming the files already: exit 2
   }
   json out = {{"sweep", "merged " + std::to_string(inputs.logs.size()) + " shard files: " +
                             std::to_string(result.summary.points_total) + " variants (" +
@@ -1238,8 +1238,8 @@ int run_field_merge(const ParsedArgs& args) {
   surrogate::SweepResult result;
   try {
     result = surrogate::merge_sweep_shards(grid, field_sweep_options(c, source), logs, c.path);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(e.what());  // names the files already
+  } catch (const std::invalid_argument&) {
+    throw;  // std::invalid_argument naming the files already: exit 2
   }
   json out = {{"sweep", "merged " + std::to_string(logs.size()) + " shard files: " +
                             std::to_string(result.summary.points_total) + " points (" +

@@ -10,7 +10,7 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "errors.hpp"
-#include "external_program.hpp"
+#include "output.hpp"
 #include "pdamp/case_file/case_error.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 
@@ -90,8 +90,6 @@ int run_command(const std::vector<std::string>& args) {
     }
     return finished(match->run(parsed));
   } catch (const InputError& e) {
-    return report(e.what(), kExitBadInput);
-  } catch (const pdamp::case_file::CaseError& e) {  // "<case file>: <pointer>: <rule>"
     return report(e.what(), kExitBadInput);
   } catch (const std::invalid_argument& e) {
     return report(("pdamp " + args[0] + ": " + e.what()).c_str(), kExitBadInput);

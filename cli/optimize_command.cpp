@@ -22,7 +22,7 @@
 #include "errors.hpp"
 #include "output.hpp"
 #include "placement_command.hpp"
-#include "report.hpp"
+#include "output.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/case_file/structure_setup.hpp"

@@ -1,82 +1,21 @@
-// Result files written atomically, gnuplot plots, and readable tables.
+// What the subcommands print and write: the report module's writers, and readable tables.
 #pragma once
 
-#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "pdamp/report/external_program.hpp"
+#include "pdamp/report/html_report.hpp"
+#include "pdamp/report/output_dir.hpp"
+#include "pdamp/report/plots.hpp"
+#include "pdamp/report/structure_plots.hpp"
 
 namespace pdamp::cli {
 
-/// Collects a command's result files in a staging folder inside DIR and moves each
-/// into place with rename() only when all are complete, so an interrupted or failed
-/// command leaves no partial file (INTERFACE.md: -o DIR writes atomically). A run
-/// replaces the whole set of files the previous run wrote into DIR (listed in
-/// DIR/.pdamp-outputs.json), so the outputs of two runs never mix; files pdamp did not
-/// write are never touched.
-class OutputDir {
- public:
-  /// Checks DIR before any work: InputError (exit 2) naming `flag` when the path is
-  /// empty, exists and is not a directory, or cannot be created or written. Removes
-  /// staging folders that processes no longer alive left behind.
-  explicit OutputDir(std::filesystem::path dir, std::string flag = "-o");
-  ~OutputDir();  ///< removes the staging folder if commit() was not reached
-  OutputDir(const OutputDir&) = delete;
-  OutputDir& operator=(const OutputDir&) = delete;
-
-  /// Stages a text file; returns its final path.
-  std::filesystem::path add(const std::string& name, const std::string& content);
-  std::filesystem::path add_json(const std::string& name, const nlohmann::json& value);
-  /// Registers `name` and returns its path in the staging folder, for writers that
-  /// take a path (they must have written it before commit()).
-  std::filesystem::path staged_path(const std::string& name);
-  /// Registers a file that a resumable job writes directly in DIR (a sweep's
-  /// results log), so that it counts as part of this run's set.
-  std::filesystem::path in_place(const std::string& name);
-  /// Stages a gnuplot script and, when gnuplot is installed, runs it in the staging
-  /// folder (an argument vector, no shell); the script must write `outputs` (e.g.
-  /// eta.png, eta.svg). Without gnuplot the script and data stay for later use and a
-  /// warning is returned.
-  std::vector<std::string> add_plot(const std::string& script_name, const std::string& script,
-                                    const std::vector<std::string>& outputs);
-  /// Moves every staged file into DIR, removes the previous run's files that this run
-  /// did not write again, and records the new set. Returns the final paths.
-  std::vector<std::string> commit();
-  const std::filesystem::path& dir() const { return dir_; }
-
- private:
-  void start_writing();
-
-  std::filesystem::path dir_;
-  std::filesystem::path staging_;
-  std::vector<std::string> names_;     // staged, moved by commit()
-  std::vector<std::string> in_place_;  // already in DIR
-  bool writing_ = false;
-  bool committed_ = false;
-};
-
-/// Writes `content` to `path` through a temporary file and rename().
-void write_file_atomically(const std::filesystem::path& path, const std::string& content);
-
-/// True when a gnuplot executable is on PATH.
-bool gnuplot_available();
-
-/// A gnuplot string expression of `text` that gnuplot takes verbatim: single-quoted
-/// pieces (no backquote command substitution, no @macro expansion, no escapes inside
-/// them) joined with "'" where the text has a quote, control characters (a newline
-/// would end the command) replaced by spaces. Use with `noenhanced` so that ^ _ { } @
-/// & show as typed.
-std::string gnuplot_string(const std::string& text);
-
-/// `name` as a safe single file-name component: letters, digits, '.', '-', '_' and
-/// '+' are kept, every other byte (a '/', "..", a quote, a space) becomes '_', and a
-/// leading '.' or '-' is replaced, so a name cannot steer a path out of its folder.
-std::string safe_file_name(const std::string& name);
+using namespace report;
 
 /// Two-column "name  value" table for the readable (non --json) output.
 std::string key_value_table(const std::vector<std::pair<std::string, std::string>>& rows);
-std::string format_number(double value, int significant = 6);
 
 }  // namespace pdamp::cli

@@ -13,7 +13,7 @@
 
 #include "errors.hpp"
 #include "output.hpp"
-#include "report.hpp"
+#include "output.hpp"
 #include "structure_commands.hpp"
 #include "pdamp/case_file/placement_problem.hpp"
 #include "pdamp/optimizer/placement.hpp"

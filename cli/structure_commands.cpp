@@ -27,12 +27,13 @@
 
 #include "distributed.hpp"
 #include "errors.hpp"
-#include "external_program.hpp"
+#include "output.hpp"
 #include "output.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/output_file.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/cosimulation.hpp"
@@ -40,8 +41,8 @@
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
 #include "pdamp/structure/sampled_response.hpp"
-#include "report.hpp"
-#include "structure_plots.hpp"
+#include "output.hpp"
+#include "output.hpp"
 
 namespace pdamp::cli {
 
@@ -781,7 +782,7 @@ std::string read_checkpoint_payload(const DemCheckpoint& cp, const dem_reference
 
 void write_checkpoint_file(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header,
                            const std::string& payload) {
-  write_file_atomically(cp.file, dem_reference::encode_checkpoint(header, payload));
+  strict_json::write_file_atomically(cp.file, dem_reference::encode_checkpoint(header, payload));
 }
 
 std::string checkpoint_advice(const DemCheckpoint& cp, const dem_reference::CheckpointHeader& header) {

@@ -1,38 +1,24 @@
 // Result files of a DEM run (time-series CSV, VTK legacy snapshots), written to a
-// temporary file beside the target and renamed over it, so no reader sees a partial file.
+// temporary file beside the target and renamed over it (strict_json::write_file_atomically),
+// so no reader sees a partial file.
 #include "pdamp/dem_reference/result_files.hpp"
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <functional>
+#include <sstream>
 #include <stdexcept>
-#include <system_error>
+
+#include "pdamp/strict_json/output_file.hpp"
 
 namespace pdamp::dem_reference {
 
 namespace {
 
+/// The text `body` writes, stored atomically (strict_json::write_file_atomically).
 void write_atomically(const std::string& path, const std::function<void(std::ostream&)>& body) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot open " + temporary + " for writing");
-    out.precision(17);
-    body(out);
-    out.flush();
-    if (!out) {
-      out.close();
-      std::remove(temporary.c_str());
-      throw std::runtime_error(path + ": writing " + temporary + " failed");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    throw std::runtime_error(path + ": cannot rename " + temporary + ": " + error.message());
-  }
+  std::ostringstream out;
+  out.precision(17);
+  body(out);
+  strict_json::write_file_atomically(path, out.str());
 }
 
 }  // namespace

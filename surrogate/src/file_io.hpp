@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "pdamp/strict_json/output_file.hpp"
+
 namespace pdamp::surrogate::detail {
 
 /// The path as it appears in messages: formulas::printable(path), so a name holding a
@@ -22,15 +24,9 @@ std::string read_text_file(const std::filesystem::path& path);
 /// "<path>: malformed JSON: ..." or "<path>: <pointer>: duplicate key".
 nlohmann::json read_json_file(const std::filesystem::path& path);
 
-/// Writes `contents` to a temporary file next to `path`, fsyncs it, renames it over
-/// `path` and fsyncs the folder: readers see the old file or the new one, never a
-/// partial one. std::runtime_error on any I/O failure (the temporary is removed).
-void write_file_atomically(const std::filesystem::path& path, std::string_view contents);
-
-/// Writes all of `data` to the open descriptor and fsyncs it; std::runtime_error on failure.
-void write_all_synced(int fd, std::string_view data, const std::filesystem::path& path);
-
-/// fsyncs the folder holding `path` so a newly created entry survives a crash (best effort).
-void sync_parent_folder(const std::filesystem::path& path);
+/// The atomic writer and synced appends of strict_json (output_file.hpp).
+using strict_json::sync_parent_folder;
+using strict_json::write_all_synced;
+using strict_json::write_file_atomically;
 
 }  // namespace pdamp::surrogate::detail

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cli/cli_support.hpp"
-#include "report.hpp"
+#include "pdamp/report/html_report.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -53,31 +53,31 @@ void require_inert(const std::string& html) {
 }  // namespace
 
 TEST_CASE("html_escape turns the five markup characters into character references", "[cli][report]") {
-  CHECK(pdamp::cli::html_escape("a<b>&\"c'") == "a&lt;b&gt;&amp;&quot;c&#39;");
-  CHECK(pdamp::cli::html_escape("plain text, μ = 0.3") == "plain text, μ = 0.3");  // UTF-8 untouched
+  CHECK(pdamp::report::html_escape("a<b>&\"c'") == "a&lt;b&gt;&amp;&quot;c&#39;");
+  CHECK(pdamp::report::html_escape("plain text, μ = 0.3") == "plain text, μ = 0.3");  // UTF-8 untouched
 }
 
 TEST_CASE("base64 gives RFC 4648's test vectors", "[cli][report]") {
   // RFC 4648 §10.
-  CHECK(pdamp::cli::base64("") == "");
-  CHECK(pdamp::cli::base64("f") == "Zg==");
-  CHECK(pdamp::cli::base64("fo") == "Zm8=");
-  CHECK(pdamp::cli::base64("foo") == "Zm9v");
-  CHECK(pdamp::cli::base64("foob") == "Zm9vYg==");
-  CHECK(pdamp::cli::base64("fooba") == "Zm9vYmE=");
-  CHECK(pdamp::cli::base64("foobar") == "Zm9vYmFy");
-  CHECK(pdamp::cli::base64(std::string("\xff\x00\x80", 3)) == "/wCA");  // high bytes and a NUL
+  CHECK(pdamp::report::base64("") == "");
+  CHECK(pdamp::report::base64("f") == "Zg==");
+  CHECK(pdamp::report::base64("fo") == "Zm8=");
+  CHECK(pdamp::report::base64("foo") == "Zm9v");
+  CHECK(pdamp::report::base64("foob") == "Zm9vYg==");
+  CHECK(pdamp::report::base64("fooba") == "Zm9vYmE=");
+  CHECK(pdamp::report::base64("foobar") == "Zm9vYmFy");
+  CHECK(pdamp::report::base64(std::string("\xff\x00\x80", 3)) == "/wCA");  // high bytes and a NUL
 }
 
 TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs", "[cli][report]") {
-  pdamp::cli::ReportInput in;
+  pdamp::report::ReportInput in;
   in.case_name = kHostile;
   in.case_description = "description " + kHostile;
   in.case_file = "/cases/" + kHostile + ".json";
   in.result = {{"task", "decay"}, {"case", kHostile}, {"settling_time_s", 17.25}, {"decay", {{"outcome", kHostile}}}};
   in.warnings = {"warning " + kHostile};
   in.pictures = {{"decay.png", "\x89PNG\r\n\x1a\n"}};
-  const std::string html = pdamp::cli::report_html(in);
+  const std::string html = pdamp::report::report_html(in);
   require_inert(html);
   CHECK(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;") != std::string::npos);
   CHECK(html.find("Content-Security-Policy") != std::string::npos);
@@ -88,7 +88,7 @@ TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs
 
   in.pictures.clear();
   in.gnuplot_found = false;
-  CHECK(pdamp::cli::report_html(in).find("gnuplot was not found") != std::string::npos);
+  CHECK(pdamp::report::report_html(in).find("gnuplot was not found") != std::string::npos);
 }
 
 TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {

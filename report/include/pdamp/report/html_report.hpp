@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "output.hpp"
+#include "pdamp/report/output_dir.hpp"
 #include "pdamp/case_file/case.hpp"
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 /// While one is alive (pdamp run, for the duration of its task), stage_run_report writes
 /// the report; other commands write none. Not thread-safe (one task per process).
@@ -60,4 +60,4 @@ std::string html_escape(std::string_view text);
 /// Standard base64 (RFC 4648 §4, padded), for data URIs.
 std::string base64(std::string_view bytes);
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

@@ -1,5 +1,5 @@
 // External programs through fork/exec with an argument vector, and signal handling.
-#include "external_program.hpp"
+#include "pdamp/report/external_program.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -13,9 +13,9 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "errors.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 namespace fs = std::filesystem;
 
@@ -120,7 +120,7 @@ void end_output_phase() { --g_output_phase; }
 int pending_interrupt() { return g_pending_signal; }
 
 void stop_if_interrupted() {
-  if (const int s = g_pending_signal; s != 0) throw Interrupted(s);
+  if (const int s = g_pending_signal; s != 0) throw strict_json::Interrupted(s);
 }
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

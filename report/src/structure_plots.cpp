@@ -1,6 +1,6 @@
 // CSV tables and gnuplot pictures of pdamp modes, frf and decay (PNG and SVG, rendered
 // when gnuplot is there; the scripts stay with the data either way).
-#include "structure_plots.hpp"
+#include "pdamp/report/structure_plots.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <map>
 #include <sstream>
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 namespace {
 
@@ -429,4 +429,4 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
   return out.add_plot("frf_compare.gp", gp.str(), {"frf_compare.png", "frf_compare.svg"});
 }
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

@@ -5,11 +5,11 @@
 #include <vector>
 
 #include "pdamp/case_file/case.hpp"
-#include "output.hpp"
+#include "pdamp/report/output_dir.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 /// One point of a closed-form eta*(X) curve.
 struct CurvePoint {
@@ -33,4 +33,4 @@ std::vector<std::string> write_force_velocity_plot(OutputDir& out, const std::st
 std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::EffectiveField& field,
                                                   const std::string& case_name, const case_file::DamperSpec& damper);
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

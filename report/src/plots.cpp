@@ -1,9 +1,9 @@
 // gnuplot pictures: data files and scripts (PNG and SVG), rendered when gnuplot is there.
-#include "plots.hpp"
+#include "pdamp/report/plots.hpp"
 
 #include <sstream>
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 namespace fm = formulas;
 
@@ -198,4 +198,4 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
   return warnings;
 }
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

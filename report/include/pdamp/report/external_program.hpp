@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 /// The executable `name` on PATH (an absolute path), or nothing. Searched directly,
 /// never through `sh -c "command -v ..."`.
@@ -46,7 +46,7 @@ class DeferredSignals {
 /// The signal received during an output phase, or 0.
 int pending_interrupt();
 
-/// Throws Interrupted (errors.hpp) when a signal arrived during the output phase.
+/// Throws strict_json::Interrupted when a signal arrived during the output phase.
 void stop_if_interrupted();
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

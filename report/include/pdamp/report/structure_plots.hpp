@@ -7,13 +7,13 @@
 
 #include <Eigen/Dense>
 
-#include "output.hpp"
+#include "pdamp/report/output_dir.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
 #include "pdamp/structure/modal_model.hpp"
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 /// What modes.csv holds: one row per reported mode (1-based in the file).
 struct ModeTable {
@@ -83,4 +83,4 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const structure
                                                  const std::vector<CompareDemPoint>& dem,
                                                  const std::string& magnitude_label, const std::string& title);
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

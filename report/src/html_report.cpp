@@ -1,6 +1,6 @@
 // DIR/report.html of pdamp run: a page built from the result JSON and the staged pictures.
 // The CLI only formats here: numbers come from the result, pictures from gnuplot.
-#include "report.hpp"
+#include "pdamp/report/html_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace pdamp::cli {
+namespace pdamp::report {
 
 namespace {
 
@@ -333,4 +333,4 @@ void stage_run_report(OutputDir& files, const case_file::Case& c, const json& re
   if (!out) throw std::runtime_error("cannot write " + page.string());
 }
 
-}  // namespace pdamp::cli
+}  // namespace pdamp::report

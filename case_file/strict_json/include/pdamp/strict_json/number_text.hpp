@@ -1,0 +1,12 @@
+// Numbers in messages and tables: the one formatter of pdamp's texts.
+#pragma once
+
+#include <string>
+
+namespace pdamp::strict_json {
+
+/// `value` with `significant` significant digits in the shortest of fixed and scientific
+/// notation (std::ostream's default floatfield), "n/a" for NaN.
+std::string format_number(double value, int significant = 6);
+
+}  // namespace pdamp::strict_json

@@ -1,0 +1,17 @@
+// The number formatter of number_text.hpp.
+#include "pdamp/strict_json/number_text.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace pdamp::strict_json {
+
+std::string format_number(double value, int significant) {
+  if (std::isnan(value)) return "n/a";
+  std::ostringstream out;
+  out.precision(significant);
+  out << value;
+  return out.str();
+}
+
+}  // namespace pdamp::strict_json

@@ -1,0 +1,230 @@
+// The output folder of a run (output_dir.hpp): staged result files committed as one set, plots.
+#include "pdamp/report/output_dir.hpp"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "pdamp/report/external_program.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/output_file.hpp"
+
+namespace pdamp::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kStagingPrefix = ".pdamp-staging-";
+constexpr const char* kManifest = ".pdamp-outputs.json";
+
+/// A staging folder ".pdamp-staging-<pid>" whose process is gone (killed during a
+/// run) is garbage: nothing else uses that name.
+void remove_stale_staging(const fs::path& dir) {
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kStagingPrefix, 0) != 0) continue;
+    const std::string digits = name.substr(std::string(kStagingPrefix).size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+    const auto pid = static_cast<pid_t>(std::stol(digits));
+    if (::kill(pid, 0) != 0 && errno == ESRCH) fs::remove_all(entry.path(), error);
+  }
+}
+
+/// The files the previous run recorded; only plain names of this folder count, so a
+/// tampered manifest cannot delete anything outside it.
+std::vector<std::string> previous_outputs(const fs::path& dir) {
+  std::vector<std::string> names;
+  try {
+    const auto doc = strict_json::parse_json_document(strict_json::read_input_file((dir / kManifest).string()), kManifest);
+    for (const auto& item : doc.at("files")) {
+      const std::string name = item.get<std::string>();
+      if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name[0] == '.') continue;
+      names.push_back(name);
+    }
+  } catch (const std::exception&) {
+    // no manifest (first run) or an unreadable one: nothing is removed
+  }
+  return names;
+}
+
+/// Blocks SIGINT, SIGTERM and SIGHUP for its lifetime: the renames of a commit are
+/// done as a whole (a signal that arrives is delivered afterwards).
+class SignalBlock {
+ public:
+  SignalBlock() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, s);
+    ::sigprocmask(SIG_BLOCK, &set, &old_);
+  }
+  ~SignalBlock() { ::sigprocmask(SIG_SETMASK, &old_, nullptr); }
+
+ private:
+  sigset_t old_;
+};
+
+}  // namespace
+
+OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
+  const std::string shown = strict_json::printable(dir_.string());
+  if (dir_.empty()) throw strict_json::InputError(flag, "", "'': an empty path is not an output directory");
+  std::error_code error;
+  const auto status = fs::status(dir_, error);
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw strict_json::InputError(flag, "", "'" + shown + "' exists and is not a directory");
+  fs::create_directories(dir_, error);
+  if (error || !fs::is_directory(dir_))
+    throw strict_json::InputError(flag, "", "'" + shown + "': cannot create the output directory (" +
+                                   (error ? error.message() : std::string("not a directory")) + ")");
+  remove_stale_staging(dir_);
+  staging_ = dir_ / (kStagingPrefix + std::to_string(::getpid()));
+  fs::remove_all(staging_, error);
+  if (!fs::create_directory(staging_, error) || ::access(staging_.c_str(), W_OK) != 0) {
+    fs::remove(staging_, error);
+    throw strict_json::InputError(flag, "", "'" + shown + "': cannot write into the output directory");
+  }
+}
+
+OutputDir::~OutputDir() {
+  std::error_code error;
+  fs::remove_all(staging_, error);
+  // After a commit signals stay deferred until pdamp exits: one that arrives now finds
+  // the results complete, and main says so (finished()).
+  if (writing_ && !committed_) end_output_phase();
+}
+
+void OutputDir::start_writing() {
+  if (!writing_) {
+    writing_ = true;
+    begin_output_phase();
+  }
+  stop_if_interrupted();
+}
+
+fs::path OutputDir::add(const std::string& name, const std::string& content) {
+  start_writing();
+  std::ofstream out(staging_ / name, std::ios::binary | std::ios::trunc);
+  out << content;
+  if (!out) throw std::runtime_error("cannot write " + (staging_ / name).string());
+  names_.push_back(name);
+  return dir_ / name;
+}
+
+fs::path OutputDir::staged_path(const std::string& name) {
+  start_writing();
+  names_.push_back(name);
+  return staging_ / name;
+}
+
+fs::path OutputDir::in_place(const std::string& name) {
+  in_place_.push_back(name);
+  return dir_ / name;
+}
+
+fs::path OutputDir::add_json(const std::string& name, const nlohmann::json& value) {
+  return add(name, value.dump(2) + "\n");
+}
+
+bool gnuplot_available() {
+  static const bool available = find_executable("gnuplot").has_value();
+  return available;
+}
+
+std::vector<std::string> OutputDir::add_plot(const std::string& script_name, const std::string& script,
+                                             const std::vector<std::string>& outputs) {
+  add(script_name, script);
+  const auto gnuplot = find_executable("gnuplot");
+  if (!gnuplot)
+    return {"gnuplot not found: wrote " + script_name + " and its data; run 'gnuplot " + script_name +
+            "' in the output directory for the plots"};
+  const std::string log = script_name + ".log";
+  const int status = run_program(*gnuplot, {script_name}, staging_, staging_ / log);
+  stop_if_interrupted();  // gnuplot ended by Ctrl-C: its pictures may be cut short
+  std::vector<std::string> warnings;
+  if (status != 0) {
+    // A failed run may leave truncated pictures: keep only the log, for the reason.
+    names_.push_back(log);
+    warnings.push_back("gnuplot failed on " + script_name + " (see " + log + "); data files are written");
+    return warnings;
+  }
+  for (const auto& name : outputs) {
+    if (fs::exists(staging_ / name)) names_.push_back(name);
+    else warnings.push_back("gnuplot did not produce " + name);
+  }
+  return warnings;
+}
+
+std::vector<std::string> OutputDir::commit() {
+  start_writing();
+  std::vector<std::string> paths;
+  // A result name taken by a folder (or a device) would stop the renames half-way:
+  // refused before the first one, so the set is moved whole or not at all.
+  std::error_code error;
+  std::vector<std::string> targets = names_;
+  targets.push_back(kManifest);
+  for (const auto& name : targets) {
+    const auto status = fs::symlink_status(dir_ / name, error);
+    if (fs::exists(status) && !fs::is_regular_file(status))
+      throw strict_json::InputError("-o", "", "'" + strict_json::printable((dir_ / name).string()) +
+                                     "' exists and is not a file: move it away (pdamp writes " + name + " there)");
+  }
+  const SignalBlock whole;
+  std::set<std::string> current(names_.begin(), names_.end());
+  current.insert(in_place_.begin(), in_place_.end());
+  for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
+  for (const auto& old : previous_outputs(dir_))
+    if (!current.count(old) && fs::is_regular_file(fs::symlink_status(dir_ / old, error))) fs::remove(dir_ / old, error);
+  strict_json::write_file_atomically(dir_ / kManifest,
+                        nlohmann::json{{"format", "pdamp.outputs"}, {"files", current}}.dump(2) + "\n");
+  for (const auto& name : current) paths.push_back((dir_ / name).string());
+  committed_ = true;
+  return paths;
+}
+
+std::string gnuplot_string(const std::string& text) {
+  // gnuplot 5.4 misreads a doubled quote at the start of a single-quoted string (a
+  // title of three quotes and a letter is a syntax error), so a quote is spliced in as
+  // the double-quoted string "'" instead: 'it'."'".'s'. A double-quoted string holding
+  // only a quote has nothing to expand.
+  std::string out, piece;
+  const auto flush = [&] {
+    if (piece.empty()) return;
+    out += (out.empty() ? "'" : ".'") + piece + "'";
+    piece.clear();
+  };
+  for (char c : text) {
+    if (c == '\'') {
+      flush();
+      out += out.empty() ? "\"'\"" : ".\"'\"";
+    } else {
+      piece += static_cast<unsigned char>(c) < 0x20 || c == 0x7F ? ' ' : c;
+    }
+  }
+  flush();
+  return out.empty() ? "''" : out;
+}
+
+std::string safe_file_name(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                      c == '-' || c == '_' || c == '+';
+    out += keep ? c : '_';
+  }
+  if (out.size() > 100) out.resize(100);
+  if (out.empty()) out = "case";
+  if (out[0] == '.' || out[0] == '-') out[0] = '_';
+  return out;
+}
+
+}  // namespace pdamp::report
