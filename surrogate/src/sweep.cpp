@@ -491,12 +491,23 @@ std::size_t pending_points(const Points& all, const SweepOptions& options) {
 }  // namespace
 
 SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options) {
+  if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
+  return run_sweep(
+      grid,
+      [&](std::size_t k) {
+        const DrivePoint drive = drive_point(grid, k, options.clearance_m);
+        return evaluator(drive.frequency_hz, drive.amplitude_m);
+      },
+      options);
+}
+
+SweepResult run_sweep(const Grid& grid, const std::function<FieldPoint(std::size_t node)>& evaluator,
+                      const SweepOptions& options) {
   detail::throw_if_any(grid.validate(), "sweep grid");
   detail::throw_if_any(options.validate(), "sweep options");
   if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   PointSweepResult r = run_points(
-      grid_points(grid, options.clearance_m),
-      [&evaluator](std::size_t, const DrivePoint& drive) { return evaluator(drive.frequency_hz, drive.amplitude_m); },
+      grid_points(grid, options.clearance_m), [&evaluator](std::size_t k, const DrivePoint&) { return evaluator(k); },
       options);
   return {field_of(grid, std::move(r.points), options), std::move(r.summary)};
 }

@@ -108,6 +108,11 @@ struct SweepResult {
 /// non-finite η*, or status missing, counts as throwing std::runtime_error.
 /// Throws std::invalid_argument for an invalid grid or options, std::runtime_error for I/O.
 SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options);
+/// The same with an evaluator of the node index k (Grid::index order; its drive is
+/// drive_point(grid, k, options.clearance_m)): for callers that hand nodes to other
+/// processes by number.
+SweepResult run_sweep(const Grid& grid, const std::function<FieldPoint(std::size_t node)>& evaluator,
+                      const SweepOptions& options);
 
 /// Grid nodes a run_sweep(grid, evaluator, options) would evaluate now: the nodes of
 /// options' shard (grid.size() unless sharded) minus the points already saved in options.results_path (0 saved if the path is

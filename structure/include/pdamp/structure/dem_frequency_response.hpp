@@ -1,0 +1,128 @@
+#pragma once
+// The frequency response of a structure with its beds as DEM worlds (the DEM in the loop,
+// cosimulate): a stepped sine, each frequency continuing the previous one's state, and a
+// linear sine sweep from the steady state at its start; their resonance measures.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pdamp/structure/cosimulation.hpp"
+#include "pdamp/structure/sampled_response.hpp"
+
+namespace pdamp::structure {
+
+/// Settling to a steady state at each frequency of a stepped sine. The defaults hold for a
+/// DEM bed, whose per-period amplitude scatters by a few per cent (chaotic impacts):
+/// amplitudes_settled judges the drift against that scatter, so a tolerance of 1% (not a
+/// single steady state's tighter CosimulationOptions default) ends the transient without
+/// waiting for a drift the scatter hides.
+struct SteadyStateSettling {
+  int max_transient_periods = 100;  ///< at most, per frequency, >= 0
+  double stable_tolerance = 1e-2;   ///< amplitudes_settled's tolerance, (0, 1)
+};
+
+/// The co-simulation options of a stepped sine's points: `steady` with the settling rule and
+/// the drive's phase π/2 at each frequency's start (U sin(Ω(t − t_i) + π/2): every run ends
+/// on whole periods, so each junction is at the turning point, base displacement and
+/// velocity, or the force, continuous).
+CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling);
+
+/// One frequency of a stepped sine.
+struct SteppedSinePoint {
+  std::string sweep;                   ///< "up" or "down"
+  double frequency_hz = 0.0;           ///< as run (CosimulationSteadyState::frequency_hz)
+  double requested_frequency_hz = 0.0;
+  std::vector<double> magnitude, phase_deg;  ///< per damper: |ŷ_d| per unit excitation, arg ŷ_d in degrees
+  std::vector<double> bed_eta_star, bed_apparent_mass_fraction;  ///< per damper, in the loop
+  double spread = NAN;          ///< sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation
+  double standard_error = NAN;  ///< spread/√(analysed periods): periods taken as independent
+  double energy_error = 0.0;
+  int transient_periods = 0;
+  bool stable = false;
+  std::int64_t steps = 0;
+  double time_step_s = 0.0, wall_time_s = 0.0;
+  std::vector<std::string> warnings;  ///< the co-simulation's
+};
+
+/// One direction of a stepped sine: its points in the order run.
+struct SteppedSineBranch {
+  std::string sweep;
+  std::vector<SteppedSinePoint> points;
+  double wall_time_s = 0.0;
+  /// kCompleted, or the outcome of the point that stopped the branch (its `message` says
+  /// why; the points before it are kept).
+  dem_reference::Outcome outcome = dem_reference::Outcome::kCompleted;
+  std::string message;
+};
+
+/// Progress of point `index` of a branch.
+using SteppedSineProgress = std::function<void(std::size_t index, const CosimulationProgress&)>;
+
+/// The common step of a stepped sine over `frequencies`: the smallest automatic step (each
+/// period then the nearest whole number of steps). std::invalid_argument as cosimulate.
+double stepped_sine_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, const std::vector<double>& frequencies_hz);
+
+/// One direction of a stepped sine over `frequencies_hz` in the order given: each frequency
+/// continues the previous one's final state (modes, bed, the drive's phase); the bed is
+/// settled once, before the first. `options` from stepped_sine_options, validated.
+SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                      CosimulationOptions options, const std::vector<double>& frequencies_hz,
+                                      const std::string& sweep, double time_step_s, const SteppedSineProgress& progress);
+
+/// The points of a branch in ascending frequency and their resonance measures (sampled_peak)
+/// of one output; the standard errors are the first output's (its per-period amplitudes are
+/// recorded), the others' peaks have none.
+struct SteppedSinePeak {
+  std::vector<const SteppedSinePoint*> ascending;
+  SampledPeak peak;
+  std::size_t output = 0;
+};
+SteppedSinePeak stepped_sine_peak(const SteppedSineBranch& branch, std::size_t output = 0);
+
+/// The default rate of a linear sweep: the quasi-stationary ratio (docs/cosimulation.md §6),
+/// the time spent in the half-power band over the response time, 4πζ²f²/r, at
+/// `quasi_stationary_ratio` for a resonance at f with damping ratio ζ, Hz/s. The cycles' lag
+/// error is first order in 1/ratio: 2.2% at 63 on a linear mode, halving with the rate, so
+/// about 1.4% at 100, below the DEM bed's own cycle-to-cycle scatter (3-4%).
+double quasi_stationary_sweep_rate(double frequency_hz, double damping_ratio, double quasi_stationary_ratio = 100.0);
+
+/// The peak of a linear sweep is read off the means of this many consecutive cycles (the
+/// window of amplitudes_settled), their standard error the window's spread over its root.
+inline constexpr std::size_t kSweepWindowCycles = kSettledWindowPeriods;
+
+/// One output's resonance measures over a sweep, read off the moving means of
+/// kSweepWindowCycles consecutive cycles (ascending frequency); none with fewer cycles.
+struct SweepPeak {
+  std::vector<double> window_frequency_hz, window_magnitude, window_standard_error;
+  SampledPeak peak;
+  bool found() const { return !window_magnitude.empty(); }
+  double standard_error() const { return found() ? window_standard_error[peak.index] : NAN; }
+};
+SweepPeak sweep_peak(const std::vector<CosimulationSweepCycle>& cycles, std::size_t output);
+
+/// One direction of a linear sine sweep: the steady state at the start frequency, then the
+/// sweep to the end frequency continuing from it.
+struct LinearSineSweep {
+  std::string sweep;
+  double start_hz = 0.0, end_hz = 0.0, rate_hz_s = 0.0, duration_s = 0.0;
+  int start_transient_periods = 0;
+  bool start_stable = false;
+  std::vector<CosimulationSweepCycle> cycles;
+  double energy_error = 0.0, time_step_s = 0.0, wall_time_s = 0.0;
+  std::int64_t steps = 0;
+  std::vector<std::string> warnings;  ///< the co-simulations', "<sweep> sweep: " before each
+  std::vector<SweepPeak> peaks;  ///< per output
+  dem_reference::Outcome outcome = dem_reference::Outcome::kCompleted;  ///< as SteppedSineBranch
+  std::string message;
+};
+
+/// Runs one direction: `steady` (stepped_sine_options) settles the structure at `start_hz`
+/// on the sweep's step, then the sweep runs to `end_hz` at `rate_hz_s`. `progress` gets the
+/// start (index 0) and the sweep (index 1).
+LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                  const CosimulationOptions& steady, const std::string& sweep, double start_hz,
+                                  double end_hz, double rate_hz_s, const SteppedSineProgress& progress);
+
+}  // namespace pdamp::structure

@@ -1,0 +1,171 @@
+// The DEM-in-the-loop frequency response: stepped sine and linear sine sweep
+// (dem_frequency_response.hpp).
+#include "pdamp/structure/dem_frequency_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace pdamp::structure {
+
+CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling) {
+  steady.transient_periods = settling.max_transient_periods;
+  steady.settle_until_stable = true;
+  steady.stable_tolerance = settling.stable_tolerance;
+  steady.excitation_phase_rad = std::numbers::pi / 2.0;
+  return steady;
+}
+
+double stepped_sine_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationOptions& options, const std::vector<double>& frequencies_hz) {
+  double dt = INFINITY;
+  for (const double f : frequencies_hz) {
+    CosimulationOptions o = options;
+    o.excitation.frequency_hz = f;
+    dt = std::min(dt, cosimulation_time_step(model, dampers, o).time_step_s);
+  }
+  return dt;
+}
+
+SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                      CosimulationOptions options, const std::vector<double>& frequencies_hz,
+                                      const std::string& sweep, double time_step_s, const SteppedSineProgress& progress) {
+  SteppedSineBranch branch;
+  branch.sweep = sweep;
+  CosimulationState state;  // the bed, the modes and the drive's phase, carried over
+  for (std::size_t i = 0; i < frequencies_hz.size(); ++i) {
+    options.excitation.frequency_hz = frequencies_hz[i];
+    options.time_step_s = state.started() ? 0.0 : time_step_s;
+    const auto r = cosimulate(model, dampers, options, state, [&](const CosimulationProgress& p) {
+      if (progress) progress(i, p);
+    });
+    branch.wall_time_s += r.wall_time_s;
+    if (r.outcome != dem_reference::Outcome::kCompleted) {
+      branch.outcome = r.outcome;
+      branch.message = r.message;
+      return branch;
+    }
+    const auto& ss = r.steady_state;
+    SteppedSinePoint p;
+    p.sweep = sweep;
+    p.frequency_hz = ss.frequency_hz;
+    p.requested_frequency_hz = frequencies_hz[i];
+    for (std::size_t d = 0; d < dampers.size(); ++d) {
+      p.magnitude.push_back(ss.site_amplitude_per_excitation.at(d));
+      p.phase_deg.push_back(std::arg(ss.site_amplitudes_m.at(d)) * 180.0 / std::numbers::pi);
+      p.bed_eta_star.push_back(ss.bed_reduced_loss_factor.at(d));
+      p.bed_apparent_mass_fraction.push_back(ss.bed_apparent_mass_fraction.at(d));
+    }
+    // Spread: sample standard deviation of the analysed periods' |ŷ| of the first site, per unit excitation.
+    const auto& per = ss.period_site_amplitudes_m;
+    const std::size_t na = static_cast<std::size_t>(std::max(ss.analysed_periods, 0));
+    if (na >= 2 && per.size() >= na) {
+      double mean = 0.0, var = 0.0;
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) mean += per[k];
+      mean /= static_cast<double>(na);
+      for (std::size_t k = per.size() - na; k < per.size(); ++k) var += (per[k] - mean) * (per[k] - mean);
+      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / options.excitation.amplitude;
+      p.standard_error = p.spread / std::sqrt(static_cast<double>(na));
+    }
+    p.energy_error = r.energy.relative_error;
+    p.transient_periods = ss.transient_periods;
+    p.stable = ss.stable;
+    p.steps = r.steps;
+    p.time_step_s = r.time_step_s;
+    p.wall_time_s = r.wall_time_s;
+    p.warnings = r.warnings;
+    branch.points.push_back(std::move(p));
+  }
+  return branch;
+}
+
+SteppedSinePeak stepped_sine_peak(const SteppedSineBranch& branch, std::size_t output) {
+  SteppedSinePeak out;
+  out.output = output;
+  for (const auto& p : branch.points) out.ascending.push_back(&p);
+  std::sort(out.ascending.begin(), out.ascending.end(),
+            [](const SteppedSinePoint* a, const SteppedSinePoint* b) { return a->frequency_hz < b->frequency_hz; });
+  std::vector<double> f, m, se;
+  for (const SteppedSinePoint* p : out.ascending) {
+    f.push_back(p->frequency_hz);
+    m.push_back(p->magnitude.at(output));
+    se.push_back(output == 0 && std::isfinite(p->standard_error) ? p->standard_error : 0.0);
+  }
+  out.peak = sampled_peak(f, m, se);
+  return out;
+}
+
+double quasi_stationary_sweep_rate(double frequency_hz, double damping_ratio, double quasi_stationary_ratio) {
+  return 4.0 * std::numbers::pi * damping_ratio * damping_ratio * frequency_hz * frequency_hz / quasi_stationary_ratio;
+}
+
+SweepPeak sweep_peak(const std::vector<CosimulationSweepCycle>& cycles, std::size_t output) {
+  SweepPeak out;
+  std::vector<std::pair<double, double>> fm;
+  for (const auto& c : cycles) fm.push_back({c.frequency_hz, c.site_amplitude_per_excitation.at(output)});
+  std::sort(fm.begin(), fm.end());
+  const std::size_t w = kSweepWindowCycles;
+  for (std::size_t i = 0; i + w <= fm.size(); ++i) {
+    double f = 0.0, m = 0.0, ss = 0.0;
+    for (std::size_t k = i; k < i + w; ++k) f += fm[k].first, m += fm[k].second;
+    f /= static_cast<double>(w);
+    m /= static_cast<double>(w);
+    for (std::size_t k = i; k < i + w; ++k) ss += (fm[k].second - m) * (fm[k].second - m);
+    out.window_frequency_hz.push_back(f);
+    out.window_magnitude.push_back(m);
+    out.window_standard_error.push_back(std::sqrt(ss / static_cast<double>(w - 1)) / std::sqrt(static_cast<double>(w)));
+  }
+  if (out.found()) out.peak = sampled_peak(out.window_frequency_hz, out.window_magnitude, out.window_standard_error);
+  return out;
+}
+
+LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                  const CosimulationOptions& steady, const std::string& sweep, double start_hz,
+                                  double end_hz, double rate_hz_s, const SteppedSineProgress& progress) {
+  LinearSineSweep s;
+  s.sweep = sweep;
+  s.start_hz = start_hz;
+  s.end_hz = end_hz;
+  s.rate_hz_s = rate_hz_s;
+  s.duration_s = std::abs(end_hz - start_hz) / rate_hz_s;
+  CosimulationOptions run = steady;
+  run.excitation.frequency_hz = start_hz;
+  run.sweep_end_frequency_hz = end_hz;
+  run.duration_s = s.duration_s;
+  CosimulationOptions start = steady;  // the steady state at the start, on the sweep's step
+  start.excitation.frequency_hz = start_hz;
+  start.time_step_s = cosimulation_time_step(model, dampers, run).time_step_s;
+  CosimulationState state;
+  const auto report = [&](std::size_t index) {
+    return [&, index](const CosimulationProgress& p) {
+      if (progress) progress(index, p);
+    };
+  };
+  const auto first = cosimulate(model, dampers, start, state, report(0));
+  s.wall_time_s = first.wall_time_s;
+  s.steps = first.steps;
+  for (const auto& w : first.warnings) s.warnings.push_back(sweep + " sweep: " + w);
+  if (first.outcome != dem_reference::Outcome::kCompleted) {
+    s.outcome = first.outcome;
+    s.message = first.message;
+    return s;
+  }
+  s.start_transient_periods = first.steady_state.transient_periods;
+  s.start_stable = first.steady_state.stable;
+  const auto r = cosimulate(model, dampers, run, state, report(1));
+  for (const auto& w : r.warnings) s.warnings.push_back(sweep + " sweep: " + w);
+  s.wall_time_s += r.wall_time_s;
+  s.steps += r.steps;
+  if (r.outcome != dem_reference::Outcome::kCompleted) {
+    s.outcome = r.outcome;
+    s.message = r.message;
+    return s;
+  }
+  s.cycles = r.sweep_cycles;
+  s.energy_error = r.energy.relative_error;
+  s.time_step_s = r.time_step_s;
+  for (std::size_t d = 0; d < dampers.size(); ++d) s.peaks.push_back(sweep_peak(s.cycles, d));
+  return s;
+}
+
+}  // namespace pdamp::structure

@@ -1,0 +1,85 @@
+// Task kind decay (pdamp decay): the free decay of a structure with its dampers from the
+// task's initial state, by averaging on the layers' loss models (formulas or field) or by
+// the DEM in the loop (checkpointed in segments, resumable); the DEM decay also serves the
+// design verification.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/structure/cosimulation.hpp"
+#include "pdamp/structure/free_decay.hpp"
+#include "pdamp/structure/sampled_decay.hpp"
+#include "pdamp/tasks/checkpoint.hpp"
+#include "pdamp/tasks/output_folder.hpp"
+#include "pdamp/tasks/run_hooks.hpp"
+
+namespace pdamp::tasks {
+
+/// The checkpoints of a DEM decay: its file, what it continues ("decay_dem",
+/// "verify_chosen", ...) and the caller's own settings that a resume must match (a design).
+struct DemDecayCheckpoint {
+  CheckpointFile file;
+  std::string kind = "decay_dem";
+  std::string settings;
+};
+
+/// A DEM-in-the-loop free decay of the first damper's site.
+struct DemDecay {
+  structure::CosimulationResult cosimulation;
+  structure::SampledSettling settling;
+  double static_offset_m = 0.0;        ///< y_s: the beds' weight along the drives, m
+  double initial_envelope_m = 0.0;     ///< Σ_j |b_j| |q0_j| at the first damper's site, m
+  double threshold_m = 0.0;            ///< settling_threshold · initial_envelope_m, m
+  double dominant_frequency_hz = 0.0;  ///< of the dominant mode with the empty containers
+  Eigen::Index dominant_mode = 0;      ///< 0-based
+  std::vector<std::string> warnings;   ///< the co-simulation's, not settled, energy ledger above 1%
+};
+
+/// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds) from
+/// rest at q0 over task.duration_s and measures its settling against
+/// task.settling_threshold (structure::sampled_settling). With a checkpoint file the run
+/// goes in segments of whole sample intervals (about 2 s of wall time each), saves its
+/// state when the hooks say a checkpoint is due, and when they ask to stop saves one and
+/// throws strict_json::Interrupted; with file.resume it continues from the file (bit for
+/// bit the uninterrupted run). `containers`: the same dampers as the structure sees them
+/// (drive shapes and the static offset of the case's beds). Progress lines carry `label`;
+/// `duration_pointer` is named in the not-settled warning. InputError for refused options,
+/// strict_json::NumericalError for a World that stops.
+DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal, std::vector<structure::Damper> containers,
+                   const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
+                   const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
+                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks);
+
+enum class DecayMethod { kFormulas, kField, kDem };
+
+struct DecayOptions {
+  DecayMethod method = DecayMethod::kFormulas;
+  DemDecayCheckpoint checkpoint;  ///< kDem: where it saves its state (empty file: none)
+};
+
+struct DecayResult {
+  std::string case_name;
+  DecayMethod method = DecayMethod::kFormulas;
+  std::vector<std::string> damper_names;
+  std::string threshold_point;           ///< the first damper's site
+  double threshold_fraction = 0.0;
+  Eigen::VectorXd initial_modal_amplitudes;
+  Eigen::Index modes = 0;
+  structure::FreeDecay decay;            ///< kFormulas, kField
+  DemDecay dem;                          ///< kDem
+  std::vector<std::string> warnings;
+};
+/// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
+DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, RunHooks& hooks);
+/// The result keys (task, case, method, file, settling_time_s, damping_ratio, decay, ...).
+nlohmann::json to_json(const DecayResult& result, const OutputFolder& folder);
+/// The co-simulation's energy ledger (docs/cosimulation.md §4) as JSON.
+nlohmann::json to_json(const structure::CosimulationEnergy& energy);
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,108 @@
+// Task kind filling_ratios (pdamp optimize, pdamp run): how many whole slabs each layer of
+// the first damper holds for the fastest free decay under a particle-mass budget (NLopt or
+// Ipopt on the closed forms), the rounded neighbours and the best single layer, the decays
+// that compare them, and the DEM verification of the chosen design against the baseline.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/filling_ratio_problem.hpp"
+#include "pdamp/optimizer/filling_ratios.hpp"
+#include "pdamp/optimizer/options.hpp"
+#include "pdamp/structure/free_decay.hpp"
+#include "pdamp/structure/sampled_decay.hpp"
+#include "pdamp/tasks/executor.hpp"
+#include "pdamp/tasks/output_folder.hpp"
+#include "pdamp/tasks/run_hooks.hpp"
+
+namespace pdamp::tasks {
+
+struct FillingRatiosOptions {
+  std::optional<optimizer::Backend> backend;  ///< default: the task's
+  /// The DEM verification: the task's verify block when present; `force_verify` runs it
+  /// with its defaults when the task has none; `skip_verify` runs none.
+  bool force_verify = false;
+  bool skip_verify = false;
+  /// The verification's checkpoints, verify_<design>.checkpoint in this folder (empty: none).
+  std::filesystem::path checkpoint_dir;
+  bool resume = false;  ///< continue the verification's decays from their checkpoints
+};
+
+/// What the verification keeps of a design's DEM decay: what it compares, reports and plots.
+struct VerifiedDecay {
+  std::vector<double> time_s;               ///< the co-simulation's samples, s
+  std::vector<double> site_displacement_m;  ///< y − y_s at the first damper's site, per sample
+  structure::SampledSettling settling;
+  double threshold_m = 0.0, initial_envelope_m = 0.0;
+  double energy_error = 0.0, dem_dissipated_j = 0.0, structural_dissipated_j = 0.0;
+  std::int64_t steps = 0;
+  double time_step_s = 0.0, wall_time_s = 0.0;
+  std::vector<std::string> warnings;
+};
+
+/// One design checked by the DEM: the prediction over the verification's duration and the
+/// DEM's decay over the same time.
+struct DesignCheck {
+  std::string name;               ///< "chosen" or "baseline"
+  optimizer::FillingDesign design;
+  optimizer::FillingDesign predicted;   ///< the closed forms over verify.duration_s
+  double predicted_objective = NAN;     ///< its settling time or ½∫e² dt
+  double predicted_end_envelope_m = NAN;
+  std::vector<double> predicted_envelope_m;  ///< at the DEM's sample times
+  VerifiedDecay dem;
+  double dem_objective = NAN;     ///< settling time (NaN: not settled) or ½∫e² dt
+  double dem_end_envelope_m = NAN;
+  std::string compared;           ///< "objective", "end_envelope" or "settled_only_one"
+  double relative_difference = NAN;
+  bool passed = false;
+  int particles = 0;
+};
+
+struct Verification {
+  case_file::VerifySpec spec;
+  double dem_stiffness_softening = 1.0;  ///< the case's /dem softening (the runs use it times spec's)
+  bool settling_objective = true;
+  std::vector<DesignCheck> designs;  ///< chosen, baseline
+  bool predicted_chosen_ahead = false;
+  bool dem_chosen_ahead = false;
+  bool ranking_passed = false;
+  bool passed = false;
+  double wall_time_s = 0.0;
+  nlohmann::json mpi;  ///< how the two decays spread over processes, or null
+};
+
+/// The closed-form envelopes of the chosen, baseline and starting designs on one time grid
+/// (decay_compare.csv).
+struct DesignComparison {
+  std::vector<structure::FreeDecay> decays;  ///< chosen, baseline, initial
+};
+
+struct FillingRatiosResult {
+  std::string case_name;
+  case_file::FillingRatioProblem problem;
+  double mass_budget_kg = 0.0;
+  optimizer::FillingRatioResult optimum;
+  DesignComparison comparison;
+  std::optional<Verification> verification;
+  std::vector<std::filesystem::path> checkpoints;  ///< the verification's files, to remove once its results are kept
+  std::vector<std::string> warnings;
+};
+
+/// The slabs of a design, one per layer.
+std::vector<double> slabs_of(const optimizer::FillingDesign& design);
+
+/// The filling-ratio study of a case whose task is kind filling_ratios. The verification's
+/// two DEM decays are jobs of `executor` (on a process that serves another:
+/// JobsServedElsewhere); their progress and checkpoints go through `hooks`.
+FillingRatiosResult run_filling_ratios(const case_file::Case& c, const FillingRatiosOptions& options, RunHooks& hooks,
+                                       Executor& executor);
+/// The result keys (task, case, method, design, designs, solver, verification, ...).
+nlohmann::json to_json(const FillingRatiosResult& result);
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,100 @@
+// Task kind frf (pdamp frf): the frequency response of a structure with its dampers, by the
+// harmonic balance on the layers' loss models (formulas or field: every root, stability,
+// branches, jumps, peaks, and the response without beds), by the DEM in the loop (a stepped
+// sine up and down in frequency whose two directions an Executor spreads, or a linear sine
+// sweep), or all three compared.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/structure/dem_frequency_response.hpp"
+#include "pdamp/structure/harmonic_balance.hpp"
+#include "pdamp/tasks/executor.hpp"
+#include "pdamp/tasks/output_folder.hpp"
+#include "pdamp/tasks/run_hooks.hpp"
+
+namespace pdamp::tasks {
+
+enum class FrfMethod { kFormulas, kField, kDem, kCompare };
+
+/// The DEM's part of an frf study (--method dem and --compare).
+struct DemFrfOptions {
+  int points = 9;                          ///< stepped sine: frequencies, linear over the band, [2, 1000]
+  double min_frequency_hz = 0.0;           ///< the band, Hz (the task's by default), max > min > 0
+  double max_frequency_hz = 0.0;
+  std::vector<std::string> directions{"up", "down"};  ///< "up", "down" (those asked for, up first)
+  bool linear_sweep = false;               ///< a linear sine sweep instead of the stepped sine
+  std::optional<double> sweep_rate_hz_s;   ///< linear sweep: default quasi_stationary_sweep_rate at the formulas' resonance
+  structure::SteadyStateSettling settling; ///< each frequency's settling to its steady state
+};
+/// The band and points of the case's frf task.
+DemFrfOptions default_dem_frf_options(const case_file::Case& c);
+
+struct FrfOptions {
+  FrfMethod method = FrfMethod::kFormulas;
+  DemFrfOptions dem;
+};
+
+/// The harmonic balance's response for one loss method.
+struct HarmonicFrf {
+  case_file::LossMethod method = case_file::LossMethod::kFormulas;
+  structure::FrequencyResponse response;
+  std::vector<std::string> damper_names;
+  bool converged = true;
+  surrogate::AxisSpacing spacing = surrogate::AxisSpacing::kLinear;  ///< of the task's frequencies
+};
+
+/// The stepped sine's branches (up first).
+struct SteppedSineFrf {
+  std::vector<structure::SteppedSineBranch> branches;
+  std::vector<double> frequencies_hz;  ///< requested, ascending
+  std::vector<std::string> damper_names;
+  bool parallel = false;
+  int analysed_periods = 0;
+  double time_step_s = 0.0;
+  double solve_time_s = 0.0;           ///< wall time of the whole sweep (both directions)
+  structure::SteadyStateSettling settling;
+  nlohmann::json mpi;                  ///< how the directions spread over processes, or null
+};
+
+/// The linear sine sweep's directions.
+struct LinearSweepFrf {
+  std::vector<structure::LinearSineSweep> sweeps;
+  std::vector<std::string> damper_names;
+  double rate_hz_s = 0.0, duration_s = 0.0, min_frequency_hz = 0.0, max_frequency_hz = 0.0;
+  std::string rate_basis;  ///< "--dem-sweep-rate", or where the default came from
+  bool parallel = false;
+  double solve_time_s = 0.0;
+};
+
+struct FrfResult {
+  std::string case_name;
+  FrfMethod method = FrfMethod::kFormulas;
+  bool base_excitation = true;  ///< transmissibility |X/U|, else receptance |X/F|
+  std::optional<HarmonicFrf> harmonic;  ///< kFormulas, kField; kCompare: the formulas'
+  std::optional<HarmonicFrf> field;     ///< kCompare: when every layer has a field_file
+  std::optional<SteppedSineFrf> stepped;  ///< kDem (stepped), kCompare
+  std::optional<LinearSweepFrf> linear;   ///< kDem with linear_sweep
+  std::vector<std::string> warnings;
+};
+
+/// The frf study of a case whose task is kind frf (InputError naming /task otherwise). On a
+/// process that serves another (an MPI worker) the stepped sine throws JobsServedElsewhere.
+FrfResult run_frf(const case_file::Case& c, const FrfOptions& options, RunHooks& hooks, Executor& executor);
+/// The result keys (task, case, method, file, peaks, branches, frf or compare, ...); "warnings"
+/// and "outputs" are the caller's.
+nlohmann::json to_json(const FrfResult& result, const OutputFolder& folder);
+/// "transmissibility |X/U|" or "receptance |X/F| / (m/N)": the magnitude's axis label.
+std::string magnitude_label(const FrfResult& result);
+/// The largest peak of the first output, or nullptr.
+const structure::ResponsePeak* first_output_peak(const structure::FrequencyResponse& response);
+/// "fold", "discontinuity" or "stroke_range".
+std::string_view branch_end_kind(structure::BranchEnd::Kind kind);
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,51 @@
+// Task kind modes (pdamp modes): natural frequencies with the empty containers and bare,
+// mode shapes at the named points, the beds' modal mass ratios, and the backbones f(X),
+// zeta_add(X) of each mode with the dampers' loss models.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/structure/backbone.hpp"
+#include "pdamp/structure/modal_model.hpp"
+#include "pdamp/tasks/output_folder.hpp"
+
+namespace pdamp::tasks {
+
+struct ModesOptions {
+  case_file::LossMethod method = case_file::LossMethod::kFormulas;  ///< formulas or field
+};
+
+struct ModesResult {
+  std::string case_name;
+  case_file::LossMethod method = case_file::LossMethod::kFormulas;
+  structure::ModalModel modal;                     ///< the structure's modes (bare frequencies, shapes at points)
+  Eigen::Index mode_count = 0;                     ///< modes reported
+  Eigen::VectorXd frequencies_with_containers_hz;  ///< the empty containers attached
+  Eigen::MatrixXd drive_shapes;                    ///< modes x dampers, along each damper's drive
+  Eigen::MatrixXd mass_ratio;                      ///< modes x dampers: μ_dj = b_dj² Σ_l m_bed,l / m_j
+  std::vector<std::string> damper_names;
+  std::vector<std::string> layer_names;            ///< "damper/layer"
+  std::vector<structure::Backbone> backbones;      ///< of the modes in which the first damper moves
+  std::map<Eigen::Index, std::size_t> backbone_of_mode;
+  double backbone_min_amplitude_m = 0.0, backbone_max_amplitude_m = 0.0;
+  int backbone_points = 0;
+  bool backbone_from_task = false;                 ///< the task's range, else the default
+  int rigid_modes_dropped = 0;
+  bool converged = true;                           ///< every backbone point converged
+  std::vector<std::string> warnings;
+};
+
+/// The modes study of a format-2 case (any task kind: the backbone range is the modes
+/// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance).
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options);
+/// The result keys (task, case, method, file, modes, frequencies, backbone, outcome, ...).
+nlohmann::json to_json(const ModesResult& result, const OutputFolder& folder);
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,48 @@
+// What a long run reports and asks while it works: progress, when to save a checkpoint,
+// whether to stop. Every long library run (a DEM run, a sweep, a DEM-in-the-loop decay or
+// stepped sine, a verification) takes one RunHooks; the command line implements it
+// (progress lines on stderr, its checkpoint interval, the signals), tests and benchmarks
+// take the silent defaults.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+namespace pdamp::tasks {
+
+/// Where a long run stands.
+struct Progress {
+  std::string label;           ///< the run: "pdamp dem", "pdamp frf (dem) up 3/9 1.8 Hz", ...
+  std::string stage;           ///< "setup", "settle", "transient", "analysis", "decay", "sweep", "points"
+  double done = 0.0;           ///< simulated time reached, s; points done when counts_points
+  double total = 0.0;          ///< simulated time at the end, s; points in all when counts_points
+  bool counts_points = false;  ///< a sweep: done and total count points, not seconds
+  double steps_per_s = NAN;    ///< integration steps per wall-clock second (NaN: none yet)
+  double eta_s = NAN;          ///< wall-clock seconds to the end (NaN: not known yet)
+};
+
+/// The hooks of a run. Runs that go in parallel (two DEM decays, a sweep's points) share one
+/// object and call it from several threads: implementations must be thread-safe.
+class RunHooks {
+ public:
+  virtual ~RunHooks() = default;
+  /// A progress report, about twice a second while a run steps and once per finished point.
+  virtual void progress(const Progress&) {}
+  /// A line for the user that is not a result: the cost estimate of a run before it starts,
+  /// "resuming from ...", a checkpoint of an earlier run being replaced.
+  virtual void note(const std::string&) {}
+  /// Whether a run that last saved a checkpoint `seconds_since_checkpoint` wall-clock seconds
+  /// ago (or started that long ago) should save one at its next consistent point.
+  virtual bool checkpoint_due(double /*seconds_since_checkpoint*/) { return false; }
+  /// Nonzero (the signal number) when the runs should stop at their next consistent point,
+  /// save their checkpoint and throw strict_json::Interrupted; 0 to go on.
+  virtual int stop_requested() { return 0; }
+};
+
+/// The hooks that report nothing, save no checkpoint and never stop.
+inline RunHooks& silent_hooks() {
+  static RunHooks hooks;
+  return hooks;
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,436 @@
+// Task kind decay (decay.hpp).
+#include "pdamp/tasks/decay.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "pdamp/dem_reference/checkpoint.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/structure/backbone.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
+#include "structure_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace st = structure;
+using case_file::Case;
+using detail::number_or_null;
+using nlohmann::json;
+using strict_json::format_number;
+using strict_json::InputError;
+using strict_json::NumericalError;
+
+namespace {
+
+/// Free-decay samples: about 50 per period of the first mode, at least 2000, at most 20000
+/// (the averaging and the DEM in the loop alike).
+constexpr double kDecaySamplesPerPeriod = 50.0;
+constexpr double kDecayMinSamples = 2000.0;
+constexpr double kDecayMaxSamples = 20000.0;
+
+double decay_samples(const st::ModalModel& modal, double duration_s) {
+  return std::clamp(std::ceil(kDecaySamplesPerPeriod * modal.natural_frequencies_hz[0] * duration_s), kDecayMinSamples,
+                    kDecayMaxSamples);
+}
+
+/// Wall-clock seconds a segment aims at: short enough that an interrupted run stops soon,
+/// long enough that its start (no allocation, a few vector copies) costs nothing.
+constexpr double kSegmentWallSeconds = 2.0;
+/// The first segment (settling included, no rate known yet): this fraction of the run.
+constexpr double kFirstSegmentFraction = 0.01;
+/// A segment is at most this many times the last one.
+constexpr std::int64_t kSegmentGrowth = 4;
+
+void report_progress(RunHooks& hooks, const std::string& label, const st::CosimulationProgress& p) {
+  hooks.progress({label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN});
+}
+
+/// What must match for a resume besides the case's physics: the structure, the task, the
+/// run's own settings (duration, sampling, q0, step) and the caller's (a design).
+std::string decay_settings(const Case& c, const st::CosimulationOptions& o, double dt, const std::string& own) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "structure " << surrogate::case_hash(c.resolved.value("structure", json())) << "; task "
+    << surrogate::case_hash(c.resolved.value("task", json())) << "; duration_s " << o.duration_s
+    << "; sample_interval_s " << o.sample_interval_s << "; time_step_s " << dt << "; q0";
+  for (Eigen::Index j = 0; j < o.initial_modal_displacements.size(); ++j) s << ' ' << o.initial_modal_displacements[j];
+  if (!own.empty()) s << "; " << own;
+  return s.str();
+}
+
+void save_decay(const DemDecayCheckpoint& cp, const dem_reference::CheckpointHeader& header,
+                const st::CosimulationState& state, const st::CosimulationResult& sum) {
+  dem_reference::StateWriter out;
+  st::save_cosimulation_state(state, out);
+  st::save_cosimulation_result(sum, out);
+  write_checkpoint(cp.file, header, out.bytes());
+}
+
+/// One co-simulation run of `options`, its refusals as the case's errors.
+st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
+                                       const std::vector<st::CosimulationDamper>& dampers,
+                                       const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
+                                       st::CosimulationState* state = nullptr) {
+  detail::check_cosimulation(c, modal, dampers, options);
+  const auto report = [&](const st::CosimulationProgress& p) { report_progress(hooks, label, p); };
+  auto r = detail::call_dem(c, [&] {
+    return state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
+  });
+  detail::check_outcome(r.outcome, r.message, label);
+  return r;
+}
+
+/// The decay of `options` in segments, checkpointed (DemDecayCheckpoint).
+st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& modal,
+                                          const std::vector<st::CosimulationDamper>& dampers,
+                                          const st::CosimulationOptions& options, const std::string& label,
+                                          const DemDecayCheckpoint& cp, RunHooks& hooks) {
+  const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
+  const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(options.sample_interval_s / dt));
+  const std::int64_t total = std::llround(options.duration_s / dt);
+  dem_reference::CheckpointHeader header;
+  header.kind = cp.kind;
+  header.case_hash = case_file::physics_hash(c, "dem");
+  header.physics_model_version = dem_reference::kPhysicsModelVersion;
+  header.settings = decay_settings(c, options, dt, cp.settings);
+  header.end_time_s = static_cast<double>(total) * dt;
+  const std::string shown = strict_json::printable(cp.file.path.string());
+
+  st::CosimulationState state;
+  st::CosimulationResult sum;
+  std::int64_t done = 0;
+  if (cp.file.resume) {
+    const std::string payload = read_checkpoint(cp.file, header);
+    try {
+      dem_reference::StateReader in(payload, "checkpoint state");
+      state = st::restore_cosimulation_state(modal, dampers, in);
+      sum = st::restore_cosimulation_result(in, modal.mode_count(), dampers.size());
+      in.finish();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(cp.file.path.string(), "", e.what());
+    }
+    done = sum.steps;
+    if (done <= 0 || done > total || state.steps != done)
+      throw InputError(cp.file.path.string(), "", "its step count " + std::to_string(done) + " does not fit this run's " +
+                                                      std::to_string(total) + " steps");
+    hooks.note(label + ": resuming at t = " + format_number(static_cast<double>(done) * dt, 6) + " s of " +
+               format_number(header.end_time_s, 6) + " s from " + shown);
+  } else if (std::filesystem::exists(cp.file.path)) {
+    hooks.note("pdamp: warning: " + shown + " of an earlier run is replaced (--resume continues it)");
+  }
+
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  std::int64_t segment = sample_every * std::max<std::int64_t>(1, std::llround(kFirstSegmentFraction *
+                                                                                static_cast<double>(total / sample_every)));
+  while (done < total) {
+    const std::int64_t steps = std::min(segment, total - done);
+    st::CosimulationOptions o = options;
+    o.duration_s = static_cast<double>(steps) * dt;
+    if (state.started()) o.initial_modal_displacements.resize(0), o.initial_modal_velocities.resize(0);
+    const std::int64_t offset = done;
+    const auto report = [&](const st::CosimulationProgress& p) {
+      st::CosimulationProgress whole = p;
+      whole.simulated_time_s += static_cast<double>(offset) * dt;
+      whole.end_time_s = header.end_time_s;
+      report_progress(hooks, label, whole);
+    };
+    const auto started = std::chrono::steady_clock::now();
+    st::CosimulationResult part = detail::call_dem(c, [&] { return st::cosimulate(modal, dampers, o, state, report); });
+    detail::check_outcome(part.outcome, part.message, label);
+    if (done == 0 && !cp.file.resume) {
+      sum = std::move(part);
+    } else {
+      st::append_continuation(sum, part, state);
+    }
+    done += steps;
+    // The next segment: about kSegmentWallSeconds at this segment's rate, whole sample
+    // intervals, at most kSegmentGrowth times this one (a short first segment, settling and
+    // all, measures its rate poorly).
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double rate = static_cast<double>(steps) / std::max(wall, 1e-3);
+    // A progress line per segment (the segments' own lines come only from long ones).
+    report_progress(hooks, label, st::CosimulationProgress{"decay", static_cast<double>(done) * dt, header.end_time_s, rate});
+    segment = std::min(kSegmentGrowth * steps,
+                       sample_every * std::max<std::int64_t>(1, std::llround(kSegmentWallSeconds * rate /
+                                                                             static_cast<double>(sample_every))));
+    segment = std::max(segment, sample_every);
+    const int signal = hooks.stop_requested();
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
+    // At the end a stop still gets a checkpoint: the results are not written yet.
+    if (signal != 0 || (done < total && hooks.checkpoint_due(since))) {
+      header.simulated_time_s = static_cast<double>(done) * dt;
+      save_decay(cp, header, state, sum);
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
+    if (signal != 0) throw strict_json::Interrupted(signal, resume_advice(cp.file, header));
+  }
+  return sum;
+}
+
+/// The loss models' own sentences (with numbers) at one sample: each layer at its damper's
+/// amplitude and the frequency the decay uses for the dominant mode there (its backbone's
+/// natural frequency with containers and beds, structure::backbone_point).
+void add_loss_messages(detail::Warnings& warnings, const detail::Setup& setup, const st::CoupledModel& coupled,
+                       const st::DecaySample& s, const std::string& when) {
+  Eigen::Index dominant = 0;
+  s.modal_amplitudes.maxCoeff(&dominant);
+  const double f =
+      st::backbone_point(coupled, static_cast<int>(dominant), s.modal_amplitudes[dominant]).natural_frequency_hz;
+  if (!std::isfinite(f)) return;
+  for (std::size_t d = 0; d < setup.s.dampers.size(); ++d) {
+    const double x = s.damper_amplitudes_m[d];
+    if (!(x > 0.0)) continue;
+    for (const auto& layer : setup.s.dampers[d].layers)
+      for (const auto& m : layer.loss_model->warning_messages(f, x))
+        warnings.add(when + ", " + setup.s.dampers[d].name + "/" + layer.name + " (X = " + format_number(x, 4) +
+                     " m, f = " + format_number(f, 4) + " Hz): " + m);
+  }
+}
+
+/// The free decay by averaging on the layers' loss models.
+void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& q0, DecayResult& out) {
+  const auto& task = *c.task.decay;
+  const auto& modal = setup.s.modal;
+  st::FreeDecayOptions options;
+  options.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
+  options.duration_s = task.duration_s;
+  options.threshold_fraction = task.settling_threshold;
+  options.sample_times_s = detail::spaced(0.0, task.duration_s, static_cast<int>(decay_samples(modal, task.duration_s)) + 1, false);
+  if (const auto problems = options.validate(modal.mode_count()); !problems.empty())
+    throw InputError(c.path, "/task", problems.front());
+  out.decay = detail::call_solver(c, "/task", [&] { return st::free_decay(modal, setup.s.dampers, options); });
+  const auto& decay = out.decay;
+  for (const auto& s : decay.samples)
+    if (!std::isfinite(s.threshold_measure_m) || !std::isfinite(s.mechanical_energy_j))
+      throw NumericalError("pdamp decay: the envelope is not finite at t = " + format_number(s.time_s) + " s (" +
+                           decay.brief_report() + ")");
+  if (decay.samples.empty()) throw NumericalError("pdamp decay: the solver returned no samples (" + decay.brief_report() + ")");
+  setup.warnings.add(decay.warnings);
+  const bool settled = decay.outcome == st::FreeDecay::Outcome::kSettled;
+  const auto coupled = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, setup.s.dampers); });
+  add_loss_messages(setup.warnings, setup, coupled, decay.samples.front(), "at the start");
+  if (settled) {
+    const auto at = std::lower_bound(decay.samples.begin(), decay.samples.end(), decay.settling_time_s,
+                                     [](const st::DecaySample& s, double t) { return s.time_s < t; });
+    add_loss_messages(setup.warnings, setup, coupled, at == decay.samples.end() ? decay.samples.back() : *at, "at settling");
+  } else {
+    setup.warnings.add("the decay did not settle within duration_s = " + format_number(task.duration_s) +
+                       " s (envelope " + format_number(decay.samples.back().threshold_measure_m, 4) + " m, threshold " +
+                       format_number(decay.threshold_used_m, 4) + " m): lengthen /task/duration_s");
+  }
+}
+
+}  // namespace
+
+DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
+                   const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
+                   const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
+                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+  for (auto& d : containers) d.layers.clear();
+  const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
+
+  // The settling measure as the other methods: Σ_j |b_j| |q0_j| at the first damper's site.
+  const Eigen::VectorXd weights = empty.drive_shapes.col(0).cwiseAbs();
+  const double measure0 = weights.dot(q0.cwiseAbs());
+  if (!(measure0 > 0.0))
+    throw InputError(c.path, "/task/initial_state", "does not move the first damper's site along its drive");
+  const double threshold = task.settling_threshold * measure0;
+  Eigen::Index dominant = 0;
+  weights.cwiseProduct(q0.cwiseAbs()).maxCoeff(&dominant);
+
+  st::CosimulationOptions options;
+  options.excitation.kind = st::CosimulationExcitationKind::kFreeDecay;
+  options.initial_modal_displacements = q0;
+  options.initial_modal_velocities = Eigen::VectorXd::Zero(q0.size());
+  options.duration_s = task.duration_s;
+  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  options.sample_interval_s = task.duration_s / decay_samples(modal, task.duration_s);
+  DemDecay out;
+  out.cosimulation = checkpoint.file.path.empty() ? cosimulate_case(c, modal, dampers, options, label, hooks)
+                                                  : checkpointed_decay(c, modal, dampers, options, label, checkpoint, hooks);
+  const auto& r = out.cosimulation;
+  out.warnings = r.warnings;
+
+  const auto& h = r.history;
+  if (h.time_s.size() < 2) throw NumericalError(label + ": the co-simulation returned no history");
+  const Eigen::VectorXd y = h.site_displacement_m.col(0);
+  if (!y.allFinite()) throw NumericalError(label + ": the site displacement is not finite");
+  std::vector<double> bed_masses, drive_gravity;
+  for (const auto& spec : c.dampers) {
+    double bed = 0.0;
+    for (const auto& l : spec.layers) bed += l.bed_mass_kg;
+    bed_masses.push_back(bed);
+    drive_gravity.push_back(spec.gravity_m_s2[static_cast<std::size_t>(spec.drive_axis)]);
+  }
+  out.static_offset_m = st::static_site_offset(modal, empty.drive_shapes, bed_masses, drive_gravity);
+  out.dominant_mode = dominant;
+  out.dominant_frequency_hz = r.frequencies_with_containers_hz[dominant];
+  out.initial_envelope_m = measure0;
+  out.threshold_m = threshold;
+  out.settling = st::sampled_settling(h.time_s, y, out.static_offset_m, 1.0 / out.dominant_frequency_hz, measure0,
+                                      threshold, out.dominant_frequency_hz);
+  if (!std::isfinite(out.settling.settling_time_s))
+    out.warnings.push_back("the decay did not settle within duration_s = " + format_number(task.duration_s) +
+                           " s (envelope " +
+                           format_number(out.settling.envelope_m.empty() ? NAN : out.settling.envelope_m.back(), 4) +
+                           " m, threshold " + format_number(threshold, 4) + " m): lengthen " + duration_pointer);
+  if (r.energy.relative_error > 0.01)
+    out.warnings.push_back("the co-simulation's energy ledger closes to " + format_number(r.energy.relative_error, 3) +
+                           " only (docs/cosimulation.md §4): a smaller /dem/time_step_s");
+  return out;
+}
+
+DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hooks) {
+  if (c.task.kind != case_file::TaskKind::kDecay || !c.task.decay)
+    throw InputError(c.path, "/task",
+                     "pdamp decay needs a task of kind decay (this case's task is '" +
+                         std::string(case_file::to_string(c.task.kind)) +
+                         "'): give \"task\": {\"kind\": \"decay\", \"initial_state\", \"duration_s\"} (docs/cases.md, Format 2)");
+  const bool dem = options.method == DecayMethod::kDem;
+  detail::Setup setup = detail::make_setup(
+      c, options.method == DecayMethod::kField ? case_file::LossMethod::kField : case_file::LossMethod::kFormulas, !dem);
+  DecayResult out;
+  out.case_name = c.name;
+  out.method = options.method;
+  out.damper_names = detail::damper_names(setup);
+  out.threshold_point = setup.s.dampers.front().point;
+  out.threshold_fraction = c.task.decay->settling_threshold;
+  out.modes = setup.s.modal.mode_count();
+  out.initial_modal_amplitudes = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
+  if (!(out.initial_modal_amplitudes.cwiseAbs().maxCoeff() > 0.0))
+    throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+  if (dem) {
+    out.dem = dem_decay(c, setup.s.modal, setup.s.dampers, detail::dem_dampers(c), out.initial_modal_amplitudes,
+                        *c.task.decay, "pdamp decay (dem)", "/task/duration_s", options.checkpoint, hooks);
+    setup.warnings.add(out.dem.warnings);
+  } else {
+    averaged_decay(c, setup, out.initial_modal_amplitudes, out);
+  }
+  out.warnings = setup.warnings.list();
+  return out;
+}
+
+json to_json(const st::CosimulationEnergy& e) {
+  return {{"excitation_work_j", e.excitation_work_j},
+          {"structural_damping_j", e.structural_damping_j},
+          {"delta_structure_kinetic_j", e.delta_structure_kinetic_j},
+          {"delta_structure_potential_j", e.delta_structure_potential_j},
+          {"dem_dissipated_j", e.dem_dissipated_j()},
+          {"dem_normal_damping_j", e.dem_normal_damping_j},
+          {"dem_friction_j", e.dem_friction_j},
+          {"dem_rolling_j", e.dem_rolling_j},
+          {"delta_bed_kinetic_j", e.delta_bed_kinetic_j},
+          {"delta_bed_potential_j", e.delta_bed_potential_j},
+          {"delta_bed_elastic_j", e.delta_bed_elastic_j},
+          {"container_work_j", e.container_work_j},
+          {"relative_error", e.relative_error}};
+}
+
+namespace {
+
+json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
+  const DemDecay& decay = res.dem;
+  const auto& r = decay.cosimulation;
+  const auto& h = r.history;
+  const auto& settle = decay.settling;
+  const bool settled = std::isfinite(settle.settling_time_s);
+  const Eigen::VectorXd& q0 = res.initial_modal_amplitudes;
+  std::vector<double> initial(q0.data(), q0.data() + q0.size());
+  json envelope = json::array();
+  for (std::size_t k = 0; k < settle.envelope_m.size(); ++k) envelope.push_back({settle.envelope_time_s[k], settle.envelope_m[k]});
+  json d = {{"file", folder.file("decay_dem.csv")},
+            {"plot", folder.file("decay_dem.png")},
+            {"method", "dem"},
+            {"settling_time_s", number_or_null(settle.settling_time_s)},
+            {"damping_ratio", number_or_null(settle.damping_ratio)},
+            {"dominant_mode", decay.dominant_mode + 1},
+            {"outcome", settled ? "settled" : "not_settled"},
+            {"threshold_point", res.threshold_point},
+            {"threshold_m", decay.threshold_m},
+            {"threshold_fraction", res.threshold_fraction},
+            {"initial_envelope_m", decay.initial_envelope_m},
+            {"initial_modal_amplitudes", initial},
+            {"static_offset_m", decay.static_offset_m},
+            {"envelope", "the largest |y - static_offset_m| of the first damper's site along its drive over each whole "
+                         "period of the dominant mode (with the empty containers)"},
+            {"envelope_period_s", 1.0 / decay.dominant_frequency_hz},
+            {"envelope_points", envelope},
+            {"frequency_hz", settle.frequency_hz},
+            {"final_time_s", h.time_s.back()},
+            {"final_envelope_m", settle.envelope_m.empty() ? json(nullptr) : json(settle.envelope_m.back())},
+            {"energy_error", r.energy.relative_error},
+            {"energy", to_json(r.energy)},
+            {"structural_dissipated_energy_j", r.energy.structural_damping_j},
+            {"dem_dissipated_energy_j", r.energy.dem_dissipated_j()},
+            {"samples", h.time_s.size()},
+            {"steps", r.steps},
+            {"settling_steps", r.settling_steps},
+            {"time_step_s", r.time_step_s},
+            {"solve_time_s", r.wall_time_s},
+            {"warnings", res.warnings}};
+  json result = {{"task", "decay"}, {"case", res.case_name}, {"method", "dem"}};
+  result["file"] = d["file"];
+  result["settling_time_s"] = d["settling_time_s"];
+  result["damping_ratio"] = d["damping_ratio"];
+  result["energy_balance_error"] = r.energy.relative_error;
+  result["decay"] = d;
+  return result;
+}
+
+json averaged_decay_json(const DecayResult& res, const OutputFolder& folder) {
+  const auto& decay = res.decay;
+  const bool settled = decay.outcome == st::FreeDecay::Outcome::kSettled;
+  const auto& first = decay.samples.front();
+  const auto& last = decay.samples.back();
+  json layers = json::array();
+  double dissipated = last.structural_dissipated_energy_j;
+  for (double e : last.layer_dissipated_energy_j) dissipated += e;
+  for (std::size_t l = 0; l < decay.layer_names.size(); ++l)
+    layers.push_back({{"name", decay.layer_names[l]},
+                      {"dissipated_energy_j", last.layer_dissipated_energy_j[l]},
+                      {"share", dissipated > 0.0 ? last.layer_dissipated_energy_j[l] / dissipated : 0.0}});
+  const Eigen::VectorXd& q0 = res.initial_modal_amplitudes;
+  std::vector<double> initial(q0.data(), q0.data() + q0.size());
+  const std::string method = res.method == DecayMethod::kField ? "field" : "formulas";
+  json d = {{"file", folder.file("decay.csv")},
+            {"plot", folder.file("decay.png")},
+            {"method", method},
+            {"settling_time_s", number_or_null(decay.settling_time_s)},
+            {"damping_ratio", number_or_null(decay.equivalent_damping_ratio)},
+            {"dominant_mode", decay.dominant_mode + 1},
+            {"outcome", settled ? "settled" : "not_settled"},
+            {"threshold_point", res.threshold_point},
+            {"threshold_m", decay.threshold_used_m},
+            {"threshold_fraction", res.threshold_fraction},
+            {"initial_envelope_m", first.threshold_measure_m},
+            {"initial_modal_amplitudes", initial},
+            {"initial_energy_j", first.mechanical_energy_j},
+            {"final_time_s", last.time_s},
+            {"final_envelope_m", last.threshold_measure_m},
+            {"final_energy_j", last.mechanical_energy_j},
+            {"structural_dissipated_energy_j", last.structural_dissipated_energy_j},
+            {"layers", layers},
+            {"samples", decay.samples.size()},
+            {"steps", decay.steps},
+            {"solve_time_s", decay.solve_time_s},
+            {"report", decay.brief_report()},
+            {"warnings", res.warnings}};
+  json result = {{"task", "decay"}, {"case", res.case_name}, {"method", method}};
+  result["file"] = d["file"];
+  result["settling_time_s"] = d["settling_time_s"];
+  result["damping_ratio"] = d["damping_ratio"];
+  result["decay"] = d;
+  return result;
+}
+
+}  // namespace
+
+json to_json(const DecayResult& result, const OutputFolder& folder) {
+  return result.method == DecayMethod::kDem ? dem_decay_json(result, folder) : averaged_decay_json(result, folder);
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,223 @@
+// pdamp dem as a study (dem_run.hpp).
+#include "pdamp/tasks/dem_run.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "task_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace fm = formulas;
+using nlohmann::json;
+using strict_json::format_number;
+using strict_json::InputError;
+
+double available_memory_bytes() {
+  double available = std::numeric_limits<double>::infinity();
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string key; meminfo >> key;) {
+    double kib = 0.0;
+    meminfo >> kib;
+    if (key == "MemAvailable:") available = kib * 1024.0;
+    meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  std::ifstream limit("/sys/fs/cgroup/memory.max"), current("/sys/fs/cgroup/memory.current");
+  double max_bytes = 0.0, used = 0.0;
+  if (limit >> max_bytes && current >> used) available = std::min(available, max_bytes - used);  // "max": no limit
+  return available;
+}
+
+std::string megabytes(double bytes) {
+  return bytes >= 1e9 ? format_number(bytes / 1e9, 3) + " GB" : format_number(bytes / 1e6, 3) + " MB";
+}
+
+void check_memory(const case_file::Case& c, std::size_t damper, const dem_reference::RunEstimate& e, double runs_at_once) {
+  const double available = available_memory_bytes();
+  if (!(runs_at_once * static_cast<double>(e.memory_bytes) > available)) return;
+  const std::string counts = c.format_version == 1 ? "/damper/particles/count"
+                                                   : "/dampers/" + std::to_string(damper) + "/layers/*/particles/count";
+  throw InputError(c.path, "/dem",
+                   "the DEM needs about " + megabytes(runs_at_once * static_cast<double>(e.memory_bytes)) + " (" +
+                       std::to_string(e.particles) + " particles, " + std::to_string(e.recorded_samples) +
+                       " recorded samples = samples_per_period x analysed_periods, " + std::to_string(e.snapshots) +
+                       " snapshots" + (runs_at_once > 1 ? ", " + format_number(runs_at_once, 3) + " runs at once" : "") +
+                       "), more than the " + megabytes(available) +
+                       " available: reduce /dem/samples_per_period, /dem/analysed_periods, /dem/snapshots or " + counts);
+}
+
+dem_reference::RunEstimate check_dem_run(const case_file::Case& c, std::size_t damper,
+                                         const dem_reference::DamperSimulationOptions& options) {
+  const auto problems = options.validate("");
+  if (!problems.empty()) throw case_file::dem_case_error(c, damper, problems.front());
+  dem_reference::RunEstimate e;
+  try {
+    e = dem_reference::estimate_run(options);
+  } catch (const std::invalid_argument& error) {  // the time step above its bound
+    const std::string what = error.what();
+    throw case_file::dem_case_error(c, damper, what.substr(0, what.find('\n')));
+  }
+  check_memory(c, damper, e, 1.0);
+  return e;
+}
+
+void check_dem_placement(const case_file::Case& c, std::size_t damper, const dem_reference::DamperSimulationOptions& options) {
+  try {
+    dem_reference::check_initial_placement(options);
+  } catch (const std::invalid_argument& error) {
+    const std::string what = error.what();
+    throw case_file::dem_case_error(c, damper, what.substr(0, what.find('\n')));
+  }
+}
+
+std::string case_key_names(const std::string& advice) {
+  static const std::regex kOption(R"(\bintegration\.(\w+))");
+  return std::regex_replace(advice, kOption, "/dem/$1");
+}
+
+std::string estimate_text(const dem_reference::RunEstimate& e) {
+  return std::to_string(e.particles) + " particles, " + std::to_string(e.total_steps) + " steps of " +
+         format_number(e.time_step_s, 3) + " s = " + format_number(e.particle_steps, 3) + " particle-steps, about " +
+         format_number(e.wall_time_s, 2) + " s at " + format_number(e.particle_steps_per_s, 2) +
+         " particle-steps/s; memory about " + megabytes(static_cast<double>(e.memory_bytes));
+}
+
+DemRunPlan plan_dem(const case_file::Case& c, const DemRunOptions& o) {
+  (void)detail::single_damper(c, "pdamp dem");
+  DemRunPlan plan;
+  plan.label = o.label;
+  plan.frequency_hz = o.frequency_hz.value_or(c.excitation.frequency_hz);
+  if (!o.amplitude_m && !c.excitation.amplitude_m)
+    throw InputError(c.path, "/excitation/amplitude_m", "required by pdamp dem (or give --amplitude M)");
+  plan.amplitude_m = o.amplitude_m.value_or(c.excitation.amplitude_m.value_or(0.0));
+  plan.options = case_file::dem_options(c, 0, plan.amplitude_m, plan.frequency_hz);
+  if (o.analysed_periods) plan.options.analysed_periods = *o.analysed_periods;
+  if (o.threads) plan.options.world.threads = *o.threads;
+  plan.estimate = check_dem_run(c, 0, plan.options);
+  check_dem_placement(c, 0, plan.options);
+  return plan;
+}
+
+DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, RunHooks& hooks) {
+  const auto& options = plan.options;
+  const double x = plan.amplitude_m, f = plan.frequency_hz;
+  const bool checkpointing = !checkpoint.path.empty();
+
+  // Checkpoints at period ends (docs/dem.md "Checkpoints"): when the hooks say one is due,
+  // and when they ask to stop (then Interrupted follows).
+  dem_reference::CheckpointHeader header;
+  header.kind = "dem";
+  header.case_hash = case_file::physics_hash(c, "dem");
+  header.physics_model_version = dem_reference::kPhysicsModelVersion;
+  {
+    std::ostringstream settings;
+    settings.precision(17);
+    settings << "amplitude_m " << x << "; frequency_hz " << f << "; transient_periods " << options.transient_periods
+             << "; analysed_periods " << options.analysed_periods << "; samples_per_period " << options.samples_per_period
+             << "; snapshots " << options.snapshots << "; threads " << options.world.threads;
+    header.settings = settings.str();
+  }
+  header.end_time_s = (options.transient_periods + options.analysed_periods) / f;
+  dem_reference::HarmonicCheckpoints saving;
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  saving.due = [&] {
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
+    return hooks.stop_requested() != 0 || hooks.checkpoint_due(since);
+  };
+  saving.stop = [&] { return hooks.stop_requested() != 0; };
+  saving.write = [&](const std::string& state, double t) {
+    header.simulated_time_s = t;
+    write_checkpoint(checkpoint, header, state);
+    last_checkpoint = std::chrono::steady_clock::now();
+  };
+  if (checkpoint.resume) saving.resume_state = read_checkpoint(checkpoint, header);  // refused before any work
+  hooks.note(plan.label + ": " + estimate_text(plan.estimate));
+  if (checkpoint.resume) {
+    hooks.note(plan.label + ": resuming from " + strict_json::printable(checkpoint.path.string()));
+  } else if (checkpointing && std::filesystem::exists(checkpoint.path)) {
+    hooks.note("pdamp: warning: " + strict_json::printable(checkpoint.path.string()) +
+               " of an earlier run is replaced (--resume continues it)");
+  }
+
+  DemRunResult out;
+  out.case_name = c.name;
+  out.amplitude_m = x;
+  out.frequency_hz = f;
+  try {
+    out.dem = dem_reference::run_harmonic(
+        options,
+        [&](const dem_reference::Progress& p) {
+          hooks.progress({plan.label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false,
+                          p.stage == "setup" ? NAN : p.steps_per_s, p.eta_s});
+        },
+        checkpointing ? &saving : nullptr);
+  } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound, a resume that does not fit
+    throw InputError(checkpoint.resume ? checkpoint.path.string() : c.path, checkpoint.resume ? "" : "/dem", e.what());
+  }
+  if (out.dem.stopped) throw strict_json::Interrupted(hooks.stop_requested(), resume_advice(checkpoint, header));
+  if (out.dem.summary.outcome == dem_reference::Outcome::kUnstable)
+    throw strict_json::NumericalError("DEM unstable: " + case_key_names(out.dem.summary.message));
+  if (out.dem.summary.outcome != dem_reference::Outcome::kCompleted)  // a step threw (on any thread)
+    throw strict_json::NumericalError("DEM failed: " + case_key_names(out.dem.summary.message));
+
+  // The closed form at the same point, for comparison (same model family as the case).
+  const auto& damper = c.dampers.front();
+  out.closed_form = fm::reduced_loss_factor(damper.model, out.dem.clearance_m, x, f, damper.model_options);
+  out.warnings = out.dem.warnings;
+  return out;
+}
+
+json to_json(const dem_reference::DamperResult& r) {
+  const auto& e = r.energy;
+  const auto& m = r.indicators;
+  return {{"eta_star", r.eta_star},
+          {"eta_star_stderr", r.eta_star_stderr},
+          {"eta_star_energy_balance", r.eta_star_energy_balance},
+          {"e_diss_j", r.e_diss_j},
+          {"energy_per_cycle_j", r.energy_per_cycle_j},
+          {"apparent_mass_kg", r.apparent_mass_kg},
+          {"apparent_mass_fraction", r.apparent_mass_kg / r.bed_mass_kg},
+          {"energy_balance_error", r.energy_balance_error},
+          {"particle_steps_per_s", r.particle_steps_per_s},
+          {"motion_mode", dem_reference::to_string(r.motion_mode)},
+          {"clearance_m", r.clearance_m},
+          {"bed_mass_kg", r.bed_mass_kg},
+          {"intensity", r.intensity},
+          {"velocity_amplitude_m_s", r.velocity_amplitude_m_s},
+          {"time_step_s", r.time_step_s},
+          {"steps_per_period", r.steps_per_period},
+          {"eta_star_per_period", r.eta_star_per_period},
+          {"energy",
+           {{"container_work_j", e.container_work_j}, {"normal_damping_j", e.normal_damping_j},
+            {"friction_j", e.friction_j}, {"rolling_j", e.rolling_j}, {"delta_kinetic_j", e.delta_kinetic_j},
+            {"delta_potential_j", e.delta_potential_j}, {"delta_elastic_j", e.delta_elastic_j}}},
+          {"motion_indicators",
+           {{"relative_stroke_over_clearance", m.relative_stroke_over_clearance},
+            {"period_correlation", m.period_correlation}, {"eta_star_variation", m.eta_star_variation},
+            {"apparent_mass_fraction", m.apparent_mass_fraction}, {"base_contact_fraction", m.base_contact_fraction},
+            {"airborne_fraction", m.airborne_fraction}, {"spread_over_packed", m.spread_over_packed},
+            {"phase_locked_stroke", m.phase_locked_stroke}, {"phase_coherence", m.phase_coherence},
+            {"phase_lag_deg", m.phase_lag_deg}, {"crossing_fraction", m.crossing_fraction},
+            {"settled_base_contact_fraction", m.settled_base_contact_fraction}, {"mobile_fraction", m.mobile_fraction}}},
+          {"run",
+           {{"outcome", dem_reference::to_string(r.summary.outcome)}, {"steps", r.summary.steps},
+            {"particles", r.summary.particles}, {"wall_time_s", r.summary.wall_time_s},
+            {"neighbour_rebuilds", r.summary.neighbour_rebuilds}}}};
+}
+
+json to_json(const DemRunResult& r) {
+  json out = to_json(r.dem);
+  out.update({{"case", r.case_name}, {"amplitude_m", r.amplitude_m}, {"frequency_hz", r.frequency_hz}});
+  out["closed_form"] = {{"eta_star", r.closed_form.eta_star}, {"model_used", fm::to_string(r.closed_form.model_used)},
+                        {"regime", fm::to_string(r.closed_form.regime)}};
+  return out;
+}
+
+}  // namespace pdamp::tasks

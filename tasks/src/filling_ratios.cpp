@@ -1,0 +1,428 @@
+// Task kind filling_ratios (filling_ratios.hpp).
+#include "pdamp/tasks/filling_ratios.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include "pdamp/formulas/bed_packing.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/tasks/decay.hpp"
+#include "structure_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace opt = optimizer;
+namespace st = structure;
+using case_file::Case;
+using detail::number_or_null;
+using nlohmann::json;
+using strict_json::format_number;
+using strict_json::InputError;
+
+void to_json(json& j, const VerifiedDecay& v) {
+  const auto& s = v.settling;
+  j = json::array({v.time_s, v.site_displacement_m, s.envelope_time_s, s.envelope_m, s.sample_envelope_m, s.settling_time_s,
+                   s.frequency_hz, s.damping_ratio, v.threshold_m, v.initial_envelope_m, v.energy_error, v.dem_dissipated_j,
+                   v.structural_dissipated_j, v.steps, v.time_step_s, v.wall_time_s, v.warnings});
+}
+void from_json(const json& j, VerifiedDecay& v) {
+  auto& s = v.settling;
+  j.at(0).get_to(v.time_s);
+  j.at(1).get_to(v.site_displacement_m);
+  j.at(2).get_to(s.envelope_time_s);
+  j.at(3).get_to(s.envelope_m);
+  j.at(4).get_to(s.sample_envelope_m);
+  j.at(5).get_to(s.settling_time_s);
+  j.at(6).get_to(s.frequency_hz);
+  j.at(7).get_to(s.damping_ratio);
+  j.at(8).get_to(v.threshold_m);
+  j.at(9).get_to(v.initial_envelope_m);
+  j.at(10).get_to(v.energy_error);
+  j.at(11).get_to(v.dem_dissipated_j);
+  j.at(12).get_to(v.structural_dissipated_j);
+  j.at(13).get_to(v.steps);
+  j.at(14).get_to(v.time_step_s);
+  j.at(15).get_to(v.wall_time_s);
+  j.at(16).get_to(v.warnings);
+}
+
+namespace {
+
+/// Instants of the comparison decays (decay_compare.csv).
+constexpr int kComparisonSamples = 2001;
+
+/// The case with the first damper's layers holding design `d`'s whole slabs (layers of
+/// 0 slabs left out) and the verification's further softening on every DEM material: what
+/// the DEM builds for that design. The lattice is the case's (auto or explicit transverse
+/// counts), n slabs along the drive, so h = L − n·2r as the optimiser has it.
+Case design_case(const Case& c, const opt::FillingDesign& d, double softening) {
+  const case_file::FillingRatiosTask& task = *c.task.filling_ratios;
+  Case out = c;
+  case_file::DamperSpec& damper = out.dampers.front();
+  std::vector<case_file::LayerSpec> kept;
+  for (std::size_t k = 0; k < damper.layers.size(); ++k) {
+    const long slabs = std::lround(d.layers.at(k).slabs);
+    if (slabs <= 0) continue;
+    case_file::LayerSpec layer = damper.layers[k];
+    layer.particle_count = static_cast<int>(slabs) * task.spheres_per_slab.at(k);
+    if (layer.packing.lattice_counts) {
+      (*layer.packing.lattice_counts)[static_cast<std::size_t>(damper.drive_axis)] = static_cast<int>(slabs);
+      layer.compartment.lattice_counts.assign(layer.packing.lattice_counts->begin(), layer.packing.lattice_counts->end());
+    }
+    try {
+      layer.bed = formulas::collected_lattice(layer.container, layer.particle_count, layer.particle_radius_m, layer.packing);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.path, "/dampers/0/layers/" + std::to_string(k) + "/particles",
+                       "the verified design's " + std::to_string(layer.particle_count) + " spheres: " + e.what());
+    }
+    layer.clearance_m = layer.bed.settled_clearance_m;
+    layer.bed_mass_kg = d.layers[k].bed_mass_kg;
+    layer.compartment.particles.front().count = layer.particle_count;
+    kept.push_back(std::move(layer));
+  }
+  damper.layers = std::move(kept);
+  for (auto& m : out.dem.simulation.world.materials) m.material.youngs_modulus_pa *= softening;
+  return out;
+}
+
+bool settling_objective(const case_file::FillingRatioProblem& p) {
+  return p.options.objective == opt::FillingObjective::kSettlingTime;
+}
+
+/// a ahead of b (settles sooner, or the smaller objective): settled beats not settled; two
+/// unsettled decays rank by their envelopes at the end.
+bool ahead(double objective_a, double end_a, double objective_b, double end_b) {
+  if (std::isfinite(objective_a) && std::isfinite(objective_b)) return objective_a < objective_b;
+  if (std::isfinite(objective_a) != std::isfinite(objective_b)) return std::isfinite(objective_a);
+  return end_a < end_b;
+}
+
+VerifiedDecay verified_decay(const DemDecay& d) {
+  const auto& r = d.cosimulation;
+  VerifiedDecay v;
+  v.time_s = r.history.time_s;
+  for (std::size_t i = 0; i < v.time_s.size(); ++i)
+    v.site_displacement_m.push_back(r.history.site_displacement_m(static_cast<Eigen::Index>(i), 0) - d.static_offset_m);
+  v.settling = d.settling;
+  v.threshold_m = d.threshold_m;
+  v.initial_envelope_m = d.initial_envelope_m;
+  v.energy_error = r.energy.relative_error;
+  v.dem_dissipated_j = r.energy.dem_dissipated_j();
+  v.structural_dissipated_j = r.energy.structural_damping_j;
+  v.steps = r.steps;
+  v.time_step_s = r.time_step_s;
+  v.wall_time_s = r.wall_time_s;
+  v.warnings = d.warnings;
+  return v;
+}
+
+/// The design's slabs as one number, exact for up to five layers of < 1000 slabs: a process
+/// asked to verify a design checks that its own optimisation chose the same.
+double design_fingerprint(const opt::FillingDesign& design) {
+  double fingerprint = 0.0, place = 1.0;
+  for (const double n : slabs_of(design)) fingerprint += n * place, place *= 1000.0;
+  return fingerprint;
+}
+
+/// The checkpoint of design `name`'s verification decay.
+DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const case_file::VerifySpec& verify,
+                                           const std::string& name, const opt::FillingDesign& design, RunHooks& hooks) {
+  DemDecayCheckpoint checkpoint;
+  if (o.checkpoint_dir.empty()) return checkpoint;
+  checkpoint.file = {o.checkpoint_dir / ("verify_" + name + ".checkpoint"), o.resume};
+  checkpoint.kind = "verify_" + name;
+  std::ostringstream design_text;
+  for (double n : slabs_of(design)) design_text << ' ' << n;
+  design_text << "; softening " << verify.stiffness_softening;
+  checkpoint.settings = "design" + design_text.str();
+  // A design that completed before the interruption left no checkpoint: it runs again.
+  if (checkpoint.file.resume && !std::filesystem::exists(checkpoint.file.path)) {
+    checkpoint.file.resume = false;
+    hooks.note("pdamp: warning: no checkpoint of the " + name + " design's verification: it runs from the start");
+  }
+  return checkpoint;
+}
+
+/// The DEM-in-the-loop decay of `design` over the verification's duration (the task's
+/// decay from its initial state, the verification's softening).
+VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
+                                 const std::string& name, const opt::FillingDesign& design,
+                                 const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+  const Case dc = design_case(c, design, verify.stiffness_softening);
+  std::vector<st::Damper> containers = {p.options.damper};
+  containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
+  case_file::DecayTask decay = c.task.filling_ratios->decay;
+  decay.duration_s = verify.duration_s;
+  return verified_decay(dem_decay(dc, p.modal, containers, detail::dem_dampers(dc), p.initial_modal_displacements, decay,
+                                  "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s", checkpoint, hooks));
+}
+
+/// The design against its DEM decay `dem`.
+DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
+                         const std::string& name, const opt::FillingDesign& design, VerifiedDecay dem) {
+  DesignCheck out;
+  out.name = name;
+  out.design = design;
+  for (const auto& l : design.layers) out.particles += static_cast<int>(std::lround(l.particles));
+  const std::vector<double> slabs = slabs_of(design);
+  opt::FillingRatioOptions options = p.options;
+  options.decay.duration_s = verify.duration_s;
+  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
+  out.predicted_objective = settling_objective(p) ? out.predicted.settling_time_s : out.predicted.integral_square_m2_s;
+  out.dem = std::move(dem);
+  const auto& settle = out.dem.settling;
+  out.dem_end_envelope_m = settle.envelope_m.empty() ? NAN : settle.envelope_m.back();
+  out.dem_objective = settling_objective(p) ? settle.settling_time_s
+                                            : st::half_integral_square(out.dem.time_s, settle.sample_envelope_m);
+
+  // The prediction at the DEM's instants (its envelope for the plot and the end value).
+  st::FreeDecayOptions at_samples = options.decay;
+  at_samples.sample_times_s = out.dem.time_s;
+  at_samples.sample_times_s.front() = 0.0;
+  for (auto& t : at_samples.sample_times_s) t = std::clamp(t, 0.0, verify.duration_s);
+  at_samples.sample_times_s.back() = verify.duration_s;
+  std::vector<st::Damper> dampers = {opt::filling_damper(options, slabs)};
+  dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
+  const st::FreeDecay curve = st::free_decay(p.modal, dampers, at_samples);
+  for (const auto& s : curve.samples) out.predicted_envelope_m.push_back(s.threshold_measure_m);
+  out.predicted_end_envelope_m = out.predicted_envelope_m.empty() ? NAN : out.predicted_envelope_m.back();
+
+  const double predicted = out.predicted_objective;
+  if (std::isfinite(predicted) && std::isfinite(out.dem_objective)) {
+    out.compared = "objective";
+    out.relative_difference = (out.dem_objective - predicted) / predicted;
+  } else if (!std::isfinite(predicted) && !std::isfinite(out.dem_objective)) {
+    out.compared = "end_envelope";  // neither settled: how far each got
+    out.relative_difference = (out.dem_end_envelope_m - out.predicted_end_envelope_m) / out.predicted_end_envelope_m;
+  } else {
+    out.compared = "settled_only_one";
+  }
+  out.passed = std::isfinite(out.relative_difference) && std::abs(out.relative_difference) <= verify.tolerance_relative;
+  return out;
+}
+
+/// The DEM verification of the chosen and baseline designs: two independent DEM runs (one
+/// World each, single-threaded by default), jobs of `executor` on two threads or two
+/// processes. Every process optimised the same way (NLopt's seed is fixed); a job carries
+/// the design it verifies, so a process that chose another design refuses it.
+Verification verify_designs(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r,
+                            const case_file::VerifySpec& verify, const FillingRatiosOptions& o, RunHooks& hooks,
+                            Executor& executor, std::vector<std::filesystem::path>& checkpoints) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
+  DemDecayCheckpoint files[2];
+  for (std::size_t k = 0; k < 2; ++k) {
+    files[k] = verification_checkpoint(o, verify, designs[k].first, *designs[k].second, hooks);
+    if (!files[k].file.path.empty()) checkpoints.push_back(files[k].file.path);
+  }
+  Verification v;
+  v.spec = verify;
+  v.dem_stiffness_softening = c.dem.stiffness_softening;
+  v.settling_objective = settling_objective(p);
+  const auto decays = run_jobs<VerifiedDecay>(
+      executor, 2, true,
+      [&](std::size_t k) {
+        return verification_decay(c, p, verify, designs[k].first, *designs[k].second, files[k], hooks);
+      },
+      &v.mpi, [&](std::size_t k) { return design_fingerprint(*designs[k].second); });
+  for (std::size_t k = 0; k < 2; ++k)
+    v.designs.push_back(check_design(p, verify, designs[k].first, *designs[k].second, decays[k]));
+  const DesignCheck& a = v.designs[0];
+  const DesignCheck& b = v.designs[1];
+  v.predicted_chosen_ahead = ahead(a.predicted_objective, a.predicted_end_envelope_m, b.predicted_objective,
+                                   b.predicted_end_envelope_m);
+  v.dem_chosen_ahead = ahead(a.dem_objective, a.dem_end_envelope_m, b.dem_objective, b.dem_end_envelope_m);
+  v.ranking_passed = v.dem_chosen_ahead;
+  v.passed = a.passed && b.passed && (!verify.require_ranking || v.ranking_passed);
+  v.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return v;
+}
+
+json design_json(const opt::FillingDesign& d) {
+  json layers = json::array();
+  for (const auto& l : d.layers)
+    layers.push_back({{"name", l.name},
+                      {"slabs", l.slabs},
+                      {"particles", l.particles},
+                      {"filling_ratio", l.filling_ratio},
+                      {"volume_fraction", l.volume_fraction},
+                      {"clearance_m", l.clearance_m},
+                      {"bed_mass_kg", l.bed_mass_kg}});
+  return {{"layers", layers},
+          {"total_mass_kg", d.total_mass_kg},
+          {"feasible", d.feasible},
+          {"settled", d.settled},
+          {"settling_time_s", number_or_null(d.settling_time_s)},
+          {"integral_square_m2_s", number_or_null(d.integral_square_m2_s)},
+          {"objective", d.objective}};
+}
+
+json verification_json(const Verification& v) {
+  json designs = json::object();
+  for (const auto& d : v.designs) {
+    designs[d.name] = {
+        {"slabs", slabs_of(d.design)},
+        {"particles", d.particles},
+        {"bed_mass_kg", d.design.total_mass_kg},
+        {"predicted", {{"settled", d.predicted.settled},
+                       {"settling_time_s", number_or_null(d.predicted.settling_time_s)},
+                       {"objective", number_or_null(d.predicted_objective)},
+                       {"end_envelope_m", number_or_null(d.predicted_end_envelope_m)}}},
+        {"dem", {{"settled", std::isfinite(d.dem.settling.settling_time_s)},
+                 {"outcome", std::isfinite(d.dem.settling.settling_time_s) ? "settled" : "not_settled"},
+                 {"settling_time_s", number_or_null(d.dem.settling.settling_time_s)},
+                 {"objective", number_or_null(d.dem_objective)},
+                 {"end_envelope_m", number_or_null(d.dem_end_envelope_m)},
+                 {"damping_ratio", number_or_null(d.dem.settling.damping_ratio)},
+                 {"threshold_m", d.dem.threshold_m},
+                 {"initial_envelope_m", d.dem.initial_envelope_m},
+                 {"energy_error", d.dem.energy_error},
+                 {"dem_dissipated_energy_j", d.dem.dem_dissipated_j},
+                 {"structural_dissipated_energy_j", d.dem.structural_dissipated_j},
+                 {"steps", d.dem.steps},
+                 {"time_step_s", d.dem.time_step_s},
+                 {"solve_time_s", d.dem.wall_time_s}}},
+        {"compared", d.compared},
+        {"relative_difference", number_or_null(d.relative_difference)},
+        {"passed", d.passed}};
+  }
+  const auto& verify = v.spec;
+  json out = {{"method", "dem"},
+              {"what", "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
+                       "optimiser's modal model, from the task's initial state, against the closed forms over the same time"},
+              {"objective", v.settling_objective ? "settling_time" : "integral_square"},
+              {"duration_s", verify.duration_s},
+              {"tolerance_relative", verify.tolerance_relative},
+              {"stiffness_softening", verify.stiffness_softening},
+              {"dem_stiffness_softening", v.dem_stiffness_softening},
+              {"effective_stiffness_softening", v.dem_stiffness_softening * verify.stiffness_softening},
+              {"require_ranking", verify.require_ranking},
+              {"designs", designs},
+              {"ranking", {{"predicted_chosen_ahead", v.predicted_chosen_ahead},
+                           {"dem_chosen_ahead", v.dem_chosen_ahead},
+                           {"passed", v.ranking_passed}}},
+              {"passed", v.passed},
+              {"wall_time_s", v.wall_time_s}};
+  if (!v.mpi.is_null()) out["mpi"] = v.mpi;
+  return out;
+}
+
+/// The closed-form envelopes of the chosen, baseline and starting designs on one grid.
+DesignComparison compare_designs(const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r) {
+  st::FreeDecayOptions decay = p.options.decay;
+  decay.sample_times_s.resize(kComparisonSamples);
+  for (int i = 0; i < kComparisonSamples; ++i)
+    decay.sample_times_s[static_cast<std::size_t>(i)] = decay.duration_s * i / (kComparisonSamples - 1);
+  decay.sample_times_s.back() = decay.duration_s;
+  DesignComparison out;
+  for (const auto* d : {&r.chosen, &r.baseline, &r.initial}) {
+    std::vector<st::Damper> dampers = {opt::filling_damper(p.options, slabs_of(*d))};
+    dampers.insert(dampers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
+    out.decays.push_back(st::free_decay(p.modal, dampers, decay));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<double> slabs_of(const opt::FillingDesign& d) {
+  std::vector<double> n;
+  for (const auto& l : d.layers) n.push_back(l.slabs);
+  return n;
+}
+
+FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions& o, RunHooks& hooks, Executor& executor) {
+  const case_file::FillingRatiosTask& task = *c.task.filling_ratios;
+  FillingRatiosResult out;
+  out.case_name = c.name;
+  out.mass_budget_kg = task.mass_budget_kg;
+  out.problem = case_file::filling_ratio_problem(c);
+  const auto& p = out.problem;
+
+  opt::Options solver;
+  solver.backend = o.backend.value_or(*opt::backend_from_string(task.backend));
+  solver.global_evaluations = task.global_evaluations;
+  solver.max_evaluations = task.max_evaluations;
+  try {
+    out.optimum = opt::optimize_filling_ratios(p.modal, p.options, solver);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path, "/task", e.what());
+  }
+  const auto& r = out.optimum;
+  out.warnings = p.warnings;
+  out.warnings.insert(out.warnings.end(), r.warnings.begin(), r.warnings.end());
+  for (const auto* d : {&r.chosen, &r.relaxed, &r.baseline})
+    if (!std::isfinite(d->objective)) throw strict_json::NumericalError("pdamp optimize: a design's objective is not finite");
+
+  // The DEM verification: the task's verify block, or --verify with its defaults.
+  std::optional<case_file::VerifySpec> verify = task.verify;
+  if (!verify && o.force_verify) {
+    verify = case_file::VerifySpec{};
+    verify->duration_s = task.decay.duration_s;
+  }
+  if (o.skip_verify) verify.reset();
+  if (verify) {
+    out.verification = verify_designs(c, p, r, *verify, o, hooks, executor, out.checkpoints);
+    for (const auto& d : out.verification->designs)
+      for (const auto& w : d.dem.warnings) out.warnings.push_back("verify (" + d.name + "): " + w);
+    if (!out.verification->passed)
+      out.warnings.push_back("the DEM verification failed (tolerance " + format_number(verify->tolerance_relative, 3) +
+                             (out.verification->ranking_passed ? "" : "; the DEM does not rank the chosen design ahead of the baseline") +
+                             "): see verification in the result");
+  }
+  try {
+    out.comparison = compare_designs(p, r);
+  } catch (const std::invalid_argument& e) {
+    throw strict_json::NumericalError(std::string("pdamp optimize: the comparison decays failed: ") + e.what());
+  }
+  return out;
+}
+
+json to_json(const FillingRatiosResult& res) {
+  const auto& r = res.optimum;
+  const auto& p = res.problem;
+  json neighbours = json::array();
+  for (const auto& d : r.neighbours)
+    neighbours.push_back({{"slabs", slabs_of(d)}, {"objective", d.objective}, {"settling_time_s", number_or_null(d.settling_time_s)},
+                          {"total_mass_kg", d.total_mass_kg}});
+  const auto& s = r.summary;
+  const std::string unit = p.options.objective == opt::FillingObjective::kSettlingTime ? "s" : "m2_s";
+  json result = {
+      {"task", "filling_ratios"},
+      {"case", res.case_name},
+      {"method", "formulas"},
+      {"damper", p.options.damper.name},
+      {"mass_budget_kg", res.mass_budget_kg},
+      {"objective", {{"kind", std::string(opt::to_string(p.options.objective))}, {"unit", unit},
+                     {"value", r.chosen.objective}}},
+      {"design", design_json(r.chosen)},
+      {"designs", {{"chosen", design_json(r.chosen)},
+                   {"relaxed", design_json(r.relaxed)},
+                   {"baseline", design_json(r.baseline)},
+                   {"initial", design_json(r.initial)}}},
+      {"baseline_layer", r.baseline_layer},
+      {"baseline_evaluations", r.baseline_evaluations},
+      {"rounding", {{"rule", "each relaxed n_k floored and ceiled (one value when within 1e-6 of a whole number); "
+                             "every feasible point evaluated, the best chosen"},
+                    {"neighbours_total", r.neighbours_total},
+                    {"neighbours_feasible", r.neighbours_feasible},
+                    {"neighbours", neighbours}}},
+      {"solver", {{"backend", std::string(opt::to_string(s.backend))},
+                  {"outcome", std::string(opt::to_string(s.outcome))},
+                  {"iterations", s.iterations},
+                  {"evaluations", s.evaluations},
+                  {"global_evaluations", s.global_evaluations},
+                  {"gradient_evaluations", s.gradient_evaluations},
+                  {"global_stage_s", s.stage_times.global_stage_s},
+                  {"local_stage_s", s.stage_times.local_stage_s},
+                  {"message", s.message},
+                  {"report", s.brief_report()}}},
+      {"decay_evaluations", r.decay_evaluations},
+      {"solve_time_s", r.solve_time_s}};
+  result["verification"] = res.verification ? verification_json(*res.verification) : json(nullptr);
+  return result;
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,659 @@
+// Task kind frf (frf.hpp).
+#include "pdamp/tasks/frf.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "job_codecs.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "structure_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace st = structure;
+using case_file::Case;
+using detail::number_or_null;
+using nlohmann::json;
+using strict_json::format_number;
+using strict_json::InputError;
+using strict_json::NumericalError;
+
+namespace {
+
+/// --dem-signal linear: the longest sweep accepted, s (simulated), per direction.
+constexpr double kMaxSweepDuration_s = 1e5;
+
+const char* const kDemPeakNote =
+    "frequency_hz: vertex of the parabola through the largest point and its neighbours; band: where the points "
+    "stay >= 0.9 of the largest (linear between points), its centre a flat top's better-conditioned resonance "
+    "frequency; indistinguishable: the points within two standard errors of the largest (the argmax lies among "
+    "them); standard error = spread/sqrt(analysed periods); damping_ratio: half-power width (f2 - f1)/(2 f) "
+    "between the points (null where a side does not fall to 1/sqrt(2) of the largest)";
+
+bool base_excitation(const Case& c) { return c.task.frf->excitation == case_file::FrfTask::Excitation::kBase; }
+
+/// The frf task's excitation, checked against the modal model (InputError naming /task/excitation).
+st::Excitation task_excitation(const Case& c, const st::ModalModel& modal) {
+  const auto& task = *c.task.frf;
+  st::Excitation excitation;
+  excitation.direction = {task.direction[0], task.direction[1]};
+  if (task.excitation == case_file::FrfTask::Excitation::kBase) {
+    excitation.kind = st::Excitation::Kind::kBaseTranslation;
+    excitation.amplitude = task.base_amplitude_m;
+  } else {
+    excitation.kind = st::Excitation::Kind::kPointForce;
+    excitation.amplitude = task.force_amplitude_n;
+    excitation.point = task.force_point;
+  }
+  if (const auto problems = excitation.validate(modal); !problems.empty())
+    throw InputError(c.path, "/task/excitation", problems.front());
+  return excitation;
+}
+
+/// The harmonic balance over the frf task's frequencies for the setup's loss models.
+st::FrequencyResponse task_harmonic_balance(const Case& c, const detail::Setup& setup, const st::Excitation& excitation) {
+  const auto& task = *c.task.frf;
+  st::HarmonicBalanceOptions options;
+  options.frequencies_hz = detail::spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
+                                          task.spacing == surrogate::AxisSpacing::kLog);
+  return detail::call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
+}
+
+/// pdamp frf --method formulas|field: the harmonic balance, its checks and warnings.
+HarmonicFrf harmonic_frf(const Case& c, detail::Setup& setup) {
+  HarmonicFrf out;
+  out.method = setup.method;
+  out.damper_names = detail::damper_names(setup);
+  out.spacing = c.task.frf->spacing;
+  out.response = task_harmonic_balance(c, setup, task_excitation(c, setup.s.modal));
+  const auto& response = out.response;
+  std::size_t with_state = 0;
+  for (const auto& p : response.points)
+    if (!p.roots.empty() || !p.held_at_jump.empty()) ++with_state;
+  if (with_state == 0)
+    throw NumericalError("pdamp frf: no first-harmonic response found at any frequency (" + response.brief_report() +
+                         "); check the excitation amplitude against the layers' stroke range, or try --method formulas");
+  for (const auto& p : response.peaks)
+    if (!std::isfinite(p.frequency_hz) || !std::isfinite(p.magnitude))
+      throw NumericalError("pdamp frf: a response peak is not finite (" + response.brief_report() + ")");
+  setup.warnings.add(response.warnings);
+  out.converged = response.outcome == st::FrequencyResponse::Outcome::kConverged;
+  if (!out.converged)
+    setup.warnings.add("some roots did not converge (" + std::to_string(response.unconverged_starts) +
+                       " Newton starts failed): the response may miss branches");
+  return out;
+}
+
+/// The harmonic-balance FRF of one loss method as --compare runs it (warnings prefixed).
+HarmonicFrf compared_response(const Case& c, detail::Setup& setup) {
+  HarmonicFrf out;
+  out.method = setup.method;
+  out.damper_names = detail::damper_names(setup);
+  out.response = task_harmonic_balance(c, setup, task_excitation(c, setup.s.modal));
+  const auto& response = out.response;
+  for (const auto& p : response.peaks)
+    if (!std::isfinite(p.frequency_hz) || !std::isfinite(p.magnitude))
+      throw NumericalError("pdamp frf --compare: a response peak is not finite (" + response.brief_report() + ")");
+  const std::string method(case_file::to_string(setup.method));
+  setup.warnings.add(response.warnings, method + ": ");
+  out.converged = response.outcome == st::FrequencyResponse::Outcome::kConverged;
+  if (!out.converged)
+    setup.warnings.add(method + ": some roots did not converge (" + std::to_string(response.unconverged_starts) +
+                       " Newton starts failed): the response may miss branches");
+  return out;
+}
+
+/// The frf task's harmonic co-simulation options: excitation, each frequency settled to a
+/// steady state, the case's DEM settings; the excitation checked (InputError naming /task/excitation).
+st::CosimulationOptions dem_frf_options(const Case& c, const st::ModalModel& modal, const st::SteadyStateSettling& settling) {
+  const auto& task = *c.task.frf;
+  const bool base = base_excitation(c);
+  st::CosimulationOptions options;
+  options.excitation.kind = base ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
+  options.excitation.direction = {task.direction[0], task.direction[1]};
+  options.excitation.amplitude = base ? task.base_amplitude_m : task.force_amplitude_n;
+  options.excitation.point = base ? std::string() : task.force_point;
+  options.analysed_periods = c.dem.simulation.analysed_periods;
+  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  task_excitation(c, modal);  // the excitation's own checks first
+  return st::stepped_sine_options(options, settling);
+}
+
+/// The warnings of a branch's points: the co-simulation's, a point that did not settle, an
+/// energy ledger that does not close.
+std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, const st::SteadyStateSettling& settling) {
+  std::vector<std::string> out;
+  for (const auto& p : branch.points) {
+    out.insert(out.end(), p.warnings.begin(), p.warnings.end());
+    if (!p.stable)
+      out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the period-to-period change of "
+                    "the site amplitude did not stay below " + format_number(settling.stable_tolerance) + " within " +
+                    std::to_string(settling.max_transient_periods) +
+                    " transient periods: the analysed periods may still carry the transient");
+    if (p.energy_error > 0.01)
+      out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the co-simulation's energy ledger "
+                    "closes to " + format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
+  }
+  return out;
+}
+
+/// The stepped sine over the band, up and down, the directions as jobs of `executor` (a
+/// direction cannot be split: each frequency continues from the previous one's state).
+SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks, Executor& executor) {
+  const st::ModalModel& modal = setup.s.modal;
+  auto dampers = detail::dem_dampers(c);
+  const st::CosimulationOptions options = dem_frf_options(c, modal, o.settling);
+  SteppedSineFrf out;
+  out.frequencies_hz = detail::spaced(o.min_frequency_hz, o.max_frequency_hz, o.points, false);
+  out.analysed_periods = options.analysed_periods;
+  out.settling = o.settling;
+  detail::check_cosimulation(c, modal, dampers, options);
+  out.time_step_s = detail::call_dem(c, [&] { return st::stepped_sine_time_step(modal, dampers, options, out.frequencies_hz); });
+  std::vector<std::pair<std::string, std::vector<double>>> directions;
+  for (const auto& d : o.directions)
+    directions.push_back({d, d == "up" ? out.frequencies_hz
+                                       : std::vector<double>(out.frequencies_hz.rbegin(), out.frequencies_hz.rend())});
+  out.parallel = parallel_jobs(executor, directions.size());
+  // Two sweeps on two cores: one thread each (the worlds' own OpenMP would oversubscribe).
+  // On several processes too, so that a direction run elsewhere is the serial run's bit for bit.
+  if (out.parallel)
+    for (auto& d : dampers) d.world.threads = 1;
+  if (executor.processes() > 1)
+    hooks.note("pdamp frf (dem): " + std::to_string(directions.size()) + " sweep direction(s) over " +
+               std::to_string(executor.processes()) + " MPI ranks; progress lines only of a direction run on rank 0");
+  const auto started = std::chrono::steady_clock::now();
+  const std::size_t n = out.frequencies_hz.size();
+  out.branches = run_jobs<st::SteppedSineBranch>(
+      executor, directions.size(), out.parallel,
+      [&](std::size_t k) {
+        const auto& [sweep, frequencies] = directions.at(k);
+        const auto label = [&, sweep = sweep](std::size_t i) {
+          return "pdamp frf (dem) " + sweep + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
+                 format_number(frequencies[i], 5) + " Hz";
+        };
+        auto branch = detail::call_dem(c, [&] {
+          return st::stepped_sine_branch(modal, dampers, options, frequencies, sweep, out.time_step_s,
+                                         [&](std::size_t i, const st::CosimulationProgress& p) {
+                                           hooks.progress({label(i), std::string(p.stage), p.simulated_time_s,
+                                                           p.end_time_s, false, p.steps_per_s, NAN});
+                                         });
+        });
+        detail::check_outcome(branch.outcome, branch.message, label(branch.points.size()));
+        for (std::size_t i = 0; i < branch.points.size(); ++i)
+          for (double m : branch.points[i].magnitude)
+            if (!std::isfinite(m)) throw NumericalError(label(i) + ": the steady-state amplitude is not finite");
+        return branch;
+      },
+      &out.mpi);
+  out.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  for (const auto& b : out.branches) setup.warnings.add(branch_warnings(b, o.settling));
+  for (const auto& d : dampers) out.damper_names.push_back(d.name);
+  return out;
+}
+
+/// The default rate from the formulas' harmonic balance (its largest first-output peak), or
+/// from the lightest-damped mode in the band when that peak has no half-power band.
+double default_sweep_rate(const Case& c, detail::Setup& formulas, const DemFrfOptions& o, std::string& basis) {
+  const auto response = task_harmonic_balance(c, formulas, task_excitation(c, formulas.s.modal));
+  double f = NAN, zeta = NAN;
+  if (const st::ResponsePeak* p = first_output_peak(response); p && std::isfinite(p->damping_ratio) && p->damping_ratio > 0)
+    f = p->frequency_hz, zeta = p->damping_ratio, basis = "the formulas' resonance";
+  if (!std::isfinite(zeta)) {
+    const auto& modal = formulas.s.modal;
+    for (Eigen::Index j = 0; j < modal.mode_count(); ++j) {
+      const double fj = modal.natural_frequencies_hz[j], zj = std::max(modal.damping_ratios[j], 1e-4);
+      if (fj >= o.min_frequency_hz && fj <= o.max_frequency_hz && !(zj >= zeta)) f = fj, zeta = zj;
+    }
+    basis = "the lightest-damped bare mode in the band";
+  }
+  if (!std::isfinite(zeta))
+    throw InputError("--dem-sweep-rate", "", "not given, and neither a resonance of the formulas nor a mode lies in [" +
+                                                 format_number(o.min_frequency_hz) + ", " + format_number(o.max_frequency_hz) +
+                                                 "] Hz: give the rate in Hz/s");
+  basis += " (" + format_number(f, 4) + " Hz, zeta " + format_number(zeta, 3) + ")";
+  return st::quasi_stationary_sweep_rate(f, zeta);
+}
+
+/// --dem-signal linear: per direction, the structure brought to its steady state at the
+/// band's start, then a linear sine sweep to the other end; the directions in parallel.
+LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks) {
+  const st::ModalModel& modal = setup.s.modal;
+  auto dampers = detail::dem_dampers(c);
+  const st::CosimulationOptions steady = dem_frf_options(c, modal, o.settling);
+  LinearSweepFrf out;
+  out.min_frequency_hz = o.min_frequency_hz;
+  out.max_frequency_hz = o.max_frequency_hz;
+  out.rate_basis = "--dem-sweep-rate";
+  out.rate_hz_s = o.sweep_rate_hz_s ? *o.sweep_rate_hz_s : default_sweep_rate(c, setup, o, out.rate_basis);
+  out.duration_s = (o.max_frequency_hz - o.min_frequency_hz) / out.rate_hz_s;
+  if (!(out.duration_s <= kMaxSweepDuration_s))
+    throw InputError("--dem-sweep-rate", "", format_number(out.rate_hz_s) + " Hz/s: the sweep over [" +
+                                                 format_number(o.min_frequency_hz) + ", " + format_number(o.max_frequency_hz) +
+                                                 "] Hz would take " + format_number(out.duration_s) + " s (at most " +
+                                                 format_number(kMaxSweepDuration_s) + " s): a faster rate or a narrower band");
+  out.sweeps.resize(o.directions.size());
+  out.parallel = o.directions.size() > 1 && std::thread::hardware_concurrency() >= 2;
+  if (out.parallel)
+    for (auto& d : dampers) d.world.threads = 1;
+  for (const auto& direction : o.directions) {  // every run's options checked before any starts
+    st::CosimulationOptions run = steady;
+    run.excitation.frequency_hz = direction == "up" ? o.min_frequency_hz : o.max_frequency_hz;
+    run.sweep_end_frequency_hz = direction == "up" ? o.max_frequency_hz : o.min_frequency_hz;
+    run.duration_s = out.duration_s;
+    detail::check_cosimulation(c, modal, dampers, run);
+    detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, run); });
+  }
+  const auto started = std::chrono::steady_clock::now();
+  for_each_concurrently(out.sweeps.size(), out.parallel, [&](std::size_t k) {
+    const std::string& direction = o.directions[k];
+    const double start = direction == "up" ? o.min_frequency_hz : o.max_frequency_hz;
+    const double end = direction == "up" ? o.max_frequency_hz : o.min_frequency_hz;
+    const std::string label = "pdamp frf (dem) linear " + direction;
+    const std::string labels[2] = {label + " start " + format_number(start, 5) + " Hz", label + " sweep"};
+    auto s = detail::call_dem(c, [&] {
+      return st::linear_sine_sweep(modal, dampers, steady, direction, start, end, out.rate_hz_s,
+                                   [&](std::size_t i, const st::CosimulationProgress& p) {
+                                     hooks.progress({labels[i], std::string(p.stage), p.simulated_time_s, p.end_time_s,
+                                                     false, p.steps_per_s, NAN});
+                                   });
+    });
+    detail::check_outcome(s.outcome, s.message, labels[s.cycles.empty() && s.start_transient_periods == 0 ? 0 : 1]);
+    for (const auto& cycle : s.cycles)
+      for (double m : cycle.site_amplitude_per_excitation)
+        if (!std::isfinite(m)) throw NumericalError(label + ": a cycle's amplitude is not finite");
+    if (!s.start_stable)
+      s.warnings.push_back(s.sweep + " sweep: the steady state at " + format_number(s.start_hz, 5) +
+                           " Hz was not reached within " + std::to_string(o.settling.max_transient_periods) +
+                           " periods: the sweep's first cycles may carry the transient");
+    if (s.energy_error > 0.01)
+      s.warnings.push_back(s.sweep + " sweep: the co-simulation's energy ledger closes to " +
+                           format_number(s.energy_error, 3) + " only: a smaller /dem/time_step_s");
+    out.sweeps[k] = std::move(s);
+  });
+  out.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  for (const auto& s : out.sweeps) setup.warnings.add(s.warnings);
+  for (const auto& d : dampers) out.damper_names.push_back(d.name);
+  return out;
+}
+
+json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<std::string>& names) {
+  json out = json::array();
+  for (const auto& p : peaks)
+    out.push_back({{"output", p.output < names.size() ? names[p.output] : std::to_string(p.output)},
+                   {"frequency_hz", p.frequency_hz},
+                   {"magnitude", p.magnitude},
+                   {"damping_ratio", number_or_null(p.damping_ratio)},
+                   {"band_centre_hz", number_or_null(p.band_centre_hz)}});
+  return out;
+}
+
+/// A branch's resonance measures of one output as JSON (sampled_response.hpp).
+json dem_peak_json(const std::string& output, const st::SteppedSineBranch& branch, const st::SteppedSinePeak& bp) {
+  const st::SteppedSinePoint& top = *bp.ascending[bp.peak.index];
+  return {{"output", output},
+          {"sweep", branch.sweep},
+          {"frequency_hz", bp.peak.frequency_hz},
+          {"largest_point_frequency_hz", top.frequency_hz},
+          {"magnitude", bp.peak.magnitude},
+          {"magnitude_standard_error", bp.output == 0 ? number_or_null(top.standard_error) : json(nullptr)},
+          {"band_low_hz", number_or_null(bp.peak.band.low_hz)},
+          {"band_high_hz", number_or_null(bp.peak.band.high_hz)},
+          {"band_centre_hz", number_or_null(bp.peak.band_centre_hz)},
+          {"indistinguishable_low_hz", bp.peak.indistinguishable_low_hz},
+          {"indistinguishable_high_hz", bp.peak.indistinguishable_high_hz},
+          {"damping_ratio", number_or_null(bp.peak.damping_ratio)}};
+}
+
+/// Relative differences of a method's largest first-output peak from a DEM branch's, for
+/// the peak (argmax) frequency, the 0.9 band's centre and the magnitude.
+json agreement_json(const st::ResponsePeak* peak, const st::SampledPeak& dem) {
+  if (!peak) return nullptr;
+  const auto relative = [](double a, double b) { return number_or_null((a - b) / b); };
+  return {{"frequency_hz", peak->frequency_hz},
+          {"band_centre_hz", number_or_null(peak->band_centre_hz)},
+          {"magnitude", peak->magnitude},
+          {"frequency_relative_difference", relative(peak->frequency_hz, dem.frequency_hz)},
+          {"band_centre_relative_difference", relative(peak->band_centre_hz, dem.band_centre_hz)},
+          {"magnitude_relative_difference", relative(peak->magnitude, dem.magnitude)},
+          {"damping_ratio", number_or_null(peak->damping_ratio)},
+          {"dem_damping_ratio", number_or_null(dem.damping_ratio)},
+          {"frequency_within_dem_indistinguishable",
+           peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz}};
+}
+
+json names_json(const std::vector<std::string>& names) {
+  json n = json::array();
+  for (const auto& name : names) n.push_back(name);
+  return n;
+}
+
+json harmonic_result(const FrfResult& r, const HarmonicFrf& h, const OutputFolder& folder) {
+  const auto& response = h.response;
+  const bool base = r.base_excitation;
+  std::size_t held = 0;
+  for (const auto& p : response.points)
+    if (!p.held_at_jump.empty()) ++held;
+  // Branches: the frequency span and stability of each.
+  struct BranchInfo {
+    double f_min = INFINITY, f_max = -INFINITY, x_max = 0.0;
+    std::size_t points = 0, stable = 0, unstable = 0, marginal = 0;
+  };
+  std::map<int, BranchInfo> info;
+  for (const auto& p : response.points)
+    for (const auto& root : p.roots) {
+      auto& b = info[root.branch_id];
+      b.f_min = std::min(b.f_min, p.frequency_hz);
+      b.f_max = std::max(b.f_max, p.frequency_hz);
+      if (!root.damper_amplitudes_m.empty()) b.x_max = std::max(b.x_max, root.damper_amplitudes_m.front());
+      ++b.points;
+      (root.stability == st::Stability::kStable ? b.stable : root.stability == st::Stability::kUnstable ? b.unstable : b.marginal)++;
+    }
+  json branches = json::array();
+  for (const auto& [id, b] : info)
+    branches.push_back({{"branch", id}, {"min_frequency_hz", b.f_min}, {"max_frequency_hz", b.f_max},
+                        {"points", b.points}, {"stable_points", b.stable}, {"unstable_points", b.unstable},
+                        {"marginal_points", b.marginal}, {"max_amplitude_m", b.x_max}});
+  json jumps = json::array();
+  for (const auto& e : response.branch_ends) {
+    json j = {{"kind", branch_end_kind(e.kind)}, {"frequency_hz", e.frequency_hz}, {"amplitude_m", e.damper_amplitude_m},
+              {"branch", e.branch_id}, {"branch_exists_below", e.ends_toward_higher_frequency}};
+    if (e.kind == st::BranchEnd::Kind::kFold) j["other_branch"] = e.other_branch_id;
+    jumps.push_back(std::move(j));
+  }
+  const json peaks = peaks_json(response.peaks, response.output_names);
+  json frf = {{"file", folder.file("frf.csv")},
+              {"branches_file", folder.file("frf_branches.csv")},
+              {"plot", folder.file("frf.png")},
+              {"method", case_file::to_string(h.method)},
+              {"outputs", response.output_names},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude)"
+                                 : "receptance |X/F| in m/N"},
+              {"excitation", base ? "base" : "force"},
+              {"frequencies", {{"min_hz", response.points.front().frequency_hz},
+                               {"max_hz", response.points.back().frequency_hz},
+                               {"points", response.points.size()},
+                               {"spacing", h.spacing == surrogate::AxisSpacing::kLog ? "log" : "linear"}}},
+              {"peaks", peaks},
+              {"linear_peaks", peaks_json(response.linear_peaks, response.output_names)},
+              {"jumps", jumps},
+              {"branches", branches},
+              {"held_at_jump_points", held},
+              {"outcome", h.converged ? "converged" : "some_roots_not_converged"},
+              {"loss_evaluations", response.loss_evaluations},
+              {"solve_time_s", response.solve_time_s},
+              {"report", response.brief_report()},
+              {"warnings", r.warnings}};
+  json result = {{"task", "frf"}, {"case", r.case_name}, {"method", case_file::to_string(h.method)}};
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["branches"] = branches;
+  result["frf"] = frf;
+  return result;
+}
+
+json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFolder& folder) {
+  const bool base = r.base_excitation;
+  const auto& names = s.damper_names;
+  json peaks = json::array(), list = json::array();
+  for (const auto& branch : s.branches) {
+    for (std::size_t d = 0; d < names.size(); ++d)
+      peaks.push_back(dem_peak_json(names[d], branch, st::stepped_sine_peak(branch, d)));
+    for (const auto& p : branch.points) {
+      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
+      for (std::size_t d = 0; d < names.size(); ++d) {
+        magnitude[names[d]] = p.magnitude[d], phase[names[d]] = p.phase_deg[d];
+        eta[names[d]] = number_or_null(p.bed_eta_star[d]);
+        mass[names[d]] = number_or_null(p.bed_apparent_mass_fraction[d]);
+      }
+      list.push_back({{"sweep", p.sweep}, {"frequency_hz", p.frequency_hz}, {"requested_frequency_hz", p.requested_frequency_hz},
+                      {"magnitude", magnitude}, {"phase_deg", phase},
+                      {"bed_eta_star", eta}, {"bed_apparent_mass_fraction", mass},
+                      {"magnitude_spread", number_or_null(p.spread)},
+                      {"magnitude_standard_error", number_or_null(p.standard_error)}, {"energy_error", p.energy_error},
+                      {"transient_periods", p.transient_periods}, {"stable", p.stable}, {"steps", p.steps},
+                      {"time_step_s", p.time_step_s}, {"solve_time_s", p.wall_time_s}});
+    }
+  }
+  const std::string bed_state =
+      "each direction (up, down) continues from frequency to frequency with the previous one's final state: modes "
+      "(q, dq/dt), the bed (particles and contacts) and the drive's phase; the bed is settled once, before a "
+      "direction's first frequency";
+  json sweeps = json::array();
+  for (const auto& b : s.branches) sweeps.push_back(b.sweep);
+  json frf = {{"file", folder.file("frf_dem.csv")},
+              {"plot", folder.file("frf_dem.png")},
+              {"method", "dem"},
+              {"outputs", names_json(names)},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic"
+                                 : "receptance |X/F| in m/N, first harmonic"},
+              {"excitation", base ? "base" : "force"},
+              {"frequencies", {{"min_hz", s.frequencies_hz.front()}, {"max_hz", s.frequencies_hz.back()},
+                               {"points", s.frequencies_hz.size()}, {"spacing", "linear"}}},
+              {"points", list},
+              {"peaks", peaks},
+              {"peak_note", kDemPeakNote},
+              {"bed_carried_over", true},
+              {"stepped_sine", {{"sweeps", sweeps},
+                                {"parallel", s.parallel},
+                                {"bed_state", bed_state}, {"bed_carried_over", true},
+                                {"drive", "sin(2 pi f (t - t_i) + pi/2) from each frequency's start t_i: the junctions "
+                                          "are at the turning point, the base displacement and velocity (or the "
+                                          "force) continuous"},
+                                {"time_step_s", s.time_step_s},
+                                {"max_transient_periods", s.settling.max_transient_periods},
+                                {"stable_tolerance", s.settling.stable_tolerance},
+                                {"analysed_periods", s.analysed_periods}}},
+              {"solve_time_s", s.solve_time_s},
+              {"warnings", r.warnings}};
+  json result = {{"task", "frf"}, {"case", r.case_name}, {"method", "dem"}};
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["branches"] = json::array();
+  result["bed_carried_over"] = true;
+  result["frf"] = frf;
+  if (!s.mpi.is_null()) result["mpi"] = s.mpi;
+  return result;
+}
+
+json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFolder& folder) {
+  const bool base = r.base_excitation;
+  const auto& names = l.damper_names;
+  json peaks = json::array(), list = json::array(), runs = json::array();
+  for (const auto& s : l.sweeps) {
+    for (std::size_t d = 0; d < names.size(); ++d) {
+      const st::SweepPeak& sp = s.peaks[d];
+      const auto value = [&](double v) { return sp.found() ? number_or_null(v) : json(nullptr); };
+      peaks.push_back({{"output", names[d]},
+                       {"sweep", s.sweep},
+                       {"frequency_hz", value(sp.peak.frequency_hz)},
+                       {"magnitude", value(sp.peak.magnitude)},
+                       {"magnitude_standard_error", value(sp.standard_error())},
+                       {"band_low_hz", value(sp.peak.band.low_hz)},
+                       {"band_high_hz", value(sp.peak.band.high_hz)},
+                       {"band_centre_hz", value(sp.peak.band_centre_hz)},
+                       {"damping_ratio", value(sp.peak.damping_ratio)}});
+    }
+    runs.push_back({{"sweep", s.sweep}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
+                    {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
+                    {"start_transient_periods", s.start_transient_periods}, {"start_stable", s.start_stable},
+                    {"energy_error", s.energy_error}, {"steps", s.steps}, {"time_step_s", s.time_step_s},
+                    {"solve_time_s", s.wall_time_s}});
+    for (const auto& cycle : s.cycles) {
+      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
+      for (std::size_t d = 0; d < names.size(); ++d) {
+        magnitude[names[d]] = cycle.site_amplitude_per_excitation[d];
+        phase[names[d]] = std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
+        eta[names[d]] = number_or_null(cycle.bed_reduced_loss_factor[d]);
+        mass[names[d]] = number_or_null(cycle.bed_apparent_mass_fraction[d]);
+      }
+      list.push_back({{"sweep", s.sweep}, {"time_s", cycle.time_s}, {"frequency_hz", cycle.frequency_hz},
+                      {"magnitude", magnitude}, {"phase_deg", phase}, {"bed_eta_star", eta},
+                      {"bed_apparent_mass_fraction", mass}});
+    }
+  }
+  json frf = {{"file", folder.file("frf_dem_sweep.csv")},
+              {"plot", folder.file("frf_dem_sweep.png")},
+              {"method", "dem"},
+              {"signal", "linear_sweep"},
+              {"outputs", names_json(names)},
+              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic "
+                                   "of each drive cycle"
+                                 : "receptance |X/F| in m/N, first harmonic of each drive cycle"},
+              {"excitation", base ? "base" : "force"},
+              {"rate_hz_per_s", l.rate_hz_s},
+              {"rate_basis", l.rate_basis},
+              {"quasi_stationary_ratio_default", 100.0},
+              {"sweeps", runs},
+              {"parallel", l.parallel},
+              {"points", list},
+              {"peaks", peaks},
+              {"peak_note", "the peak is read off moving means of " + std::to_string(st::kSweepWindowCycles) +
+                                " consecutive cycles (standard error: their spread over the root of the count); a "
+                                "sweep's response lags its drive by about a response time, so an up sweep's peak "
+                                "sits above the steady one and a down sweep's below, by about rate x response time"},
+              {"solve_time_s", l.solve_time_s},
+              {"warnings", r.warnings}};
+  json result = {{"task", "frf"}, {"case", r.case_name}, {"method", "dem"}, {"signal", "linear_sweep"}};
+  result["file"] = frf["file"];
+  result["peaks"] = peaks;
+  result["frf"] = frf;
+  return result;
+}
+
+json compare_result(const FrfResult& r, const OutputFolder& folder) {
+  const auto& f_response = r.harmonic->response;
+  const std::vector<std::string>& names = f_response.output_names;
+  const std::string output = names.empty() ? std::string() : names.front();
+  json dem_list = json::array(), dem_peaks = json::array(), agreement = json::array();
+  for (const auto& branch : r.stepped->branches) {
+    const st::SteppedSinePeak bp = st::stepped_sine_peak(branch);
+    for (const st::SteppedSinePoint* p : bp.ascending)
+      dem_list.push_back({{"sweep", branch.sweep}, {"frequency_hz", p->frequency_hz}, {"magnitude", p->magnitude.front()},
+                          {"magnitude_spread", number_or_null(p->spread)},
+                          {"magnitude_standard_error", number_or_null(p->standard_error)},
+                          {"energy_error", p->energy_error}, {"stable", p->stable}});
+    dem_peaks.push_back(dem_peak_json(output, branch, bp));
+    const json a_formulas = agreement_json(first_output_peak(f_response), bp.peak);
+    const json a_field = r.field ? agreement_json(first_output_peak(r.field->response), bp.peak) : json(nullptr);
+    agreement.push_back({{"reference", "dem " + branch.sweep}, {"formulas", a_formulas}, {"field", a_field}});
+  }
+  const json f_peaks = peaks_json(f_response.peaks, names);
+  const json field_peaks = r.field ? peaks_json(r.field->response.peaks, r.field->response.output_names) : json(nullptr);
+  json compare = {
+      {"output", output},
+      {"formulas", {{"peaks", f_peaks}}},
+      {"field", r.field ? json{{"peaks", field_peaks}} : json(nullptr)},
+      {"dem", {{"peaks", dem_peaks}, {"points", dem_list}, {"bed_carried_over", true}, {"peak_note", kDemPeakNote}}},
+      {"agreement_definition", "(method - dem) / dem of the largest peak of the first output, per DEM sweep direction"},
+      {"agreement", agreement},
+      {"file", folder.file("frf_compare.csv")},
+      {"plot", folder.file("frf_compare.png")},
+      {"dem_solve_time_s", r.stepped->solve_time_s}};
+  json result = {{"task", "frf"}, {"case", r.case_name}, {"method", "compare"}};
+  result["file"] = compare["file"];
+  result["peaks"] = f_peaks;  // the contract's peaks: the formulas' (compare holds all three)
+  result["branches"] = json::array();
+  result["compare"] = compare;
+  return result;
+}
+
+}  // namespace
+
+const st::ResponsePeak* first_output_peak(const st::FrequencyResponse& r) {
+  const st::ResponsePeak* best = nullptr;
+  for (const auto& p : r.peaks)
+    if (p.output == 0 && (!best || p.magnitude > best->magnitude)) best = &p;
+  return best;
+}
+
+std::string_view branch_end_kind(st::BranchEnd::Kind kind) {
+  switch (kind) {
+    case st::BranchEnd::Kind::kFold: return "fold";
+    case st::BranchEnd::Kind::kDiscontinuity: return "discontinuity";
+    case st::BranchEnd::Kind::kStrokeRange: return "stroke_range";
+  }
+  return "";
+}
+
+DemFrfOptions default_dem_frf_options(const Case& c) {
+  DemFrfOptions o;
+  if (c.task.frf) {
+    o.min_frequency_hz = c.task.frf->min_frequency_hz;
+    o.max_frequency_hz = c.task.frf->max_frequency_hz;
+  }
+  return o;
+}
+
+FrfResult run_frf(const Case& c, const FrfOptions& options, RunHooks& hooks, Executor& executor) {
+  if (c.task.kind != case_file::TaskKind::kFrf || !c.task.frf)
+    throw InputError(c.path, "/task",
+                     "pdamp frf needs a task of kind frf (this case's task is '" +
+                         std::string(case_file::to_string(c.task.kind)) +
+                         "'): give \"task\": {\"kind\": \"frf\", \"min_frequency_hz\", \"max_frequency_hz\", "
+                         "\"excitation\"} (docs/cases.md, Format 2)");
+  FrfResult out;
+  out.case_name = c.name;
+  out.method = options.method;
+  out.base_excitation = base_excitation(c);
+  switch (options.method) {
+    case FrfMethod::kFormulas:
+    case FrfMethod::kField: {
+      detail::Setup setup = detail::make_setup(
+          c, options.method == FrfMethod::kField ? case_file::LossMethod::kField : case_file::LossMethod::kFormulas);
+      out.harmonic = harmonic_frf(c, setup);
+      out.warnings = setup.warnings.list();
+      break;
+    }
+    case FrfMethod::kDem: {
+      detail::Setup setup = detail::make_setup(c, case_file::LossMethod::kFormulas, false);
+      if (options.dem.linear_sweep) out.linear = linear_sweep(c, setup, options.dem, hooks);
+      else out.stepped = stepped_sine(c, setup, options.dem, hooks, executor);
+      out.warnings = setup.warnings.list();
+      break;
+    }
+    case FrfMethod::kCompare: {
+      detail::Setup formulas = detail::make_setup(c, case_file::LossMethod::kFormulas);
+      out.harmonic = compared_response(c, formulas);
+      detail::Warnings& warnings = formulas.warnings;
+      bool every_field = true;
+      for (const auto& d : c.dampers)
+        for (const auto& l : d.layers) every_field = every_field && !l.field_file.empty();
+      if (every_field) {
+        detail::Setup field = detail::make_setup(c, case_file::LossMethod::kField);
+        out.field = compared_response(c, field);
+        warnings.add(field.warnings.list());
+      } else {
+        warnings.add("--compare: the field curve is skipped: not every layer has a field_file (make one with pdamp field)");
+      }
+      detail::Setup dem = detail::make_setup(c, case_file::LossMethod::kFormulas, false);
+      out.stepped = stepped_sine(c, dem, options.dem, hooks, executor);
+      warnings.add(dem.warnings.list(), "dem: ");
+      if (out.stepped->branches.empty() || out.stepped->branches.front().points.empty())
+        throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
+      out.warnings = warnings.list();
+      break;
+    }
+  }
+  return out;
+}
+
+std::string magnitude_label(const FrfResult& r) {
+  return r.base_excitation ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+}
+
+json to_json(const FrfResult& r, const OutputFolder& folder) {
+  switch (r.method) {
+    case FrfMethod::kFormulas:
+    case FrfMethod::kField: return harmonic_result(r, *r.harmonic, folder);
+    case FrfMethod::kDem: return r.linear ? linear_result(r, *r.linear, folder) : stepped_result(r, *r.stepped, folder);
+    case FrfMethod::kCompare: return compare_result(r, folder);
+  }
+  return nullptr;
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,171 @@
+// Task kind modes (modes.hpp).
+#include "pdamp/tasks/modes.hpp"
+
+#include <algorithm>
+
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+#include "structure_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace st = structure;
+using nlohmann::json;
+
+namespace {
+
+/// Default backbone range when the case's task is not `modes`: 40 log-spaced damper
+/// amplitudes from 1 mm to twice the largest clearance of the reference damper's layers.
+constexpr int kDefaultBackbonePoints = 40;
+constexpr double kDefaultBackboneMinM = 1e-3;
+constexpr double kDefaultBackboneMaxOverClearance = 2.0;
+/// A mode in which the reference damper moves less than this fraction of its largest
+/// drive shape gets no backbone (its amplitude there would be meaningless).
+constexpr double kNoMotionFraction = 1e-9;
+
+}  // namespace
+
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options) {
+  detail::Setup setup = detail::make_setup(c, options.method);
+  const st::ModalModel& modal = setup.s.modal;
+  const auto& dampers = setup.s.dampers;
+  ModesResult out;
+  out.case_name = c.name;
+  out.method = options.method;
+  out.damper_names = detail::damper_names(setup);
+  out.layer_names = detail::layer_names(setup);
+  out.rigid_modes_dropped = setup.s.rigid_modes_dropped;
+
+  Eigen::Index mode_count = modal.mode_count();
+  const bool from_task = c.task.kind == case_file::TaskKind::kModes && c.task.modes.has_value();
+  if (from_task && c.task.modes->mode_count > 0) mode_count = std::min<Eigen::Index>(mode_count, c.task.modes->mode_count);
+  out.mode_count = mode_count;
+
+  // Backbone amplitudes of the reference damper (the first).
+  double lo = kDefaultBackboneMinM, hi = 0.0;
+  int points = kDefaultBackbonePoints;
+  if (from_task) {
+    lo = c.task.modes->backbone_min_amplitude_m;
+    hi = c.task.modes->backbone_max_amplitude_m;
+    points = c.task.modes->backbone_points;
+  } else {
+    for (const auto& layer : c.dampers.front().layers) hi = std::max(hi, kDefaultBackboneMaxOverClearance * layer.clearance_m);
+    if (!(hi > lo)) lo = hi / 100.0;
+  }
+  out.backbone_min_amplitude_m = lo;
+  out.backbone_max_amplitude_m = hi;
+  out.backbone_points = points;
+  out.backbone_from_task = from_task;
+  const auto amplitudes = detail::spaced(lo, hi, points, true);
+
+  std::vector<st::Damper> containers = dampers;
+  for (auto& d : containers) d.layers.clear();
+  const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
+  const auto coupled = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, dampers); });
+  out.frequencies_with_containers_hz = st::natural_frequencies_with_containers_hz(empty);
+  out.drive_shapes = coupled.drive_shapes;
+
+  // μ_dj = b_dj² Σ_l m_bed,l / m_j.
+  out.mass_ratio.resize(mode_count, static_cast<Eigen::Index>(dampers.size()));
+  for (Eigen::Index d = 0; d < out.mass_ratio.cols(); ++d) {
+    double bed = 0.0;
+    for (const auto& l : dampers[static_cast<std::size_t>(d)].layers) bed += l.bed_mass_kg;
+    for (Eigen::Index j = 0; j < mode_count; ++j)
+      out.mass_ratio(j, d) = coupled.drive_shapes(j, d) * coupled.drive_shapes(j, d) * bed / coupled.modal_masses_kg[j];
+  }
+
+  const double largest_drive = coupled.drive_shapes.col(0).cwiseAbs().maxCoeff();
+  std::map<std::string, std::vector<Eigen::Index>> backbone_warnings;  // sentence -> modes (1-based)
+  for (Eigen::Index j = 0; j < mode_count; ++j) {
+    if (!(std::abs(coupled.drive_shapes(j, 0)) > kNoMotionFraction * largest_drive)) {
+      setup.warnings.add("mode " + std::to_string(j + 1) + ": damper " + dampers.front().name +
+                         " does not move along its drive in this mode: no backbone");
+      continue;
+    }
+    st::BackboneOptions backbone;
+    backbone.mode = static_cast<int>(j);
+    backbone.reference_damper = 0;
+    backbone.damper_amplitudes_m = amplitudes;
+    auto b = detail::call_solver(c, "/task", [&] { return st::backbone(modal, dampers, backbone); });
+    for (const auto& p : b.points) out.converged = out.converged && p.converged;
+    for (const auto& w : b.warnings) backbone_warnings[w].push_back(j + 1);
+    out.backbone_of_mode[j] = out.backbones.size();
+    out.backbones.push_back(std::move(b));
+  }
+  for (const auto& [sentence, modes] : backbone_warnings) {
+    std::string list;
+    for (const auto m : modes) list += (list.empty() ? "" : ", ") + std::to_string(m);
+    setup.warnings.add("backbone (mode" + std::string(modes.size() > 1 ? "s " : " ") + list + "): " + sentence);
+  }
+  for (Eigen::Index j = 0; j < mode_count; ++j)
+    if (!std::isfinite(out.frequencies_with_containers_hz[j]) || !std::isfinite(modal.natural_frequencies_hz[j]))
+      throw strict_json::NumericalError("pdamp modes: the natural frequency of mode " + std::to_string(j + 1) + " is not finite");
+  if (!out.converged) setup.warnings.add("some backbone points did not converge (converged = 0 in backbone_mode<j>.csv)");
+  out.modal = modal;
+  out.warnings = setup.warnings.list();
+  return out;
+}
+
+json to_json(const ModesResult& r, const OutputFolder& folder) {
+  const st::ModalModel& modal = r.modal;
+  json modes = json::array();
+  for (Eigen::Index j = 0; j < r.mode_count; ++j) {
+    json shapes = json::object();
+    for (const auto& p : modal.points)
+      shapes[p.name] = {{"translation_x", p.translation(0, j)}, {"translation_y", p.translation(1, j)},
+                        {"rotation", p.rotation(j)}};
+    json ratio_per_damper = json::object(), drive = json::object();
+    double ratio_total = 0.0;
+    for (std::size_t d = 0; d < r.damper_names.size(); ++d) {
+      const auto col = static_cast<Eigen::Index>(d);
+      ratio_per_damper[r.damper_names[d]] = r.mass_ratio(j, col);
+      drive[r.damper_names[d]] = r.drive_shapes(j, col);
+      ratio_total += r.mass_ratio(j, col);
+    }
+    json mode = {{"mode", j + 1},
+                 {"frequency_hz", r.frequencies_with_containers_hz[j]},
+                 {"bare_frequency_hz", modal.natural_frequencies_hz[j]},
+                 {"damping_ratio", modal.damping_ratios[j]},
+                 {"modal_mass_kg", modal.modal_masses_kg[j]},
+                 {"modal_mass_ratio", ratio_total},
+                 {"modal_mass_ratio_per_damper", ratio_per_damper},
+                 {"drive_shape_per_damper", drive},
+                 {"shapes", shapes},
+                 {"backbone", nullptr}};
+    if (const auto it = r.backbone_of_mode.find(j); it != r.backbone_of_mode.end()) {
+      const auto& b = r.backbones[it->second];
+      const auto best = std::max_element(b.points.begin(), b.points.end(), [](const auto& a, const auto& x) {
+        return a.added_damping_ratio < x.added_damping_ratio;
+      });
+      double f_min = b.points.front().damped_frequency_hz, f_max = f_min;
+      for (const auto& p : b.points) f_min = std::min(f_min, p.damped_frequency_hz), f_max = std::max(f_max, p.damped_frequency_hz);
+      mode["backbone"] = {{"file", folder.file("backbone_mode" + std::to_string(j + 1) + ".csv")},
+                          {"points", b.points.size()},
+                          {"modal_mass_ratio", b.modal_mass_ratio},
+                          {"max_added_damping_ratio", best->added_damping_ratio},
+                          {"max_added_damping_amplitude_m", best->damper_amplitude_m},
+                          {"min_damped_frequency_hz", f_min},
+                          {"max_damped_frequency_hz", f_max}};
+    }
+    modes.push_back(std::move(mode));
+  }
+  json result = {{"task", "modes"}, {"case", r.case_name}, {"method", case_file::to_string(r.method)}};
+  result["file"] = folder.file("modes.csv");
+  result["modes"] = modes;
+  result["frequencies"] =
+      "frequency_hz: natural frequencies with the empty containers attached (beds removed); bare_frequency_hz: "
+      "the structure alone; damping_ratio: the structural modal damping ratio";
+  result["rigid_modes_dropped"] = r.rigid_modes_dropped;
+  result["backbone"] = {{"reference_damper", r.damper_names.front()},
+                        {"amplitude_source", r.backbone_from_task ? "task" : "default"},
+                        {"min_amplitude_m", r.backbone_min_amplitude_m},
+                        {"max_amplitude_m", r.backbone_max_amplitude_m},
+                        {"points", r.backbone_points},
+                        {"spacing", "log"},
+                        {"plot", folder.file("backbone.png")}};
+  result["outcome"] = r.converged ? "converged" : "not_converged";
+  return result;
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,94 @@
+// Task kind placement (placement.hpp).
+#include "pdamp/tasks/placement.hpp"
+
+#include "pdamp/case_file/placement_problem.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
+#include "task_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace opt = optimizer;
+using detail::number_or_null;
+using nlohmann::json;
+
+namespace {
+
+json site_json(const opt::PlacementPoint& p) {
+  json modes = json::array();
+  for (const auto& m : p.modes)
+    modes.push_back({{"mode", m.mode + 1},
+                     {"natural_frequency_hz", m.natural_frequency_hz},
+                     {"drive_shape", m.drive_shape},
+                     {"modal_amplitude", m.modal_amplitude},
+                     {"damper_amplitude_m", m.damper_amplitude_m},
+                     {"eta_star", m.eta_star},
+                     {"modal_mass_ratio", m.modal_mass_ratio},
+                     {"added_damping_ratio", m.added_damping_ratio},
+                     {"rotation_ratio", number_or_null(m.rotation_ratio)},
+                     {"rotation_flagged", m.rotation_flagged},
+                     {"loss_warnings", surrogate::describe_loss_warnings(m.loss_warnings)}});
+  return {{"site", p.site}, {"position_m", number_or_null(p.position_m)}, {"objective", p.objective}, {"modes", modes}};
+}
+
+}  // namespace
+
+PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options) {
+  const case_file::PlacementTask& task = *c.task.placement;
+  case_file::PlacementProblem p = case_file::placement_problem(c, options.method);
+  opt::Options solver = opt::placement_solver_options();
+  solver.backend = options.backend.value_or(*opt::backend_from_string(task.backend));
+  PlacementStudy out;
+  out.case_name = c.name;
+  out.method = options.method;
+  out.damper = p.options.damper.name;
+  out.objective = p.options.objective;
+  out.beam = p.beam.has_value();
+  try {
+    out.result = p.beam ? opt::optimize_placement_on_beam(*p.beam, p.options, solver, p.current_position_m)
+                        : opt::optimize_placement_at_points(p.modal, p.candidate_points, p.options);
+  } catch (const std::invalid_argument& e) {
+    throw strict_json::InputError(c.path, "/task", e.what());
+  }
+  out.warnings = p.warnings;
+  out.warnings.insert(out.warnings.end(), out.result.warnings.begin(), out.result.warnings.end());
+  if (!std::isfinite(out.result.best.objective))
+    throw strict_json::NumericalError("pdamp optimize: the placement objective is not finite");
+  return out;
+}
+
+json to_json(const PlacementStudy& study) {
+  const auto& r = study.result;
+  const auto& s = r.summary;
+  const json solver_json =
+      r.refined ? json{{"backend", std::string(opt::to_string(s.backend))},
+                       {"stages", "scan of " + std::to_string(r.scan.size()) + " positions, then a local refinement"},
+                       {"outcome", std::string(opt::to_string(s.outcome))},
+                       {"iterations", s.iterations},
+                       {"evaluations", r.evaluations},
+                       {"refinement_evaluations", s.evaluations},
+                       {"message", s.message},
+                       {"report", s.brief_report()}}
+                : json{{"backend", "scan"},
+                       {"stages", "every candidate point evaluated"},
+                       {"outcome", "converged"},
+                       {"iterations", 0},
+                       {"evaluations", r.evaluations}};
+  return {{"task", "placement"},
+          {"case", study.case_name},
+          {"method", std::string(case_file::to_string(study.method))},
+          {"damper", study.damper},
+          {"objective", {{"kind", std::string(opt::to_string(study.objective))}, {"unit", "damping ratio"},
+                         {"value", r.best.objective}}},
+          {"design", site_json(r.best)},
+          {"current", r.current ? site_json(*r.current) : json(nullptr)},
+          {"improvement_over_current",
+           r.current && r.current->objective > 0.0 ? json(r.best.objective / r.current->objective) : json(nullptr)},
+          {"sites_evaluated", r.scan.size()},
+          {"solver", solver_json},
+          {"verification", nullptr},
+          {"solve_time_s", r.solve_time_s}};
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,196 @@
+// pdamp sensitivity as a study (sensitivity.hpp).
+#include "pdamp/tasks/sensitivity.hpp"
+
+#include <cmath>
+
+#include "job_codecs.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/surrogate/dem_evaluator.hpp"
+#include "pdamp/tasks/dem_run.hpp"
+#include "pdamp/tasks/field.hpp"
+#include "task_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace fm = formulas;
+using nlohmann::json;
+using strict_json::format_number;
+
+SensitivityStudy sensitivity_study(const case_file::Case& c) {
+  const detail::SingleDamper single = detail::single_damper(c, "pdamp sensitivity");
+  SensitivityStudy study;
+  study.frequency_hz = c.sensitivity ? c.sensitivity->frequency_hz : c.excitation.frequency_hz;
+  double x = c.sensitivity ? c.sensitivity->amplitude_m : c.excitation.amplitude_m.value_or(0.0);
+  if (!(x > 0.0)) {
+    const auto family = single.damper.model == fm::DamperModel::kBouncing ? fm::DamperModel::kBouncing
+                                                                           : fm::DamperModel::kRolling;
+    x = fm::optimum_stroke(family, single.layer.clearance_m, single.damper.model_options).x_opt_m;
+  }
+  study.amplitude_m = x;
+  study.variants = case_file::sensitivity_variants(c, study.warnings);
+  study.points.identity = json::array();
+  for (const auto& v : study.variants) {
+    study.points.drives.push_back({study.frequency_hz, study.amplitude_m});
+    study.points.identity.push_back({{"parameter", v.parameter}, {"value", v.value}});
+  }
+  return study;
+}
+
+namespace {
+
+/// What evaluates variant k: the DEM at the study's drive, or the closed form.
+surrogate::PointEvaluator variant_evaluator(const case_file::SensitivityVariant& v, bool dem, double x, double f) {
+  if (dem) {
+    auto options = case_file::dem_options(v.variant, 0, x, f);
+    options.world.threads = 1;  // the study runs variants in parallel instead
+    return surrogate::dem_evaluator(options);
+  }
+  const detail::SingleDamper d = detail::single_damper(v.variant, "pdamp sensitivity");
+  return surrogate::formula_evaluator(d.damper.model, d.layer.clearance_m, d.layer.bed_mass_kg, d.damper.model_options);
+}
+
+surrogate::SweepOptions study_sweep(const case_file::Case& c, const std::string& source) {
+  surrogate::SweepOptions sweep = field_sweep_options(c, source);
+  sweep.threads = source == "dem" ? (c.sensitivity ? c.sensitivity->threads : c.field.threads) : 1;
+  return sweep;
+}
+
+/// The rows of a study's points (a run's, a shard's or a merge's).
+SensitivityResult study_result(const case_file::Case& c, const SensitivityStudy& study,
+                               const surrogate::PointSweepResult& result, const std::string& source) {
+  const double f = study.frequency_hz, x = study.amplitude_m;
+  SensitivityResult out;
+  out.case_name = c.name;
+  out.source = source;
+  out.frequency_hz = f;
+  out.amplitude_m = x;
+  out.warnings = study.warnings;
+  out.warnings.insert(out.warnings.end(), result.summary.warnings.begin(), result.summary.warnings.end());
+  const surrogate::FieldPoint& base = result.points.front();
+  const bool base_ok = base.status == surrogate::PointStatus::kOk;
+  for (std::size_t k = 0; k < study.variants.size(); ++k) {
+    const auto& v = study.variants[k];
+    const auto& p = result.points[k];
+    const detail::SingleDamper d = detail::single_damper(v.variant, "pdamp sensitivity");
+    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, d.damper.model_options);
+    const bool ok = p.status == surrogate::PointStatus::kOk;
+    SensitivityRow row;
+    row.parameter = v.parameter;
+    row.value = k == 0 ? NAN : v.value;
+    row.unit = v.unit;
+    row.status = surrogate::to_string(p.status);
+    row.eta_star = ok ? p.eta_star : NAN;
+    row.eta_star_stderr = ok ? p.eta_star_stderr : NAN;
+    row.delta_eta_star = ok && base_ok ? p.eta_star - base.eta_star : NAN;
+    row.motion_mode = p.motion_mode;
+    row.apparent_mass_fraction = p.apparent_mass_fraction;
+    row.closed_form_eta_star = closed.eta_star;
+    row.closed_form_regime = fm::to_string(closed.regime);
+    row.clearance_m = d.layer.clearance_m;
+    row.bed_mass_kg = d.layer.bed_mass_kg;
+    row.intensity = x * std::pow(2.0 * fm::kPi * f, 2) / fm::kStandardGravity;
+    out.rows.push_back(std::move(row));
+  }
+  out.baseline_eta_star = base_ok ? base.eta_star : NAN;
+  return out;
+}
+
+}  // namespace
+
+SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOptions& options, const Executor& executor) {
+  SensitivityPlan plan;
+  plan.options = options;
+  plan.study = sensitivity_study(c);
+  const bool dem = options.source == "dem";
+  plan.sweep = study_sweep(c, options.source);
+  plan.sweep.shard_index = options.shard_index;
+  plan.sweep.shard_count = options.shard_count;
+  plan.sweep.results_path = options.results_log;
+  const double f = plan.study.frequency_hz, x = plan.study.amplitude_m;
+  // Every variant's DEM checked and costed before any work (exit 2 naming its key).
+  double wall_time_s = 0.0, particle_steps = 0.0;
+  if (dem)
+    for (const auto& v : plan.study.variants) {
+      auto o = case_file::dem_options(v.variant, 0, x, f);
+      o.world.threads = 1;
+      const auto e = check_dem_run(v.variant, 0, o);
+      check_dem_placement(v.variant, 0, o);
+      wall_time_s += e.wall_time_s;
+      particle_steps += e.particle_steps;
+    }
+  std::size_t pending = 0;
+  try {
+    pending = surrogate::pending_point_sweep(plan.study.points, plan.sweep);
+  } catch (const std::invalid_argument& e) {
+    throw strict_json::InputError(c.path, "/sensitivity", e.what());
+  }
+  if (dem) {
+    const double variants = static_cast<double>(plan.study.variants.size());
+    const double at_once = std::min<double>(executor.concurrency(plan.sweep.threads), variants);
+    plan.estimate = std::to_string(plan.study.variants.size()) + " DEM runs at f = " + format_number(f) + " Hz, X = " +
+                    format_number(x) + " m (" + std::to_string(pending) + " to run), about " +
+                    format_number(particle_steps * static_cast<double>(pending) / variants, 3) + " particle-steps, " +
+                    format_number(wall_time_s * static_cast<double>(pending) / variants / at_once, 3) + " s on " +
+                    format_number(at_once) + " threads" +
+                    (executor.processes() > 1 ? ", spread over " + std::to_string(executor.processes()) + " MPI ranks" : "");
+  }
+  return plan;
+}
+
+SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, RunHooks& hooks,
+                                  Executor& executor) {
+  const auto& study = plan.study;
+  const bool dem = plan.options.source == "dem";
+  std::vector<surrogate::PointEvaluator> evaluators;
+  for (const auto& v : study.variants) evaluators.push_back(variant_evaluator(v, dem, study.amplitude_m, study.frequency_hz));
+  Jobs<surrogate::FieldPoint> jobs(
+      executor, [&](std::size_t k) { return evaluators.at(k)(study.frequency_hz, study.amplitude_m); });
+  surrogate::SweepOptions sweep = plan.sweep;
+  sweep.threads = executor.concurrency(sweep.threads);
+  if (dem) {
+    hooks.note(plan.options.label + ": " + plan.estimate);
+    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
+      hooks.progress({plan.options.label, "runs", static_cast<double>(done), static_cast<double>(total), true, NAN, eta_s});
+    };
+  }
+  const auto result = surrogate::run_point_sweep(study.points, [&](std::size_t k) { return jobs(k); }, sweep);
+  SensitivityResult out = study_result(c, study, result, plan.options.source);
+  out.sweep_report = result.summary.brief_report();
+  out.mpi = jobs.balance();
+  return out;
+}
+
+SensitivityResult merge_sensitivity(const case_file::Case& c, const std::string& source,
+                                    const std::vector<std::filesystem::path>& logs) {
+  const SensitivityStudy study = sensitivity_study(c);
+  const auto result = surrogate::merge_point_sweep_shards(study.points, field_sweep_options(c, source), logs, c.path);
+  SensitivityResult out = study_result(c, study, result, source);
+  out.sweep_report = "merged " + std::to_string(logs.size()) + " shard files: " +
+                     std::to_string(result.summary.points_total) + " variants (" +
+                     std::to_string(result.summary.points_failed) + " failed)";
+  return out;
+}
+
+json to_json(const SensitivityResult& r) {
+  json rows = json::array();
+  for (const auto& row : r.rows)
+    rows.push_back({{"parameter", row.parameter},
+                    {"value", detail::number_or_null(row.value)},
+                    {"unit", row.unit},
+                    {"status", row.status},
+                    {"eta_star", detail::number_or_null(row.eta_star)},
+                    {"eta_star_stderr", detail::number_or_null(row.eta_star_stderr)},
+                    {"delta_eta_star", detail::number_or_null(row.delta_eta_star)},
+                    {"motion_mode", row.motion_mode},
+                    {"apparent_mass_fraction", detail::number_or_null(row.apparent_mass_fraction)},
+                    {"closed_form_eta_star", detail::number_or_null(row.closed_form_eta_star)},
+                    {"closed_form_regime", row.closed_form_regime},
+                    {"clearance_m", row.clearance_m},
+                    {"bed_mass_kg", row.bed_mass_kg},
+                    {"intensity", row.intensity}});
+  return {{"case", r.case_name}, {"source", r.source}, {"frequency_hz", r.frequency_hz},
+          {"amplitude_m", r.amplitude_m}, {"rows", rows}, {"sweep", r.sweep_report}};
+}
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,55 @@
+// Private helpers of the structure tasks (structure_support.hpp).
+#include "structure_support.hpp"
+
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/structure/damper_coupling.hpp"
+
+namespace pdamp::tasks::detail {
+
+Setup make_setup(const case_file::Case& c, case_file::LossMethod method, bool rotation_check) {
+  Setup out{method, case_file::structure_setup(c, method), {}};
+  out.warnings.add(out.s.warnings);
+  if (rotation_check) out.warnings.add(structure::rotation_warnings(out.s.modal, out.s.dampers));
+  if (out.s.rigid_modes_dropped > 0)
+    out.warnings.add("the structure has " + std::to_string(out.s.rigid_modes_dropped) +
+                     " rigid-body mode(s) at 0 Hz; they are not kept (docs/structures.md)");
+  return out;
+}
+
+std::vector<std::string> damper_names(const Setup& setup) {
+  std::vector<std::string> names;
+  for (const auto& d : setup.s.dampers) names.push_back(d.name);
+  return names;
+}
+
+std::vector<std::string> layer_names(const Setup& setup) {
+  std::vector<std::string> names;
+  for (const auto& d : setup.s.dampers)
+    for (const auto& l : d.layers) names.push_back(d.name + "/" + l.name);
+  return names;
+}
+
+std::vector<structure::CosimulationDamper> dem_dampers(const case_file::Case& c) {
+  std::vector<structure::CosimulationDamper> out;
+  for (std::size_t d = 0; d < c.dampers.size(); ++d) out.push_back(case_file::cosimulation_damper(c, d));
+  return out;
+}
+
+void check_cosimulation(const case_file::Case& c, const structure::ModalModel& modal,
+                        const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationOptions& options) {
+  if (const auto problems = options.validate(modal); !problems.empty())
+    throw strict_json::InputError(c.path, "/task", problems.front());
+  for (std::size_t d = 0; d < dampers.size(); ++d)
+    if (const auto problems = dampers[d].validate(modal); !problems.empty())
+      throw strict_json::InputError(c.path, "/dampers/" + std::to_string(d), problems.front());
+}
+
+void check_outcome(dem_reference::Outcome outcome, const std::string& message, const std::string& label) {
+  if (outcome == dem_reference::Outcome::kUnstable)
+    throw strict_json::NumericalError(label + ": DEM unstable: " + message +
+                                      " (a smaller /dem/time_step_s, a larger /dem/steps_per_contact or "
+                                      "/dem/max_impact_speed_m_s)");
+  if (outcome != dem_reference::Outcome::kCompleted) throw strict_json::NumericalError(label + ": DEM failed: " + message);
+}
+
+}  // namespace pdamp::tasks::detail
