@@ -1,4 +1,4 @@
-// Co-simulation benchmark (issue 11 §5): particle-steps per second of the DEM bed in the
+// Co-simulation benchmark (docs/cosimulation.md): particle-steps per second of the DEM bed in the
 // loop (structure::cosimulate, one mode, base excitation) against the bare DEM stepping the
 // same bed through the coupled run's own container motion (replayed step by step), one
 // thread, best of N. Also the bare DEM under a harmonic drive (another motion, other

@@ -2,9 +2,10 @@
 // 36, 1,000, 10,000 and 100,000 steel spheres in a vibrating box (the 100,000 also with
 // the particles numbered in random order, as a bed that has been fluidised for a while
 // leaves them), a whole harmonic run of the 36-sphere case, and the memory per
-// particle; the 6 × 6 single layer of issue 9 with the perfect lattice and with the ball-lot
-// tolerance (the perfect lattice's lanes move as clones and keep zero-overlap contacts).
-// Prints a table (issue 3 targets).
+// particle; the 6 × 6 single layer of the shipped low-intensity box with the perfect
+// lattice and with the ball-lot tolerance (the perfect lattice's lanes move as clones and
+// keep zero-overlap contacts).
+// Prints a table (the targets: bench/results/README.md).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -21,7 +22,7 @@ namespace {
 namespace dr = pdamp::dem_reference;
 using Clock = std::chrono::steady_clock;
 
-/// The low-intensity case of PHYSICS.md §8: 36 steel spheres (r = 5 mm) in one layer,
+/// The low-intensity case of docs/physics.md §8: 36 steel spheres (r = 5 mm) in one layer,
 /// collected against −x in a 160 × 61 × 40 mm box driven along x at 2 Hz, X = 40 mm.
 dr::DamperSimulationOptions low_intensity_case() {
   dr::DamperSimulationOptions o;
@@ -55,7 +56,7 @@ dr::DamperSimulationOptions vibrated_box(int count) {
   return o;
 }
 
-/// Issue 9's 6 × 6 single layer: r = 5 mm, ε = 0.7, μ = 0.15, μ_r = 0.005, steel, 2 Hz,
+/// The 6 × 6 single layer: r = 5 mm, ε = 0.7, μ = 0.15, μ_r = 0.005, steel, 2 Hz,
 /// X = 0.3 h = 30 mm (below the jump) in the shipped 160 × 61 × 40 mm box; `perfect`:
 /// identical spheres (lot_diameter_variation_m = 0), else the default G100 tolerance.
 dr::DamperSimulationOptions layer_6x6_case(bool perfect) {

@@ -1,5 +1,5 @@
 // Optimiser benchmarks: the analytic cliff problem and the robust clearance sizing, per back
-// end; the filling ratios of the shipped 3-layer case and the clearance on the beam (issue 12 §6).
+// end; the filling ratios of the shipped 3-layer case and the clearance on the beam.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -79,7 +79,7 @@ FillingProblem manipulator_link_problem() {
 
 /// The whole 3-layer optimisation of the shipped case on the closed forms (relaxed solve,
 /// rounded neighbours, single-layer baseline; no DEM verification), as `pdamp optimize
-/// cases/manipulator_link_optimize.json --no-verify`. Target (issue 12 §6): < 2 s.
+/// cases/manipulator_link_optimize.json --no-verify`. Target: < 2 s.
 void BM_FillingRatios(benchmark::State& state, opt::Backend backend) {
   FillingProblem p = manipulator_link_problem();
   p.solver.backend = backend;

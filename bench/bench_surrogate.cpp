@@ -1,4 +1,4 @@
-// Effective-field lookup benchmarks: lookups per second on one core (issue 4 target >= 1e7/s).
+// Effective-field lookup benchmarks: lookups per second on one core (target >= 1e7/s).
 #include <benchmark/benchmark.h>
 
 #include <cmath>

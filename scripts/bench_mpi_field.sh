@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Speed-up of 2 MPI ranks over 1 on a DEM effective field, and the load balance (busy
-# fraction per rank), for bench/results/<machine>/mpi_field.txt (issue 13 §1).
+# fraction per rank), for bench/results/<machine>/mpi_field.txt (docs/distributed.md).
 # Needs an MPI build: cmake -S . -B build -DPDAMP_MPI=ON && cmake --build build -j2 --target pdamp
 # Usage: scripts/bench_mpi_field.sh [BUILD_DIR] [CASE]   (default build, the shipped 36-sphere case)
 set -euo pipefail

@@ -443,7 +443,7 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
   }
   if (options.gravity_along_drive) {
     warn([&] { return std::string(
-        "gravity along the drive is not in the ideal models (PHYSICS.md section 2): it moves "
+        "gravity along the drive is not in the ideal models (docs/physics.md section 2): it moves "
         "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
         " is an optimistic estimate"); });
   }

@@ -1,4 +1,4 @@
-// Placement of a particle damper along a beam or among named points (issue 12 §1.4).
+// Placement of a particle damper along a beam or among named points (docs/optimizer.md, "Placement").
 #include "pdamp/optimizer/placement.hpp"
 
 #include <algorithm>

@@ -73,7 +73,7 @@ double sweep_cycle_time(double f0, double rate, double cycles) {
 }
 
 /// A bed's η* and m_app/m_bed from its force and site amplitudes at ω (the Level II measure,
-/// PHYSICS.md §1): P = ½F̂ conj V̂, V̂ = iωŷ; NaN for an empty bed or a still site.
+/// docs/physics.md §1): P = ½F̂ conj V̂, V̂ = iωŷ; NaN for an empty bed or a still site.
 void bed_measures(std::complex<double> force_hat, std::complex<double> y, double omega, double m_bed,
                   std::vector<double>& eta_star, std::vector<double>& apparent_mass_fraction) {
   const std::complex<double> velocity = std::complex<double>(0.0, omega) * y;

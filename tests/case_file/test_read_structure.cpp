@@ -139,7 +139,7 @@ TEST_CASE("an invalid modal data file is named with its own pointer", "[case_fil
   require_case_error(path, modal, "", "no such file");
 }
 
-// `task.verify` of kind filling_ratios (issue 12 §3): the DEM check of the optimised design.
+// `task.verify` of kind filling_ratios: the DEM check of the optimised design.
 namespace {
 
 /// The shipped optimisation case with one edit of its task, written into `dir`.

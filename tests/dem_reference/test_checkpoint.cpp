@@ -1,4 +1,4 @@
-// Checkpoints of the DEM world (issue 13 §4): a world restored from a saved state continues
+// Checkpoints of the DEM world (docs/dem.md "Checkpoints"): a world restored from a saved state continues
 // bit for bit as the saved one (the reference is the uninterrupted run itself), states of
 // other worlds and damaged states are refused with the world unchanged, and checkpoint files
 // carry their header and refuse damage.

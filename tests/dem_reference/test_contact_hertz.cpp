@@ -1,4 +1,4 @@
-// Issue 3 test 1: single normal impacts reproduce the coefficient-of-restitution model.
+// Single normal impacts reproduce the coefficient-of-restitution model.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -37,7 +37,7 @@ double pair_restitution(const dr::WorldOptions& options, double v) {
 }  // namespace
 
 // Reference: the target ε is the model's input; the calibrated damping must realise it
-// in the explicit DEM. Tolerance 2% (issue 3): the 50-step resolution of the contact
+// in the explicit DEM. Tolerance 2%, the DEM's for single impacts: the 50-step resolution of the contact
 // and the half-step velocity in the damping term cost well under 1%.
 TEST_CASE("sphere-wall and sphere-sphere impacts reproduce a constant restitution", "[dem_reference]") {
   for (const double eps : {0.3, 0.5, 0.7, 0.9, 0.95}) {

@@ -1,4 +1,4 @@
-// Issue 8 "hostile input", the DEM part: restitution below the damping table, exceptions
+// Hostile input (docs/bad_inputs.md), the DEM part: restitution below the damping table, exceptions
 // inside the OpenMP step, inner structures outside their container, the ranges of the
 // options, the run estimate and the first progress report.
 #include <catch2/catch.hpp>

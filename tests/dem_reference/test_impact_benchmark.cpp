@@ -1,4 +1,4 @@
-// Issue 3 test 7: the particle-impact benchmark cases of Chung & Ooi (Granular Matter
+// The particle-impact benchmark cases of Chung & Ooi (Granular Matter
 // 13, 2011) — elastic normal impact of two spheres and oblique impacts of a sphere on a
 // plane — against independent references: Hertz's closed forms, and a fine
 // fourth-order Runge–Kutta integration of the same Hertz–Mindlin single-contact ODE

@@ -1,4 +1,4 @@
-// Issue 9 part 3: a perfect collected lattice moves as clones of one lane; the ball-lot
+// A perfect collected lattice moves as clones of one lane; the ball-lot
 // tolerance (ParticleGroupOptions::lot_diameter_variation_m) breaks the symmetry; lane gaps.
 #include <catch2/catch.hpp>
 
@@ -18,11 +18,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadius = 0.005;
 constexpr int kSamples = 50;  ///< snapshots per analysed period
 
-/// The 6 × 6 single layer of issue 9 (r = 5 mm, ε = 0.7, μ = 0.15, μ_r = 0.005, 2 Hz,
+/// The 6 × 6 single layer (r = 5 mm, ε = 0.7, μ = 0.15, μ_r = 0.005, 2 Hz,
 /// X/h = 0.3 of h = 100 mm, below the jump) in the shipped 160 × 61 × 40 mm box, or a
 /// single lane of 6 spheres in a box one lane (10 mm) wide. Stiffness E/100: at 2 Hz the
 /// softened contact (~0.5 ms) is still 1/1000 of the period, and the conclusion of the
-/// tests is the same at full stiffness (issue 9: perfect 0.228 ± 0.020 against 0.200 ±
+/// tests is the same at full stiffness (measured there: perfect 0.228 ± 0.020 against 0.200 ±
 /// 0.011 with radius_spread 0.002; here E/100: 0.229 ± 0.050 against 0.153 ± 0.016 with
 /// the default tolerance and 0.185 ± 0.019 with the spread, 20 periods each).
 dr::DamperSimulationOptions layer(int lanes, double lot_variation_m, int analysed_periods) {
@@ -127,7 +127,7 @@ double sample_sd(const std::vector<double>& v) {
 // lane of 6 spheres in a box one lane wide (to the rounding of the sum over six lanes,
 // 1e-12), and its lanes' motions correlate exactly. The default ball-lot tolerance (ISO 3290-1 G100, V_DwL = 5 µm) makes the
 // lanes drift apart: within 4 periods their fluctuations correlate below 0.5 (measured
-// 0.1-0.3; 0.5 is issue 9's bound).
+// 0.1-0.3; bound 0.5).
 TEST_CASE("a perfect collected lattice moves as clones of one lane and the ball-lot tolerance breaks the symmetry",
           "[dem_reference]") {
   const int periods = 4;
@@ -155,7 +155,7 @@ TEST_CASE("a perfect collected lattice moves as clones of one lane and the ball-
 // Reference: independent lanes. Once the lanes have drifted apart the layer's η* of a
 // period is the mean of six nearly independent lanes, so its period-to-period scatter is
 // that of the mean of six independently seeded single lanes, sd_1/√6, and not that of one
-// lane (the perfect lattice: 2-3 times more, issue 9). 20 periods: an estimated sd has a
+// lane (the perfect lattice: 2-3 times more, docs/dem.md "Initial state"). 20 periods: an estimated sd has a
 // relative error ~1/√(2·19) = 16%; neighbouring lanes also touch (friction couples
 // them): a factor 1.6 either way. The perfect lattice must scatter at least 1.8 times as
 // much (√6 = 2.45 expected).

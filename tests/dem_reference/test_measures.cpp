@@ -1,4 +1,4 @@
-// Issue 9: measures that do not alias (the drive bin accumulated every step), the
+// Measures that do not alias (the drive bin accumulated every step), the
 // realised restitution of the explicit contact over 40-200 steps per contact, and the
 // time step of run_harmonic (impact speed from the free fall height, user steps up to
 // the stability limit with a warning).
@@ -54,7 +54,7 @@ dr::DamperSimulationOptions bouncing_peak() {
   return o;
 }
 
-/// η* and m_app from the recorded block series: the measure before issue 9.
+/// η* and m_app from the recorded block series: the measure used before the drive bin.
 pdamp::formulas::ComplexPower block_measure(const dr::DamperResult& r, const dr::DamperSimulationOptions& o) {
   const double block_dt = 1.0 / (o.frequency_hz * o.samples_per_period);
   return pdamp::formulas::complex_power(r.series.force_n, r.series.container_velocity_m_s, block_dt, o.frequency_hz);
@@ -66,7 +66,7 @@ pdamp::formulas::ComplexPower block_measure(const dr::DamperResult& r, const dr:
 // the same (a period of 2000k steps is whole blocks at 16 and at 1000 blocks), so the
 // measures of both runs must agree; the drive bin sums the same steps in the same order,
 // so they agree to round-off (tolerance 1e-12 relative). The block measure of the 16-block
-// run is printed against them: its fold of (16j ± 1)Ω into the bin is what issue 9 removes.
+// run is printed against them: its fold of (16j ± 1)Ω into the bin is what the drive bin removes.
 TEST_CASE("eta* and the apparent mass do not depend on samples_per_period", "[dem_reference]") {
   auto o = bouncing_peak();
   const double period = 1.0 / o.frequency_hz;
@@ -101,7 +101,7 @@ TEST_CASE("eta* and the apparent mass do not depend on samples_per_period", "[de
   }
   CHECK(coarse.eta_star_stderr == Approx(fine.eta_star_stderr).epsilon(1e-9));
   // The block measure fails the same comparison: measured η* −0.29%, m_app −0.0068 m_bed
-  // at 16 blocks (the 260-sphere bed of the sweep: up to 1.3%, ±0.13 m_bed, issue 9).
+  // at 16 blocks (the 260-sphere bed of the sweep: up to 1.3%, ±0.13 m_bed).
   CHECK(std::abs(old16.reduced_loss_factor(m) / old1000.reduced_loss_factor(m) - 1.0) > 1e-3);
   CHECK(std::abs(old16.apparent_mass_kg - old1000.apparent_mass_kg) > 1e-3 * m);
   // The bin agrees with the 1000-block measure (its fold starts at 999Ω) within 1e-3

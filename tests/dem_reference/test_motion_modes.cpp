@@ -1,6 +1,6 @@
-// Issue 9 part 4: the motion-mode labels of PHYSICS.md (docs/dem.md "Motion modes") on
+// The motion-mode labels of docs/physics.md §8.1 (docs/dem.md "Motion modes") on
 // runs that show each mode. The thresholds come from the mode definitions and the ideal
-// orbits of PHYSICS.md §2-3 (dem_reference/src/damper_simulation.cpp, ModeThresholds),
+// orbits of docs/physics.md §2-3 (dem_reference/src/damper_simulation.cpp, ModeThresholds),
 // not from these runs. Softened runs (E/100) are repeated at full stiffness under [long].
 #include <catch2/catch.hpp>
 
@@ -16,7 +16,7 @@ namespace {
 
 namespace dr = pdamp::dem_reference;
 
-/// The shipped low-intensity layer (cases/low_intensity_36_spheres.json, PHYSICS.md §8):
+/// The shipped low-intensity layer (cases/low_intensity_36_spheres.json, docs/physics.md §8):
 /// 36 steel spheres r = 5 mm, 6 × 6 × 1 collected against −x in 160 × 61 × 40 mm
 /// (h_roll = 0.1 m), 2 Hz along x, gravity −z; ε, μ, μ_r as given, E = 210 GPa / softening.
 dr::DamperSimulationOptions layer(double x_over_h, double restitution, double friction, double rolling,
@@ -102,7 +102,7 @@ dr::DamperSimulationOptions local_run(double softening) {
 
 }  // namespace
 
-// Reference: PHYSICS.md §8 definition of solid-like motion, the bed moving with the
+// Reference: docs/physics.md §8.1 definition of solid-like motion, the bed moving with the
 // container: relative stroke ≪ h and m_app = m_bed. The bed does not move at all (see
 // solid_run), so m_f = 1 within the elastic jitter (5%).
 TEST_CASE("a layer held by rolling resistance at Gamma = 0.08 is solid_like", "[dem_reference]") {
@@ -124,7 +124,7 @@ TEST_CASE("a floating bed at X = 0.03 h without gravity is decoupled", "[dem_ref
   CHECK(std::abs(r.indicators.phase_lag_deg) > 160.0);
 }
 
-// Reference: the ideal bouncing orbit (PHYSICS.md §2): one crossing per half period,
+// Reference: the ideal bouncing orbit (docs/physics.md §2): one crossing per half period,
 // η* = 1.08 at X = 0.4 h and 0.59 at X = h for a plastic block; with ε = 0.5 the bed
 // rebounds and loses less at X = h (measured 1.05 and 0.46: within 0.2 of the plastic
 // value at 0.4 h, above half of it at h). No gravity: no base contact.
@@ -140,7 +140,7 @@ TEST_CASE("a collected bed without gravity at X/h = 0.4 and 1.0 is bouncing coll
   }
 }
 
-// Reference: the rolling orbit of PHYSICS.md §3 above X_opt ≈ 0.4 h_roll: the layer
+// Reference: the rolling orbit of docs/physics.md §3 above X_opt ≈ 0.4 h_roll: the layer
 // crosses in step once per half period while rolling on its base (at X = 0.6 h, Γ = 0.97:
 // the drive acceleration stays below gravity). η* near the ideal 0.88 (rolling curve at
 // 0.6 h): above 0.7.
@@ -152,7 +152,7 @@ TEST_CASE("the shipped layer at X/h = 0.6 is rolling collect-and-collide", "[dem
   CHECK(r.eta_star > 0.7);
 }
 
-// Reference: issue 9's runs (ε = 0.7, μ = 0.15, μ_r = 0.005) with identical spheres (no
+// Reference: the shipped layer with ε = 0.7, μ = 0.15, μ_r = 0.005 and identical spheres (no
 // lot variation): the 36 clones scatter η* from period to period (coefficient of
 // variation 0.2-0.3, standard error 0.06) while the bed crosses the clearance in step
 // with the drive. The label reads the phase-locked crossing, not that scatter: rolling
@@ -171,7 +171,7 @@ TEST_CASE("rolling runs with period-to-period scatter are rolling collect-and-co
   }
 }
 
-// Reference: the scattered state below the onset (PHYSICS.md §4): no synchronous orbit,
+// Reference: the scattered state below the onset (docs/physics.md §4): no synchronous orbit,
 // little dissipation. The layer at X = 0.2 h_roll (onset 0.376 h) and the floating bed at
 // X = 0.15 h (onset 0.27 h); neither crosses in step (crossings < 0.5).
 TEST_CASE("below the onset the layer and a floating bed are scattering", "[dem_reference]") {
@@ -232,13 +232,13 @@ TEST_CASE("full stiffness gives the same labels as the softened unit runs", "[de
   }
 }
 
-// Reference: issue 9's runs at full stiffness with identical spheres (the issue's
-// η* = 0.87 ± 0.07 at X = 0.4 h, 0.41 ± 0.03 at X = h, both labelled scattering before):
+// Reference: the same layer at full stiffness with identical spheres (η* = 0.87 ± 0.07
+// at X = 0.4 h, 0.41 ± 0.03 at X = h, both labelled scattering by the earlier rule):
 // the bed crosses the clearance in step with the drive, so both are collect-and-collide.
 // At X = 0.4 h the bed rolls on its base (Γ = 0.64); at X = h (Γ = 1.6) about half of
 // the spheres hop after the wall impacts and the base-contact fraction sits near its
 // threshold (0.44-0.56 across stiffness and lot), so there either family is accepted.
-TEST_CASE("the issue's layer runs at full stiffness are collect-and-collide", "[dem_reference][long]") {
+TEST_CASE("the layer of identical spheres at full stiffness is collect-and-collide", "[dem_reference][long]") {
   for (const double x : {0.4, 1.0}) {
     auto o = layer(x, 0.7, 0.15, 0.005, 1.0);
     o.world.compartments.front().particles.front().lot_diameter_variation_m = 0.0;

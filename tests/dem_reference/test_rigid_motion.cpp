@@ -68,7 +68,7 @@ dr::ContainerState turntable(double t) {
 // from the spin axis, 2 cm above the origin: there the centrifugal potential along the
 // wall is least, so the sphere stays put (against a flat wall it would sit on a
 // potential ridge and roll off, as the DEM rightly shows). Tolerances: 1% on the force
-// (brief; the start's Hertz oscillation decays within a few ms, read after 50 ms);
+// (the start's Hertz oscillation decays within a few ms, read after 50 ms);
 // rounding on the moment, which is the same force at the contact point; 0.1 µm on the
 // position in the container: the static Hertz overlap (~20 nm) and the slow rocking
 // about the equilibrium that the start leaves.
@@ -157,7 +157,7 @@ TEST_CASE("a container translating and rotating around a free sphere returns zer
 // walls alone (particle–particle forces cancel in pairs), so the container's force on
 // the particles is −Σ m_i g and its moment about the body origin o is −Σ (x_i − o) × m_i g.
 // The container is turned by a general rotation and its origin sits away from the bed,
-// so all three components count. 0.1% (brief): after 0.1 s the damped bed's residual
+// so all three components count. 0.1%: after 0.1 s the damped bed's residual
 // accelerations are far below that.
 TEST_CASE("a settled bed in a static turned container loads it with its weight", "[dem_reference]") {
   dr::WorldOptions o;

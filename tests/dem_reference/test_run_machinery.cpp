@@ -1,4 +1,4 @@
-// The run machinery of issue 11 §1 driven from outside run_harmonic: the time-step rule,
+// The run machinery (docs/dem.md "Run machinery") driven from outside run_harmonic: the time-step rule,
 // settling, the block recorder, the drive-bin measure, the energy ledger and the motion
 // accumulator, fed step by step by a harmonic and by a two-tone driver of the test's own.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// Buffered walls (a polymer layer on the container walls, PHYSICS.md §5) against Hertz's
+// Buffered walls (a polymer layer on the container walls, docs/physics.md §5) against Hertz's
 // elastic impact, the energy balance of the bottomed-out layer, and the layer sizing of
 // formulas::size_buffer_layer checked in the DEM.
 #include <catch2/catch.hpp>
@@ -34,7 +34,7 @@ double effective_modulus(double e1, double nu1, double e2, double nu2) {
 /// Hertz stiffness K = (4/3)E*√r of a sphere on a flat surface, N/m^{3/2}.
 double hertz_stiffness(double e_star) { return 4.0 / 3.0 * e_star * std::sqrt(kRadius); }
 
-/// Elastic maximum penetration from ½mv² = (2/5)Kδ^{5/2} (PHYSICS.md §5), m.
+/// Elastic maximum penetration from ½mv² = (2/5)Kδ^{5/2} (docs/physics.md §5), m.
 double elastic_penetration(double mass, double stiffness, double v) {
   return std::pow(1.25 * mass * v * v / stiffness, 0.4);
 }
@@ -100,8 +100,8 @@ fm::LayeredContact layer_law(double thickness) {
 // rebound. The 0.15 mm layer under a 5 mm sphere (a/t ≈ 2 at the peak) is much stiffer
 // than the Hertz half-space of the same modulus: the penetration must be well below
 // Hertz's. 1% on δ_max: the impact is resolved by ~900 steps (the step is set by the
-// stiffer steel contact), the peak read to a step's travel. 2% on ε (issue 3; the
-// layered damping table itself realises ε within 1e-3, tests/formulas).
+// stiffer steel contact), the peak read to a step's travel. 2% on ε (the DEM's
+// tolerance for single impacts; the layered damping table itself realises ε within 1e-3, tests/formulas).
 TEST_CASE("a slow sphere presses into the bonded layer as the layered law predicts and rebounds with its restitution",
           "[dem_reference]") {
   const double v = 0.5;
@@ -181,12 +181,12 @@ TEST_CASE("a fast sphere bottoms out the layer and the hard wall stops it", "[de
   CHECK(impact.rebound == Approx(1.0).epsilon(0.005));
 }
 
-// Reference: the sizing itself (PHYSICS.md §5 asks for it to be "checked in the DEM").
+// Reference: the sizing itself (docs/physics.md §5: the sizing "must be checked in the DEM").
 // formulas::size_buffer_layer (layered model) chooses the thickness t whose full
 // compression (δ = t, a strain of 1) one front-row sphere carrying particles_per_contact
 // spheres just reaches at v = 2XΩ. The DEM gets the designed t and one sphere of that
 // effective mass (density scaled, same radius and moduli) at the design speed, elastic
-// like the sizing: penetration/t within 5% of 1 (the brief's bound; the impact is
+// like the sizing: penetration/t within 5% of 1 (the impact is
 // resolved to < 1%). At 80% of the design speed it must not bottom out and must match
 // the layered law's δ_max there (formulas::layered_impact, 1%). The half-space sizing of
 // the source study, labelled as such, gives a thicker layer that the same impact does
@@ -241,7 +241,7 @@ TEST_CASE("the buffered-wall sizing is just fully compressed by the design impac
 }
 
 // Reference: geometry. The collected bed's clearance in a layered box is the inner
-// length less both layers and the bed's extent (PHYSICS.md "Clearance of a real bed").
+// length less both layers and the bed's extent (docs/physics.md §9, "Clearance of a real bed").
 TEST_CASE("a layered compartment's clearance excludes both layers", "[dem_reference]") {
   dr::WorldOptions o = layered_world(0.8, 0.8, 1.0);
   auto& c = o.compartments.front();

@@ -1,4 +1,4 @@
-// Issue 3 tests 2 and 3 (energy conservation, rolling on an accelerating base), the
+// Energy conservation and rolling on an accelerating base (docs/dem.md "Verification"), the
 // determinism hash and the error paths of the DEM world.
 #include <catch2/catch.hpp>
 
@@ -78,7 +78,7 @@ double rolling_acceleration(double friction, double a) {
 
 // Reference: conservation of energy. With ε = 1, μ = 0 and no gravity the Hertz force is
 // conservative and leapfrog is symplectic: the total energy (kinetic + Hertz) must not
-// drift. 1e-4 over >= 1e4 contact durations is issue 3's bound; the bounded O(dt²)
+// drift. The bound is 1e-4 over >= 1e4 contact durations; the bounded O(dt²)
 // oscillation of the energy inside a contact is why the energy is read while no
 // contact is active.
 TEST_CASE("total energy of elastic frictionless spheres in a closed box does not drift", "[dem_reference]") {
@@ -109,9 +109,9 @@ TEST_CASE("total energy of elastic frictionless spheres in a closed box does not
 }
 
 // Reference: rigid-body mechanics. A solid sphere (I = 2/5 m r²) rolling without slip on
-// a base accelerating at a_c has centre acceleration κ/(1+κ)·a_c = 2/7·a_c (PHYSICS.md §3);
+// a base accelerating at a_c has centre acceleration κ/(1+κ)·a_c = 2/7·a_c (docs/physics.md §3);
 // it needs friction μ >= 2a_c/(7g) = 0.058 at a_c = 2 m/s². Below that it slides with
-// kinetic friction: a = μg. 2% (issue 3): the fit over 50 ms averages out the small
+// kinetic friction: a = μg. 2%: the fit over 50 ms averages out the small
 // oscillation of the Mindlin spring.
 TEST_CASE("a sphere on an accelerating base rolls at 2/7 of the base acceleration or slides", "[dem_reference]") {
   const double a = 2.0;
@@ -149,7 +149,7 @@ std::uint64_t colliding_gas_hash(int threads, int particles, double radius_m, co
 
 }  // namespace
 
-// Reference: reproducibility (issue 3): the same input and thread count give the same
+// Reference: reproducibility: the same input and thread count give the same
 // bits. The expected hash pins the physics; change it only in a commit that explains why.
 TEST_CASE("a seeded run reproduces its final-state hash", "[dem_reference]") {
   const dr::Vec3 box{0.04, 0.04, 0.04};

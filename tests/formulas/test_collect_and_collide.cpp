@@ -454,7 +454,7 @@ TEST_CASE("bouncing landmarks: 4/pi at h/pi, 1.069 at h/2, 0.585 at h, 0.906 at 
 
   const fm::IdealOrbit half = fm::ideal_orbit(0.0, h, h / 2.0);
   REQUIRE(half.eta_star == Approx(1.06876978910505817788).epsilon(1e-13));
-  REQUIRE(half.eta_star == Approx(1.069).margin(5e-4));  // PHYSICS.md §2, stated digits
+  REQUIRE(half.eta_star == Approx(1.069).margin(5e-4));  // docs/physics.md §2, stated digits
   REQUIRE(half.impact_phase_rad == Approx(2.55419595283704303783).epsilon(1e-14));
 
   const fm::IdealOrbit full = fm::ideal_orbit(0.0, h, h);
@@ -609,7 +609,8 @@ TEST_CASE("auto rolls while the base friction holds the spheres and slides conti
   const auto floating = fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.5 * x_unit, f, weightless);
   REQUIRE(floating.model_used == fm::DamperModel::kBouncing);
   REQUIRE(floating.inertia_factor == 0.0);
-  // The issue's case: h = 8.28 mm at 10 Hz jumped six-fold between Γ = 0.99 and 1.01.
+  // A rule that switched at Γ = 1 made η* at h = 8.28 mm and 10 Hz jump six-fold between
+  // Γ = 0.99 and 1.01.
   const double jump_h = 0.00828;
   const double eta_099 = fm::reduced_loss_factor(fm::DamperModel::kAuto, jump_h, 0.99 * x_unit, f).eta_star;
   const double eta_101 = fm::reduced_loss_factor(fm::DamperModel::kAuto, jump_h, 1.01 * x_unit, f).eta_star;
@@ -635,7 +636,7 @@ TEST_CASE("below the onset every model gives the scattered-state fit", "[formula
     REQUIRE(r.model_used == fm::DamperModel::kRolling);
     REQUIRE(std::isnan(r.impact_phase_rad));
     REQUIRE(r.stroke_over_onset == Approx(s).epsilon(1e-14));
-    // PHYSICS.md §4 form with η*_onset = 4π/((π²+4)(1+κ)).
+    // docs/physics.md §4 form with η*_onset = 4π/((π²+4)(1+κ)).
     const double expected = 0.6 * 4.0 * kPi / ((kPi * kPi + 4.0) * 1.4) * std::pow(s, 3.0);
     REQUIRE(r.eta_star == Approx(expected).epsilon(1e-14));
     REQUIRE(has_warning(r, "does not exist") == (model == fm::DamperModel::kRolling));
@@ -702,7 +703,7 @@ TEST_CASE("validity warnings name the violated range with numbers, and none appe
   REQUIRE(has_warning(large, "X/h = 12"));
   REQUIRE(large.warnings.size() == 1);
   // Gravity across a horizontal drive (the default): below X = h the decoupled state
-  // can replace the bouncing orbit (the issue's case: h = 10 mm, X = 3.2 mm, 50 Hz).
+  // can replace the bouncing orbit (the shipped cylinder case at its optimum: h = 10 mm, X = 3.2 mm, 50 Hz).
   const auto floating = fm::reduced_loss_factor(fm::DamperModel::kAuto, 0.01, 0.0032, 50.0);
   REQUIRE(floating.model_used == fm::DamperModel::kBouncing);
   REQUIRE(has_warning(floating, "decoupled state"));
@@ -829,7 +830,7 @@ TEST_CASE("model and regime names round-trip and unknown names give nullopt", "[
 
 TEST_CASE("energy measures reproduce a viscous damper's energy per cycle", "[formulas]") {
   // A viscous damper c at amplitude X, frequency Ω dissipates πcΩX² per cycle, and its
-  // η* is c/(m Ω) (PHYSICS.md §1): independent textbook result.
+  // η* is c/(m Ω) (docs/physics.md §1): independent textbook result.
   const double c = 3.0;
   const double m = 0.7;
   const double omega = 2.0 * kPi * 5.0;

@@ -152,7 +152,7 @@ TEST_CASE("a spring gives an apparent mass of -k/Omega^2 and no dissipation", "[
 
 TEST_CASE("the apparent mass and eta* do not depend on the time origin", "[formulas]") {
   // Starting the record at t0 multiplies F* and V* by the same factor e^{iΩt0}, so
-  // F*·conj(V*) is unchanged (PHYSICS.md §1); F* itself must rotate by exactly that factor.
+  // F*·conj(V*) is unchanged (docs/physics.md §1); F* itself must rotate by exactly that factor.
   const LinearElement element{1.3, 0.45, 800.0};
   const auto force = [&](double t) { return element.force(t); };
   const ComplexPower origin = analyse(sample(force, velocity, 6));
@@ -374,7 +374,7 @@ TEST_CASE("the reduced loss factor needs a positive bed mass", "[formulas]") {
   CHECK_THROWS_AS(result.reduced_loss_factor(-1.0), std::invalid_argument);
 }
 
-// ---- Step-by-step drive bin (issue 9 part 6: measures that do not alias) ----
+// ---- Step-by-step drive bin (measures that do not alias) ----
 
 namespace {
 

@@ -63,7 +63,7 @@ ImpactOde integrate_impact(const fm::HertzContact& c, double v) {
 }
 
 // Measured agreement with this reference: δ_max 1.9e-10 relative (the sampling of the
-// maximum, as estimated above), t_c 1e-12, rebound speed 1.5e-13. The issue asks for 1%;
+// maximum, as estimated above), t_c 1e-12, rebound speed 1.5e-13. Design needs 1%;
 // 1e-8 keeps a 50-fold margin over the reference's own error.
 constexpr double kOdeTolerance = 1e-8;
 
@@ -116,7 +116,7 @@ TEST_CASE("the contact-time constant is 2(15/16)^(2/5) times twice the Hertz int
   const double integral = sum / (3.0 * kIntervals);
   CHECK(integral == Approx(1.4716).epsilon(1e-4));
   CHECK(fm::contact_time_coefficient() == Approx(2.0 * std::pow(15.0 / 16.0, 0.4) * integral).epsilon(1e-10));
-  // PHYSICS.md §5 quotes 2.87, rounded: 2.8683 is within 0.06%.
+  // 2.87 is the rounded value often quoted (docs/physics.md §5): 2.8683 is within 0.06%.
   CHECK(fm::contact_time_coefficient() == Approx(2.87).epsilon(1e-3));
 
   const fm::Material steel;
@@ -180,7 +180,7 @@ TEST_CASE("materials and contacts with invalid values are rejected with the numb
 
 namespace {
 
-// 60 Hz design at Γ = 10 (PHYSICS.md §8 hybrids): steel spheres r = 5 mm on a polymer
+// 60 Hz design at Γ = 10 (docs/physics.md §8 hybrids): steel spheres r = 5 mm on a polymer
 // layer, the front-row sphere carrying 6 spheres.
 fm::BufferDesignInput design_input() {
   fm::BufferDesignInput in;
@@ -279,7 +279,7 @@ TEST_CASE("the layered buffer layer is just bottomed out by the design impact", 
 
 // The shipped 60 Hz case (README: pdamp buffer --frequency 60 --intensity 20 --radius
 // 0.0025 --layer-modulus 60e6 --particles-per-contact 20). Reference numbers: the old
-// half-space design t = 0.378 mm (ν = 0.45) by hand (Hertz closed form), and the issue's
+// half-space design t = 0.378 mm (ν = 0.45) by hand (Hertz closed form), and the
 // elastic-foundation estimates (constrained modulus M, F = πMRδ²/t): the design impact
 // compresses the 0.378 mm layer to (3m*v²t/(2πMR))^{1/3}/t = 0.40 t, and the foundation
 // layer that bottoms out is t = √(3m*v²/(2πMR)) = 0.097 mm. The exact layered law lies

@@ -378,7 +378,7 @@ TEST_CASE("the layered damping table realises the target restitution between its
   // Reference: the one-collision solve layered_realised_restitution (20000 RK4 steps,
   // ~1e-6), which the table's inversion must hit at impacts between its ξ nodes and for
   // restitutions between its γ nodes. 1e-3 relative: the DEM's restitution tolerance is
-  // 2% (issue 3); linear inversion on the (ln ξ, ln(1 + γ)) grid stays well inside.
+  // 2%; linear inversion on the (ln ξ, ln(1 + γ)) grid stays well inside.
   const double radius = 0.005, mass = 4.1e-3;
   const fm::LayeredContact materials(radius, 100e6, 0.48, 210e9, 0.3, 1.5e-4);
   const fm::LayeredDampingTable table(materials);

@@ -1,4 +1,4 @@
-// Tests of the clearance on a structure (issue 12 §1.2): the single-mode closed form for h
+// Tests of the clearance on a structure (docs/optimizer.md): the single-mode closed form for h
 // against optimizer::solve on the harmonic balance, on a hand-built 1-mode model and on the
 // base-excited beam of cases/beam_base_excited.json, for both objectives; error paths.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// Tests of the filling-ratio optimisation of a multi-layer damper (issue 12 §1.3): the
+// Tests of the filling-ratio optimisation of a multi-layer damper (docs/optimizer.md): the
 // relaxed solve plus rounded neighbours against an exhaustive integer enumeration, both
 // back ends, the single-layer baseline and the validation of the options.
 #include <catch2/catch.hpp>

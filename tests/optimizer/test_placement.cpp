@@ -1,4 +1,4 @@
-// Tests of damper placement (issue 12 §1.4) against analytic beam modes: the sine modes of
+// Tests of damper placement (docs/optimizer.md, "Placement") against analytic beam modes: the sine modes of
 // a pinned-pinned beam, the tip slope of a cantilever, and a brute-force scan of the closed
 // forms on those analytic shapes.
 #include <catch2/catch.hpp>

@@ -351,7 +351,7 @@ TEST_CASE("the site's motion across the drive reaches the bed and its load retur
 // Reference: conservation of energy. The DEM's own ledger closes to 2e-4..1e-3 at 50 steps per
 // contact (docs/dem.md); the structure's Verlet adds O((ωdt)²) ≈ 1e-6, and the impulsive bed
 // force over a contact adds the trapezoid's O((dt/t_c)²) ≈ 4e-4 on the exchanged work: 1% holds
-// with a margin of ~5, as the brief asks.
+// with a margin of ~5.
 TEST_CASE("the energy ledger closes within 1% with impacting spheres, free and forced", "[cosimulation]") {
   const dem::WorldOptions world = bed(0.005, {0.03, 0.0201, 0.0201}, {1, 2, 2}, 2e8, {0.0, 0.0, -9.80665},
                                       dem::InitialPlacement::kCollectedLattice);

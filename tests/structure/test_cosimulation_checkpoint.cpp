@@ -1,4 +1,4 @@
-// Checkpoints of the DEM in the loop (issue 13 §4): a free decay run in segments, its state
+// Checkpoints of the DEM in the loop (docs/cosimulation.md §6b): a free decay run in segments, its state
 // and result written to bytes and read back into new worlds after every segment, equals the
 // uninterrupted run; states and results of another shape are refused naming the field.
 #include <catch2/catch.hpp>

@@ -154,7 +154,7 @@ struct ModesTask {
   int backbone_points = 50;                 ///< [2, 10000]
 };
 
-/// `verify` of task kind filling_ratios (issue 12 §3): the DEM-in-the-loop free decay
+/// `verify` of task kind filling_ratios: the DEM-in-the-loop free decay
 /// (structure::cosimulate) of the chosen and of the baseline design, reported against the
 /// closed forms' prediction with pass or fail (docs/optimizer.md, "DEM verification").
 struct VerifySpec {
@@ -174,7 +174,7 @@ struct VerifySpec {
   bool require_ranking = true;
 };
 
-/// `task` kind filling_ratios (issue 12 §1.3): the whole slabs each layer of the first
+/// `task` kind filling_ratios: the whole slabs each layer of the first
 /// damper holds, for the fastest free decay under a particle-mass budget (docs/optimizer.md).
 /// The layers' containers and lattices give the candidates; their counts, the start.
 struct FillingRatiosTask {
@@ -194,7 +194,7 @@ struct FillingRatiosTask {
   std::vector<int> spheres_per_lane;  ///< of a slab, stacked across gravity in one lane (LatticeBed)
 };
 
-/// `task` kind placement (issue 12 §1.4): where one damper adds the most damping to chosen
+/// `task` kind placement: where one damper adds the most damping to chosen
 /// modes (docs/optimizer.md, "Placement"). On a beam the site moves continuously over
 /// [min_position_m, max_position_m]; on modal data (or with candidate_points on a beam) the
 /// named candidate points are compared.
@@ -222,7 +222,7 @@ struct TaskSpec {
   std::optional<PlacementTask> placement;
 };
 
-/// `sensitivity` (issue 13 §3): the parameters `pdamp sensitivity` varies one at a time
+/// `sensitivity`: the parameters `pdamp sensitivity` varies one at a time
 /// around the damper's operating point, each over the values given (docs/sensitivity.md).
 struct SensitivityParameter {
   std::string name;            ///< friction, restitution, rolling_friction, particle_radius_m,

@@ -1,4 +1,4 @@
-// Checkpoints of long runs (issue 13 §4, docs/dem.md "Checkpoints"): the binary encoding
+// Checkpoints of long runs (docs/dem.md "Checkpoints"): the binary encoding
 // of a run's state and the file that carries it.
 //
 // A state is a flat little-endian byte string written by StateWriter and read back by

@@ -42,7 +42,7 @@ inline constexpr long long kMaxRecordedSamples = 10'000'000;
 inline constexpr int kMaxSnapshots = 10'000;
 }  // namespace limits
 
-/// A harmonic DEM run (PHYSICS.md §1): x_c = X sin(Ωt) along drive_axis.
+/// A harmonic DEM run (docs/physics.md §1): x_c = X sin(Ωt) along drive_axis.
 struct DamperSimulationOptions {
   WorldOptions world;
   Vec3 drive_axis{1.0, 0.0, 0.0};  ///< direction of the drive (normalised), world = body frame at rest
@@ -76,7 +76,7 @@ struct DamperSimulationOptions {
 
 struct DamperResult {
   Summary summary;
-  double eta_star = 0.0;               ///< reduced loss factor from complex power (PHYSICS.md §1)
+  double eta_star = 0.0;               ///< reduced loss factor from complex power (docs/physics.md §1)
   double eta_star_stderr = 0.0;        ///< standard error of the mean of the per-period values (sample sd/√n)
   /// η* from the energy balance instead: (D + ΔE)/(n·π·m_bed·V²) (independent check).
   double eta_star_energy_balance = 0.0;
@@ -99,13 +99,13 @@ struct DamperResult {
   EnergyBalance energy;
   TimeSeries series;
   std::vector<ParticleSnapshot> snapshots;
-  std::vector<std::string> warnings;   ///< validity-range remarks (INTERFACE.md)
+  std::vector<std::string> warnings;   ///< validity-range remarks (docs/interface.md)
   /// The checkpoint hook asked the run to stop (HarmonicCheckpoints::stop) after it wrote
   /// its state: the measures are unset, the run continues from that state.
   bool stopped = false;
 };
 
-/// Checkpoints of a harmonic run (issue 13 §4, docs/dem.md "Checkpoints"). At the end of
+/// Checkpoints of a harmonic run (docs/dem.md "Checkpoints"). At the end of
 /// every drive period of the transient and the analysis the run asks `due()`; when it says
 /// so, the run passes its whole state to `write` (the World, the step, the motion-mode sums
 /// and, once analysing, the drive bin, the energy ledger's opening and the recorded series

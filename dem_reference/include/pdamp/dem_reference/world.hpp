@@ -16,9 +16,9 @@ namespace pdamp::dem_reference {
 /// Version of the DEM physics (contact laws, integration, measures). Bumped whenever
 /// results change for the same input; the effective fields hash it.
 /// 2: the ISO 3290 ball-lot tolerance by default, the drive-bin measure accumulated
-/// every step, the impact speed from the free-fall height (issue 9).
-/// 3: wall layers with the bonded-layer contact law (issue 9; worlds without layers
-/// give the same results as in version 2).
+/// every step, the impact speed from the free-fall height.
+/// 3: wall layers with the bonded-layer contact law (worlds without layers give the
+/// same results as in version 2).
 inline constexpr int kPhysicsModelVersion = 3;
 
 /// The automatic time-step bound (docs/dem.md "Time step").
@@ -118,7 +118,7 @@ class World {
   int compartment(int i) const;
   double bed_mass_kg() const;          ///< all particles
   /// Clearance h of the compartment's collected bed along its collect axis (the free
-  /// travel of the settled bed, PHYSICS.md "Clearance of a real bed",
+  /// travel of the settled bed, docs/physics.md §9, "Clearance of a real bed",
   /// formulas::LatticeBed::settled_clearance_m), m; NaN if a lattice cannot be built.
   double clearance_m(int compartment) const;
   /// Σ m v: total momentum of the particles at the current time, kg·m/s.

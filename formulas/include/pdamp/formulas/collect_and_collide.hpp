@@ -1,4 +1,4 @@
-// Closed-form collect-and-collide models of a particle damper (PHYSICS.md §2-4).
+// Closed-form collect-and-collide models of a particle damper (docs/physics.md §2-4).
 //
 // One ideal model serves both regimes: the bed moves as one block that leaves a wall
 // at maximum container velocity, travels relative to the container, and hits the
@@ -36,7 +36,7 @@ enum class MotionRegime {
 };
 std::string_view to_string(MotionRegime regime);
 
-/// Empirical scattered-state law (PHYSICS.md §4) in s = X/X_onset < 1:
+/// Empirical scattered-state law (docs/physics.md §4) in s = X/X_onset < 1:
 ///   η*(s) = jump_fraction · η*_onset · s^exponent
 /// where η*_onset is the ideal orbit's value at the onset of the model in use, so
 /// jump_fraction < 1 is the height of the jump into the collect-and-collide state.
@@ -55,7 +55,7 @@ struct ScatteredFit {
   double jump_fraction_stderr = std::numeric_limits<double>::quiet_NaN(); ///< standard error of jump_fraction
   double exponent_stderr = std::numeric_limits<double>::quiet_NaN();      ///< standard error of exponent
   std::size_t points = 0;                                                 ///< samples fitted
-  /// Defaults are provisional until fitted to DEM points (effective-field issue).
+  /// Defaults are provisional until fitted to DEM points (docs/effective_fields.md §6).
   bool provisional = true;
   std::string source = "provisional default";
   /// One line per violated rule ("exponent = 12: must be in [0, 10]"); empty if valid.
@@ -99,7 +99,7 @@ struct IdealOrbit {
   /// ψ in [0, atan(2/π)] on kSubPeak; NaN when scattered.
   double impact_phase_rad = 0.0;
 };
-/// φ* in [0, π] solving φ − sin φ = r for r = h_eff/X in [0, π] (PHYSICS.md §2), to a
+/// φ* in [0, π] solving φ − sin φ = r for r = h_eff/X in [0, π] (docs/physics.md §2), to a
 /// few ulp: start from the inverse series at 0, φ ≈ (6r)^{1/3}(1 + (6r)^{2/3}/60 + ...),
 /// or at π, then 1-3 safeguarded Newton steps on the convex φ − sin φ (summed as a
 /// series below φ = 1, where the difference cancels); about 0.1 µs. Never fails on
@@ -153,7 +153,7 @@ struct LossResult {
   double velocity_amplitude_m_s = 0.0;  ///< |V*| = XΩ
   double impact_phase_rad = 0.0;  ///< NaN in the scattered state
   double stroke_over_onset = 0.0; ///< s = X/X_onset of the family used
-  std::vector<std::string> warnings;  ///< validity-range violations (INTERFACE.md)
+  std::vector<std::string> warnings;  ///< validity-range violations (docs/interface.md)
   /// How many warnings apply (warnings.size(), also when reduced_loss_factor_counted
   /// leaves `warnings` empty).
   std::size_t warning_count = 0;
@@ -169,7 +169,7 @@ double auto_inertia_factor(double intensity, const ModelOptions& options);
 /// Γ_slip = μ(1+κ)/κ: the intensity up to which the base friction keeps spheres rolling.
 double slip_intensity(const ModelOptions& options);
 /// Onset stroke (1+κ)h/√(π²+4) and η* there, 4π/((π²+4)(1+κ)), of the block of inertia
-/// factor κ (PHYSICS.md §2-3).
+/// factor κ (docs/physics.md §2-3).
 double onset_stroke_m(double inertia_factor, double clearance_m);
 double onset_reduced_loss_factor(double inertia_factor);
 
@@ -192,7 +192,7 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
 LossResult reduced_loss_factor_counted(DamperModel model, double clearance_m, double stroke_m,
                                        double frequency_hz, const ModelOptions& validated_options);
 
-/// Energy measures from η* (PHYSICS.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
+/// Energy measures from η* (docs/physics.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
 /// η* >= 0, m_bed > 0, |V*| >= 0, all finite (std::invalid_argument otherwise).
 double dissipated_energy_measure(double eta_star, double bed_mass_kg, double velocity_amplitude_m_s);
 /// Energy dissipated per cycle, 2π·E_diss, J; e_diss_j >= 0 and finite.

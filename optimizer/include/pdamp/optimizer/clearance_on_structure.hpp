@@ -1,4 +1,4 @@
-// Clearance on a structure (issue 12 §1.2): the clearance h of one particle damper on a
+// Clearance on a structure: the clearance h of one particle damper on a
 // base-excited modal model, where the damper's own stroke depends on h through the
 // damping it adds at resonance. Either the damper runs at its design stroke at the
 // resonance peak (X_peak(h) = x_opt(h)) or the FRF peak is lowest; both are solved on

@@ -1,5 +1,5 @@
-// Filling ratios of a multi-layer particle damper for a transient (issue 12 §1.3,
-// PHYSICS.md §7): how many whole slabs of spheres each stacked layer holds so that the
+// Filling ratios of a multi-layer particle damper for a transient (docs/physics.md
+// §7.7): how many whole slabs of spheres each stacked layer holds so that the
 // structure's free decay settles fastest under a particle-mass budget.
 #pragma once
 

@@ -1,5 +1,5 @@
-// Placement of a particle damper (issue 12 §1.4): where along a beam (or at which named
-// point of imported modal data) the damper adds the most damping to chosen modes, from
+// Placement of a particle damper: where along a beam (or at which named point of
+// imported modal data) the damper adds the most damping to chosen modes, from
 // the mode shapes and the damper's amplitude dependence (docs/optimizer.md, "Placement").
 //
 // At a site x the damper moves along its drive by b_j(x) = Φ_j(x)·n per unit modal
@@ -9,7 +9,7 @@
 // it (down the onset cliff into the scattered state), and the added damping ratio of the
 // single-mode averaged model (structure::backbone_point),
 // is what placement maximises. ζ_add,j is the backbone's Σ_dampers Σ_layers b_j² η* m_bed / (2 m_eff),
-// ≈ ½ η* μ_j for a small modal mass ratio μ_j = b_j² m_bed/m_j (PHYSICS.md §7).
+// ≈ ½ η* μ_j for a small modal mass ratio μ_j = b_j² m_bed/m_j (docs/physics.md §7.3).
 #pragma once
 
 #include <cstdint>

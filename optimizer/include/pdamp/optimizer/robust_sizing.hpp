@@ -1,4 +1,4 @@
-// Robust clearance sizing on the closed forms (issue 12 §1.1): the clearance h that
+// Robust clearance sizing on the closed forms: the clearance h that
 // maximises the worst-case (or mean) η* over a range of operating strokes and
 // frequencies, with every operating stroke above the onset by a margin.
 #pragma once
@@ -38,7 +38,7 @@ struct RobustSizingOptions {
   std::optional<double> clearance_min_m;
   std::optional<double> clearance_max_m;
   /// Every operating stroke stays at X >= (1 + onset_margin)·X_onset(h), X_onset the
-  /// onset of the family the closed form uses there (PHYSICS.md §2-3); in [0, 1].
+  /// onset of the family the closed form uses there (docs/physics.md §2-3); in [0, 1].
   double onset_margin = 0.1;
   RobustCriterion criterion = RobustCriterion::kWorstCase;
   /// One line per violated rule ("stroke_min_m = 0: must be > 0 and finite"), the

@@ -1,5 +1,5 @@
 // Co-simulation: a ModalModel integrated in time with one reference-DEM World per damper,
-// the bed in the loop (PHYSICS.md §7 "Full verification", docs/cosimulation.md).
+// the bed in the loop (docs/physics.md §7.8, docs/cosimulation.md).
 #pragma once
 
 #include <complex>
@@ -154,7 +154,7 @@ struct CosimulationSteadyState {
   /// F̂_d: the force the container applies to its bed along n, N (the convention above).
   std::vector<std::complex<double>> bed_force_amplitudes_n;
   /// Each bed's reduced loss factor and apparent mass in the loop, by the Level II measure
-  /// (PHYSICS.md §1, formulas::ComplexPower) on F̂_d and V̂_d = iΩŷ_d: P = ½F̂ conj V̂,
+  /// (docs/physics.md §1, formulas::ComplexPower) on F̂_d and V̂_d = iΩŷ_d: P = ½F̂ conj V̂,
   /// η* = (Re P/Ω)/(½ m_bed |V̂|²), m_app/m_bed = Im(F̂ conj V̂)/(Ω|V̂|² m_bed). They make
   /// a stepped-sine point comparable with pdamp dem and with the field at the same (f, X).
   std::vector<double> bed_reduced_loss_factor;
@@ -290,7 +290,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
                               const CosimulationOptions& options, CosimulationState& state,
                               const CosimulationProgressCallback& progress = {});
 
-/// Checkpoints of a co-simulation run in segments (issue 13 §4, docs/cosimulation.md §7).
+/// Checkpoints of a co-simulation run in segments (docs/cosimulation.md §6b).
 /// save_cosimulation_state writes a started state: each world's integration settings and
 /// whole state (World::save_state), q, q̇, the time, steps, step and the excitation with its
 /// phase. restore_cosimulation_state builds the worlds from `dampers` (their World options

@@ -1,6 +1,6 @@
 // Reading a user's input file (case, field, CSV, fit) safely: only a regular file is
 // opened, so a FIFO, a device or a directory is refused at once instead of hanging or
-// failing deep inside a parser (issue 8, docs/bad_inputs.md).
+// failing deep inside a parser (docs/bad_inputs.md).
 #pragma once
 
 #include <cstddef>
