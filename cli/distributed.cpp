@@ -1,18 +1,19 @@
-// Distributed sweeps on MPI: see distributed.hpp. Only this file knows MPI, and only
-// when built with -DPDAMP_MPI=ON (PDAMP_WITH_MPI); the default build compiles the
-// one-rank half below.
+// Jobs spread over MPI ranks: see distributed.hpp. Only this file knows MPI, and only when
+// built with -DPDAMP_MPI=ON (PDAMP_WITH_MPI); the default build compiles the one-rank half.
 #include "distributed.hpp"
 
 #include <algorithm>
-#include <cstdint>
+#include <array>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <exception>
 #include <iostream>
+#include <mutex>
 #include <stdexcept>
 #include <streambuf>
 #include <thread>
+#include <vector>
 
 #ifdef PDAMP_WITH_MPI
 #include <mpi.h>
@@ -34,96 +35,22 @@ int launcher_rank() {
   return -1;
 }
 
-// A field point as bytes: five doubles, the status, the motion-mode text.
-std::string encode_point(const surrogate::FieldPoint& p) {
-  const double values[5] = {p.eta_star, p.eta_star_stderr, p.e_diss_j, p.apparent_mass_kg, p.apparent_mass_fraction};
-  const auto status = static_cast<std::int32_t>(p.status);
-  std::string bytes(sizeof values + sizeof status, '\0');
-  std::memcpy(bytes.data(), values, sizeof values);
-  std::memcpy(bytes.data() + sizeof values, &status, sizeof status);
-  return bytes + p.motion_mode;
-}
-
-surrogate::FieldPoint decode_point(const std::string& bytes) {
-  double values[5];
-  std::int32_t status = 0;
-  if (bytes.size() < sizeof values + sizeof status)
-    throw std::runtime_error("a field point of " + std::to_string(bytes.size()) + " bytes is too short");
-  std::memcpy(values, bytes.data(), sizeof values);
-  std::memcpy(&status, bytes.data() + sizeof values, sizeof status);
-  surrogate::FieldPoint p;
-  p.eta_star = values[0];
-  p.eta_star_stderr = values[1];
-  p.e_diss_j = values[2];
-  p.apparent_mass_kg = values[3];
-  p.apparent_mass_fraction = values[4];
-  p.status = static_cast<surrogate::PointStatus>(status);
-  p.motion_mode = bytes.substr(sizeof values + sizeof status);
-  return p;
-}
+/// What a job is asked by: its index and the asker's fingerprint (tasks::Jobs), as raw
+/// doubles, so a worker computes bit for bit what rank 0 would.
+using Request = std::array<double, 2>;
 
 }  // namespace
-
-void run_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& run) {
-  if (!parallel) {
-    for (std::size_t k = 0; k < count; ++k) run(k);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(count);
-  std::vector<std::thread> threads;
-  for (std::size_t k = 0; k < count; ++k)
-    threads.emplace_back([&, k] {
-      try {
-        run(k);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    });
-  for (auto& t : threads) t.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
 
 int rank() { return g_rank; }
 int ranks() { return g_ranks; }
 void note_failure(const std::string& message) { g_failure = message; }
-
-TaskFarm::TaskFarm(Evaluator local) : local_(std::move(local)) {
-  points_.assign(static_cast<std::size_t>(g_ranks), 0);
-  busy_s_.assign(static_cast<std::size_t>(g_ranks), 0.0);
-  for (int r = g_ranks - 1; r >= 1; --r) free_.push_back(r);
-}
-
-int TaskFarm::threads(int serial_threads) const { return g_ranks > 1 ? g_ranks : serial_threads; }
-
-void TaskFarm::account(int rank, std::chrono::steady_clock::time_point start) {
-  const auto now = std::chrono::steady_clock::now();
-  std::lock_guard lock(mutex_);
-  ++points_[static_cast<std::size_t>(rank)];
-  busy_s_[static_cast<std::size_t>(rank)] += std::chrono::duration<double>(now - start).count();
-  last_ = std::max(last_, now);
-}
-
-PointFarm::PointFarm(LocalEvaluator local)
-    : farm_([local = std::move(local)](const Request& request) { return encode_point(local(request)); }) {}
-
-surrogate::FieldPoint PointFarm::evaluate(const Request& request) { return decode_point(farm_.evaluate(request)); }
-
-nlohmann::json TaskFarm::balance() const {
-  std::lock_guard lock(mutex_);
-  if (g_ranks == 1) return nullptr;
-  const double wall_s = started_ ? std::chrono::duration<double>(last_ - first_).count() : 0.0;
-  nlohmann::json busy = nlohmann::json::array();
-  for (const double b : busy_s_) busy.push_back(wall_s > 0.0 ? b / wall_s : 0.0);
-  return {{"ranks", g_ranks}, {"points", points_}, {"busy_fraction", busy}, {"wall_time_s", wall_s}};
-}
 
 #ifndef PDAMP_WITH_MPI
 
 bool built_with_mpi() { return false; }
 
 // One rank: a build without MPI refuses to run as several (each copy would write the same
-// files), and evaluates every task itself.
+// files), and runs every job itself.
 Session::Session(int*, char***) {
   const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
   if (size == nullptr) size = std::getenv("PMI_SIZE");
@@ -136,8 +63,7 @@ Session::Session(int*, char***) {
 }
 Session::~Session() = default;
 
-std::string TaskFarm::evaluate(const Request& request) { return local_(request); }
-void TaskFarm::serve() {}
+tasks::Executor& executor() { return tasks::local_executor(); }
 
 #else
 
@@ -148,7 +74,7 @@ constexpr int kTagReply = 2;
 constexpr int kTagStop = 3;
 bool g_mpi = false;
 bool g_stopped = false;  // a worker: rank 0 said stop
-std::mutex g_mpi_mutex;  // rank 0's sweep threads: one MPI call at a time (MPI_THREAD_SERIALIZED)
+std::mutex g_mpi_mutex;  // rank 0's job threads: one MPI call at a time (MPI_THREAD_SERIALIZED)
 
 /// Where a worker's output goes: rank 0 speaks for the run.
 class NullBuffer : public std::streambuf {
@@ -159,7 +85,7 @@ NullBuffer g_null;
 std::streambuf* g_cout = nullptr;
 std::streambuf* g_cerr = nullptr;
 
-// A reply: one byte kind, then the task's result or an error message.
+// A reply: one byte kind, then the job's result or an error message.
 constexpr char kResult = 'r';
 constexpr char kError = 'e';
 
@@ -224,9 +150,101 @@ bool serve_one(const std::function<std::vector<char>(const Request&)>& answer) {
   return true;
 }
 
+/// Rank 0's jobs: each to a free rank, or here when none is free; the balance per rank.
+class RankChannel : public tasks::JobChannel {
+ public:
+  RankChannel() : points_(static_cast<std::size_t>(g_ranks), 0), busy_s_(static_cast<std::size_t>(g_ranks), 0.0) {
+    for (int r = g_ranks - 1; r >= 1; --r) free_.push_back(r);
+  }
+
+  std::optional<std::string> run_elsewhere(std::size_t index, double fingerprint) override {
+    const auto start = std::chrono::steady_clock::now();
+    int rank = 0;
+    {
+      std::lock_guard lock(mutex_);
+      if (!started_) first_ = start, started_ = true;
+      if (free_.empty()) return std::nullopt;
+      rank = free_.back();
+      free_.pop_back();
+    }
+    const Request request{static_cast<double>(index), fingerprint};
+    {
+      std::lock_guard lock(g_mpi_mutex);
+      MPI_Send(request.data(), 2, MPI_DOUBLE, rank, kTagRequest, MPI_COMM_WORLD);
+    }
+    const MPI_Status status = wait_for(rank, kTagReply);
+    std::vector<char> reply;
+    {
+      std::lock_guard lock(g_mpi_mutex);
+      reply = receive_bytes(status);
+    }
+    {
+      std::lock_guard lock(mutex_);
+      free_.push_back(rank);
+    }
+    account(rank, start);
+    return decode_reply(reply, rank);
+  }
+
+  void ran_here(std::chrono::steady_clock::time_point start) override { account(0, start); }
+
+  nlohmann::json balance() const override {
+    std::lock_guard lock(mutex_);
+    const double wall_s = started_ ? std::chrono::duration<double>(last_ - first_).count() : 0.0;
+    nlohmann::json busy = nlohmann::json::array();
+    for (const double b : busy_s_) busy.push_back(wall_s > 0.0 ? b / wall_s : 0.0);
+    return {{"ranks", g_ranks}, {"points", points_}, {"busy_fraction", busy}, {"wall_time_s", wall_s}};
+  }
+
+ private:
+  void account(int rank, std::chrono::steady_clock::time_point start) {
+    const auto now = std::chrono::steady_clock::now();
+    std::lock_guard lock(mutex_);
+    if (!started_) first_ = start, started_ = true;
+    ++points_[static_cast<std::size_t>(rank)];
+    busy_s_[static_cast<std::size_t>(rank)] += std::chrono::duration<double>(now - start).count();
+    last_ = std::max(last_, now);
+  }
+
+  mutable std::mutex mutex_;  // free_, points_, busy_s_, first_, last_
+  std::vector<int> free_;     // ranks > 0 waiting for a job
+  std::vector<std::size_t> points_;
+  std::vector<double> busy_s_;
+  std::chrono::steady_clock::time_point first_{}, last_{};
+  bool started_ = false;
+};
+
+class MpiExecutor : public tasks::Executor {
+ public:
+  int concurrency(int local_jobs) const override { return g_ranks > 1 ? g_ranks : local_jobs; }
+  int processes() const override { return g_ranks; }
+  std::unique_ptr<tasks::JobChannel> open(EncodedJob encoded_job) override {
+    if (!g_mpi || g_ranks == 1) return tasks::local_executor().open(std::move(encoded_job));
+    if (g_rank == 0) return std::make_unique<RankChannel>();
+    // A worker: compute what rank 0 sends until it says stop; it has no result of its own.
+    const auto answer = [&](const Request& request) {
+      try {
+        return encode_reply(kResult, encoded_job(static_cast<std::size_t>(request[0]), request[1]));
+      } catch (const std::exception& e) {
+        return encode_error(e.what());
+      } catch (...) {
+        return encode_error("an unknown exception");
+      }
+    };
+    while (serve_one(answer)) {
+    }
+    throw tasks::JobsServedElsewhere();
+  }
+};
+
 }  // namespace
 
 bool built_with_mpi() { return true; }
+
+tasks::Executor& executor() {
+  static MpiExecutor mpi;
+  return mpi;
+}
 
 Session::Session(int* argc, char*** argv) {
   if (launcher_rank() < 0) return;  // not under mpirun: one rank, no MPI (no singleton start-up)
@@ -246,7 +264,7 @@ Session::Session(int* argc, char*** argv) {
   if (provided < MPI_THREAD_SERIALIZED) {
     if (g_rank == 0)
       std::fprintf(stderr, "pdamp: error: this MPI library gives no thread support (MPI_THREAD_SERIALIZED), "
-                           "which rank 0's sweep threads need\n");
+                           "which rank 0's job threads need\n");
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
   if (g_rank != 0) {
@@ -262,60 +280,14 @@ Session::~Session() {
   } else {
     // This rank's command ended before rank 0's (it takes no part, or it failed): keep
     // answering, with the reason, so that rank 0 reports it instead of waiting.
-    const std::string why = g_failure.empty() ? "takes no part in this command's sweep"
-                                              : "could not set up its part of the sweep: " + g_failure;
+    const std::string why = g_failure.empty() ? "takes no part in this command's jobs"
+                                              : "could not set up its part of the jobs: " + g_failure;
     while (!g_stopped && serve_one([&](const Request&) { return encode_error(why); })) {
     }
     std::cout.rdbuf(g_cout);
     std::cerr.rdbuf(g_cerr);
   }
   MPI_Finalize();
-}
-
-std::string TaskFarm::evaluate(const Request& request) {
-  const auto start = std::chrono::steady_clock::now();
-  int rank = 0;
-  {
-    std::lock_guard lock(mutex_);
-    if (!started_) first_ = start, started_ = true;
-    if (!free_.empty()) rank = free_.back(), free_.pop_back();
-  }
-  if (rank == 0) {
-    auto result = local_(request);
-    account(0, start);
-    return result;
-  }
-  {
-    std::lock_guard lock(g_mpi_mutex);
-    MPI_Send(request.data(), 2, MPI_DOUBLE, rank, kTagRequest, MPI_COMM_WORLD);
-  }
-  const MPI_Status status = wait_for(rank, kTagReply);
-  std::vector<char> reply;
-  {
-    std::lock_guard lock(g_mpi_mutex);
-    reply = receive_bytes(status);
-  }
-  {
-    std::lock_guard lock(mutex_);
-    free_.push_back(rank);
-  }
-  account(rank, start);
-  return decode_reply(reply, rank);
-}
-
-void TaskFarm::serve() {
-  if (!g_mpi || g_rank == 0) return;
-  const auto answer = [&](const Request& request) {
-    try {
-      return encode_reply(kResult, local_(request));
-    } catch (const std::exception& e) {
-      return encode_error(e.what());
-    } catch (...) {
-      return encode_error("an unknown exception");
-    }
-  };
-  while (serve_one(answer)) {
-  }
 }
 
 #endif

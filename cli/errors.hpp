@@ -1,6 +1,10 @@
-// The command line's exit codes and the error classes they stand for (docs/interface.md):
-// the classes are the libraries' own (strict_json: InputError, NumericalError, Interrupted).
+// The command line's exit codes and the one table that maps pdamp's error classes to them
+// (docs/interface.md): the classes are the libraries' own (strict_json: InputError,
+// NumericalError, Interrupted; tasks: JobsServedElsewhere).
 #pragma once
+
+#include <exception>
+#include <string>
 
 #include "pdamp/strict_json/input_error.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
@@ -15,5 +19,19 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitOther = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitNumerical = 3;
+
+/// What an error that ended a command means for the process.
+struct ErrorOutcome {
+  int exit_code = kExitOther;
+  std::string message;    ///< the one line after "pdamp: error: "; empty: say nothing
+  int end_by_signal = 0;  ///< nonzero: end by this signal's default action after the line
+};
+
+/// The table: strict_json::InputError (a file, flag or key breaks a rule) and a library's
+/// std::invalid_argument (it refuses a value it was given) exit 2; NumericalError exits 3;
+/// Interrupted ends by its signal; JobsServedElsewhere (an MPI worker) exits 0 silently;
+/// std::bad_alloc and anything else exit 1. `command` names the subcommand for a bare
+/// std::invalid_argument.
+ErrorOutcome classify_error(const std::exception_ptr& error, const std::string& command);
 
 }  // namespace pdamp::cli

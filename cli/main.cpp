@@ -10,8 +10,7 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "errors.hpp"
-#include "output.hpp"
-#include "pdamp/case_file/case_error.hpp"
+#include "pdamp/report/external_program.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 
 namespace {
@@ -28,9 +27,9 @@ void print_overview() {
                "2 bad input, 3 numerical failure at run time.\n";
 }
 
-/// One error line on stderr (INTERFACE.md); the message is made printable so that a
+/// One error line on stderr (docs/interface.md); the message is made printable so that a
 /// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
-int report(const char* what, int exit_code) {
+int print_error(const std::string& what, int exit_code) {
   pdamp::cli::distributed::note_failure(what);  // a worker rank tells rank 0 in its replies
   std::cerr << "pdamp: error: " << pdamp::strict_json::printable(what) << "\n";
   return exit_code;
@@ -50,58 +49,58 @@ int report(const char* what, int exit_code) {
 /// (they are complete then: said on stderr, then the signal's default action).
 int finished(int exit_code) {
   std::cout.flush();
-  if (!std::cout) return report("cannot write the result to standard output", pdamp::cli::kExitOther);
-  if (const int s = pdamp::cli::pending_interrupt(); s != 0) {
+  if (!std::cout) return print_error("cannot write the result to standard output", pdamp::cli::kExitOther);
+  if (const int s = pdamp::report::pending_interrupt(); s != 0) {
     std::cerr << "pdamp: error: interrupted after the results were written (they are complete)" << std::endl;
     die_by(s);
   }
   return exit_code;
 }
 
-/// The command `args` names, run; its exit code (INTERFACE.md).
+/// The command `args` names.
+const pdamp::cli::Command* find_command(const std::vector<std::string>& args, std::size_t& words) {
+  // A two-word command ("field merge") before its one-word prefix ("field").
+  const pdamp::cli::Command* match = nullptr;
+  words = 0;
+  for (const auto& command : pdamp::cli::commands()) {
+    const std::string& name = command.spec.name;
+    const bool two = name.find(' ') != std::string::npos;
+    if (two ? (args.size() >= 2 && name == args[0] + " " + args[1]) : name == args[0]) {
+      if (!match || (two ? 2u : 1u) > words) {
+        match = &command;
+        words = two ? 2 : 1;
+      }
+    }
+  }
+  return match;
+}
+
+/// The command `args` names, run; its exit code (classify_error: bad input 2, a numerical
+/// failure 3, a signal its own end, anything else 1).
 int run_command(const std::vector<std::string>& args) {
   using namespace pdamp::cli;
-  if (args.empty()) return report("missing the command (usage: pdamp <command> [options]; see pdamp --help)", kExitBadInput);
+  if (args.empty()) return print_error("missing the command (usage: pdamp <command> [options]; see pdamp --help)", kExitBadInput);
   if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     print_overview();
     return kExitOk;
   }
   try {
-    // A two-word command ("field merge") before its one-word prefix ("field").
-    const Command* match = nullptr;
     std::size_t words = 0;
-    for (const auto& command : commands()) {
-      const std::string& name = command.spec.name;
-      const auto space = name.find(' ');
-      const bool two = space != std::string::npos;
-      if (two ? (args.size() >= 2 && name == args[0] + " " + args[1]) : name == args[0]) {
-        if (!match || (two ? 2u : 1u) > words) {
-          match = &command;
-          words = two ? 2 : 1;
-        }
-      }
-    }
+    const Command* match = find_command(args, words);
     if (match == nullptr) throw InputError(args[0], "", "unknown command (see pdamp --help)");
-    if (distributed::worker() && !match->every_rank) return kExitOk;  // rank 0 runs it; this rank waits
+    CommandContext context{distributed::executor(), !distributed::worker()};
+    if (!context.primary && !match->every_rank) return kExitOk;  // rank 0 runs it; this rank waits
     const ParsedArgs parsed(match->spec, std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(words), args.end()));
     if (parsed.help_requested()) {
       std::cout << help_text(match->spec);
       return finished(kExitOk);
     }
-    return finished(match->run(parsed));
-  } catch (const InputError& e) {
-    return report(e.what(), kExitBadInput);
-  } catch (const std::invalid_argument& e) {
-    return report(("pdamp " + args[0] + ": " + e.what()).c_str(), kExitBadInput);
-  } catch (const NumericalError& e) {
-    return report(e.what(), kExitNumerical);
-  } catch (const Interrupted& e) {  // the OutputDir's destructor removed what was staged
-    report(e.what(), kExitOther);
-    die_by(e.signal_number());
-  } catch (const std::bad_alloc&) {
-    return report("out of memory (see the run's estimate on stderr; reduce the case's sizes)", kExitOther);
-  } catch (const std::exception& e) {
-    return report(e.what(), kExitOther);
+    return finished(match->run(parsed, context));
+  } catch (...) {
+    const ErrorOutcome outcome = classify_error(std::current_exception(), args[0]);
+    if (!outcome.message.empty()) print_error(outcome.message, outcome.exit_code);
+    if (outcome.end_by_signal != 0) die_by(outcome.end_by_signal);
+    return outcome.exit_code;
   }
 }
 
@@ -110,7 +109,7 @@ int run_command(const std::vector<std::string>& args) {
 int main(int argc, char** argv) {
   using namespace pdamp::cli;
   const distributed::Session mpi(&argc, &argv);  // under mpirun: until main returns
-  install_interrupt_handlers();
+  pdamp::report::install_interrupt_handlers();
   const int exit_code = run_command(std::vector<std::string>(argv + 1, argv + argc));
   // Under mpirun rank 0 speaks for the run: another rank's failure reaches it in that
   // rank's replies (distributed.hpp), and an exit code here would make mpirun kill rank 0

@@ -1,16 +1,58 @@
-// Readable tables of the subcommands (output.hpp).
+// The end every command shares, and readable tables (output.hpp).
 #include "output.hpp"
 
+#include <iostream>
 #include <sstream>
+
+#include "pdamp/report/html_report.hpp"
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/tasks/closed_forms.hpp"
 
 namespace pdamp::cli {
 
-std::string key_value_table(const std::vector<std::pair<std::string, std::string>>& rows) {
+std::string key_value_table(const Rows& rows) {
   std::size_t width = 0;
   for (const auto& row : rows) width = std::max(width, row.first.size());
   std::ostringstream out;
   for (const auto& [key, value] : rows) out << key << std::string(width + 2 - key.size(), ' ') << value << "\n";
   return out.str();
+}
+
+void print_warnings(const std::vector<std::string>& warnings) {
+  for (const auto& w : warnings) std::cerr << "pdamp: warning: " << strict_json::printable(w) << "\n";
+}
+
+std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context) {
+  if (!context.primary) return nullptr;
+  if (const auto dir = args.optional_text("-o")) return std::make_unique<report::OutputDir>(*dir);
+  return nullptr;
+}
+
+tasks::OutputFolder output_folder(const report::OutputDir* files) {
+  return files ? tasks::OutputFolder{files->dir()} : tasks::OutputFolder{};
+}
+
+int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& result,
+           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how) {
+  if (how.refuse_non_finite) tasks::require_finite(result);
+  nlohmann::json paths = nlohmann::json::array();
+  if (files) {
+    result["warnings"] = warnings;
+    if (how.resolved) files->add_json("case_resolved.json", how.resolved->resolved);
+    if (!how.json_name.empty()) files->add_json(how.json_name, result);
+    if (how.report && how.resolved) report::stage_report(*files, *how.resolved, result, warnings);
+    paths = files->commit();
+  }
+  result["warnings"] = warnings;
+  if (files || how.paths_without_folder) result[how.paths_key] = paths;
+  print_warnings(warnings);
+  if (args.has("--json")) {
+    std::cout << result.dump(2) << "\n";
+  } else {
+    for (const auto& path : paths) rows.push_back({"wrote", path.get<std::string>()});
+    std::cout << key_value_table(rows);
+  }
+  return 0;
 }
 
 }  // namespace pdamp::cli

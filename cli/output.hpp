@@ -1,21 +1,50 @@
-// What the subcommands print and write: the report module's writers, and readable tables.
+// What the subcommands print and write: the output folder, the end every command shares
+// (result JSON, resolved case, report, commit, warnings, the result on stdout), tables.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "pdamp/report/external_program.hpp"
-#include "pdamp/report/html_report.hpp"
+#include <nlohmann/json.hpp>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "pdamp/case_file/case.hpp"
 #include "pdamp/report/output_dir.hpp"
-#include "pdamp/report/plots.hpp"
-#include "pdamp/report/structure_plots.hpp"
+#include "pdamp/tasks/output_folder.hpp"
 
 namespace pdamp::cli {
 
-using namespace report;
+using Rows = std::vector<std::pair<std::string, std::string>>;
+using report::format_number;
 
 /// Two-column "name  value" table for the readable (non --json) output.
-std::string key_value_table(const std::vector<std::pair<std::string, std::string>>& rows);
+std::string key_value_table(const Rows& rows);
+/// One line each on stderr, "pdamp: warning: ...", made printable.
+void print_warnings(const std::vector<std::string>& warnings);
+
+/// The -o folder, checked before any work (report::OutputDir), or none: without -o, and on
+/// a process that writes nothing (an MPI worker).
+std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context);
+/// Where a task's result JSON says its files are.
+tasks::OutputFolder output_folder(const report::OutputDir* files);
+
+/// How a command ends.
+struct ResultFiles {
+  std::string json_name;                      ///< the result JSON's file name ("decay.json"); empty: none
+  const case_file::Case* resolved = nullptr;  ///< also case_resolved.json
+  bool report = false;                        ///< also report.html (of this case)
+  const char* paths_key = "outputs";          ///< the key of the written paths ("files" for loss, dem, field)
+  bool paths_without_folder = true;           ///< the key, empty, also without -o
+  bool refuse_non_finite = false;             ///< a closed form's result: a number that is not finite is exit 3
+};
+
+/// The end of a command: with `files`, result["warnings"], the result JSON, the resolved
+/// case and the report staged and all committed; the warnings on stderr; the result on
+/// stdout with --json, else `rows` and a "wrote" row per file. Returns the exit code.
+int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& result,
+           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how);
 
 }  // namespace pdamp::cli

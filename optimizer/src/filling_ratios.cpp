@@ -1,5 +1,6 @@
 // Filling ratios of a multi-layer damper: relaxed solve, rounded neighbours, baseline.
 #include "pdamp/optimizer/filling_ratios.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -268,7 +269,7 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
   }
   if (out.neighbours.empty()) {
     // Cannot happen for a feasible relaxed point (flooring only lowers mass and slabs).
-    throw std::runtime_error("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
+    throw strict_json::NumericalError("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
                              out.summary.brief_report() + ")");
   }
 

@@ -18,8 +18,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-bool g_report_requested = false;
-
 /// Rows of the generic key-number table at most (a result is a few dozen numbers; the
 /// long series belong in the CSV files).
 constexpr std::size_t kMaxGenericRows = 120;
@@ -227,9 +225,6 @@ std::vector<ReportPicture> staged_pictures(const fs::path& folder) {
 
 }  // namespace
 
-RunReportScope::RunReportScope() : previous_(g_report_requested) { g_report_requested = true; }
-RunReportScope::~RunReportScope() { g_report_requested = previous_; }
-
 std::string html_escape(std::string_view text) {
   std::string out;
   out.reserve(text.size());
@@ -316,9 +311,7 @@ std::string report_html(const ReportInput& in) {
   return out.str();
 }
 
-void stage_run_report(OutputDir& files, const case_file::Case& c, const json& result,
-                      const std::vector<std::string>& warnings) {
-  if (!g_report_requested) return;
+void stage_report(OutputDir& files, const case_file::Case& c, const json& result, const std::vector<std::string>& warnings) {
   const fs::path page = files.staged_path("report.html");
   ReportInput in;
   in.case_name = c.name;

@@ -2,6 +2,7 @@
 // consistent masses), gravity's geometric stiffness and the modal reduction of the beam.
 // Model, conventions and limits: docs/structures.md, "Beam models".
 #include "pdamp/structure/beam.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
 #include "numbers.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -419,7 +420,7 @@ FreeVibration free_vibration(const Assembly& a) {
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(
       stiffness, mass, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
   if (solver.info() != Eigen::Success) {
-    throw std::runtime_error("beam model: the generalized eigenproblem failed (mass matrix not positive definite?)");
+    throw strict_json::NumericalError("beam model: the generalized eigenproblem failed (mass matrix not positive definite?)");
   }
   const Eigen::VectorXd& lambda = solver.eigenvalues();  // ascending
   const Eigen::Index rigid = a.rigid_modes;

@@ -1,5 +1,6 @@
 // Scattered-state law: samples below the onset, weighted least squares (NLopt), coefficient file.
 #include "pdamp/surrogate/scattered_fit.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -165,7 +166,7 @@ ScatteredFitResult fit_scattered_law(std::span<const ScatteredSample> samples, s
     // The optimum is resolved to rounding: x holds the best point found, which is the answer.
     chi2 = objective(x[0], x[1], nullptr);
   } catch (const std::exception& e) {
-    throw std::runtime_error(std::string("scattered fit: NLopt failed (") + e.what() + ")");
+    throw strict_json::NumericalError(std::string("scattered fit: NLopt failed (") + e.what() + ")");
   }
   ScatteredFitResult result;
   result.fit.jump_fraction = x[0];

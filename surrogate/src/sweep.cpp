@@ -1,5 +1,6 @@
 // Parallel, resumable sweeps over a grid or a list of points with a JSON-lines results file.
 #include "pdamp/surrogate/sweep.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -112,14 +113,14 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
   const std::string where =
       "evaluator at frequency_hz = " + number(drive.frequency_hz) + ", amplitude_m = " + number(drive.amplitude_m);
   if (p.status == PointStatus::kMissing) {
-    throw std::runtime_error(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
+    throw strict_json::NumericalError(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
   }
   if (p.status == PointStatus::kFailed) {
     p.eta_star = p.eta_star_stderr = p.e_diss_j = p.apparent_mass_kg = p.apparent_mass_fraction = FieldPoint::kUnknown;
     return p;
   }
   if (!std::isfinite(p.eta_star))
-    throw std::runtime_error(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
+    throw strict_json::NumericalError(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
   if (std::isnan(p.e_diss_j)) {
     const double velocity = 2.0 * formulas::kPi * drive.frequency_hz * drive.amplitude_m;  // |V*| = XΩ
     p.e_diss_j = p.eta_star * 0.5 * options.bed_mass_kg * velocity * velocity;
@@ -129,7 +130,7 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
   }
   if (!std::isfinite(p.e_diss_j) || std::isinf(p.apparent_mass_kg) || std::isinf(p.apparent_mass_fraction) ||
       !(std::isnan(p.eta_star_stderr) || (p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr)))) {
-    throw std::runtime_error(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
+    throw strict_json::NumericalError(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
                              ", eta_star_stderr = " + number(p.eta_star_stderr) + ")");
   }
   return p;

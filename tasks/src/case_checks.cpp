@@ -1,6 +1,7 @@
 // The checks of a case without the work (case_checks.hpp).
 #include "pdamp/tasks/case_checks.hpp"
 
+#include "pdamp/strict_json/input_error.hpp"
 #include "pdamp/tasks/damper_design.hpp"
 #include "pdamp/tasks/dem_run.hpp"
 #include "pdamp/tasks/field.hpp"
@@ -16,6 +17,23 @@ void check_case(const case_file::Case& c) {
     // check_dem_field places the bed as every DEM run of the case would.
     (void)check_dem_field(c, i, grid, nullptr, c.field.threads);
   }
+}
+
+void require_task(const case_file::Case& c, case_file::TaskKind kind) {
+  using case_file::TaskKind;
+  const auto& t = c.task;
+  const bool present = (kind == TaskKind::kFrf && t.frf) || (kind == TaskKind::kDecay && t.decay) ||
+                       (kind == TaskKind::kModes && t.modes) || (kind == TaskKind::kFillingRatios && t.filling_ratios) ||
+                       (kind == TaskKind::kPlacement && t.placement) || kind == TaskKind::kDamperDesign;
+  if (t.kind == kind && present) return;
+  const std::string name(case_file::to_string(kind));
+  const std::string needed = kind == TaskKind::kFrf     ? "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\""
+                             : kind == TaskKind::kDecay ? "\"initial_state\", \"duration_s\""
+                                                        : "...";
+  throw strict_json::InputError(c.path, "/task",
+                                "pdamp " + name + " needs a task of kind " + name + " (this case's task is '" +
+                                    std::string(case_file::to_string(t.kind)) + "'): give \"task\": {\"kind\": \"" + name +
+                                    "\", " + needed + "} (docs/cases.md, Format 2)");
 }
 
 }  // namespace pdamp::tasks

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 
+#include "pdamp/strict_json/run_errors.hpp"
+#include "task_support.hpp"
+
 namespace pdamp::tasks {
 
 namespace fm = formulas;
@@ -105,6 +108,11 @@ json to_json(const fm::BufferDesign& b) {
           {"layered_compression_of_half_space_design", b.layered_compression_of_half_space_design},
           {"assumptions", b.assumptions},
           {"warnings", b.warnings}};
+}
+
+void require_finite(const json& result) {
+  if (const auto bad = detail::non_finite_number(result))
+    throw strict_json::NumericalError("the result " + *bad + " is not finite: the inputs lie where the model cannot be evaluated");
 }
 
 }  // namespace pdamp::tasks

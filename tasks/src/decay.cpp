@@ -12,6 +12,7 @@
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/tasks/case_checks.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -285,11 +286,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
 }
 
 DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hooks) {
-  if (c.task.kind != case_file::TaskKind::kDecay || !c.task.decay)
-    throw InputError(c.path, "/task",
-                     "pdamp decay needs a task of kind decay (this case's task is '" +
-                         std::string(case_file::to_string(c.task.kind)) +
-                         "'): give \"task\": {\"kind\": \"decay\", \"initial_state\", \"duration_s\"} (docs/cases.md, Format 2)");
+  require_task(c, case_file::TaskKind::kDecay);
   const bool dem = options.method == DecayMethod::kDem;
   detail::Setup setup = detail::make_setup(
       c, options.method == DecayMethod::kField ? case_file::LossMethod::kField : case_file::LossMethod::kFormulas, !dem);

@@ -11,6 +11,7 @@
 #include "job_codecs.hpp"
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/tasks/case_checks.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -152,7 +153,11 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   out.frequencies_hz = detail::spaced(o.min_frequency_hz, o.max_frequency_hz, o.points, false);
   out.analysed_periods = options.analysed_periods;
   out.settling = o.settling;
-  detail::check_cosimulation(c, modal, dampers, options);
+  for (const double f : out.frequencies_hz) {  // every point's options checked before any runs
+    st::CosimulationOptions o = options;
+    o.excitation.frequency_hz = f;
+    detail::check_cosimulation(c, modal, dampers, o);
+  }
   out.time_step_s = detail::call_dem(c, [&] { return st::stepped_sine_time_step(modal, dampers, options, out.frequencies_hz); });
   std::vector<std::pair<std::string, std::vector<double>>> directions;
   for (const auto& d : o.directions)
@@ -590,12 +595,7 @@ DemFrfOptions default_dem_frf_options(const Case& c) {
 }
 
 FrfResult run_frf(const Case& c, const FrfOptions& options, RunHooks& hooks, Executor& executor) {
-  if (c.task.kind != case_file::TaskKind::kFrf || !c.task.frf)
-    throw InputError(c.path, "/task",
-                     "pdamp frf needs a task of kind frf (this case's task is '" +
-                         std::string(case_file::to_string(c.task.kind)) +
-                         "'): give \"task\": {\"kind\": \"frf\", \"min_frequency_hz\", \"max_frequency_hz\", "
-                         "\"excitation\"} (docs/cases.md, Format 2)");
+  require_task(c, case_file::TaskKind::kFrf);
   FrfResult out;
   out.case_name = c.name;
   out.method = options.method;

@@ -26,7 +26,7 @@ constexpr double kPi = 3.14159265358979323846;
 std::string data(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/" + name; }
 
 /// Runs `args` with --json, requires exit 0 and returns the one JSON object on stdout.
-json run_json(const std::string& args, double time_limit_s = 120.0) {
+json run_json(const std::string& args, double time_limit_s = 900.0) {
   RunOptions options;
   options.time_limit_s = time_limit_s;
   const auto r = run_pdamp(args + " --json", options);

@@ -14,24 +14,11 @@
 
 namespace pdamp::report {
 
-/// While one is alive (pdamp run, for the duration of its task), stage_run_report writes
-/// the report; other commands write none. Not thread-safe (one task per process).
-class RunReportScope {
- public:
-  RunReportScope();
-  ~RunReportScope();
-  RunReportScope(const RunReportScope&) = delete;
-  RunReportScope& operator=(const RunReportScope&) = delete;
-
- private:
-  bool previous_;
-};
-
-/// Call just before files.commit(): under a RunReportScope stages report.html built from
-/// the result JSON, the warnings and the pictures already staged in `files` (PNG, else
-/// SVG, as produced by gnuplot); otherwise does nothing.
-void stage_run_report(OutputDir& files, const case_file::Case& c, const nlohmann::json& result,
-                      const std::vector<std::string>& warnings);
+/// Stages report.html built from the result JSON, the warnings and the pictures already
+/// staged in `files` (PNG, else SVG, as produced by gnuplot): call it just before
+/// files.commit().
+void stage_report(OutputDir& files, const case_file::Case& c, const nlohmann::json& result,
+                  const std::vector<std::string>& warnings);
 
 /// A picture for the report: its file name (caption key) and its bytes.
 struct ReportPicture {

@@ -8,14 +8,11 @@
 #include "pdamp/report/output_dir.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/tasks/closed_forms.hpp"
 
 namespace pdamp::report {
 
-/// One point of a closed-form eta*(X) curve.
-struct CurvePoint {
-  double stroke_m;
-  formulas::LossResult loss;
-};
+using tasks::CurvePoint;
 
 /// eta_curve.csv and its plot (PNG, SVG) with onset, ideal peak and design stroke
 /// marked. Returns warnings (e.g. gnuplot missing).

@@ -9,4 +9,8 @@ namespace pdamp::tasks {
 /// strict_json::InputError naming the file and key of the first check that fails.
 void check_case(const case_file::Case& c);
 
+/// InputError naming /task unless the case's task is of `kind` (with its settings), saying
+/// which keys such a task needs.
+void require_task(const case_file::Case& c, case_file::TaskKind kind);
+
 }  // namespace pdamp::tasks

@@ -1,0 +1,35 @@
+// The command line's RunHooks: progress lines on stderr, notes, the checkpoint interval
+// of --checkpoint-interval, and the signals that ask a run to stop.
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "pdamp/tasks/run_hooks.hpp"
+
+namespace pdamp::cli {
+
+class CliHooks : public tasks::RunHooks {
+ public:
+  /// `checkpoint_interval_s`: wall-clock seconds between checkpoints (0: at every chance).
+  explicit CliHooks(double checkpoint_interval_s = 60.0);
+  ~CliHooks() override;
+  /// One line per report: rewritten in place on a terminal, else at most one line every
+  /// 10 s per run (the first and the last of a run always).
+  void progress(const tasks::Progress& p) override;
+  void note(const std::string& line) override;
+  bool checkpoint_due(double seconds_since_checkpoint) override;
+  /// The signal (SIGINT, SIGTERM, SIGHUP) that arrived while a run defers signals, or 0.
+  int stop_requested() override;
+
+ private:
+  std::mutex mutex_;
+  double checkpoint_interval_s_;
+  bool tty_;
+  bool line_open_ = false;  // a terminal line being rewritten
+  std::map<std::string, std::chrono::steady_clock::time_point> last_line_;
+};
+
+}  // namespace pdamp::cli

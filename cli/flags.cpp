@@ -1,0 +1,77 @@
+// Flags several subcommands share (flags.hpp).
+#include "flags.hpp"
+
+#include "errors.hpp"
+
+namespace pdamp::cli {
+
+const FlagSpec kJsonFlag{"--json", "", "print exactly one JSON object on stdout"};
+const FlagSpec kOutFlag{"-o", "DIR", "write result files (JSON, CSV, plots) into DIR, atomically"};
+
+const FlagSpec kMethodFlag{"--method", "M",
+                           "source of each layer's eta*(f, X) and apparent mass: formulas (the closed\n"
+                           "                          forms of its model and clearance; default), field (the\n"
+                           "                          layer's field_file, made by pdamp field) or dem (frf and\n"
+                           "                          decay only: the structure co-simulated in time with each\n"
+                           "                          damper's bed as a DEM world, the case's dem settings)"};
+
+const std::vector<FlagSpec> kDemSweepFlags{
+    {"--dem-points", "N",
+     "--method dem: frequencies of the stepped sine, linear over its band,\n"
+     "                          [2, 1000] (default 9)"},
+    {"--dem-min-frequency", "HZ", "--method dem: lowest frequency of the stepped sine, Hz, > 0\n"
+                                  "                          (default: the task's min_frequency_hz)"},
+    {"--dem-max-frequency", "HZ", "--method dem: highest frequency of the stepped sine, Hz, above the\n"
+                                  "                          lowest (default: the task's max_frequency_hz)"},
+    {"--dem-sweep", "D", "--method dem: up, down or both (default both: the two directions\n"
+                         "                          run in parallel on a machine of two or more cores)"},
+    {"--dem-signal", "S", "--method dem: stepped (a stepped sine, default) or linear (a linear sine\n"
+                          "                          sweep over the band, from the steady state at its start)"},
+    {"--dem-sweep-rate", "HZ/S", "--dem-signal linear: the sweep's rate, Hz/s, > 0 (default: 4 pi zeta^2 f^2 / 100\n"
+                                 "                          at the formulas' resonance: quasi-stationary)"}};
+
+const std::vector<FlagSpec> kCheckpointFlags{
+    {"--resume", "", "continue the DEM run from its checkpoint in the -o folder (left by a run that\n"
+                     "                          was interrupted or killed; same case, settings and thread count)"},
+    {"--checkpoint-interval", "S", "wall-clock seconds between checkpoints of a DEM run in the -o folder,\n"
+                                   "                          >= 0 (default 60; 0: after every segment of about 2 s); one is\n"
+                                   "                          also written when SIGINT, SIGTERM or SIGHUP arrives"}};
+
+const FlagSpec kNoVerifyFlag{"--no-verify", "",
+                             "skip the DEM verification the task's verify block asks for (the optimisation only)"};
+
+case_file::LossMethod loss_method(const ParsedArgs& args, const std::string& command) {
+  const std::string name = args.optional_text("--method").value_or("formulas");
+  if (name == "formulas") return case_file::LossMethod::kFormulas;
+  if (name == "field") return case_file::LossMethod::kField;
+  if (name == "dem")
+    throw InputError("--method", "", "'dem': " + command + " takes formulas or field (the DEM co-simulation runs in "
+                                     "pdamp frf and pdamp decay)");
+  throw InputError("--method", "", "'" + name + "': must be formulas, field or dem");
+}
+
+bool dem_method(const ParsedArgs& args) { return args.optional_text("--method").value_or("") == "dem"; }
+
+tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string& name) {
+  tasks::CheckpointFile out;
+  out.resume = args.has("--resume");
+  (void)checkpoint_interval(args);  // a bad interval is refused before any work
+  const auto dir = args.optional_text("-o");
+  if (!dir) {
+    if (out.resume) throw InputError("--resume", "", "needs -o DIR: the checkpoint is in the output folder");
+    return out;
+  }
+  out.path = std::filesystem::path(*dir) / (name + ".checkpoint");
+  return out;
+}
+
+double checkpoint_interval(const ParsedArgs& args) {
+  return args.optional_number("--checkpoint-interval", Range{0.0, 1e9}).value_or(60.0);
+}
+
+void refuse_checkpoint_flags(const ParsedArgs& args, const std::string& why) {
+  for (const auto& flag : kCheckpointFlags)
+    if (args.has(flag.name)) throw InputError(flag.name, "", why);
+}
+
+}  // namespace pdamp::cli

@@ -1,0 +1,37 @@
+// Flags several subcommands share, and what they map to.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "args.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/tasks/checkpoint.hpp"
+
+namespace pdamp::cli {
+
+extern const FlagSpec kJsonFlag;
+extern const FlagSpec kOutFlag;
+/// `--method formulas|field|dem` (default formulas): pdamp modes, frf, decay and run.
+extern const FlagSpec kMethodFlag;
+/// The stepped sine's and the linear sweep's flags of pdamp frf --method dem; pdamp run
+/// accepts them on an frf task.
+extern const std::vector<FlagSpec> kDemSweepFlags;
+/// `--resume` and `--checkpoint-interval` (pdamp dem, decay --method dem, optimize --verify, run).
+extern const std::vector<FlagSpec> kCheckpointFlags;
+extern const FlagSpec kNoVerifyFlag;
+
+/// The loss models `--method` asks for (formulas, the default, or field); InputError for
+/// dem (a co-simulation, not a loss model) and anything else. `command` names who refuses dem.
+case_file::LossMethod loss_method(const ParsedArgs& args, const std::string& command = "pdamp modes");
+/// `--method dem` given.
+bool dem_method(const ParsedArgs& args);
+
+/// The checkpoint of a DEM run named `name` in the -o folder (InputError for --resume without -o).
+tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string& name);
+/// --checkpoint-interval, s (default 60; 0: at every chance).
+double checkpoint_interval(const ParsedArgs& args);
+/// InputError when a checkpoint flag is given to a run that makes no checkpoints.
+void refuse_checkpoint_flags(const ParsedArgs& args, const std::string& why);
+
+}  // namespace pdamp::cli

@@ -1,0 +1,372 @@
+// The files of each task's result (task_files.hpp).
+#include "pdamp/report/task_files.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+#include <sstream>
+
+#include "pdamp/dem_reference/result_files.hpp"
+#include "pdamp/report/plots.hpp"
+#include "pdamp/report/structure_plots.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/surrogate/scattered_fit.hpp"
+
+namespace pdamp::report {
+
+namespace fm = formulas;
+namespace opt = optimizer;
+namespace st = structure;
+using Warnings = std::vector<std::string>;
+
+namespace {
+
+void append(Warnings& to, const Warnings& from) { to.insert(to.end(), from.begin(), from.end()); }
+
+}  // namespace
+
+Warnings write_files(OutputDir& out, const tasks::DamperDesignResult& d) {
+  return write_eta_curve(out, d.curve, d.optimum, d.frequency_hz, d.case_name);
+}
+
+Warnings write_files(OutputDir& out, const tasks::LossStudy& loss) {
+  return write_eta_curve(out, loss.curve, loss.landmarks, loss.options.frequency_hz,
+                         "pdamp loss --model " + std::string(fm::to_string(loss.options.model)));
+}
+
+Warnings write_files(OutputDir& out, const tasks::DemRunResult& r) {
+  dem_reference::write_time_series_csv(out.staged_path("time_series.csv").string(), r.dem.series);
+  for (std::size_t i = 0; i < r.dem.snapshots.size(); ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "particles_%04zu.vtk", i);
+    dem_reference::write_vtk_snapshot(out.staged_path(name).string(), r.dem.snapshots[i]);
+  }
+  return write_force_velocity_plot(out, r.case_name + ": X = " + format_number(r.amplitude_m * 1e3, 4) + " mm, f = " +
+                                            format_number(r.frequency_hz, 4) + " Hz");
+}
+
+Warnings write_files(OutputDir& out, const tasks::FieldResult& r, const case_file::Case& c) {
+  surrogate::write_effective_field(r.field, out.staged_path("field.json"));
+  if (r.scattered_fit) surrogate::write_scattered_fit(*r.scattered_fit, out.staged_path("scattered_fit.json"));
+  return write_field_pictures(out, r.field, c.name, c.dampers.front());
+}
+
+void write_shard_files(OutputDir& out, const nlohmann::json& summary, const case_file::Case& c) {
+  out.add_json("shard.json", summary);
+  std::ifstream in(c.path, std::ios::binary);
+  out.add("shard_case.json", std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+}
+
+Warnings write_files(OutputDir& out, const tasks::SensitivityResult& study) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "parameter,value,unit,eta_star,eta_star_stderr,delta_eta_star,motion_mode,apparent_mass_fraction,"
+         "closed_form_eta_star,clearance_m,bed_mass_kg,status\n";
+  for (const auto& r : study.rows)
+    csv << r.parameter << ',' << r.value << ',' << r.unit << ',' << r.eta_star << ',' << r.eta_star_stderr << ','
+        << r.delta_eta_star << ',' << r.motion_mode << ',' << r.apparent_mass_fraction << ',' << r.closed_form_eta_star
+        << ',' << r.clearance_m << ',' << r.bed_mass_kg << ',' << r.status << '\n';
+  out.add("sensitivity.csv", csv.str());
+
+  // Per parameter the lowest and highest eta* of its values, sorted by that range, about
+  // the baseline's eta*.
+  struct Bar {
+    std::string parameter;
+    double low = INFINITY, high = -INFINITY, low_value = NAN, high_value = NAN;
+  };
+  std::vector<Bar> bars;
+  for (const auto& r : study.rows) {
+    if (r.parameter == "baseline" || !std::isfinite(r.eta_star)) continue;
+    auto it = std::find_if(bars.begin(), bars.end(), [&](const Bar& b) { return b.parameter == r.parameter; });
+    if (it == bars.end()) it = bars.insert(bars.end(), Bar{r.parameter});
+    if (r.eta_star < it->low) it->low = r.eta_star, it->low_value = r.value;
+    if (r.eta_star > it->high) it->high = r.eta_star, it->high_value = r.value;
+  }
+  std::sort(bars.begin(), bars.end(), [](const Bar& a, const Bar& b) { return a.high - a.low < b.high - b.low; });
+  std::ostringstream tornado;
+  tornado.precision(10);
+  tornado << "parameter,eta_star_low,eta_star_high,value_at_low,value_at_high\n";
+  for (const auto& b : bars) tornado << b.parameter << ',' << b.low << ',' << b.high << ',' << b.low_value << ',' << b.high_value << '\n';
+  out.add("sensitivity_tornado.csv", tornado.str());
+  const double baseline = study.baseline_eta_star;
+  std::ostringstream gp;
+  gp << "# tornado plot of pdamp sensitivity: eta* over each parameter's values; run: gnuplot sensitivity.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(study.case_name + ": sensitivity of eta* (one parameter at a time)") << " noenhanced\n"
+     << "set xlabel 'reduced loss factor {/Symbol h}*'\nset ytics noenhanced\nset grid x\nset key bottom right\n"
+     << "set offsets 0, 0, 0.5, 0.5\nset style fill solid 0.6 border -1\n"
+     << "set arrow from " << baseline << ", graph 0 to " << baseline << ", graph 1 nohead lc rgb 'black' dt 2\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900," << 200 + 45 * static_cast<int>(bars.size()) << " enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'sensitivity.svg' : 'sensitivity.png'\n"
+     << "  plot 'sensitivity_tornado.csv' every ::1 using (($2+$3)/2):($0):2:3:($0-0.3):($0+0.3):ytic(1) "
+        "with boxxyerror lc rgb 'steelblue' title 'range over the values', \\\n"
+     << "       NaN with lines dt 2 lc rgb 'black' title " << gnuplot_string("baseline " + format_number(baseline, 4)) << "\n"
+     << "}\n";
+  return out.add_plot("sensitivity.gp", gp.str(), {"sensitivity.png", "sensitivity.svg"});
+}
+
+Warnings write_files(OutputDir& out, const tasks::ModesResult& m) {
+  ModeTable table;
+  for (Eigen::Index j = 0; j < m.mode_count; ++j) {
+    table.frequency_hz.push_back(m.frequencies_with_containers_hz[j]);
+    table.bare_frequency_hz.push_back(m.modal.natural_frequencies_hz[j]);
+    table.damping_ratio.push_back(m.modal.damping_ratios[j]);
+  }
+  table.damper_names = m.damper_names;
+  table.mass_ratio = m.mass_ratio;
+  table.points = m.modal.points;
+  write_modes_table(out, table);
+  return write_backbone_files(out, m.backbones, m.layer_names,
+                              m.case_name + ": backbones (" + std::string(case_file::to_string(m.method)) + ")");
+}
+
+namespace {
+
+std::string csv_name(const std::string& name) { return safe_file_name(name); }
+
+Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
+  const auto& s = *r.stepped;
+  const auto& names = s.damper_names;
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "sweep,frequency_hz";
+  for (const auto& d : names) csv << ",magnitude_" << csv_name(d) << ",phase_deg_" << csv_name(d);
+  csv << ",magnitude_spread_" << csv_name(names.front()) << ",magnitude_standard_error_" << csv_name(names.front())
+      << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front())
+      << ",energy_error,transient_periods,stable,steps,time_step_s\n";
+  for (const auto& branch : s.branches)
+    for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending) {
+      csv << p->sweep << ',' << p->frequency_hz;
+      for (std::size_t d = 0; d < names.size(); ++d) csv << ',' << p->magnitude[d] << ',' << p->phase_deg[d];
+      csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
+          << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->bed_eta_star.front() << ','
+          << p->bed_apparent_mass_fraction.front() << ',' << p->energy_error << ',' << p->transient_periods << ','
+          << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->time_step_s << '\n';
+    }
+  out.add("frf_dem.csv", csv.str());
+  return write_frf_dem_plot(out, names, tasks::magnitude_label(r), r.case_name + ": stepped-sine DEM co-simulation");
+}
+
+Warnings linear_sweep_files(OutputDir& out, const tasks::FrfResult& r) {
+  const auto& l = *r.linear;
+  const auto& names = l.damper_names;
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "sweep,time_s,frequency_hz";
+  for (const auto& d : names) csv << ",magnitude_" << csv_name(d) << ",phase_deg_" << csv_name(d);
+  csv << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front()) << '\n';
+  for (const auto& s : l.sweeps)
+    for (const auto& cycle : s.cycles) {
+      csv << s.sweep << ',' << cycle.time_s << ',' << cycle.frequency_hz;
+      for (std::size_t d = 0; d < names.size(); ++d)
+        csv << ',' << cycle.site_amplitude_per_excitation[d] << ','
+            << std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
+      csv << ',' << cycle.bed_reduced_loss_factor.front() << ',' << cycle.bed_apparent_mass_fraction.front() << '\n';
+    }
+  out.add("frf_dem_sweep.csv", csv.str());
+  return write_frf_dem_sweep_plot(out, names, tasks::magnitude_label(r), r.case_name + ": linear-sweep DEM co-simulation");
+}
+
+Warnings compare_files(OutputDir& out, const tasks::FrfResult& r) {
+  std::vector<CompareDemPoint> dem_points;
+  for (const auto& branch : r.stepped->branches)
+    for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending)
+      dem_points.push_back({p->frequency_hz, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, branch.sweep});
+  return write_frf_compare_files(out, r.harmonic->response, r.field ? &r.field->response : nullptr, dem_points,
+                                 tasks::magnitude_label(r),
+                                 r.case_name + (r.field ? ": formulas, field and DEM" : ": formulas and DEM (no field)"));
+}
+
+}  // namespace
+
+Warnings write_files(OutputDir& out, const tasks::FrfResult& r) {
+  switch (r.method) {
+    case tasks::FrfMethod::kFormulas:
+    case tasks::FrfMethod::kField:
+      return write_frf_files(out, r.harmonic->response, r.harmonic->damper_names, tasks::magnitude_label(r),
+                             r.case_name + ": frequency response (" +
+                                 std::string(case_file::to_string(r.harmonic->method)) + ")");
+    case tasks::FrfMethod::kDem: return r.linear ? linear_sweep_files(out, r) : stepped_sine_files(out, r);
+    case tasks::FrfMethod::kCompare: return compare_files(out, r);
+  }
+  return {};
+}
+
+Warnings write_files(OutputDir& out, const tasks::DecayResult& r) {
+  if (r.method != tasks::DecayMethod::kDem)
+    return write_decay_files(out, r.decay, r.damper_names,
+                             r.case_name + ": free decay (" +
+                                 std::string(r.method == tasks::DecayMethod::kField ? "field" : "formulas") + ")");
+  const auto& decay = r.dem;
+  const auto& h = decay.cosimulation.history;
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "time_s";
+  for (const auto& d : r.damper_names) csv << ",site_displacement_m_" << csv_name(d);
+  csv << ",envelope_m";
+  for (Eigen::Index j = 0; j < r.modes; ++j) csv << ",q_mode" << j + 1;
+  for (const auto& d : r.damper_names) csv << ",site_rotation_rad_" << csv_name(d);
+  for (const auto& d : r.damper_names) csv << ",bed_force_n_" << csv_name(d);
+  csv << '\n';
+  for (std::size_t s = 0; s < h.time_s.size(); ++s) {
+    const auto row = static_cast<Eigen::Index>(s);
+    csv << h.time_s[s];
+    for (Eigen::Index d = 0; d < h.site_displacement_m.cols(); ++d) csv << ',' << h.site_displacement_m(row, d);
+    csv << ',' << decay.settling.sample_envelope_m[s];
+    for (Eigen::Index j = 0; j < h.modal_displacements.cols(); ++j) csv << ',' << h.modal_displacements(row, j);
+    for (Eigen::Index d = 0; d < h.site_rotation_rad.cols(); ++d) csv << ',' << h.site_rotation_rad(row, d);
+    for (Eigen::Index d = 0; d < h.container_load_n.cols(); ++d) csv << ',' << h.container_load_n(row, d);
+    csv << '\n';
+  }
+  out.add("decay_dem.csv", csv.str());
+  return write_decay_dem_plot(out, decay.static_offset_m, decay.threshold_m, decay.settling.settling_time_s,
+                              r.damper_names.size(), r.case_name + ": free decay (dem co-simulation)");
+}
+
+namespace {
+
+/// designs.csv (one row per design and layer), decay_compare.csv and its plot.
+Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
+  const auto& r = res.optimum;
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "design,layer,slabs,particles,filling_ratio,volume_fraction,clearance_m,bed_mass_kg,settling_time_s,objective\n";
+  const std::vector<std::pair<std::string, const opt::FillingDesign*>> designs = {
+      {"chosen", &r.chosen}, {"relaxed", &r.relaxed}, {"baseline", &r.baseline}, {"initial", &r.initial}};
+  for (const auto& [name, d] : designs)
+    for (const auto& l : d->layers)
+      csv << name << ',' << l.name << ',' << l.slabs << ',' << l.particles << ',' << l.filling_ratio << ','
+          << l.volume_fraction << ',' << l.clearance_m << ',' << l.bed_mass_kg << ','
+          << (std::isfinite(d->settling_time_s) ? d->settling_time_s : -1.0) << ',' << d->objective << '\n';
+  out.add("designs.csv", csv.str());
+
+  const auto& runs = res.comparison.decays;
+  std::ostringstream env;
+  env.precision(10);
+  env << "time_s,envelope_chosen_m,envelope_baseline_m,envelope_initial_m,threshold_m\n";
+  for (std::size_t i = 0; i < runs.front().samples.size(); ++i)
+    env << runs[0].samples[i].time_s << ',' << runs[0].samples[i].threshold_measure_m << ','
+        << runs[1].samples[i].threshold_measure_m << ',' << runs[2].samples[i].threshold_measure_m << ','
+        << runs[0].threshold_used_m << '\n';
+  out.add("decay_compare.csv", env.str());
+  std::ostringstream gp;
+  gp << "# free-decay envelopes of pdamp optimize (filling ratios); run: gnuplot decay_compare.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(res.case_name + ": chosen multi-layer design vs best single layer") << " noenhanced\n"
+     << "set xlabel 'time t / s'\nset ylabel 'envelope at the damper site / mm'\nset grid\nset key top right\n"
+     << "set logscale y\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'decay_compare.svg' : 'decay_compare.png'\n"
+     << "  plot 'decay_compare.csv' using 1:($2*1e3) every ::1 with lines lw 2 lc rgb 'blue' title 'chosen', \\\n"
+     << "       '' using 1:($3*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer', \\\n"
+     << "       '' using 1:($4*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'gray40' title 'case start', \\\n"
+     << "       '' using 1:($5*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
+     << "}\n";
+  return out.add_plot("decay_compare.gp", gp.str(), {"decay_compare.png", "decay_compare.svg"});
+}
+
+/// verify_decay.csv (one block per design: the DEM's site displacement and envelope and the
+/// predicted envelope at the same instants) and its plot.
+Warnings verification_files(OutputDir& out, const std::string& case_name, const tasks::Verification& v) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "# design, time_s, site_displacement_m (DEM), dem_envelope_m, predicted_envelope_m, threshold_m; "
+         "one block per design (chosen, then baseline), blocks separated by two blank lines\n";
+  csv << "design,time_s,site_displacement_m,dem_envelope_m,predicted_envelope_m,threshold_m\n";
+  for (std::size_t k = 0; k < v.designs.size(); ++k) {
+    const auto& d = v.designs[k];
+    if (k > 0) csv << "\n\n";
+    for (std::size_t i = 0; i < d.dem.time_s.size(); ++i)
+      csv << d.name << ',' << d.dem.time_s[i] << ',' << d.dem.site_displacement_m[i] << ','
+          << d.dem.settling.sample_envelope_m[i] << ',' << (i < d.predicted_envelope_m.size() ? d.predicted_envelope_m[i] : NAN)
+          << ',' << d.dem.threshold_m << '\n';
+  }
+  out.add("verify_decay.csv", csv.str());
+  std::ostringstream gp;
+  gp << "# DEM verification of pdamp optimize: envelopes, DEM against the closed forms; run: gnuplot verify_decay.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(case_name + ": DEM verification (DEM in the loop vs closed forms)") << " noenhanced\n"
+     << "set xlabel 'time t / s'\nset ylabel 'envelope at the damper site / mm'\nset grid\nset key top right\n"
+     << "set logscale y\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 900,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'verify_decay.svg' : 'verify_decay.png'\n"
+     << "  plot 'verify_decay.csv' index 0 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'blue' title 'chosen, DEM', \\\n"
+     << "       '' index 0 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'blue' title 'chosen, closed forms', \\\n"
+     << "       '' index 1 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer, DEM', \\\n"
+     << "       '' index 1 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'red' title 'best single layer, closed forms', \\\n"
+     << "       '' index 0 using 2:($6*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
+     << "}\n";
+  return out.add_plot("verify_decay.gp", gp.str(), {"verify_decay.png", "verify_decay.svg"});
+}
+
+}  // namespace
+
+Warnings write_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
+  Warnings warnings = design_files(out, res);
+  if (res.verification) append(warnings, verification_files(out, res.case_name, *res.verification));
+  return warnings;
+}
+
+Warnings write_files(OutputDir& out, const tasks::PlacementStudy& study) {
+  const auto& r = study.result;
+  const bool beam = study.beam;
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "site,position_m,objective";
+  for (const auto& m : r.best.modes) {
+    const std::string k = "mode" + std::to_string(m.mode + 1);
+    csv << ',' << k << "_frequency_hz," << k << "_damper_amplitude_m," << k << "_eta_star," << k
+        << "_added_damping_ratio," << k << "_rotation_ratio";
+  }
+  csv << '\n';
+  for (const auto& p : r.scan) {
+    csv << p.site << ',' << (beam ? p.position_m : NAN) << ',' << p.objective;
+    for (const auto& m : p.modes)
+      csv << ',' << m.natural_frequency_hz << ',' << m.damper_amplitude_m << ',' << m.eta_star << ','
+          << m.added_damping_ratio << ',' << (std::isfinite(m.rotation_ratio) ? m.rotation_ratio : -1.0);
+    csv << '\n';
+  }
+  out.add("placement.csv", csv.str());
+
+  std::ostringstream gp;
+  gp << "# added damping against the damper's site (pdamp optimize, task placement); run: gnuplot placement.gp\n"
+     << "set datafile separator ','\n"
+     << "set title " << gnuplot_string(study.case_name + ": damper placement") << " noenhanced\n"
+     << "set ylabel 'added damping ratio {/Symbol z}_{add} / %'\nset grid\nset key outside right top\n";
+  const std::string x = beam ? "2" : "0";  // the position, or the row number with the point's name as tic
+  if (beam) {
+    gp << "set xlabel 'damper position along the beam x / m'\n"
+       << "set xrange [" << r.scan.front().position_m << ":" << r.scan.back().position_m << "]\n"
+       << "set arrow from " << r.best.position_m << ", graph 0 to " << r.best.position_m
+       << ", graph 1 nohead lc rgb 'black' dt 2\n"
+       << "set label 'chosen' at " << r.best.position_m << ", graph 0.97 left offset 0.5,0\n";
+    if (r.current)
+      gp << "set arrow from " << r.current->position_m << ", graph 0 to " << r.current->position_m
+         << ", graph 1 nohead lc rgb 'gray50' dt 3\n"
+         << "set label 'case site' at " << r.current->position_m << ", graph 0.91 left offset 0.5,0 tc rgb 'gray40'\n";
+  } else {
+    gp << "set xlabel 'candidate point'\nset offsets 0.5, 0.5, 0, 0\n";
+  }
+  const std::string style = beam ? "with lines" : "with linespoints pt 7";
+  gp << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'placement.svg' : 'placement.png'\n"
+     << "  plot 'placement.csv' using " << x << ":($3*100)" << (beam ? "" : ":xticlabels(1)") << " every ::1 " << style
+     << " lw 3 lc rgb 'black' title "
+     << gnuplot_string(study.objective == opt::PlacementObjective::kWorstMode ? "objective (worst mode)"
+                                                                              : "objective (weighted mean)");
+  for (std::size_t k = 0; k < r.best.modes.size(); ++k) {
+    const int column = 4 + 5 * static_cast<int>(k) + 3;  // modeN_added_damping_ratio
+    gp << ", \\\n       '' using " << x << ":($" << column << "*100) every ::1 " << style << " lw 2 title "
+       << gnuplot_string("mode " + std::to_string(r.best.modes[k].mode + 1));
+  }
+  gp << "\n}\n";
+  return out.add_plot("placement.gp", gp.str(), {"placement.png", "placement.svg"});
+}
+
+}  // namespace pdamp::report
