@@ -1,0 +1,168 @@
+// The single-damper studies as library calls, without the binary: the closed forms, the
+// damper design, a formulas field and sensitivity study, and a DEM run stopped through
+// its hooks and resumed.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <string>
+
+#include "cli/cli_support.hpp"
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/tasks/closed_forms.hpp"
+#include "pdamp/tasks/damper_design.hpp"
+#include "pdamp/tasks/dem_run.hpp"
+#include "pdamp/tasks/field.hpp"
+#include "pdamp/tasks/sensitivity.hpp"
+#include "support/temp_dir.hpp"
+#include "tasks/executor_support.hpp"
+
+using namespace pdamp;
+using test::case_path;
+
+namespace {
+
+const case_file::Case& low_intensity() {
+  static const case_file::Case c = case_file::load_case(case_path("low_intensity_36_spheres.json"));
+  return c;
+}
+
+}  // namespace
+
+// Reference: the definitions of docs/physics.md §1, E_diss = η*·½ m_bed (XΩ)², the energy
+// per cycle 2π E_diss and c_eq = η* m_bed Ω, evaluated here from η* (rounding only: 1e-12).
+TEST_CASE("a loss point's energies follow from eta* by the complex-power definitions", "[tasks]") {
+  tasks::LossOptions o;
+  o.model = formulas::DamperModel::kAuto;
+  o.clearance_m = 0.1;
+  o.amplitude_m = 0.04;
+  o.frequency_hz = 2.0;
+  o.bed_mass_kg = 0.148;
+  o.with_curve = true;
+  const auto study = tasks::run_loss(o);
+  const double omega = 2.0 * M_PI * o.frequency_hz, v = o.amplitude_m * omega;
+  const double eta = study.point.loss.eta_star;
+  CHECK(study.point.e_diss_j == Approx(eta * 0.5 * 0.148 * v * v).epsilon(1e-12));
+  CHECK(study.point.energy_per_cycle_j == Approx(2.0 * M_PI * study.point.e_diss_j).epsilon(1e-12));
+  CHECK(study.point.equivalent_damping_n_s_m == Approx(eta * 0.148 * omega).epsilon(1e-12));
+  REQUIRE(study.curve.size() == 301);
+  CHECK(study.curve.front().stroke_m == Approx(0.02 * o.clearance_m));
+  CHECK(study.curve.back().stroke_m == Approx(1.5 * o.clearance_m));
+  o.bed_mass_kg.reset();
+  CHECK_THAT(tasks::run_loss(o).warnings.back(), Catch::Contains("1 kg bed"));
+}
+
+// Reference: size_for_stroke inverts optimum_stroke (the design stroke of the clearance it
+// returns is the target); 1e-9 is the root finder's tolerance.
+TEST_CASE("the clearance for a stroke has that stroke as its design stroke", "[tasks]") {
+  for (const auto model : {formulas::DamperModel::kRolling, formulas::DamperModel::kBouncing}) {
+    const auto sizing = tasks::size_for_stroke(model, 0.003, {});
+    CHECK(formulas::optimum_stroke(model, sizing.clearance_m, {}).x_opt_m == Approx(0.003).epsilon(1e-9));
+    CHECK(sizing.at.x_onset_m < sizing.stroke_m);
+  }
+}
+
+// Reference: the rolling design stroke is 0.4 h_roll (docs/physics.md §3, the design value
+// of the source study's experiments); the curve spans the case's design sweep.
+TEST_CASE("the damper design of the shipped low-intensity case is the rolling design stroke", "[tasks]") {
+  const auto& c = low_intensity();
+  const auto d = tasks::run_damper_design(c);
+  CHECK(d.family == formulas::DamperModel::kRolling);
+  CHECK(d.optimum.x_opt_m == Approx(0.4 * d.clearance_m).epsilon(1e-4));
+  REQUIRE(d.curve.size() == static_cast<std::size_t>(c.design.sweep_points));
+  CHECK(d.curve.front().stroke_m == Approx(c.design.sweep_min_over_clearance * d.clearance_m));
+  const auto j = tasks::to_json(d);
+  CHECK(j["optimum"]["x_opt_m"] == d.optimum.x_opt_m);
+  CHECK(j["task"] == "damper_design");
+}
+
+TEST_CASE("a study of one damper refuses a case of several layers, naming /dampers", "[tasks]") {
+  const auto c = case_file::load_case(case_path("manipulator_link_decay.json"));
+  try {
+    (void)tasks::run_damper_design(c);
+    FAIL("no error");
+  } catch (const strict_json::InputError& e) {
+    CHECK(e.pointer() == "/dampers");
+    CHECK_THAT(e.rule(), Catch::Contains("one damper of one layer"));
+  }
+}
+
+// Reference: formulas::reduced_loss_factor at each node's drive (the field is the closed
+// form sampled, nothing else); exact. The same sweep with every point computed through its
+// bytes ("another process") gives the same field.
+TEST_CASE("a formulas field is the closed form at every node, here or spread over processes", "[tasks]") {
+  const auto& c = low_intensity();
+  tasks::FieldOptions options;
+  const auto plan = tasks::plan_field(c, options, tasks::local_executor());
+  const auto here = tasks::run_field(c, plan, tasks::silent_hooks(), tasks::local_executor());
+  const auto& damper = c.dampers.front();
+  const double h = damper.layers.front().clearance_m;
+  REQUIRE(here.field.points.size() == plan.grid.size());
+  for (std::size_t k = 0; k < plan.grid.size(); ++k) {
+    const auto drive = surrogate::drive_point(plan.grid, k, h);
+    const auto loss = formulas::reduced_loss_factor(damper.model, h, drive.amplitude_m, drive.frequency_hz, damper.model_options);
+    CHECK(here.field.points[k].eta_star == loss.eta_star);
+  }
+  test::BytesExecutor elsewhere;
+  const auto spread = tasks::run_field(c, plan, tasks::silent_hooks(), elsewhere);
+  CHECK(elsewhere.jobs_elsewhere == static_cast<int>(plan.grid.size()));
+  CHECK(spread.field.points == here.field.points);
+  CHECK_FALSE(here.scattered_fit.has_value());  // a formulas field has no scattered state to fit
+}
+
+// Reference: the baseline variant is the case itself, so its eta* is the case's closed form
+// at the study's drive and its change 0; each variant's closed form is computed from its own
+// case (independently of the sweep).
+TEST_CASE("a formulas sensitivity study's baseline row is the case's closed form", "[tasks]") {
+  const auto& c = low_intensity();
+  tasks::SensitivityOptions options;
+  options.source = "formulas";
+  const auto plan = tasks::plan_sensitivity(c, options, tasks::local_executor());
+  const auto r = tasks::run_sensitivity(c, plan, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(r.rows.size() == plan.study.variants.size());
+  CHECK(r.rows.front().parameter == "baseline");
+  CHECK(r.rows.front().eta_star == r.rows.front().closed_form_eta_star);
+  CHECK(r.rows.front().delta_eta_star == 0.0);
+  for (const auto& row : r.rows) CHECK(row.eta_star == row.closed_form_eta_star);
+}
+
+namespace {
+
+/// Hooks that ask the run to stop at its first chance (as SIGINT would).
+struct StopAtOnce : tasks::RunHooks {
+  int stop_requested() override { return SIGINT; }
+};
+/// Hooks that save a checkpoint at every chance and never stop.
+struct SaveAlways : tasks::RunHooks {
+  bool checkpoint_due(double) override { return true; }
+};
+
+}  // namespace
+
+// Reference: the uninterrupted run of the same plan. A run asked to stop saves its state and
+// throws Interrupted; resumed from that state it gives the uninterrupted result to the bit
+// (the DEM is deterministic for a thread count).
+TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted run", "[tasks]") {
+  const auto& c = low_intensity();
+  tasks::DemRunOptions options;
+  options.analysed_periods = 2;
+  options.threads = 1;
+  const auto plan = tasks::plan_dem(c, options);
+  const auto reference = tasks::run_dem(c, plan, {}, tasks::silent_hooks());
+  const test::TempDir dir("tasks_dem_checkpoint");
+  const tasks::CheckpointFile file{dir.path / "dem.checkpoint", false};
+  StopAtOnce stop;
+  CHECK_THROWS_AS(tasks::run_dem(c, plan, file, stop), strict_json::Interrupted);
+  REQUIRE(std::filesystem::exists(file.path));
+  SaveAlways save;
+  const auto resumed = tasks::run_dem(c, plan, {file.path, true}, save);
+  CHECK(resumed.dem.eta_star == reference.dem.eta_star);
+  CHECK(resumed.dem.apparent_mass_kg == reference.dem.apparent_mass_kg);
+  CHECK(resumed.dem.series.force_n == reference.dem.series.force_n);
+  // A checkpoint of another run (here: other periods) is refused naming the file.
+  options.analysed_periods = 3;
+  CHECK_THROWS_AS(tasks::run_dem(c, tasks::plan_dem(c, options), {file.path, true}, save), strict_json::InputError);
+}

@@ -1,0 +1,78 @@
+// The structure studies as library calls, without the binary: modes, the harmonic-balance
+// frequency response and the averaged free decay of shipped cases.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "cli/cli_support.hpp"
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/tasks/decay.hpp"
+#include "pdamp/tasks/frf.hpp"
+#include "pdamp/tasks/modes.hpp"
+
+using namespace pdamp;
+using test::case_path;
+
+// Reference: the containers add mass and no stiffness, so every natural frequency with them
+// is below the bare one; μ = b² Σ m_bed / m_j is recomputed here from the result's drive
+// shapes, the case's bed masses and the modal masses (rounding only).
+TEST_CASE("modes: the containers lower every frequency, and the mass ratio is b^2 m_bed / m_j", "[tasks]") {
+  const auto c = case_file::load_case(case_path("beam_base_excited.json"));
+  const auto m = tasks::run_modes(c, {});
+  REQUIRE(m.mode_count >= 2);
+  double bed = 0.0;
+  for (const auto& l : c.dampers.front().layers) bed += l.bed_mass_kg;
+  for (Eigen::Index j = 0; j < m.mode_count; ++j) {
+    CHECK(m.frequencies_with_containers_hz[j] < m.modal.natural_frequencies_hz[j]);
+    const double b = m.drive_shapes(j, 0);
+    CHECK(m.mass_ratio(j, 0) == Approx(b * b * bed / m.modal.modal_masses_kg[j]).epsilon(1e-12));
+  }
+  CHECK(m.backbone_of_mode.count(0) == 1);
+  CHECK(tasks::to_json(m, {})["modes"].size() == static_cast<std::size_t>(m.mode_count));
+}
+
+// Reference: the linear response without beds peaks at the first natural frequency with the
+// containers (a lightly damped mode, ζ = 0.3%); 0.5% is two steps of the task's frequency grid.
+TEST_CASE("frf: the response without beds peaks at the first natural frequency with the containers", "[tasks]") {
+  const auto c = case_file::load_case(case_path("beam_base_excited.json"));
+  const auto r = tasks::run_frf(c, {}, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(r.harmonic.has_value());
+  const auto& response = r.harmonic->response;
+  REQUIRE_FALSE(response.linear_peaks.empty());
+  const auto modes = tasks::run_modes(c, {});
+  CHECK(response.linear_peaks.front().frequency_hz == Approx(modes.frequencies_with_containers_hz[0]).epsilon(5e-3));
+  // The beds damp the resonance: a lower peak than without them.
+  REQUIRE(tasks::first_output_peak(response) != nullptr);
+  CHECK(tasks::first_output_peak(response)->magnitude < response.linear_peaks.front().magnitude);
+  CHECK(tasks::to_json(r, {})["peaks"].size() == response.peaks.size());
+}
+
+TEST_CASE("frf and decay refuse a case whose task is of another kind, naming /task", "[tasks]") {
+  const auto decay_case = case_file::load_case(case_path("manipulator_link_decay.json"));
+  CHECK_THROWS_AS(tasks::run_frf(decay_case, {}, tasks::silent_hooks(), tasks::local_executor()), strict_json::InputError);
+  const auto frf_case = case_file::load_case(case_path("beam_base_excited.json"));
+  try {
+    (void)tasks::run_decay(frf_case, {}, tasks::silent_hooks());
+    FAIL("no error");
+  } catch (const strict_json::InputError& e) {
+    CHECK(e.pointer() == "/task");
+  }
+}
+
+// Reference: energy conservation. The averaged decay integrates the dissipated energies with
+// the amplitudes, so the initial mechanical energy is the final one plus what the structure
+// and each layer dissipated, to the integrator's accuracy (the shipped link closes to 5e-12).
+TEST_CASE("decay: the initial energy is the final energy plus what the structure and the layers dissipated", "[tasks]") {
+  const auto c = case_file::load_case(case_path("manipulator_link_decay.json"));
+  const auto r = tasks::run_decay(c, {}, tasks::silent_hooks());
+  const auto& first = r.decay.samples.front();
+  const auto& last = r.decay.samples.back();
+  double dissipated = last.structural_dissipated_energy_j;
+  for (double e : last.layer_dissipated_energy_j) dissipated += e;
+  CHECK(first.mechanical_energy_j == Approx(last.mechanical_energy_j + dissipated).epsilon(1e-9));
+  CHECK(std::isfinite(r.decay.settling_time_s));
+  const auto j = tasks::to_json(r, {});
+  CHECK(j["settling_time_s"] == r.decay.settling_time_s);
+  CHECK(j["decay"]["file"].is_null());
+}
