@@ -101,6 +101,7 @@ Case read_case(const json& root, const std::string& path) {
   if (!root.is_object()) throw CaseError(path, "", std::string("must be a JSON object, got ") + root.type_name());
   Case c;
   c.path = path;
+  c.document = root;
   ObjectReader r(path, root, "", c.resolved);
   c.format_version = r.integer("format_version", 1, 1, 2);
   c.name = r.text("name", std::nullopt);

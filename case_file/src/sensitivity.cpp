@@ -110,7 +110,7 @@ std::vector<SensitivityVariant> sensitivity_variants(const Case& c, std::vector<
   if (c.dampers.size() != 1 || c.dampers.front().layers.size() != 1)
     throw CaseError(c.path, "/dampers", "pdamp sensitivity studies one damper of one layer (this case has " +
                                             std::to_string(c.dampers.size()) + " dampers)");
-  const json original = strict_json::parse_json_document(strict_json::read_input_file(c.path), c.path);
+  const json& original = c.document;
   const bool constant_restitution = c.resolved.contains("dem") && c.resolved["dem"].contains("contact") &&
                                     c.resolved["dem"]["contact"].value("restitution", json()).is_number();
   const bool given = c.sensitivity && !c.sensitivity->parameters.empty();

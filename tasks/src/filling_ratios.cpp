@@ -4,7 +4,6 @@
 #include <chrono>
 #include <sstream>
 
-#include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/strict_json/input_error.hpp"
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
@@ -52,40 +51,6 @@ namespace {
 
 /// Instants of the comparison decays (decay_compare.csv).
 constexpr int kComparisonSamples = 2001;
-
-/// The case with the first damper's layers holding design `d`'s whole slabs (layers of
-/// 0 slabs left out) and the verification's further softening on every DEM material: what
-/// the DEM builds for that design. The lattice is the case's (auto or explicit transverse
-/// counts), n slabs along the drive, so h = L − n·2r as the optimiser has it.
-Case design_case(const Case& c, const opt::FillingDesign& d, double softening) {
-  const case_file::FillingRatiosTask& task = *c.task.filling_ratios;
-  Case out = c;
-  case_file::DamperSpec& damper = out.dampers.front();
-  std::vector<case_file::LayerSpec> kept;
-  for (std::size_t k = 0; k < damper.layers.size(); ++k) {
-    const long slabs = std::lround(d.layers.at(k).slabs);
-    if (slabs <= 0) continue;
-    case_file::LayerSpec layer = damper.layers[k];
-    layer.particle_count = static_cast<int>(slabs) * task.spheres_per_slab.at(k);
-    if (layer.packing.lattice_counts) {
-      (*layer.packing.lattice_counts)[static_cast<std::size_t>(damper.drive_axis)] = static_cast<int>(slabs);
-      layer.compartment.lattice_counts.assign(layer.packing.lattice_counts->begin(), layer.packing.lattice_counts->end());
-    }
-    try {
-      layer.bed = formulas::collected_lattice(layer.container, layer.particle_count, layer.particle_radius_m, layer.packing);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(c.path, "/dampers/0/layers/" + std::to_string(k) + "/particles",
-                       "the verified design's " + std::to_string(layer.particle_count) + " spheres: " + e.what());
-    }
-    layer.clearance_m = layer.bed.settled_clearance_m;
-    layer.bed_mass_kg = d.layers[k].bed_mass_kg;
-    layer.compartment.particles.front().count = layer.particle_count;
-    kept.push_back(std::move(layer));
-  }
-  damper.layers = std::move(kept);
-  for (auto& m : out.dem.simulation.world.materials) m.material.youngs_modulus_pa *= softening;
-  return out;
-}
 
 bool settling_objective(const case_file::FillingRatioProblem& p) {
   return p.options.objective == opt::FillingObjective::kSettlingTime;
@@ -150,7 +115,9 @@ DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const 
 VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
                                  const std::string& name, const opt::FillingDesign& design,
                                  const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
-  const Case dc = design_case(c, design, verify.stiffness_softening);
+  std::vector<long> slabs;
+  for (const auto& l : design.layers) slabs.push_back(std::lround(l.slabs));
+  const Case dc = case_file::with_design(c, slabs, verify.stiffness_softening);
   std::vector<st::Damper> containers = {p.options.damper};
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
   case_file::DecayTask decay = c.task.filling_ratios->decay;

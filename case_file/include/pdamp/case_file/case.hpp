@@ -254,6 +254,7 @@ struct Case {
   DemSpec dem;
   FieldSpec field;
   nlohmann::json resolved;  ///< the case with every default resolved and derived values added
+  nlohmann::json document;  ///< the case as read (its variants and designs are read again from it)
 };
 
 /// Reads and validates a case file (format 1 or 2). CaseError names the file, the JSON
@@ -262,6 +263,15 @@ Case load_case(const std::string& path);
 /// The same for a document already parsed (a variant of a case's JSON), read as if it were
 /// the file at `path` (relative paths in it resolve against that file's folder).
 Case load_case_document(const nlohmann::json& document, const std::string& path);
+
+/// The case of a filling_ratios task with its first damper's layers holding `slabs[k]` whole
+/// slabs each (a layer of 0 slabs left out; explicit lattices get the count along the drive)
+/// and every DEM Young's modulus further times `stiffness_softening` (the verification's),
+/// read again by the case reader from the case's document: the layers' beds, clearances and
+/// masses, the resolved JSON and the physics hash are the design's own, and a design the
+/// reader refuses is a CaseError naming the layer's key. Cases are not changed after loading:
+/// a design is a new case.
+Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening = 1.0);
 
 /// One case of a sensitivity study: the parameter varied, its value, and the case with it.
 struct SensitivityVariant {

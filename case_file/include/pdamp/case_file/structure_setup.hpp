@@ -1,5 +1,16 @@
 // The runtime models of a format-2 case (docs/cases.md "Format 2"): the structure's modal
 // model and its dampers, each layer with the loss model a structure solver asks.
+//
+// How a damper's shapes convert (one direction, from the case):
+//   case_file::DamperSpec (case.hpp: what the case file says, read and derived once)
+//     -> structure::Damper           structure_setup(): site, drive, container mass, and per
+//                                    layer the loss model of --method (the averaging solvers)
+//     -> structure::CosimulationDamper  cosimulation_damper(): the same site and container, the
+//                                    bed as a DEM World (the DEM in the loop)
+//     -> optimizer::LayerCandidate   filling_ratio_problem() (filling_ratio_problem.hpp): each
+//                                    layer's slabs, sphere mass and length for the optimiser
+//   and back: a design of slabs becomes a case of its own with with_design() (case.hpp),
+//   read again by the reader, so its beds and hashes are derived in one place.
 #pragma once
 
 #include <optional>
