@@ -1,4 +1,4 @@
-// Checkpointed DEM runs from the command line (issue 13 §4): pdamp decay --method dem killed
+// Checkpointed DEM runs from the command line: pdamp decay --method dem killed
 // mid-way and resumed gives the uninterrupted run's result to the bit; checkpoints of another
 // case or settings, damaged ones and misplaced flags are exit 2 naming the file or flag.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// Distributed sweeps (issue 13 §1, docs/distributed.md). The unit part runs in every
+// Distributed sweeps (docs/distributed.md). The unit part runs in every
 // build; the [mpi] part exists in an MPI build (-DPDAMP_MPI=ON) and runs pdamp under
 // mpirun with 2 ranks on this machine (loopback; CTest label `mpi`, run by .ci/run).
 #include <signal.h>

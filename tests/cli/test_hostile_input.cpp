@@ -1,4 +1,4 @@
-// Hostile and nonsensical input (issue 8, docs/bad_inputs.md): no command runs from a
+// Hostile and nonsensical input (docs/bad_inputs.md): no command runs from a
 // case file or a path, nothing hangs, every refusal is exit 2 with one line naming the
 // file or flag and the key, and an interrupted run leaves no partial result.
 #include <fcntl.h>

@@ -76,8 +76,8 @@ TEST_CASE("pdamp optimize chooses whole slabs per layer and reports the relaxed,
 TEST_CASE("the optimised three-layer design settles faster than the best single layer of the same mass",
           "[cli][optimizer]") {
   // Independent reference: the baseline is the exhaustive best over layer and slab count
-  // with all the budget in one layer; the chosen design must beat it outright (the issue's
-  // claim, PHYSICS.md §7: layers of different clearance take over one after another).
+  // with all the budget in one layer; the chosen design must beat it outright (the design's
+  // claim, docs/physics.md §7.7: layers of different clearance take over one after another).
   const json r = run_json({"optimize", case_path(kCase), "--no-verify"});
   const double chosen = r["designs"]["chosen"]["settling_time_s"].get<double>();
   const double single = r["designs"]["baseline"]["settling_time_s"].get<double>();
@@ -116,7 +116,7 @@ TEST_CASE("pdamp optimize exits 2 naming the key for a bad budget, layer or back
   require_one_line_error(run_pdamp({"optimize", case_path("manipulator_link_decay.json")}), "/task");
 }
 
-// DEM verification (issue 12 §3) on the shipped case cut short: 0.7 s of decay (2.5 periods
+// DEM verification on the shipped case cut short: 0.7 s of decay (2.5 periods
 // of the 3.6 Hz first mode) with the contacts softened 1e-4, and a short relaxed solve, so
 // that both DEM runs (chosen and baseline) take about a second each. Independent
 // references: the static tip deflection of the cantilever F L³/(3EI) (the initial
@@ -196,7 +196,7 @@ TEST_CASE("the task's verification is skipped with --no-verify, and --verify wit
   require_one_line_error(run_pdamp({"optimize", path, "--verify", "--no-verify"}), "--verify");
 }
 
-// Reference: the DEM in the loop (issue 12 §5): the shipped optimisation's chosen design must
+// Reference: the DEM in the loop: the shipped optimisation's chosen design must
 // settle faster than the best single layer by the closed forms and by the DEM verification
 // the case asks for (35 s, contacts softened 1e-3: docs/optimizer.md measures 1e-2 alike).
 // The DEM settles the chosen design in 31.0 s and leaves the baseline at 0.66 mm > 0.45 mm.

@@ -1,4 +1,4 @@
-// pdamp sensitivity (issue 13 §3): rows per variant, files, the DEM study resumed from its
+// pdamp sensitivity: rows per variant, files, the DEM study resumed from its
 // log, a tilt about gravity that changes nothing, and bad input as exit 2.
 #include <catch2/catch.hpp>
 

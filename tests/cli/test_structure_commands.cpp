@@ -408,13 +408,13 @@ TEST_CASE("pdamp frf --method dem with two dampers gives each output its peak", 
 /// that on a loaded one.
 constexpr double kLongTimeLimit_s = 900.0;
 
-// Issue 11's cross-method agreement on the shipped cases, the reduced version CI runs.
+// The cross-method agreement on the shipped cases, the reduced version CI runs.
 // Beam: the shipped case (E/100; the full-stiffness sweep gives the same plateau within the
 // bed's chaos, docs/structure_cli.md), 10 points over 1.3-2.2 Hz up and down (about a minute
 // on two cores). The DEM's top is a plateau flat within its scatter, so its argmax is only
 // known to lie among the points within two standard errors of the largest: the harmonic
 // balance's peak frequency must lie in that range (the DEM cannot place it closer), its
-// magnitude within 20% of the DEM's (the issue's bound; measured −4% to +6% for the formulas,
+// magnitude within 20% of the DEM's (the required agreement; measured −4% to +6% for the formulas,
 // −8% to −17% for the field at full stiffness).
 TEST_CASE("shipped beam: the harmonic balance's peaks agree with the DEM stepped sine", "[cli][structure][dem][long]") {
   const std::string cases = std::string(PDAMP_SOURCE_DIR) + "/cases/";
@@ -433,7 +433,7 @@ TEST_CASE("shipped beam: the harmonic balance's peaks agree with the DEM stepped
 }
 
 // Link: the decay by averaging on the layers' DEM fields against the DEM in the loop, at full
-// stiffness as shipped (about a minute): settling time within the issue's 25% (measured
+// stiffness as shipped (about a minute): settling time within the required 25% (measured
 // +23%). The closed forms settle later (+60% measured): below their rolling onset (0.376 h)
 // they see no dissipation where the packed 2 × 4 lattices already collect and collide at
 // 0.27-0.29 h (docs/structure_cli.md) — the known bias this checks the sign of.
