@@ -1,7 +1,7 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
-#include "root_finding.hpp"
+#include "pdamp/formulas/root_finding.hpp"
 #include "pdamp/formulas/csv_text.hpp"
 #include "pdamp/formulas/input_file.hpp"
 
@@ -830,7 +830,7 @@ double damping_for_restitution(double restitution) {
   }
   // |Δ ln ε| < 1e-10 gives |Δε| < 1e-10: inside the 1e-9 promise with the
   // integrator's own ~1e-11 error.
-  const double u = detail::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-10, 1e-15, 200);
+  const double u = illinois_root(residual, lo, f_lo, hi, f_hi, 1e-10, 1e-15, 200);
   return std::expm1(u);
 }
 

@@ -1,7 +1,7 @@
 // Sphere on an elastic layer bonded to a rigid wall: kernel, thin-layer limits, exact Nyström solution, table.
 #include "pdamp/formulas/layered_contact.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
-#include "root_finding.hpp"
+#include "pdamp/formulas/root_finding.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -670,7 +670,7 @@ double layered_damping_for_restitution(const LayeredContact& contact, double mas
   };
   double lo = 0.0, f_lo = -target, hi = std::log1p(100.0), f_hi = residual(hi);
   if (f_hi > 0.0) throw strict_json::NumericalError("layered_damping_for_restitution: not reached at damping 100");
-  const double u = detail::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
+  const double u = illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
   return std::min(std::expm1(u), 100.0);
 }
 

@@ -1,5 +1,7 @@
 // Filling ratios of a multi-layer damper: relaxed solve, rounded neighbours, baseline.
 #include "pdamp/optimizer/filling_ratios.hpp"
+
+#include "pdamp/structure/sampled_decay.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
 
 #include <algorithm>
@@ -162,23 +164,16 @@ FillingDesign evaluate_filling_design(const structure::ModalModel& model, const 
 
   structure::FreeDecayOptions decay = options.decay;
   const bool integral = options.objective == FillingObjective::kIntegralSquare;
-  const int samples = integral ? options.integral_samples : 2;
-  decay.sample_times_s.resize(static_cast<std::size_t>(samples));
-  for (int i = 0; i < samples; ++i) decay.sample_times_s[static_cast<std::size_t>(i)] = decay.duration_s * i / (samples - 1);
-  decay.sample_times_s.back() = decay.duration_s;
+  decay.sample_times_s = structure::uniform_sample_times(decay.duration_s, integral ? options.integral_samples : 2);
   const auto result = structure::free_decay(model, dampers, decay);
 
   design.settled = result.outcome == structure::FreeDecay::Outcome::kSettled;
   design.settling_time_s = result.settling_time_s;
   design.integral_square_m2_s = std::numeric_limits<double>::quiet_NaN();
   if (integral) {
-    double sum = 0.0;
-    for (std::size_t i = 1; i < result.samples.size(); ++i) {
-      const auto& a = result.samples[i - 1];
-      const auto& b = result.samples[i];
-      sum += 0.25 * (b.time_s - a.time_s) *
-             (a.threshold_measure_m * a.threshold_measure_m + b.threshold_measure_m * b.threshold_measure_m);
-    }
+    std::vector<double> t, e;
+    for (const auto& sample : result.samples) t.push_back(sample.time_s), e.push_back(sample.threshold_measure_m);
+    const double sum = structure::half_integral_square(t, e);
     design.integral_square_m2_s = sum;
     design.objective = sum;
   } else if (design.settled) {

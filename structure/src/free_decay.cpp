@@ -311,14 +311,25 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
   result.outcome = settled ? FreeDecay::Outcome::kSettled : FreeDecay::Outcome::kNotSettled;
   if (settled && result.settling_time_s > 0.0) {
     const BackbonePoint p = backbone_point(coupled, result.dominant_mode, a0[dominant]);  // f_d at the start
-    const double cycles = p.damped_frequency_hz * result.settling_time_s;
-    const double decrement = std::log(measure0 / result.threshold_used_m) / cycles;
-    result.equivalent_damping_ratio = decrement / std::sqrt(kTwoPi * kTwoPi + decrement * decrement);
+    result.equivalent_damping_ratio =
+        equivalent_damping_ratio(measure0, result.threshold_used_m, p.damped_frequency_hz, result.settling_time_s);
   } else {
     result.equivalent_damping_ratio = kNaN;
   }
   result.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
+}
+
+double equivalent_damping_ratio(double initial, double threshold, double frequency_hz, double settling_time_s) {
+  const double decrement = std::log(initial / threshold) / (frequency_hz * settling_time_s);
+  return decrement / std::sqrt(kTwoPi * kTwoPi + decrement * decrement);
+}
+
+std::vector<double> uniform_sample_times(double duration_s, int count) {
+  std::vector<double> t(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) t[static_cast<std::size_t>(i)] = static_cast<double>(i) / (count - 1) * duration_s;
+  t.back() = duration_s;
+  return t;
 }
 
 }  // namespace pdamp::structure

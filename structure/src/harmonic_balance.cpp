@@ -10,6 +10,8 @@
 //   (I + G·diag Z(X)) y = y_lin,   X_d = |y_d|,
 // a D-dimensional problem whatever the number of modes.
 #include "pdamp/structure/harmonic_balance.hpp"
+
+#include "pdamp/formulas/root_finding.hpp"
 #include "pdamp/structure/sampled_response.hpp"
 #include "numbers.hpp"
 
@@ -234,32 +236,20 @@ class FrequencyOperator {
   std::size_t evaluations_ = 0;
 };
 
-/// Root of a continuous residual with f(lo) and f(hi) of opposite signs, in ln X: regula
-/// falsi with the Illinois update (Dowell & Jarratt 1971), superlinear where plain regula
-/// falsi stalls; stops at a bracket narrower than the relative tolerance.
+/// Root of a continuous residual with f(lo) and f(hi) of opposite signs, in ln X: the
+/// Illinois regula falsi (formulas::IllinoisBracket) with a bisection step where the secant
+/// leaves the bracket; stops at a bracket narrower than the relative tolerance.
 template <class Residual>
 double illinois_log_root(Residual&& residual, double lo, double f_lo, double hi, double f_hi, double tolerance) {
-  double a = std::log(lo), b = std::log(hi);
-  int side = 0;
-  double x = b;
-  for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
-    x = (a * f_hi - b * f_lo) / (f_hi - f_lo);
-    if (!(x > a && x < b)) x = 0.5 * (a + b);
+  formulas::IllinoisBracket bracket{std::log(lo), f_lo, std::log(hi), f_hi};
+  for (int iteration = 0; iteration < 200 && bracket.hi - bracket.lo > tolerance; ++iteration) {
+    double x = bracket.secant();
+    if (!(x > bracket.lo && x < bracket.hi)) x = 0.5 * (bracket.lo + bracket.hi);
     const double f = residual(std::exp(x));
     if (f == 0.0) return std::exp(x);
-    if ((f > 0.0) == (f_lo > 0.0)) {
-      a = x;
-      f_lo = f;
-      if (side == -1) f_hi *= 0.5;
-      side = -1;
-    } else {
-      b = x;
-      f_hi = f;
-      if (side == 1) f_lo *= 0.5;
-      side = 1;
-    }
+    bracket.update(x, f);
   }
-  return std::exp(0.5 * (a + b));
+  return std::exp(0.5 * (bracket.lo + bracket.hi));
 }
 
 /// A smooth piece of the stroke axis: [lo, hi] with the pieces' indices counted from the

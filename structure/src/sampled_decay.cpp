@@ -1,6 +1,8 @@
 // Measures of a sampled decay (sampled_decay.hpp).
 #include "pdamp/structure/sampled_decay.hpp"
 
+#include "pdamp/structure/free_decay.hpp"
+
 #include <algorithm>
 #include <numbers>
 #include <optional>
@@ -58,10 +60,8 @@ SampledSettling sampled_settling(const std::vector<double>& t, const Eigen::Vect
   out.frequency_hz = crossings.size() >= 3
                          ? 0.5 * static_cast<double>(crossings.size() - 1) / (crossings.back() - crossings.front())
                          : fallback_frequency_hz;
-  if (std::isfinite(out.settling_time_s) && out.settling_time_s > 0.0) {
-    const double decrement = std::log(initial_m / threshold_m) / (out.frequency_hz * out.settling_time_s);
-    out.damping_ratio = decrement / std::sqrt(4.0 * std::numbers::pi * std::numbers::pi + decrement * decrement);
-  }
+  if (std::isfinite(out.settling_time_s) && out.settling_time_s > 0.0)
+    out.damping_ratio = equivalent_damping_ratio(initial_m, threshold_m, out.frequency_hz, out.settling_time_s);
   return out;
 }
 

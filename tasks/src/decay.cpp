@@ -200,7 +200,7 @@ void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& 
   options.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
   options.duration_s = task.duration_s;
   options.threshold_fraction = task.settling_threshold;
-  options.sample_times_s = detail::spaced(0.0, task.duration_s, static_cast<int>(decay_samples(modal, task.duration_s)) + 1, false);
+  options.sample_times_s = st::uniform_sample_times(task.duration_s, static_cast<int>(decay_samples(modal, task.duration_s)) + 1);
   if (const auto problems = options.validate(modal.mode_count()); !problems.empty())
     throw InputError(c.path, "/task", problems.front());
   out.decay = detail::call_solver(c, "/task", [&] { return st::free_decay(modal, setup.s.dampers, options); });

@@ -279,10 +279,7 @@ json verification_json(const Verification& v) {
 /// The closed-form envelopes of the chosen, baseline and starting designs on one grid.
 DesignComparison compare_designs(const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r) {
   st::FreeDecayOptions decay = p.options.decay;
-  decay.sample_times_s.resize(kComparisonSamples);
-  for (int i = 0; i < kComparisonSamples; ++i)
-    decay.sample_times_s[static_cast<std::size_t>(i)] = decay.duration_s * i / (kComparisonSamples - 1);
-  decay.sample_times_s.back() = decay.duration_s;
+  decay.sample_times_s = st::uniform_sample_times(decay.duration_s, kComparisonSamples);
   DesignComparison out;
   for (const auto* d : {&r.chosen, &r.baseline, &r.initial}) {
     std::vector<st::Damper> dampers = {opt::filling_damper(p.options, slabs_of(*d))};

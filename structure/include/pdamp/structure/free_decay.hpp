@@ -76,4 +76,12 @@ struct FreeDecay {
 /// the per-layer dissipated energies. Throws std::invalid_argument for invalid inputs.
 FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers, const FreeDecayOptions& options);
 
+/// The equivalent viscous damping ratio of a decay that falls from `initial` to `threshold`
+/// in `settling_time_s` at `frequency_hz`: ζ_eq = δ/√(4π² + δ²), δ = ln(initial/threshold)/(f t_s)
+/// the logarithmic decrement per cycle (a linear mode gives its own ζ).
+double equivalent_damping_ratio(double initial, double threshold, double frequency_hz, double settling_time_s);
+
+/// `count` instants evenly spaced over [0, duration_s], both ends included exactly.
+std::vector<double> uniform_sample_times(double duration_s, int count);
+
 }  // namespace pdamp::structure
