@@ -10,6 +10,7 @@
 #include "../tests/optimizer/cliff_problem.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/filling_ratio_problem.hpp"
+#include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/optimizer/clearance_on_structure.hpp"
 #include "pdamp/optimizer/filling_ratios.hpp"
@@ -96,6 +97,30 @@ void BM_FillingRatios(benchmark::State& state, opt::Backend backend) {
 }
 BENCHMARK_CAPTURE(BM_FillingRatios, nlopt, opt::Backend::kNlopt)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_FillingRatios, ipopt, opt::Backend::kIpopt)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// The shipped optimisation with its DEM verification (tasks::run_filling_ratios, as `pdamp
+/// optimize cases/manipulator_link_optimize.json` without files): the two DEM-in-the-loop
+/// decays of the chosen and baseline designs on two threads, `verify_duration_s` simulated
+/// each at the case's softening. Counters: the two decays' steps per wall second.
+void BM_FillingRatiosVerified(benchmark::State& state, double verify_duration_s) {
+  namespace cf = pdamp::case_file;
+  const cf::Case shipped = cf::load_case(std::string(PDAMP_SOURCE_DIR) + "/cases/manipulator_link_optimize.json");
+  nlohmann::json document = shipped.document;
+  document["task"]["verify"]["duration_s"] = verify_duration_s;
+  const cf::Case c = cf::load_case_document(document, shipped.path);
+  double steps = 0.0, dem_wall_s = 0.0;
+  for (auto _ : state) {
+    const auto r = pdamp::tasks::run_filling_ratios(c, {}, pdamp::tasks::silent_hooks(), pdamp::tasks::local_executor());
+    for (const auto& d : r.verification->designs) {
+      steps += static_cast<double>(d.dem.steps);
+      dem_wall_s += d.dem.wall_time_s;
+    }
+    benchmark::DoNotOptimize(r.verification->passed);
+  }
+  state.counters["dem_steps_per_s"] = benchmark::Counter(steps / dem_wall_s);
+}
+BENCHMARK_CAPTURE(BM_FillingRatiosVerified, two_s, 2.0)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_CAPTURE(BM_FillingRatiosVerified, shipped_35_s, 35.0)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 /// The base-excited beam of cases/beam_base_excited.json (tests/optimizer/beam_problem.hpp):
 /// 3 modes, the damper's weight on the
