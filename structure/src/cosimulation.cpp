@@ -455,7 +455,7 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
                               const CosimulationProgressCallback& progress) {
   Cosimulation run(model, dampers, options, std::move(state), progress);
   run.advance(std::numeric_limits<std::int64_t>::max());
-  CosimulationResult result = run.result();
+  CosimulationResult result = std::move(run).result();
   state = std::move(run).take_state();
   return result;
 }

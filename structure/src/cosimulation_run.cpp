@@ -58,6 +58,8 @@ class RunMeasure {
   virtual void after_step(const StepView& s, std::int64_t& end_step) = 0;
   /// Its part of the result after `steps` steps of the run.
   virtual void write(CosimulationResult& result, std::int64_t steps) const = 0;
+  /// The same, moving out what is large; the measure is spent afterwards.
+  virtual void release(CosimulationResult& result, std::int64_t steps) { write(result, steps); }
   /// The progress stage it is in ("decay", "transient", "analysis", "sweep").
   virtual std::string_view stage() const = 0;
 };
@@ -118,6 +120,14 @@ class SampledHistory final : public RunMeasure {
     h.site_rotation_rad = history_.site_rotation_rad.topRows(samples_);
     h.container_load_n = history_.container_load_n.topRows(samples_);
     h.container_moment_nm = history_.container_moment_nm.topRows(samples_);
+  }
+
+  void release(CosimulationResult& result, std::int64_t) override {
+    auto& h = history_;
+    for (auto* m : {&h.modal_displacements, &h.site_displacement_m, &h.site_rotation_rad, &h.container_load_n,
+                    &h.container_moment_nm})
+      m->conservativeResize(samples_, m->cols());
+    result.history = std::move(h);
   }
 
   std::string_view stage() const override { return "decay"; }
@@ -342,7 +352,8 @@ struct Cosimulation::Impl {
 
   std::int64_t advance(std::int64_t steps);
   bool finished() const { return outcome_ != dem::Outcome::kCompleted || step_ >= end_step_; }
-  CosimulationResult result() const;
+  /// The run so far; `release`: the measures' large parts moved out (the run is spent).
+  CosimulationResult result(bool release);
   void sync_state();
 
   // --- Inputs.
@@ -882,7 +893,7 @@ CosimulationEnergy Cosimulation::Impl::ledger(double work, double damping, doubl
   return e;
 }
 
-CosimulationResult Cosimulation::Impl::result() const {
+CosimulationResult Cosimulation::Impl::result(bool release) {
   CosimulationResult r;
   r.outcome = outcome_;
   r.message = message_;
@@ -896,7 +907,13 @@ CosimulationResult Cosimulation::Impl::result() const {
   r.frequencies_with_containers_hz = frequencies_with_containers_hz_;
   r.final_modal_displacements = q_;
   r.final_modal_velocities = v_;
-  for (const auto& measure : measures_) measure->write(r, step_);
+  for (const auto& measure : measures_) {
+    if (release) {
+      measure->release(r, step_);
+    } else {
+      measure->write(r, step_);
+    }
+  }
   const auto [kinetic_end, potential_end] = structure_energy_now();
   r.energy = ledger(work_, damping_, kinetic0_, potential0_, opening_, kinetic_end, potential_end);
   for (const auto& world : state_.worlds) {
@@ -971,9 +988,14 @@ bool Cosimulation::finished() const { return impl_->finished(); }
 std::int64_t Cosimulation::steps_done() const { return impl_->step_; }
 std::int64_t Cosimulation::total_steps() const { return impl_->end_step_; }
 double Cosimulation::time_step_s() const { return impl_->dt_; }
-CosimulationResult Cosimulation::result() const {
+CosimulationResult Cosimulation::result() const& {
   if (impl_->state_.worlds.empty()) throw std::logic_error("Cosimulation::result: the state was handed over");
-  return impl_->result();
+  return impl_->result(false);
+}
+
+CosimulationResult Cosimulation::result() && {
+  if (impl_->state_.worlds.empty()) throw std::logic_error("Cosimulation::result: the state was handed over");
+  return impl_->result(true);
 }
 
 const CosimulationState& Cosimulation::state() const {

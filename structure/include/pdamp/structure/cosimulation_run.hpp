@@ -62,7 +62,10 @@ class Cosimulation {
 
   /// The run so far, as cosimulate() of this length returns it (steady state: the analysed
   /// periods completed; a continuation's stage times and wall time are this run's).
-  CosimulationResult result() const;
+  CosimulationResult result() const&;
+  /// The same with the histories moved out rather than copied (a run sampled at every step
+  /// holds large ones); afterwards only take_state() may follow.
+  CosimulationResult result() &&;
   /// The state at steps_done(), to continue with a new run (a new frequency of a stepped
   /// sine) or to save.
   const CosimulationState& state() const;
