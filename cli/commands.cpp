@@ -63,7 +63,7 @@ fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
 }
 
 /// A result printed without files: the closed forms' (refused when not finite).
-constexpr ResultFiles kPrintOnly{"", nullptr, false, "files", false, true};
+const ResultFiles kPrintOnly{"", nullptr, false, "files", false, true};
 
 Rows optimum_rows(const fm::OptimumStroke& o) {
   return {{"model", std::string(fm::to_string(o.model))},
