@@ -84,6 +84,13 @@ VerifiedDecay verified_decay(const DemDecay& d) {
   return v;
 }
 
+/// The design's slabs as whole numbers (the optimiser's are whole already).
+std::vector<long> whole_slabs(const opt::FillingDesign& design) {
+  std::vector<long> slabs;
+  for (const auto& l : design.layers) slabs.push_back(std::lround(l.slabs));
+  return slabs;
+}
+
 /// The design's slabs as one number, exact for up to five layers of < 1000 slabs: a process
 /// asked to verify a design checks that its own optimisation chose the same.
 double design_fingerprint(const opt::FillingDesign& design) {
@@ -113,20 +120,37 @@ DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const 
   return checkpoint;
 }
 
+/// A design's modal model and release state (from rest at q(0)).
+struct DesignModes {
+  st::ModalModel modal;
+  Eigen::VectorXd initial_modal_displacements;
+};
+
+/// The modes of `design`: under axial gravity its own beds' weights load the beam's geometric
+/// stiffness (the beam analysed anew with them, and the static release computed on it);
+/// otherwise the modes do not depend on the beds and are the problem's, exactly.
+DesignModes design_modes(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingDesign& design) {
+  if (!c.structure || c.structure->kind != case_file::StructureSpec::Kind::kBeam ||
+      !c.structure->beam.geometric_stiffness || c.structure->beam.axial_gravity_m_s2 == 0.0)
+    return {p.modal, p.initial_modal_displacements};
+  const Case dc = case_file::with_design(c, whole_slabs(design));
+  const case_file::StructureSetup setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
+  return {setup.modal, case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay)};
+}
+
 /// The DEM-in-the-loop decay of `design` over the verification's duration (the task's
-/// decay from its initial state) at verify softening `softening`.
+/// decay from its initial state, on the design's modes) at verify softening `softening`.
 VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                                 const std::string& label, const opt::FillingDesign& design, double softening,
-                                 const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
-  std::vector<long> slabs;
-  for (const auto& l : design.layers) slabs.push_back(std::lround(l.slabs));
-  const Case dc = case_file::with_design(c, slabs, softening);
+                                 const std::string& label, const opt::FillingDesign& design, const DesignModes& modes,
+                                 double softening, const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+  const Case dc = case_file::with_design(c, whole_slabs(design), softening);
   std::vector<st::Damper> containers = {p.options.damper};
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
   case_file::DecayTask decay = c.task.filling_ratios->decay;
   decay.duration_s = verify.duration_s;
-  return verified_decay(dem_decay(dc, p.modal, containers, detail::dem_dampers(dc), p.initial_modal_displacements, decay,
-                                  "pdamp optimize --verify (" + label + ")", "/task/verify/duration_s", checkpoint, hooks));
+  return verified_decay(dem_decay(dc, modes.modal, containers, detail::dem_dampers(dc), modes.initial_modal_displacements,
+                                  decay, "pdamp optimize --verify (" + label + ")", "/task/verify/duration_s", checkpoint,
+                                  hooks));
 }
 
 /// How `objective` (with `end_envelope_m`) agrees with a reference: the objectives when both
@@ -159,8 +183,8 @@ double end_envelope(const VerifiedDecay& dem) {
 
 /// The design against its DEM decay `dem` (and, if run, the same decay ten times stiffer).
 DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                         const std::string& name, const opt::FillingDesign& design, VerifiedDecay dem,
-                         std::optional<SofteningCheck> stiffer) {
+                         const std::string& name, const opt::FillingDesign& design, const DesignModes& modes,
+                         VerifiedDecay dem, std::optional<SofteningCheck> stiffer) {
   DesignCheck out;
   out.name = name;
   out.design = design;
@@ -168,7 +192,8 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   const std::vector<double> slabs = slabs_of(design);
   opt::FillingRatioOptions options = p.options;
   options.decay.duration_s = verify.duration_s;
-  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
+  options.decay.initial_modal_amplitudes = modes.initial_modal_displacements.cwiseAbs();  // released from rest
+  out.predicted = opt::evaluate_filling_design(modes.modal, options, slabs);
   out.predicted_objective = settling_objective(p) ? out.predicted.settling_time_s : out.predicted.integral_square_m2_s;
   out.dem = std::move(dem);
   out.dem_end_envelope_m = end_envelope(out.dem);
@@ -182,7 +207,7 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   at_samples.sample_times_s.back() = verify.duration_s;
   std::vector<st::Damper> dampers = {opt::filling_damper(options, slabs)};
   dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
-  const st::FreeDecay curve = st::free_decay(p.modal, dampers, at_samples);
+  const st::FreeDecay curve = st::free_decay(modes.modal, dampers, at_samples);
   for (const auto& s : curve.samples) out.predicted_envelope_m.push_back(s.threshold_measure_m);
   out.predicted_end_envelope_m = out.predicted_envelope_m.empty() ? NAN : out.predicted_envelope_m.back();
 
@@ -223,6 +248,7 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
   const std::size_t jobs = 2 * softenings;
   std::vector<DemDecayCheckpoint> files(jobs);
+  const DesignModes modes[] = {design_modes(c, p, r.chosen), design_modes(c, p, r.baseline)};
   const auto softening_of = [&](std::size_t k) { return k < 2 ? verify.stiffness_softening : stiffer_softening; };
   const auto suffix_of = [](std::size_t k) { return std::string(k < 2 ? "" : "_stiffer"); };
   for (std::size_t k = 0; k < jobs; ++k) {
@@ -233,7 +259,8 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
       executor, jobs, true,
       [&](std::size_t k) {
         const std::string label = designs[k % 2].first + (k < 2 ? "" : ", softening " + format_number(softening_of(k), 3));
-        return verification_decay(c, p, verify, label, *designs[k % 2].second, softening_of(k), files[k], hooks);
+        return verification_decay(c, p, verify, label, *designs[k % 2].second, modes[k % 2], softening_of(k), files[k],
+                                  hooks);
       },
       &v.mpi, [&](std::size_t k) { return design_fingerprint(*designs[k % 2].second); },
       static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
@@ -245,7 +272,8 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
       stiffer->stiffness_softening = stiffer_softening;
       stiffer->dem = decays[k + 2];
     }
-    v.designs.push_back(check_design(p, verify, designs[k].first, *designs[k].second, decays[k], std::move(stiffer)));
+    v.designs.push_back(
+        check_design(p, verify, designs[k].first, *designs[k].second, modes[k], decays[k], std::move(stiffer)));
     if (v.designs.back().softening_check) v.softening_converged &= v.designs.back().softening_check->agreement.within;
   }
   const DesignCheck& a = v.designs[0];

@@ -7,6 +7,7 @@
 
 #include "cli/cli_support.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/placement.hpp"
 
@@ -73,12 +74,16 @@ namespace {
 
 /// The shipped optimisation cut short (fewer evaluations, a 1 s verification of contacts
 /// softened 1e-4) with its softening check on or off.
-case_file::Case short_verification(bool softening_check) {
+case_file::Case short_verification(bool softening_check, double axial_gravity_m_s2 = 0.0) {
   std::ifstream in(case_path("manipulator_link_optimize.json"));
   nlohmann::json c = nlohmann::json::parse(in);
   c["task"]["global_evaluations"] = 30;
   c["task"]["max_evaluations"] = 120;
   c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}, {"softening_check", softening_check}};
+  if (axial_gravity_m_s2 != 0.0) {
+    c["structure"]["axial_gravity_m_s2"] = axial_gravity_m_s2;
+    c["structure"]["geometric_stiffness"] = true;
+  }
   return case_file::load_case_document(c, "short_verification.json");
 }
 
@@ -127,5 +132,35 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
     CHECK_FALSE(d.softening_check);
     CHECK(d.dem.site_displacement_m == v.designs[k].dem.site_displacement_m);
     CHECK(d.passed == d.agreement.within);
+  }
+}
+
+// Reference: the beam analysed anew with the design's own bed weights (case_file::with_design,
+// then structure_setup and the static release on it): a link standing under axial gravity,
+// whose geometric stiffness the beds' weights load. The verification scores each design on
+// those modes; the search's modes (the case's starting design's) differ where the mass does.
+TEST_CASE("under axial gravity the verification scores each design on its own modes", "[tasks]") {
+  const case_file::Case c = short_verification(false, -9.80665);
+  tasks::FillingRatiosOptions options;
+  const auto r = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(r.verification);
+  bool warned = false;
+  for (const auto& w : r.warnings) warned = warned || w.find("its own") != std::string::npos;
+  CHECK(warned);
+  for (const auto& d : r.verification->designs) {
+    INFO(d.name);
+    std::vector<long> slabs;
+    for (const auto& l : d.design.layers) slabs.push_back(std::lround(l.slabs));
+    const case_file::Case dc = case_file::with_design(c, slabs);
+    const auto setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
+    // Another bed mass than the starting design's, other modes (the baseline may weigh the same).
+    const bool other_mass = std::abs(d.design.total_mass_kg - r.optimum.initial.total_mass_kg) > 1e-9;
+    CHECK((setup.modal.natural_frequencies_hz(0) != r.problem.modal.natural_frequencies_hz(0)) == other_mass);
+    auto own = r.problem.options;
+    own.decay.duration_s = r.verification->spec.duration_s;
+    own.decay.initial_modal_amplitudes =
+        case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay).cwiseAbs();
+    const auto expected = optimizer::evaluate_filling_design(setup.modal, own, tasks::slabs_of(d.design));
+    CHECK(d.predicted.objective == expected.objective);
   }
 }
