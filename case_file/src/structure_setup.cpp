@@ -25,7 +25,8 @@ std::string layer_pointer(std::size_t damper, std::size_t layer) {
 /// The layer's effective field, looked up at the layer's own clearance (a field of
 /// another clearance is reused at equal Γ and X/h, and said so).
 std::shared_ptr<const sg::LossModel> field_loss_model(const Case& c, std::size_t d, std::size_t l,
-                                                      std::vector<std::string>& warnings) {
+                                                      StructureSetup& setup) {
+  std::vector<std::string>& warnings = setup.warnings;
   const LayerSpec& layer = c.dampers[d].layers[l];
   if (layer.field_file.empty()) {
     throw CaseError(c.path, layer_pointer(d, l) + "/field_file",
@@ -39,6 +40,8 @@ std::shared_ptr<const sg::LossModel> field_loss_model(const Case& c, std::size_t
   } catch (const std::exception& e) {
     throw CaseError(c.path, layer_pointer(d, l) + "/field_file", e.what());
   }
+  if (field.provenance.source == sg::FieldSource::kDem && field.provenance.approach_amplitude_m == 0.0)
+    setup.fields_from_rest.push_back(c.dampers[d].name + "/" + layer.name);
   sg::LookupOptions lookup;
   lookup.clearance_m = layer.clearance_m;
   if (std::abs(field.clearance_m - layer.clearance_m) > 1e-9 * layer.clearance_m) {
@@ -117,7 +120,7 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
       coupled.loss_model = method == LossMethod::kFormulas
                                ? std::make_shared<sg::ClosedFormLossModel>(spec.model, layer.clearance_m,
                                                                            spec.model_options)
-                               : field_loss_model(c, d, l, out.warnings);
+                               : field_loss_model(c, d, l, out);
       damper.layers.push_back(std::move(coupled));
     }
     out.dampers.push_back(std::move(damper));

@@ -5,14 +5,18 @@
 
 namespace pdamp::surrogate {
 
+dem_reference::DamperSimulationOptions dem_point_options(dem_reference::DamperSimulationOptions base,
+                                                         double frequency_hz, double amplitude_m) {
+  base.frequency_hz = frequency_hz;
+  base.amplitude_m = amplitude_m;
+  // Approached from above only below the approach stroke; at and above it from rest.
+  if (amplitude_m >= base.approach_amplitude_m) base.approach_amplitude_m = 0.0;
+  return base;
+}
+
 PointEvaluator dem_evaluator(const dem_reference::DamperSimulationOptions& base) {
   return [base](double frequency_hz, double amplitude_m) {
-    auto options = base;
-    options.frequency_hz = frequency_hz;
-    options.amplitude_m = amplitude_m;
-    // Approached from above only below the approach stroke; at and above it from rest.
-    if (amplitude_m >= options.approach_amplitude_m) options.approach_amplitude_m = 0.0;
-    const auto result = dem_reference::run_harmonic(options);
+    const auto result = dem_reference::run_harmonic(dem_point_options(base, frequency_hz, amplitude_m));
     FieldPoint point;
     if (result.summary.outcome != dem_reference::Outcome::kCompleted) {
       point.status = PointStatus::kFailed;

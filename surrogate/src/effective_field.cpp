@@ -83,6 +83,7 @@ nlohmann::ordered_json metadata_of(const EffectiveField& field) {
                        {"model_version", p.model_version},
                        {"pdamp_version", p.pdamp_version},
                        {"created_utc", p.created_utc}};
+  if (p.approach_amplitude_m > 0.0) doc["provenance"]["approach_amplitude_m"] = p.approach_amplitude_m;
   doc["clearance_m"] = field.clearance_m;
   doc["bed_mass_kg"] = field.bed_mass_kg;
   doc["axes"] = nlohmann::ordered_json::array();
@@ -167,6 +168,7 @@ Provenance read_provenance(const json& value, const std::string& pointer, const 
   if (!is_iso8601_utc(p.created_utc)) {
     object.fail("created_utc", "is \"" + p.created_utc + "\", must be UTC ISO 8601 \"YYYY-MM-DDThh:mm:ssZ\"");
   }
+  if (object.contains("approach_amplitude_m")) p.approach_amplitude_m = object.number("approach_amplitude_m", true, "m");
   object.finish();
   return p;
 }

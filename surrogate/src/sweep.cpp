@@ -468,6 +468,7 @@ EffectiveField field_of(const Grid& grid, std::vector<FieldPoint> points, const 
   field.grid = grid;
   field.points = std::move(points);
   field.provenance = make_provenance(options.source, options.case_hash, options.model_version);
+  field.provenance.approach_amplitude_m = options.approach_amplitude_m;
   field.clearance_m = options.clearance_m;
   field.bed_mass_kg = options.bed_mass_kg;
   return field;

@@ -295,6 +295,12 @@ DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hook
   } else {
     averaged_decay(c, setup, out.initial_modal_amplitudes, out);
   }
+  // A decay reaches every stroke from above: a DEM field built from rest (the ascending
+  // branch) can hold another state near and below the onset.
+  for (const auto& layer : setup.s.fields_from_rest)
+    setup.warnings.add(layer + ": its DEM field was built from rest (the ascending branch); a decay follows the "
+                               "descending one, which near and below the onset can differ: build the field with "
+                               "/dem/approach (docs/dem.md, \"Approach\")");
   out.warnings = setup.warnings.list();
   return out;
 }

@@ -22,6 +22,7 @@ surrogate::SweepOptions field_sweep_options(const case_file::Case& c, const std:
   sweep.source = dem ? surrogate::FieldSource::kDem : surrogate::FieldSource::kFormulas;
   sweep.case_hash = case_file::physics_hash(c, source);
   sweep.model_version = dem ? surrogate::dem_model_version() : 0;
+  sweep.approach_amplitude_m = dem ? c.dem.simulation.approach_amplitude_m : 0.0;
   sweep.clearance_m = single.layer.clearance_m;
   sweep.bed_mass_kg = single.layer.bed_mass_kg;
   sweep.threads = dem ? c.field.threads : 1;
@@ -49,10 +50,9 @@ std::string check_dem_field(const case_file::Case& c, std::size_t damper, const 
   for (const std::size_t i0 : sampled(grid.axis0.size())) {
     for (const std::size_t i1 : sampled(grid.axis1.size())) {
       const auto drive = surrogate::drive_point(grid, i0 * grid.axis1.size() + i1, clearance_m);
-      options.amplitude_m = drive.amplitude_m;
-      options.frequency_hz = drive.frequency_hz;
-      const auto e = check_dem_run(c, damper, options);
-      if (evaluated++ == 0) check_dem_placement(c, damper, options);  // the same bed at every node
+      const auto point = surrogate::dem_point_options(options, drive.frequency_hz, drive.amplitude_m);
+      const auto e = check_dem_run(c, damper, point);
+      if (evaluated++ == 0) check_dem_placement(c, damper, point);  // the same bed at every node
       wall_time_s += e.wall_time_s;
       particle_steps += e.particle_steps;
       if (e.memory_bytes > largest.memory_bytes) largest = e;

@@ -151,6 +151,33 @@ TEST_CASE("method field needs each layer's field_file and runs with one", "[cli]
   CHECK(r["warnings"].is_array());
 }
 
+// A decay reaches each stroke from above; a DEM field built from rest (no
+// provenance.approach_amplitude_m) may hold the other branch, and the decay says so per
+// layer. Here the narrow layer's field is marked as built from above; the others are not.
+TEST_CASE("decay on DEM fields warns of each layer whose field was built from rest", "[cli][structure]") {
+  TempDir dir("decay_branch_warning");
+  const fs::path cases = fs::path(PDAMP_SOURCE_DIR) / "cases";
+  json narrow = json::parse(std::ifstream(cases / "fields/link_narrow_dem/field.json"));
+  narrow["provenance"]["approach_amplitude_m"] = 0.025;
+  std::ofstream(dir.path / "narrow_from_above.json") << narrow.dump();
+  json link = json::parse(std::ifstream(cases / "manipulator_link_decay.json"));
+  for (auto& layer : link["dampers"][0]["layers"]) {
+    layer["field_file"] = layer["name"] == "narrow" ? (dir.path / "narrow_from_above.json").string()
+                                                    : (cases / layer["field_file"].get<std::string>()).string();
+  }
+  std::ofstream(dir.path / "link.json") << link.dump();
+  const json r = run_json("decay " + (dir.path / "link.json").string() + " --method field");
+  const auto warned = [&](const std::string& layer) {
+    return std::any_of(r["warnings"].begin(), r["warnings"].end(), [&](const json& w) {
+      const auto text = w.get<std::string>();
+      return text.rfind("hybrid_damper/" + layer + ": its DEM field was built from rest", 0) == 0;
+    });
+  };
+  CHECK(warned("wide"));
+  CHECK(warned("medium"));
+  CHECK_FALSE(warned("narrow"));
+}
+
 TEST_CASE("pdamp run on a format-2 frf case equals pdamp frf", "[cli][structure]") {
   const json run = run_json("run " + data("cantilever_frf.json"));
   const json frf = run_json("frf " + data("cantilever_frf.json"));

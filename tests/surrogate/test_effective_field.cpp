@@ -77,6 +77,13 @@ TEST_CASE("a field written and read back is identical", "[surrogate]") {
   CHECK(doc["axes"][1]["spacing"] == "log");
   CHECK(doc["table"][5][2].is_null());
   CHECK(doc["table"][7][8] == "failed");
+  CHECK_FALSE(doc["provenance"].contains("approach_amplitude_m"));  // from rest: as written before the key existed
+
+  // The descending branch's approach stroke is kept.
+  EffectiveField descending = field;
+  descending.provenance.approach_amplitude_m = 0.025;
+  CHECK(to_json(descending)["provenance"]["approach_amplitude_m"] == 0.025);
+  CHECK(effective_field_from_json(to_json(descending), "memory") == descending);
 
   // Overwriting is atomic and leaves no temporary behind.
   write_effective_field(field, path);
@@ -153,6 +160,8 @@ TEST_CASE("the reader rejects bad files naming file, JSON pointer and rule", "[s
                    "must be \"formulas\", \"dem\" or \"measured\"");
     check_rejected(changed([](json& d) { d["provenance"]["created_utc"] = "yesterday"; }), "/provenance/created_utc",
                    "UTC ISO 8601");
+    check_rejected(changed([](json& d) { d["provenance"]["approach_amplitude_m"] = -0.01; }),
+                   "/provenance/approach_amplitude_m", "");
     check_rejected(changed([](json& d) { d["provenance"]["model_version"] = 1.5; }), "/provenance/model_version",
                    "must be an integer");
     check_rejected(changed([](json& d) { d["table"][0][8] = "done"; }), "/table/0/8",

@@ -41,6 +41,9 @@ struct StructureSetup {
   int rigid_modes_dropped = 0;               ///< beam: rigid-body modes at 0 Hz not kept
   std::vector<structure::Damper> dampers;    ///< in case order, layers in case order
   std::vector<std::string> warnings;         ///< one sentence each (a field reused at another clearance)
+  /// kField: "damper/layer" of each DEM field built from rest (the ascending branch; a
+  /// decay or a down sweep follows the descending one, docs/dem.md "Approach").
+  std::vector<std::string> fields_from_rest;
 };
 
 /// The case's beam with the weight (container and beds) of every damper except

@@ -14,6 +14,11 @@ namespace pdamp::surrogate {
 /// goes on); invalid options throw std::invalid_argument at the first point.
 PointEvaluator dem_evaluator(const dem_reference::DamperSimulationOptions& base);
 
+/// `base` at the field point (f, X) as dem_evaluator runs it: the approach is dropped at
+/// and above its stroke.
+dem_reference::DamperSimulationOptions dem_point_options(dem_reference::DamperSimulationOptions base,
+                                                         double frequency_hz, double amplitude_m);
+
 /// Physics-model version of dem_evaluator's points (hashed into the results file).
 int dem_model_version();
 

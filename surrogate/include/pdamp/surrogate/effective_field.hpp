@@ -49,6 +49,10 @@ struct Provenance {
   int model_version = 0;      ///< physics-model version of the source, set by the caller, >= 0
   std::string pdamp_version;  ///< pdamp release that wrote the field ("0.1.0")
   std::string created_utc;    ///< creation time, UTC ISO 8601 "YYYY-MM-DDThh:mm:ssZ"
+  /// How the DEM points were reached: 0 (default, the key absent from the file) every point
+  /// from rest, the ascending branch; X_a > 0 every point below X_a approached from X_a, the
+  /// descending branch a decay follows (docs/dem.md, "Approach").
+  double approach_amplitude_m = 0.0;
   bool operator==(const Provenance&) const = default;
 };
 

@@ -38,6 +38,7 @@ struct SweepOptions {
   FieldSource source = FieldSource::kDem;  ///< recorded in the provenance
   std::string case_hash;                   ///< case_hash() of the case; a different hash refuses to resume
   int model_version = 0;                   ///< physics-model version of the evaluator, >= 0; ditto
+  double approach_amplitude_m = 0.0;       ///< recorded in the provenance (Provenance::approach_amplitude_m)
   double clearance_m = 0.0;                ///< damper clearance h, m, > 0 (turns (Γ, X/h) nodes into drives)
   double bed_mass_kg = 0.0;  ///< m_bed, kg, > 0 (E_diss and m_app/m_bed where the evaluator leaves them NaN)
   int threads = 2;           ///< points evaluated at once, [1, 256]
