@@ -82,6 +82,9 @@ tasks::DemFrfOptions dem_frf_options(const ParsedArgs& args, const Case& c) {
   if (signal != "stepped" && signal != "linear") throw InputError("--dem-signal", "", "'" + signal + "': must be stepped or linear");
   o.linear_sweep = signal == "linear";
   o.sweep_rate_hz_s = args.optional_number("--dem-sweep-rate", {0.0, 1e6, true});
+  o.settling.stable_tolerance = args.optional_number("--dem-tolerance", {0.0, 0.99, true}).value_or(o.settling.stable_tolerance);
+  o.settling.max_transient_periods = static_cast<int>(
+      args.optional_integer("--dem-max-periods", 0, 100000).value_or(o.settling.max_transient_periods));
   return o;
 }
 
