@@ -155,14 +155,25 @@ std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, co
   std::vector<std::string> out;
   for (const auto& p : branch.points) {
     out.insert(out.end(), p.warnings.begin(), p.warnings.end());
-    if (!p.converged)
-      out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: not converged after " +
-                    std::to_string(p.transient_periods) + " transient periods: the site amplitude's period-to-period "
-                    "change reached " + format_number(p.window_max_relative_change, 3) + " (across the window " +
-                    format_number(p.window_relative_drift, 3) + ", relative spread " +
-                    format_number(p.window_relative_spread, 3) + ") over the last " + std::to_string(p.window_periods) +
-                    " periods, above the tolerance " + format_number(settling.stable_tolerance) +
-                    ": the point is marked unconverged and left out of the stable curve");
+    if (!p.converged) {
+      const std::string head = branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: not converged after " +
+                               std::to_string(p.transient_periods) + " transient periods: ";
+      const std::string tail = ": the point is marked unconverged and left out of the stable curve";
+      if (p.window_periods < 2)
+        out.push_back(head + "no two periods to compare (fewer than the " + std::to_string(st::kConvergenceWindowPeriods) +
+                      " of the convergence window; raise --dem-max-periods)" + tail);
+      else
+        out.push_back(head + "the site amplitude's period-to-period change reached " +
+                      format_number(p.window_max_relative_change, 3) + " (across the window " +
+                      format_number(p.window_relative_drift, 3) + ", relative spread " +
+                      format_number(p.window_relative_spread, 3) + ") over the last " + std::to_string(p.window_periods) +
+                      " periods" +
+                      (p.window_periods < static_cast<int>(st::kConvergenceWindowPeriods)
+                           ? ", fewer than the " + std::to_string(st::kConvergenceWindowPeriods) +
+                                 " of the convergence window (raise --dem-max-periods)"
+                           : ", above the tolerance " + format_number(settling.stable_tolerance)) +
+                      tail);
+    }
     if (p.energy_error > 0.01)
       out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the co-simulation's energy ledger "
                     "closes to " + format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
