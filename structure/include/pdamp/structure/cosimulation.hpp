@@ -389,8 +389,8 @@ AmplitudeWindow amplitude_window(const std::vector<double>& period_amplitudes,
 /// window holds `window` periods, every period-to-period change in it is at most
 /// tolerance·ā, and so is the change across it (a slow drift of r per period changes the
 /// window by (w − 1)r, so it must be below tolerance/(w − 1) per period). A beating or
-/// drifting transient, or a bed whose per-period amplitude scatters by more than about a
-/// quarter of the tolerance, does not pass.
+/// drifting transient does not pass; a stationary series of relative scatter σ passes
+/// nearly always for σ <= tolerance/5 and, for larger σ, only in a quieter stretch.
 bool amplitudes_converged(const AmplitudeWindow& w, double tolerance, std::size_t window = kConvergenceWindowPeriods);
 
 dem_reference::Matrix3 rotation_about(const dem_reference::Vec3& unit_axis, double angle_rad);
