@@ -27,6 +27,13 @@ const std::vector<FlagSpec> kDemSweepFlags{
                          "                          run in parallel on a machine of two or more cores)"},
     {"--dem-signal", "S", "--method dem: stepped (a stepped sine, default) or linear (a linear sine\n"
                           "                          sweep over the band, from the steady state at its start)"},
+    {"--dem-tolerance", "TOL", "--method dem: a point's transient has converged when, over the last 8\n"
+                               "                          periods, every period-to-period change of the site amplitude\n"
+                               "                          and its change across them are at most TOL of their mean,\n"
+                               "                          (0, 0.99] (default 0.05)"},
+    {"--dem-max-periods", "N", "--method dem: most transient periods per point, [0, 100000] (default 200,\n"
+                               "                          at least the case's dem.transient_periods); a point not\n"
+                               "                          converged by then is analysed, marked and warned"},
     {"--dem-sweep-rate", "HZ/S", "--dem-signal linear: the sweep's rate, Hz/s, > 0 (default: 4 pi zeta^2 f^2 / 100\n"
                                  "                          at the formulas' resonance: quasi-stationary)"}};
 

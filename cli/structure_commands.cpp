@@ -64,6 +64,11 @@ tasks::DemFrfOptions dem_frf_options(const ParsedArgs& args, const Case& c) {
   o.points = static_cast<int>(args.optional_integer("--dem-points", 2, kMaxDemPoints).value_or(o.points));
   o.min_frequency_hz = args.optional_number("--dem-min-frequency", {0.0, 1e6, true}).value_or(o.min_frequency_hz);
   o.max_frequency_hz = args.optional_number("--dem-max-frequency", {0.0, 1e6, true}).value_or(o.max_frequency_hz);
+  if (o.max_frequency_hz == o.min_frequency_hz)
+    throw InputError("--dem-points, --dem-min-frequency, --dem-max-frequency", "",
+                     "the band [" + format_number(o.min_frequency_hz) + ", " + format_number(o.max_frequency_hz) +
+                         "] Hz is one frequency: the " + std::to_string(o.points) +
+                         " points would all fall on it (give --dem-max-frequency above --dem-min-frequency)");
   if (!(o.max_frequency_hz > o.min_frequency_hz))
     throw InputError("--dem-max-frequency", "", format_number(o.max_frequency_hz) + " Hz: must exceed the lowest frequency " +
                                                     format_number(o.min_frequency_hz) + " Hz (--dem-min-frequency or the task's)");
@@ -77,6 +82,9 @@ tasks::DemFrfOptions dem_frf_options(const ParsedArgs& args, const Case& c) {
   if (signal != "stepped" && signal != "linear") throw InputError("--dem-signal", "", "'" + signal + "': must be stepped or linear");
   o.linear_sweep = signal == "linear";
   o.sweep_rate_hz_s = args.optional_number("--dem-sweep-rate", {0.0, 1e6, true});
+  o.settling.stable_tolerance = args.optional_number("--dem-tolerance", {0.0, 0.99, true}).value_or(o.settling.stable_tolerance);
+  o.settling.max_transient_periods = static_cast<int>(
+      args.optional_integer("--dem-max-periods", 0, 100000).value_or(o.settling.max_transient_periods));
   return o;
 }
 

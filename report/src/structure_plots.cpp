@@ -315,13 +315,18 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
 
 std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
                                             const std::string& magnitude_label, const std::string& title) {
-  // frf_dem.csv: sweep, frequency_hz, then magnitude and phase per damper, then the spread.
+  // frf_dem.csv: sweep, frequency_hz, then magnitude and phase per damper, then the spread, the
+  // standard error, η*, m_app, energy_error, transient_periods, stable, steps, time_step_s, converged.
   const std::size_t spread_column = 3 + 2 * damper_names.size();  // 1-based
+  const std::size_t converged_column = spread_column + 9;
   std::ostringstream gp;
   gp << "# stepped-sine frequency response of pdamp frf --method dem (first harmonic at each frequency,\n"
-     << "# up and down in frequency; error bars: the spread over the analysed periods); run: gnuplot frf_dem.gp\n"
+     << "# up and down in frequency; error bars: the spread over the analysed periods); the curves join\n"
+     << "# the converged points only, an unconverged point (its transient still changing) is a cross\n"
+     << "# off the curve; run: gnuplot frf_dem.gp\n"
      << "set datafile separator ','\nset grid\n"
-     << "sel(s, c) = (stringcolumn(1) eq s) ? column(c) : 1/0\n";
+     << "ok(s, c) = (stringcolumn(1) eq s && column(" << converged_column << ") == 1) ? column(c) : 1/0\n"
+     << "bad(s, c) = (stringcolumn(1) eq s && column(" << converged_column << ") == 0) ? column(c) : 1/0\n";
   gp << "do for [t in 'pngcairo svg'] {\n"
      << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'frf_dem.svg' : 'frf_dem.png'\n"
@@ -338,10 +343,13 @@ std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<st
       const std::string name = gnuplot_string(damper_names[d] + ", " + sweep);
       if (!first) gp << ", \\\n       ";
       first = false;
-      gp << "'frf_dem.csv' using 2:(sel('" << sweep << "', " << column << "))"
+      gp << "'frf_dem.csv' using 2:(ok('" << sweep << "', " << column << "))"
          << (d == 0 ? errorbars : std::string(" with points")) << " pt "
-         << (up ? 7 : 6) << " lc rgb '" << colour(d) << "' notitle, '' using 2:(sel('" << sweep << "', " << column
-         << ")) with lines lw 2 dt " << (up ? 1 : 2) << " lc rgb '" << colour(d) << "' title " << name << " noenhanced";
+         << (up ? 7 : 6) << " lc rgb '" << colour(d) << "' notitle, '' using 2:(ok('" << sweep << "', " << column
+         << ")) with lines lw 2 dt " << (up ? 1 : 2) << " lc rgb '" << colour(d) << "' title " << name << " noenhanced"
+         << ", '' using 2:(bad('" << sweep << "', " << column << ")) with points pt 2 ps 1.5 lc rgb '" << colour(d)
+         << "' title " << gnuplot_string(damper_names[d] + ", " + sweep + ": unconverged (not on the curve)")
+         << " noenhanced";
     }
   gp << "\n}\n";
   return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
@@ -400,13 +408,15 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
   if (field) branches(*field, "field");
   if (!first) csv << '\n';
   for (const auto& p : dem)
-    csv << "dem_" << p.sweep << ",0," << p.frequency_hz << ",dem," << p.magnitude << ',' << p.spread << '\n';
+    csv << "dem_" << p.sweep << ",0," << p.frequency_hz << (p.converged ? ",dem," : ",dem_unconverged,") << p.magnitude
+        << ',' << p.spread << '\n';
   out.add("frf_compare.csv", csv.str());
 
   std::ostringstream gp;
   gp << "# pdamp frf --compare: the first output by the closed-form loss models (formulas), the\n"
      << "# layers' effective fields (field) and the stepped-sine DEM co-simulation (points, error bars:\n"
-     << "# spread over the analysed periods); unstable harmonic-balance roots dashed; run: gnuplot frf_compare.gp\n"
+     << "# spread over the analysed periods; crosses: unconverged points); unstable harmonic-balance roots\n"
+     << "# dashed; run: gnuplot frf_compare.gp\n"
      << "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
      << "set xlabel 'frequency f / Hz'\nset ylabel " << gnuplot_string(magnitude_label) << " noenhanced\n"
      << "set title " << gnuplot_string(title) << " noenhanced\n"
@@ -425,7 +435,11 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
   gp << "       '' using 3:(sel('dem_up', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
      << "' title 'DEM, stepped sine up', \\\n"
      << "       '' using 3:(sel('dem_down', 'dem', 5)):6 with yerrorbars pt 6 ps 1.2 lc rgb '" << colour(3)
-     << "' title 'DEM, stepped sine down'\n}\n";
+     << "' title 'DEM, stepped sine down', \\\n"
+     << "       '' using 3:(sel('dem_up', 'dem_unconverged', 5)) with points pt 2 ps 1.5 lc rgb '" << colour(2)
+     << "' title 'DEM up, unconverged', \\\n"
+     << "       '' using 3:(sel('dem_down', 'dem_unconverged', 5)) with points pt 2 ps 1.5 lc rgb '" << colour(3)
+     << "' title 'DEM down, unconverged'\n}\n";
   return out.add_plot("frf_compare.gp", gp.str(), {"frf_compare.png", "frf_compare.svg"});
 }
 

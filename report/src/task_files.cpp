@@ -127,6 +127,15 @@ namespace {
 
 std::string csv_name(const std::string& name) { return safe_file_name(name); }
 
+/// A CSV cell: the number, or empty where it is not finite.
+std::string finite_or_empty(double v) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
 Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
   const auto& s = *r.stepped;
   const auto& names = s.damper_names;
@@ -136,7 +145,8 @@ Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
   for (const auto& d : names) csv << ",magnitude_" << csv_name(d) << ",phase_deg_" << csv_name(d);
   csv << ",magnitude_spread_" << csv_name(names.front()) << ",magnitude_standard_error_" << csv_name(names.front())
       << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front())
-      << ",energy_error,transient_periods,stable,steps,time_step_s\n";
+      << ",energy_error,transient_periods,stable,steps,time_step_s,converged,periods,convergence_max_relative_change"
+      << ",convergence_relative_drift,convergence_relative_spread\n";
   for (const auto& branch : s.branches)
     for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending) {
       csv << p->sweep << ',' << p->frequency_hz;
@@ -144,7 +154,9 @@ Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
       csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
           << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->bed_eta_star.front() << ','
           << p->bed_apparent_mass_fraction.front() << ',' << p->energy_error << ',' << p->transient_periods << ','
-          << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->time_step_s << '\n';
+          << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->time_step_s << ',' << (p->converged ? 1 : 0) << ','
+          << p->periods() << ',' << finite_or_empty(p->window_max_relative_change) << ','
+          << finite_or_empty(p->window_relative_drift) << ',' << finite_or_empty(p->window_relative_spread) << '\n';
     }
   out.add("frf_dem.csv", csv.str());
   return write_frf_dem_plot(out, names, tasks::magnitude_label(r), r.case_name + ": stepped-sine DEM co-simulation");
@@ -174,7 +186,8 @@ Warnings compare_files(OutputDir& out, const tasks::FrfResult& r) {
   std::vector<CompareDemPoint> dem_points;
   for (const auto& branch : r.stepped->branches)
     for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending)
-      dem_points.push_back({p->frequency_hz, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, branch.sweep});
+      dem_points.push_back(
+          {p->frequency_hz, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, branch.sweep, p->converged});
   return write_frf_compare_files(out, r.harmonic->response, r.field ? &r.field->response : nullptr, dem_points,
                                  tasks::magnitude_label(r),
                                  r.case_name + (r.field ? ": formulas, field and DEM" : ": formulas and DEM (no field)"));

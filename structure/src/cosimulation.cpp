@@ -87,21 +87,29 @@ std::string join(const std::vector<std::string>& lines) {
 
 }  // namespace detail
 
-bool amplitudes_settled(const std::vector<double>& period_amplitudes, double tolerance) {
-  constexpr std::size_t w = kSettledWindowPeriods;
-  const std::size_t n = period_amplitudes.size();
-  if (n < 2 * w) return false;
-  double a = 0.0, b = 0.0;
-  for (std::size_t k = 0; k < w; ++k) a += period_amplitudes[n - 1 - k], b += period_amplitudes[n - 1 - w - k];
-  a /= static_cast<double>(w);
-  b /= static_cast<double>(w);
-  double ss = 0.0;
-  for (std::size_t k = 0; k < w; ++k) {
-    ss += (period_amplitudes[n - 1 - k] - a) * (period_amplitudes[n - 1 - k] - a);
-    ss += (period_amplitudes[n - 1 - w - k] - b) * (period_amplitudes[n - 1 - w - k] - b);
+AmplitudeWindow amplitude_window(const std::vector<double>& period_amplitudes, std::size_t window) {
+  AmplitudeWindow out;
+  const std::size_t n = period_amplitudes.size(), w = std::min(window, n);
+  if (w < 2) return out;
+  const auto first = period_amplitudes.end() - static_cast<std::ptrdiff_t>(w);
+  double mean = 0.0;
+  for (auto it = first; it != period_amplitudes.end(); ++it) mean += *it;
+  mean /= static_cast<double>(w);
+  if (!(mean > 0.0)) return out;
+  double change = 0.0, ss = 0.0;
+  for (auto it = first; it != period_amplitudes.end(); ++it) {
+    ss += (*it - mean) * (*it - mean);
+    if (it != first) change = std::max(change, std::abs(*it - *(it - 1)));
   }
-  const double pooled_sd = std::sqrt(ss / static_cast<double>(2 * w - 2));
-  return std::abs(a - b) <= tolerance * a + 2.0 * pooled_sd * std::sqrt(2.0 / static_cast<double>(w));
+  out.periods = static_cast<int>(w);
+  out.max_relative_change = change / mean;
+  out.relative_drift = std::abs(period_amplitudes.back() - *first) / mean;
+  out.relative_spread = std::sqrt(ss / static_cast<double>(w - 1)) / mean;
+  return out;
+}
+
+bool amplitudes_converged(const AmplitudeWindow& w, double tolerance, std::size_t window) {
+  return w.periods >= static_cast<int>(window) && w.max_relative_change <= tolerance && w.relative_drift <= tolerance;
 }
 
 dem::Matrix3 rotation_about(const dem::Vec3& k, double angle_rad) {
@@ -153,6 +161,9 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
       p.push_back(at + "transient_periods = " + std::to_string(transient_periods) + ": must be in [0, 100000]");
     if (!(analysed_periods >= 1 && analysed_periods <= dem::limits::kMaxPeriods))
       p.push_back(at + "analysed_periods = " + std::to_string(analysed_periods) + ": must be in [1, 100000]");
+    if (!(min_transient_periods >= 0 && min_transient_periods <= std::max(transient_periods, 0)))
+      p.push_back(at + "min_transient_periods = " + std::to_string(min_transient_periods) + ": must be in [0, transient_periods = " +
+                  std::to_string(transient_periods) + "]");
     if (settle_until_stable && !(stable_tolerance > 0.0 && stable_tolerance < 1.0))
       p.push_back(at + "stable_tolerance = " + number(stable_tolerance) + ": must be in (0, 1)");
     if (sweep_end_frequency_hz != 0.0) {

@@ -150,6 +150,7 @@ class SteadyStateMeasure final : public RunMeasure {
                      std::vector<double> bed_masses_kg, Eigen::Index modes)
       : steps_per_period_(steps_per_period),
         transient_steps_(options.transient_periods * steps_per_period),
+        min_transient_steps_(std::int64_t{options.min_transient_periods} * steps_per_period),
         analysed_periods_(options.analysed_periods),
         settle_until_stable_(options.settle_until_stable),
         stable_tolerance_(options.stable_tolerance),
@@ -180,11 +181,14 @@ class SteadyStateMeasure final : public RunMeasure {
     auto& periods = steady_.period_site_amplitudes_m;
     if (periods.size() < periods.capacity()) periods.push_back(amplitude);
     if (analysing_) return;
-    if (settle_until_stable_) {
-      calm_periods_ = amplitudes_settled(periods, stable_tolerance_) ? calm_periods_ + 1 : 0;
-      if (calm_periods_ >= 2) steady_.stable = true;
-    }
+    if (settle_until_stable_ && s.step >= min_transient_steps_)
+      steady_.stable = amplitudes_converged(amplitude_window(periods), stable_tolerance_);
     if (steady_.stable || s.step >= transient_steps_) {
+      const AmplitudeWindow w = amplitude_window(periods);  // the window the transient ends with
+      steady_.window_periods = w.periods;
+      steady_.window_max_relative_change = w.max_relative_change;
+      steady_.window_relative_drift = w.relative_drift;
+      steady_.window_relative_spread = w.relative_spread;
       analysing_ = true;
       analysis_start_ = s.step;
       end_step = s.step + analysed_periods_ * steps_per_period_;
@@ -218,6 +222,7 @@ class SteadyStateMeasure final : public RunMeasure {
  private:
   std::int64_t steps_per_period_;
   std::int64_t transient_steps_;
+  std::int64_t min_transient_steps_;  ///< settle_until_stable: the transient lasts at least this
   std::int64_t analysed_periods_;
   bool settle_until_stable_;
   double stable_tolerance_;
@@ -229,7 +234,6 @@ class SteadyStateMeasure final : public RunMeasure {
   Eigen::VectorXcd modal_sum_;
   bool analysing_;
   std::int64_t analysis_start_;  ///< the step the analysis started at, −1 before
-  int calm_periods_ = 0;         ///< period ends in a row at which amplitudes_settled held
   CosimulationSteadyState steady_;  ///< the per-period amplitudes and `stable` so far
 };
 

@@ -9,11 +9,19 @@
 namespace pdamp::structure {
 
 CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling) {
-  steady.transient_periods = settling.max_transient_periods;
+  steady.transient_periods = std::max(settling.max_transient_periods, settling.min_transient_periods);
+  steady.min_transient_periods = settling.min_transient_periods;
   steady.settle_until_stable = true;
   steady.stable_tolerance = settling.stable_tolerance;
   steady.excitation_phase_rad = std::numbers::pi / 2.0;
   return steady;
+}
+
+std::vector<std::int64_t> stepped_sine_steps_per_period(const std::vector<double>& frequencies_hz, double time_step_s) {
+  std::vector<std::int64_t> out;
+  for (const double f : frequencies_hz)
+    out.push_back(std::max<std::int64_t>(1, std::llround(1.0 / (f * time_step_s))));
+  return out;
 }
 
 double stepped_sine_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
@@ -69,7 +77,13 @@ SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector
     }
     p.energy_error = r.energy.relative_error;
     p.transient_periods = ss.transient_periods;
-    p.stable = ss.stable;
+    p.analysed_periods = ss.analysed_periods;
+    p.converged = p.stable = ss.stable;
+    p.window_periods = ss.window_periods;
+    p.window_max_relative_change = ss.window_max_relative_change;
+    p.window_relative_drift = ss.window_relative_drift;
+    p.window_relative_spread = ss.window_relative_spread;
+    for (const double a : per) p.period_magnitudes.push_back(a / options.excitation.amplitude);
     p.steps = r.steps;
     p.time_step_s = r.time_step_s;
     p.wall_time_s = r.wall_time_s;

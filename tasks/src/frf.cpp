@@ -125,17 +125,55 @@ st::CosimulationOptions dem_frf_options(const Case& c, const st::ModalModel& mod
   return st::stepped_sine_options(options, settling);
 }
 
+/// The settling of each frequency: the options' rule with the case's /dem/transient_periods
+/// as the least transient.
+st::SteadyStateSettling case_settling(const Case& c, st::SteadyStateSettling settling) {
+  settling.min_transient_periods = c.dem.simulation.transient_periods;
+  settling.max_transient_periods = std::max(settling.max_transient_periods, settling.min_transient_periods);
+  return settling;
+}
+
+/// Refuses (InputError naming the flags) a stepped sine whose points would fall on one
+/// frequency: equal requested frequencies, or two that round to the same whole steps per
+/// period of the sweep's step.
+void check_distinct_frequencies(const std::vector<double>& frequencies_hz, double time_step_s, int points) {
+  const std::vector<std::int64_t> steps = st::stepped_sine_steps_per_period(frequencies_hz, time_step_s);
+  for (std::size_t i = 1; i < frequencies_hz.size(); ++i)
+    if (steps[i] == steps[i - 1] || !(frequencies_hz[i] > frequencies_hz[i - 1]))
+      throw InputError("--dem-points, --dem-min-frequency, --dem-max-frequency", "",
+                       std::to_string(points) + " points over [" + format_number(frequencies_hz.front(), 10) + ", " +
+                           format_number(frequencies_hz.back(), 10) + "] Hz: points " + std::to_string(i) + " and " +
+                           std::to_string(i + 1) + " (" + format_number(frequencies_hz[i - 1], 10) + " and " +
+                           format_number(frequencies_hz[i], 10) + " Hz) fall on one frequency (" +
+                           std::to_string(steps[i]) + " steps of " + format_number(time_step_s, 4) +
+                           " s per period): fewer points or a wider band");
+}
+
 /// The warnings of a branch's points: the co-simulation's, a point that did not settle, an
 /// energy ledger that does not close.
 std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, const st::SteadyStateSettling& settling) {
   std::vector<std::string> out;
   for (const auto& p : branch.points) {
     out.insert(out.end(), p.warnings.begin(), p.warnings.end());
-    if (!p.stable)
-      out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the period-to-period change of "
-                    "the site amplitude did not stay below " + format_number(settling.stable_tolerance) + " within " +
-                    std::to_string(settling.max_transient_periods) +
-                    " transient periods: the analysed periods may still carry the transient");
+    if (!p.converged) {
+      const std::string head = branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: not converged after " +
+                               std::to_string(p.transient_periods) + " transient periods: ";
+      const std::string tail = ": the point is marked unconverged and left out of the stable curve";
+      if (p.window_periods < 2)
+        out.push_back(head + "no two periods to compare (fewer than the " + std::to_string(st::kConvergenceWindowPeriods) +
+                      " of the convergence window; raise --dem-max-periods)" + tail);
+      else
+        out.push_back(head + "the site amplitude's period-to-period change reached " +
+                      format_number(p.window_max_relative_change, 3) + " (across the window " +
+                      format_number(p.window_relative_drift, 3) + ", relative spread " +
+                      format_number(p.window_relative_spread, 3) + ") over the last " + std::to_string(p.window_periods) +
+                      " periods" +
+                      (p.window_periods < static_cast<int>(st::kConvergenceWindowPeriods)
+                           ? ", fewer than the " + std::to_string(st::kConvergenceWindowPeriods) +
+                                 " of the convergence window (raise --dem-max-periods)"
+                           : ", above the tolerance " + format_number(settling.stable_tolerance)) +
+                      tail);
+    }
     if (p.energy_error > 0.01)
       out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the co-simulation's energy ledger "
                     "closes to " + format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
@@ -148,17 +186,19 @@ std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, co
 SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks, Executor& executor) {
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
-  const st::CosimulationOptions options = dem_frf_options(c, modal, o.settling);
+  const st::SteadyStateSettling settling = case_settling(c, o.settling);
+  const st::CosimulationOptions options = dem_frf_options(c, modal, settling);
   SteppedSineFrf out;
   out.frequencies_hz = detail::spaced(o.min_frequency_hz, o.max_frequency_hz, o.points, false);
   out.analysed_periods = options.analysed_periods;
-  out.settling = o.settling;
+  out.settling = settling;
   for (const double f : out.frequencies_hz) {  // every point's options checked before any runs
     st::CosimulationOptions o = options;
     o.excitation.frequency_hz = f;
     detail::check_cosimulation(c, modal, dampers, o);
   }
   out.time_step_s = detail::call_dem(c, [&] { return st::stepped_sine_time_step(modal, dampers, options, out.frequencies_hz); });
+  check_distinct_frequencies(out.frequencies_hz, out.time_step_s, o.points);
   std::vector<std::pair<std::string, std::vector<double>>> directions;
   for (const auto& d : o.directions)
     directions.push_back({d, d == "up" ? out.frequencies_hz
@@ -198,7 +238,7 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
       },
       &out.mpi);
   out.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  for (const auto& b : out.branches) setup.warnings.add(branch_warnings(b, o.settling));
+  for (const auto& b : out.branches) setup.warnings.add(branch_warnings(b, settling));
   for (const auto& d : dampers) out.damper_names.push_back(d.name);
   return out;
 }
@@ -231,7 +271,8 @@ double default_sweep_rate(const Case& c, detail::Setup& formulas, const DemFrfOp
 LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks) {
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
-  const st::CosimulationOptions steady = dem_frf_options(c, modal, o.settling);
+  const st::SteadyStateSettling settling = case_settling(c, o.settling);
+  const st::CosimulationOptions steady = dem_frf_options(c, modal, settling);
   LinearSweepFrf out;
   out.min_frequency_hz = o.min_frequency_hz;
   out.max_frequency_hz = o.max_frequency_hz;
@@ -275,7 +316,7 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
         if (!std::isfinite(m)) throw NumericalError(label + ": a cycle's amplitude is not finite");
     if (!s.start_stable)
       s.warnings.push_back(s.sweep + " sweep: the steady state at " + format_number(s.start_hz, 5) +
-                           " Hz was not reached within " + std::to_string(o.settling.max_transient_periods) +
+                           " Hz was not reached within " + std::to_string(settling.max_transient_periods) +
                            " periods: the sweep's first cycles may carry the transient");
     if (s.energy_error > 0.01)
       s.warnings.push_back(s.sweep + " sweep: the co-simulation's energy ledger closes to " +
@@ -403,6 +444,21 @@ json harmonic_result(const FrfResult& r, const HarmonicFrf& h, const OutputFolde
   return result;
 }
 
+const char* const kConvergenceRule =
+    "a point's transient ends once, over the last convergence_window_periods periods (and after at least "
+    "min_transient_periods, the case's /dem/transient_periods), every period-to-period change of the first site's "
+    "amplitude and its change across the window are at most stable_tolerance of the window's mean; otherwise after "
+    "max_transient_periods, and the point is converged = false";
+
+/// A point's convergence window (SteppedSinePoint::window_*) and its per-period magnitudes.
+json convergence_json(const st::SteppedSinePoint& p) {
+  return {{"window_periods", p.window_periods},
+          {"max_relative_change", number_or_null(p.window_max_relative_change)},
+          {"relative_drift", number_or_null(p.window_relative_drift)},
+          {"relative_spread", number_or_null(p.window_relative_spread)},
+          {"period_magnitudes", p.period_magnitudes}};
+}
+
 json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFolder& folder) {
   const bool base = r.base_excitation;
   const auto& names = s.damper_names;
@@ -422,7 +478,9 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
                       {"bed_eta_star", eta}, {"bed_apparent_mass_fraction", mass},
                       {"magnitude_spread", number_or_null(p.spread)},
                       {"magnitude_standard_error", number_or_null(p.standard_error)}, {"energy_error", p.energy_error},
-                      {"transient_periods", p.transient_periods}, {"stable", p.stable}, {"steps", p.steps},
+                      {"transient_periods", p.transient_periods}, {"analysed_periods", p.analysed_periods},
+                      {"periods", p.periods()}, {"converged", p.converged}, {"stable", p.stable},
+                      {"convergence", convergence_json(p)}, {"steps", p.steps},
                       {"time_step_s", p.time_step_s}, {"solve_time_s", p.wall_time_s}});
     }
   }
@@ -452,8 +510,11 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
                                           "are at the turning point, the base displacement and velocity (or the "
                                           "force) continuous"},
                                 {"time_step_s", s.time_step_s},
+                                {"min_transient_periods", s.settling.min_transient_periods},
                                 {"max_transient_periods", s.settling.max_transient_periods},
                                 {"stable_tolerance", s.settling.stable_tolerance},
+                                {"convergence_window_periods", st::kConvergenceWindowPeriods},
+                                {"convergence_rule", kConvergenceRule},
                                 {"analysed_periods", s.analysed_periods}}},
               {"solve_time_s", s.solve_time_s},
               {"warnings", r.warnings}};
@@ -543,7 +604,9 @@ json compare_result(const FrfResult& r, const OutputFolder& folder) {
       dem_list.push_back({{"sweep", branch.sweep}, {"frequency_hz", p->frequency_hz}, {"magnitude", p->magnitude.front()},
                           {"magnitude_spread", number_or_null(p->spread)},
                           {"magnitude_standard_error", number_or_null(p->standard_error)},
-                          {"energy_error", p->energy_error}, {"stable", p->stable}});
+                          {"energy_error", p->energy_error}, {"converged", p->converged}, {"stable", p->stable},
+                          {"periods", p->periods()},
+                          {"convergence_max_relative_change", number_or_null(p->window_max_relative_change)}});
     dem_peaks.push_back(dem_peak_json(output, branch, bp));
     const json a_formulas = agreement_json(first_output_peak(f_response), bp.peak);
     const json a_field = r.field ? agreement_json(first_output_peak(r.field->response), bp.peak) : json(nullptr);

@@ -30,7 +30,9 @@ namespace pdamp::structure {
 inline void to_json(nlohmann::json& j, const SteppedSinePoint& p) {
   j = nlohmann::json::array({p.sweep, p.frequency_hz, p.requested_frequency_hz, p.magnitude, p.phase_deg, p.bed_eta_star,
                              p.bed_apparent_mass_fraction, p.spread, p.standard_error, p.energy_error,
-                             p.transient_periods, p.stable, p.steps, p.time_step_s, p.wall_time_s, p.warnings});
+                             p.transient_periods, p.stable, p.steps, p.time_step_s, p.wall_time_s, p.warnings,
+                             p.analysed_periods, p.converged, p.window_periods, p.window_max_relative_change,
+                             p.window_relative_drift, p.window_relative_spread, p.period_magnitudes});
 }
 inline void from_json(const nlohmann::json& j, SteppedSinePoint& p) {
   j.at(0).get_to(p.sweep);
@@ -49,6 +51,13 @@ inline void from_json(const nlohmann::json& j, SteppedSinePoint& p) {
   j.at(13).get_to(p.time_step_s);
   j.at(14).get_to(p.wall_time_s);
   j.at(15).get_to(p.warnings);
+  j.at(16).get_to(p.analysed_periods);
+  j.at(17).get_to(p.converged);
+  j.at(18).get_to(p.window_periods);
+  j.at(19).get_to(p.window_max_relative_change);
+  j.at(20).get_to(p.window_relative_drift);
+  j.at(21).get_to(p.window_relative_spread);
+  j.at(22).get_to(p.period_magnitudes);
 }
 inline void to_json(nlohmann::json& j, const SteppedSineBranch& b) {
   j = nlohmann::json::array({b.sweep, b.points, b.wall_time_s, static_cast<int>(b.outcome), b.message});

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -300,6 +301,60 @@ TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies, u
   require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") +
                                    " --method dem --dem-min-frequency 2 --dem-max-frequency 1.5"),
                          "--dem-max-frequency: 1.5 Hz: must exceed the lowest frequency 2 Hz");
+  // Points on one frequency, refused before the run: an empty band, or points closer than a
+  // step per period of the sweep's step.
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") +
+                                   " --method dem --dem-points 3 --dem-min-frequency 1.5 --dem-max-frequency 1.5"),
+                         "--dem-points, --dem-min-frequency, --dem-max-frequency: the band [1.5, 1.5] Hz is one frequency");
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") +
+                                   " --method dem --dem-points 1000 --dem-min-frequency 1.5 --dem-max-frequency 1.500001"),
+                         "--dem-points, --dem-min-frequency, --dem-max-frequency: 1000 points over [1.5, 1.500001] Hz");
+}
+
+// A point whose transient is cut before it can converge (at most the case's 5 periods, fewer
+// than the 8 of the window) is analysed, marked converged = false in the JSON and the CSV,
+// warned in one line naming its frequency and scatter, and drawn off the stable curve.
+TEST_CASE("pdamp frf --method dem: an unconverged point is marked, warned and plotted apart", "[cli][structure][dem]") {
+  const TempDir dir("frf_dem_unconverged");
+  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") +
+                           " --method dem --dem-sweep up --dem-points 2 --dem-min-frequency 1.5 --dem-max-frequency 1.7"
+                           " --dem-max-periods 0 --json -o " + dir.path.string());
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json out = json::parse(r.out);
+  const json& points = out["frf"]["points"];
+  REQUIRE(points.size() == 2);
+  CHECK(out["frf"]["stepped_sine"]["min_transient_periods"] == 5);
+  CHECK(out["frf"]["stepped_sine"]["max_transient_periods"] == 5);  // raised to the case's least
+  CHECK(out["frf"]["stepped_sine"]["stable_tolerance"] == 0.05);
+  for (const auto& p : points) {
+    CHECK(p["converged"] == false);
+    CHECK(p["stable"] == false);
+    CHECK(p["transient_periods"] == 5);
+    CHECK(p["periods"] == 5 + 3);
+    CHECK(p["convergence"]["window_periods"] == 5);
+    CHECK(p["convergence"]["period_magnitudes"].size() == 8);
+    const std::string f = p["frequency_hz"].get<double>() < 1.6 ? "1.5 Hz" : "1.7 Hz";
+    std::size_t warned = 0;
+    for (const auto& w : out["warnings"])
+      if (w.get<std::string>().find("up sweep at " + f + ": not converged after 5 transient periods") != std::string::npos)
+        ++warned;
+    CHECK(warned == 1);
+  }
+  std::ifstream csv(dir.path / "frf_dem.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  CHECK_THAT(header, Catch::Contains(",converged,periods,convergence_max_relative_change"));
+  std::getline(csv, row);
+  CHECK(std::count(row.begin(), row.end(), ',') == std::count(header.begin(), header.end(), ','));
+  std::ifstream gp(dir.path / "frf_dem.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  CHECK_THAT(script, Catch::Contains("unconverged (not on the curve)"));
+  // Bad settling flags are exit 2.
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-tolerance 0"),
+                         "--dem-tolerance");
+  require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-max-periods -1"),
+                         "--dem-max-periods");
 }
 
 TEST_CASE("pdamp frf --method dem --dem-sweep up: one direction over the given band", "[cli][structure][dem]") {
@@ -319,7 +374,9 @@ TEST_CASE("pdamp frf --method dem --dem-sweep up: one direction over the given b
 // sine on one case, one figure and table; the agreement is each method's peak against DEM's.
 TEST_CASE("pdamp frf --compare: formulas, field and DEM in one figure with the peaks' agreement", "[cli][structure][dem]") {
   const TempDir dir("frf_compare");
-  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --dem-points 3 --json -o " +
+  // At most 20 transient periods per point (the test's time; a point not converged by then is
+  // marked, which this test does not look at).
+  const auto r = run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --dem-points 3 --dem-max-periods 20 --json -o " +
                            dir.path.string());
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
@@ -416,7 +473,7 @@ TEST_CASE("pdamp frf --method dem with two dampers gives each output its peak", 
   c["dampers"][1]["container_mass_kg"] = 0.1;
   const std::string path = (dir.path / "two.json").string();
   std::ofstream(path) << c.dump(2);
-  const auto r = run_pdamp("frf " + path + " --method dem --dem-sweep up --dem-points 3 --json");
+  const auto r = run_pdamp("frf " + path + " --method dem --dem-sweep up --dem-points 3 --dem-max-periods 20 --json");
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   const json out = json::parse(r.out);

@@ -1,11 +1,10 @@
-// The resonance measures of a sampled response (structure/sampled_response.hpp) and the
-// stepped sine's steady-state test (amplitudes_settled), against curves whose answers are
-// known in closed form.
+// The resonance measures of a sampled response (structure/sampled_response.hpp), against
+// curves whose answers are known in closed form (the stepped sine's steady-state test:
+// test_stepped_sine.cpp).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "pdamp/structure/cosimulation.hpp"
@@ -92,34 +91,6 @@ TEST_CASE("sampled_peak: standard errors widen the argmax's range to the points 
   CHECK_THROWS_AS(st::sampled_peak({1.0, 1.0}, {1.0, 2.0}), std::invalid_argument);
   CHECK_THROWS_AS(st::sampled_peak({1.0, 2.0}, {1.0}), std::invalid_argument);
   CHECK_THROWS_AS(st::sampled_peak({1.0, 2.0}, {1.0, 2.0}, {0.1, -0.1}), std::invalid_argument);
-}
-
-TEST_CASE("amplitudes_settled: stationary scatter settles, a drift beyond the scatter does not",
-          "[structure][cosimulation]") {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 0.04);  // 4% per-period scatter, as a DEM bed
-  const std::size_t w = st::kSettledWindowPeriods;
-  std::vector<double> drifting, smooth_decay;
-  for (std::size_t k = 0; k < 2 * w; ++k) {
-    // A transient decaying 15% per period: the windows differ by far more than the scatter.
-    drifting.push_back(1.0 + std::pow(0.85, static_cast<double>(k)) + 0.01 * noise(rng));
-    smooth_decay.push_back(1.0 + 0.2 * std::exp(-0.05 * static_cast<double>(k)));
-  }
-  // Over many draws the stationary series is accepted about 95% of the time (2 standard
-  // errors); the window test is not a lottery as a 1% period-to-period test is.
-  int accepted = 0, trials = 2000;
-  for (int t = 0; t < trials; ++t) {
-    std::vector<double> a;
-    for (std::size_t k = 0; k < 2 * w; ++k) a.push_back(1.0 + noise(rng));
-    accepted += st::amplitudes_settled(a, 1e-2) ? 1 : 0;
-  }
-  CHECK(accepted > 0.9 * trials);
-  CHECK_FALSE(st::amplitudes_settled(drifting, 1e-2));
-  // No scatter, a slow decay: window means 1.186 and 1.152 (2.9% apart), the trend inside a
-  // window adds 2·s·√(2/w) = 0.9%: 1% does not accept it, 5% does.
-  CHECK_FALSE(st::amplitudes_settled(smooth_decay, 1e-2));
-  CHECK(st::amplitudes_settled(smooth_decay, 5e-2));
-  CHECK_FALSE(st::amplitudes_settled(std::vector<double>(2 * w - 1, 1.0), 1e-2));  // too few periods
 }
 
 // Reference: the half-power width of a lightly damped SDOF, (f₂ − f₁)/(2f_peak) = ζ + O(ζ²)

@@ -7,6 +7,7 @@
 #include "cli/cli_support.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/frf.hpp"
 #include "pdamp/tasks/modes.hpp"
@@ -75,4 +76,69 @@ TEST_CASE("decay: the initial energy is the final energy plus what the structure
   const auto j = tasks::to_json(r, {});
   CHECK(j["settling_time_s"] == r.decay.settling_time_s);
   CHECK(j["decay"]["file"].is_null());
+}
+
+// The DEM stepped sine as a library call on the CLI tests' one-mode case (a 0.5 kg mode at
+// 2 Hz, 0.3 kg container, a small bed). Reference: the rules themselves: every point runs
+// at least the case's /dem/transient_periods, and reports its convergence; points that would
+// fall on one frequency are refused before any run, naming the flags.
+TEST_CASE("frf --method dem: the case's transient periods are honoured and each point says whether it converged",
+          "[tasks][dem]") {
+  auto c = case_file::load_case(std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/one_mode_dem_frf.json");
+  c.dem.simulation.transient_periods = 12;
+  tasks::FrfOptions o;
+  o.method = tasks::FrfMethod::kDem;
+  o.dem = tasks::default_dem_frf_options(c);
+  o.dem.points = 2;
+  o.dem.min_frequency_hz = 1.5;
+  o.dem.max_frequency_hz = 1.7;
+  o.dem.directions = {"up"};
+  const auto r = tasks::run_frf(c, o, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(r.stepped);
+  CHECK(r.stepped->settling.min_transient_periods == 12);
+  const auto& points = r.stepped->branches.at(0).points;
+  REQUIRE(points.size() == 2);
+  for (const auto& p : points) {
+    INFO(p.frequency_hz << " Hz: " << p.transient_periods << " transient periods, change " << p.window_max_relative_change);
+    CHECK(p.transient_periods >= 12);
+    CHECK(p.analysed_periods == c.dem.simulation.analysed_periods);
+    CHECK(p.period_magnitudes.size() == static_cast<std::size_t>(p.periods()));
+    CHECK(p.window_periods == static_cast<int>(structure::kConvergenceWindowPeriods));
+    CHECK(p.converged == (p.window_max_relative_change <= o.dem.settling.stable_tolerance &&
+                          p.window_relative_drift <= o.dem.settling.stable_tolerance));
+    // Unconverged: one warning naming the frequency and the scatter.
+    std::size_t named = 0;
+    for (const auto& w : r.warnings)
+      if (w.find("not converged") != std::string::npos &&
+          w.find(strict_json::format_number(p.frequency_hz, 5) + " Hz") != std::string::npos)
+        ++named;
+    CHECK(named == (p.converged ? 0u : 1u));
+  }
+  const auto json = tasks::to_json(r, tasks::OutputFolder{});
+  CHECK(json["frf"]["stepped_sine"]["min_transient_periods"] == 12);
+  for (const auto& p : json["frf"]["points"]) {
+    CHECK(p.contains("converged"));
+    CHECK(p["periods"].get<int>() >= 12 + c.dem.simulation.analysed_periods);
+    CHECK(p["convergence"].contains("max_relative_change"));
+  }
+}
+
+TEST_CASE("frf --method dem: points that would fall on one frequency are refused before the run, naming the flags",
+          "[tasks][dem]") {
+  const auto c = case_file::load_case(std::string(PDAMP_SOURCE_DIR) + "/tests/cli/data/one_mode_dem_frf.json");
+  tasks::FrfOptions o;
+  o.method = tasks::FrfMethod::kDem;
+  o.dem = tasks::default_dem_frf_options(c);
+  o.dem.points = 1000;  // 1e-9 Hz apart: far closer than a step per period (N ~ 1e5)
+  o.dem.min_frequency_hz = 1.5;
+  o.dem.max_frequency_hz = 1.5 + 1e-6;
+  bool refused = false;
+  try {
+    tasks::run_frf(c, o, tasks::silent_hooks(), tasks::local_executor());
+  } catch (const strict_json::InputError& e) {
+    refused = true;
+    CHECK(e.file() == "--dem-points, --dem-min-frequency, --dem-max-frequency");
+    CHECK(std::string(e.rule()).find("fall on one frequency") != std::string::npos);
+  }
+  CHECK(refused);
 }

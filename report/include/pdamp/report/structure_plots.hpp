@@ -71,6 +71,7 @@ struct CompareDemPoint {
   double magnitude = 0.0;
   double spread = 0.0;  ///< sample standard deviation over the analysed periods (0 if not defined)
   std::string sweep;    ///< "up" or "down"
+  bool converged = true;  ///< its transient converged (else drawn apart, stability "dem_unconverged")
 };
 
 /// frf_compare.csv (source,branch,frequency_hz,stability,magnitude,magnitude_spread: the

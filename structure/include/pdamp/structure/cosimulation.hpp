@@ -5,6 +5,7 @@
 #include <complex>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -85,13 +86,18 @@ struct CosimulationOptions {
   /// sweep's highest frequency, the peak site speed from the linear response over the band.
   double sweep_end_frequency_hz = 0.0;
   /// Harmonic kinds: periods run before the analysis, >= 0; with settle_until_stable the
-  /// largest number allowed (the run stops settling earlier once stable).
+  /// largest number allowed (the run stops settling earlier once converged).
   int transient_periods = 0;
+  /// Harmonic kinds with settle_until_stable: periods the transient runs at least before the
+  /// convergence test may end it, in [0, transient_periods] (the case's /dem/transient_periods
+  /// in a stepped sine).
+  int min_transient_periods = 0;
   /// Harmonic kinds: whole periods of the DFT (steady-state amplitudes), >= 1.
   int analysed_periods = 1;
   /// Harmonic kinds: end the transient once the first damper's site amplitude along its
-  /// drive (DFT at Ω of each period) has stopped drifting: amplitudes_settled on the
-  /// periods run so far, at two period ends in a row.
+  /// drive (|DFT at Ω| of each period) has converged: amplitude_window over the last
+  /// kConvergenceWindowPeriods periods, every period-to-period change and the change across
+  /// the window at most stable_tolerance of the window's mean (amplitudes_converged).
   bool settle_until_stable = false;
   double stable_tolerance = 1e-3;  ///< in (0, 1)
   /// Bed settling before the coupling starts, with the structure held in its initial state
@@ -144,7 +150,14 @@ struct CosimulationSteadyState {
   double frequency_hz = 0.0;
   int transient_periods = 0;  ///< periods run before the analysed ones
   int analysed_periods = 0;
-  bool stable = false;        ///< settle_until_stable reached its tolerance (false when not asked)
+  bool stable = false;        ///< settle_until_stable: the transient converged (false when not asked)
+  /// The convergence test's window when the transient ended (converged, or at its cap):
+  /// the last min(kConvergenceWindowPeriods, transient periods) per-period amplitudes of the
+  /// first site (amplitude_window); periods 0 and NaN measures with fewer than two.
+  int window_periods = 0;
+  double window_max_relative_change = std::numeric_limits<double>::quiet_NaN();
+  double window_relative_drift = std::numeric_limits<double>::quiet_NaN();
+  double window_relative_spread = std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXcd modal_amplitudes;                    ///< q̂_j
   std::vector<std::complex<double>> site_amplitudes_m;  ///< ŷ_d along n (absolute), m
   /// |ŷ_d| per unit excitation: transmissibility |ŷ/U| (base) or receptance |ŷ/F| in m/N.
@@ -353,17 +366,32 @@ CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::
                                             const CosimulationOptions& options);
 
 /// Rodrigues rotation about a unit axis by angle θ (rad), row-major (body → world).
-/// Periods averaged by each of the two windows of amplitudes_settled.
+/// Cycles averaged by each window of a linear sweep's peak (kSweepWindowCycles).
 inline constexpr std::size_t kSettledWindowPeriods = 4;
 
-/// The steady-state test of a stepped sine, made for a DEM bed whose per-period amplitude
-/// scatters by a few per cent (chaotic impacts), so a period-to-period change never stays
-/// below a tight tolerance: the means A (last kSettledWindowPeriods amplitudes) and B (the
-/// ones before) agree, |A − B| <= tolerance·A + 2·s·√(2/w), s the pooled sample standard
-/// deviation of the two windows. A drift that the scatter hides is accepted only up to
-/// twice the standard error of A − B; a smooth response (no bed) has s ≈ 0 and meets
-/// the tolerance alone. False with fewer than 2w amplitudes.
-bool amplitudes_settled(const std::vector<double>& period_amplitudes, double tolerance);
+/// Consecutive periods over which a harmonic run's transient must have converged.
+inline constexpr std::size_t kConvergenceWindowPeriods = 8;
+
+/// The per-period amplitudes a_1 … a_w of the last w = min(window, n) periods, relative to
+/// their mean ā: the largest period-to-period change max|a_k − a_{k−1}|/ā, the change across
+/// the window |a_w − a_1|/ā, and the sample standard deviation over ā. NaN measures (periods
+/// 0) with fewer than two amplitudes or a mean that is not > 0.
+struct AmplitudeWindow {
+  int periods = 0;
+  double max_relative_change = std::numeric_limits<double>::quiet_NaN();
+  double relative_drift = std::numeric_limits<double>::quiet_NaN();
+  double relative_spread = std::numeric_limits<double>::quiet_NaN();
+};
+AmplitudeWindow amplitude_window(const std::vector<double>& period_amplitudes,
+                                 std::size_t window = kConvergenceWindowPeriods);
+
+/// The steady-state test of a harmonic run (a stepped sine's points, a sweep's start): the
+/// window holds `window` periods, every period-to-period change in it is at most
+/// tolerance·ā, and so is the change across it (a slow drift of r per period changes the
+/// window by (w − 1)r, so it must be below tolerance/(w − 1) per period). A beating or
+/// drifting transient does not pass; a stationary series of relative scatter σ passes
+/// nearly always for σ <= tolerance/5 and, for larger σ, only in a quieter stretch.
+bool amplitudes_converged(const AmplitudeWindow& w, double tolerance, std::size_t window = kConvergenceWindowPeriods);
 
 dem_reference::Matrix3 rotation_about(const dem_reference::Vec3& unit_axis, double angle_rad);
 
