@@ -212,6 +212,12 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
   return options;
 }
 
+formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer) {
+  formulas::ModelOptions options = damper.model_options;
+  options.nested_bed = layer.bed.settled_upper_spheres > 0;
+  return options;
+}
+
 std::vector<std::string> settled_bed_warnings(const Case& c) {
   std::vector<std::string> out;
   for (const DamperSpec& d : c.dampers) {
@@ -225,8 +231,11 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
            << " mm, not the lattice's " << bed.clearance_m * 1e3 << " mm";
       if (bed.settled_upper_spheres > 0)
         text << "; " << bed.settled_upper_spheres
-             << " spheres stay above the bottom rows, which the closed forms (one rolling layer) do not model: "
-                "use the layer's DEM field (docs/collect_and_collide.md §8)";
+             << " spheres stay above the bottom rows, resting on two or more others: a nested bed, which does not "
+                "roll; model auto takes it as a Coulomb block held by its base up to Gamma = mu = "
+             << d.model_options.base_friction
+             << " (docs/physics.md §3.3), which the DEM supports only up to that threshold: use the layer's DEM "
+                "field (docs/collect_and_collide.md §8)";
       out.push_back(text.str());
     }
   }

@@ -116,7 +116,7 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
       coupled.bed_mass_kg = layer.bed_mass_kg;
       coupled.loss_model = method == LossMethod::kFormulas
                                ? std::make_shared<sg::ClosedFormLossModel>(spec.model, layer.clearance_m,
-                                                                           spec.model_options)
+                                                                           layer_model_options(spec, layer))
                                : field_loss_model(c, d, l, out.warnings);
       damper.layers.push_back(std::move(coupled));
     }

@@ -309,6 +309,11 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
 /// /dem/inner_structures/pins/0, /dampers/0/layers/1/particles, ...).
 CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::string& problem);
 
+/// The closed forms' options of one layer: its damper's, with nested_bed set where the
+/// layer's settled bed keeps spheres above its bottom rows (LatticeBed::settled_upper_spheres
+/// > 0, docs/physics.md §3.3): those rest on two or more others and cannot rotate.
+formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer);
+
 /// One sentence per layer whose bed is stacked across gravity (formulas::LatticeBed): its
 /// clearance is the settled bed's (smaller than its lattice's), and where spheres stay
 /// above the settled bottom rows the closed forms, which model one rolling layer, are
