@@ -26,7 +26,14 @@ void CliHooks::progress(const tasks::Progress& p) {
   auto [it, first] = last_line_.try_emplace(p.label, now);
   if (!tty_ && !first && !last && now - it->second < std::chrono::seconds(10)) return;
   it->second = now;
-  const std::string eta = std::isfinite(p.eta_s) ? std::to_string(static_cast<long long>(p.eta_s)) + " s" : "?";
+  double eta_s = p.eta_s;
+  const auto [start, inserted] = first_report_.try_emplace(p.label, now, p.done);
+  if (!std::isfinite(eta_s) && !inserted) {
+    const double wall = std::chrono::duration<double>(now - start->second.first).count();
+    const double progressed = p.done - start->second.second;
+    if (wall > 0.0 && progressed > 0.0) eta_s = (p.total - p.done) * wall / progressed;
+  }
+  const std::string eta = std::isfinite(eta_s) ? std::to_string(static_cast<long long>(eta_s)) + " s" : "?";
   char line[300];
   if (p.counts_points) {
     std::snprintf(line, sizeof line, "%s: %.0f/%.0f %s, ETA %s", p.label.c_str(), p.done, p.total, p.stage.c_str(),

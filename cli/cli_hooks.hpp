@@ -17,7 +17,8 @@ class CliHooks : public tasks::RunHooks {
   explicit CliHooks(double checkpoint_interval_s = 60.0);
   ~CliHooks() override;
   /// One line per report: rewritten in place on a terminal, else at most one line every
-  /// 10 s per run (the first and the last of a run always).
+  /// 10 s per run (the first and the last of a run always). A run that gives no ETA gets
+  /// one from its mean rate since its first report.
   void progress(const tasks::Progress& p) override;
   void note(const std::string& line) override;
   bool checkpoint_due(double seconds_since_checkpoint) override;
@@ -30,6 +31,8 @@ class CliHooks : public tasks::RunHooks {
   bool tty_;
   bool line_open_ = false;  // a terminal line being rewritten
   std::map<std::string, std::chrono::steady_clock::time_point> last_line_;
+  /// Per run: the wall time and progress of its first report, for an ETA where the run gives none.
+  std::map<std::string, std::pair<std::chrono::steady_clock::time_point, double>> first_report_;
 };
 
 }  // namespace pdamp::cli

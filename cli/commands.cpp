@@ -63,7 +63,7 @@ fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
 }
 
 /// A result printed without files: the closed forms' (refused when not finite).
-constexpr ResultFiles kPrintOnly{"", nullptr, false, "files", false, true};
+const ResultFiles kPrintOnly{"", nullptr, false, "files", false, true};
 
 Rows optimum_rows(const fm::OptimumStroke& o) {
   return {{"model", std::string(fm::to_string(o.model))},
@@ -137,6 +137,8 @@ int run_buffer(const ParsedArgs& args, CommandContext&) {
   in.layer.poisson_ratio =
       args.optional_number("--layer-poisson", limits::kPoisson).value_or(fm::kDefaultLayerPoissonRatio);
   in.model = case_file::buffer_model(args.optional_text("--layer-model").value_or("layered"), "--layer-model", "");
+  in.allowable_strain =
+      args.optional_number("--allowable-strain", limits::kAllowableStrain).value_or(fm::kDefaultAllowableStrain);
   in.particles_per_contact = args.optional_number("--particles-per-contact", Range{1.0, 1e9}).value_or(1.0);
   in.impact_velocity_m_s = args.optional_number("--impact-velocity", limits::kImpactSpeed).value_or(0.0);
   const auto problems = in.validate();
@@ -146,6 +148,8 @@ int run_buffer(const ParsedArgs& args, CommandContext&) {
   return finish(args, nullptr, out, design.warnings,
                 {{"model", std::string(design.model == fm::BufferModel::kLayered ? "layered" : "half_space")},
                  {"layer_thickness_m", format_number(design.layer_thickness_m)},
+                 {"allowable_strain", format_number(design.allowable_strain, 4) +
+                                          (design.model == fm::BufferModel::kHalfSpace ? "  (half_space: t = delta_max)" : "")},
                  {"contact_radius/thickness", format_number(design.contact_radius_over_thickness, 3)},
                  {"half-space thickness", format_number(design.half_space_thickness_m) + "  (compressed to " +
                                               format_number(design.layered_compression_of_half_space_design, 3) +
@@ -547,8 +551,8 @@ const std::vector<Command>& commands() {
        run_loss},
       {{"buffer",
         "pdamp buffer --frequency HZ (--amplitude M | --intensity G) --radius M --layer-modulus PA [options] [--json]",
-        "Hertz sizing of a buffered (polymer-coated) wall: the layer thickness that the design\n"
-        "impact just compresses fully (docs/physics.md section 5)",
+        "sizing of a buffered (polymer-coated) wall: the layer thickness whose tip strain under the\n"
+        "design impact is the allowable strain (docs/physics.md section 5)",
         {{"--frequency", "HZ", "design frequency, Hz (> 0)"},
          {"--amplitude", "M", "design stroke X, m (> 0); or give --intensity"},
          {"--intensity", "G", "design intensity Gamma = X Omega^2/g (> 0)"},
@@ -560,6 +564,8 @@ const std::vector<Command>& commands() {
          {"--layer-poisson", "NU", "layer Poisson ratio, [0, 0.5] (default 0.48, polyurethane; 0.5 incompressible)"},
          {"--layer-model", "LAW", "layered (default: sphere on a layer bonded to the wall, exact for any\n"
                                   "                          contact radius/thickness) or half_space (the source study's Hertz rule)"},
+         {"--allowable-strain", "EPS", "allowable tip strain delta_max/t of the layer, (0, 1] (default 0.3,\n"
+                                       "                          polyurethane; 1: the design impact compresses it fully)"},
          {"--particles-per-contact", "N", "particles whose momentum drives one contact (default 1)"},
          {"--impact-velocity", "M_S", "impact speed, m/s (default 2*X*Omega, the bouncing optimum)"},
          kJsonFlag}},

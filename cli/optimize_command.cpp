@@ -117,6 +117,10 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
                                           std::to_string(r.neighbours_total) + " evaluated"},
                {"chosen", design_row(r.chosen, true)},
                {"baseline (" + r.baseline_layer + ")", design_row(r.baseline, true)},
+               {"same mass, one compartment", format_number(r.same_mass.total_mass_kg * 1e3, 4) + " g at h = " +
+                                                  format_number(r.same_mass.layers.front().clearance_m * 1e3, 4) +
+                                                  " mm, settling " + seconds_or_not_settled(r.same_mass.settling_time_s)},
+               {"without particles", "settling " + seconds_or_not_settled(r.bare.settling_time_s)},
                {"case start", design_row(r.initial, true)},
                {"solver", r.summary.brief_report()},
                {"time", format_number(r.solve_time_s, 4) + " s, " + std::to_string(r.decay_evaluations) + " free decays"}};

@@ -68,6 +68,7 @@ void read_buffer(ObjectReader& b, Case& c) {
   in.impact_velocity_m_s = b.optional_number("impact_velocity_m_s", limits::kImpactSpeed, " m/s").value_or(0.0);
   in.model = buffer_model(b.text("model", std::string("layered"), {"layered", "half_space"}), b.file(),
                           b.pointer() + "/model");
+  in.allowable_strain = b.number("allowable_strain", formulas::kDefaultAllowableStrain, limits::kAllowableStrain);
   const LayerSpec& layer = c.dampers.front().layers.front();
   in.particle_radius_m = layer.particle_radius_m;
   in.particle = c.materials.at(layer.particle_material);

@@ -188,6 +188,10 @@ std::vector<std::string> BufferDesignInput::validate() const {
   }
   for (auto& line : particle.validate("particle")) problems.push_back(std::move(line));
   for (auto& line : layer.validate("layer")) problems.push_back(std::move(line));
+  // ε_a = 1 is full compression; a strain above it would put the sphere through the layer.
+  if (!(allowable_strain > 0.0 && allowable_strain <= 1.0)) {
+    problems.push_back("allowable_strain = " + number(allowable_strain) + ": must be in (0, 1]");
+  }
   if (model != BufferModel::kLayered && model != BufferModel::kHalfSpace) {
     problems.push_back("model = " + std::to_string(static_cast<int>(model)) + ": must be layered or half_space");
   }
@@ -226,26 +230,33 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
       layered_impact(half_space_design, design.effective_mass_kg, v).max_overlap_m / half_space_thickness;
   design.model = input.model;
   if (input.model == BufferModel::kHalfSpace) {
+    design.allowable_strain = 1.0;  // the source study's rule, t = δ_max, as it was
     design.max_penetration_m = half_space_thickness;
     design.layer_thickness_m = half_space_thickness;
     design.contact_time_s = contact_time(contact, v);
     design.max_force_n = contact.force(design.max_penetration_m);
     design.contact_radius_m = std::sqrt(r * design.max_penetration_m);
   } else {
-    // ½m*v² = U(t; t): U at bottoming out grows with t (∝ t^{5/2} for a/t → 0, ∝ t² for
-    // the compressible and ∝ t for the incompressible thin layer), so bisection on ln t
-    // between the half-space value (an upper bound: the layer is stiffer) and 1e-6 of it.
+    // δ_max(t) = ε_a t  <=>  ½m*v² = U(ε_a t; t) (energy balance at the turning point,
+    // docs/hertz_and_buffer.md "Buffered-wall sizing"). U(ε_a t; t) grows with t: with
+    // χ = √(rε_a/t) it is U_Hertz(ε_a t)·W(χ), ∝ t^{5/2} for a/t → 0, ∝ t² for the
+    // compressible and ∝ t for the incompressible thin layer. Bisection on ln t between
+    // t_H/ε_a (an upper bound: the bonded layer is stiffer than Hertz, G >= 1, so
+    // U(ε_a t; t) >= U_Hertz(t_H) = ½m*v² there) and 1e-6 of it. ε_a = 1 is the former
+    // full-compression sizing, to the bit.
+    const double strain = input.allowable_strain;
+    design.allowable_strain = strain;
     const double kinetic = 0.5 * design.effective_mass_kg * v * v;
-    double hi = half_space_thickness, lo = 1e-6 * half_space_thickness;
+    double hi = half_space_thickness / strain, lo = 1e-6 * hi;
     for (int i = 0; i < 200 && hi / lo - 1.0 > 1e-13; ++i) {
       const double mid = std::sqrt(lo * hi);
-      (layered(mid).energy(mid) > kinetic ? hi : lo) = mid;
+      (layered(mid).energy(strain * mid) > kinetic ? hi : lo) = mid;
     }
     const double thickness = std::sqrt(lo * hi);
     const LayeredContact law = layered(thickness);
     const LayeredImpact impact = layered_impact(law, design.effective_mass_kg, v);
     design.layer_thickness_m = thickness;
-    design.max_penetration_m = impact.max_overlap_m;  // = t to the bisection's 1e-13
+    design.max_penetration_m = impact.max_overlap_m;  // = ε_a t to the bisection's 1e-13
     design.contact_time_s = impact.contact_time_s;
     design.max_force_n = impact.max_force_n;
     design.contact_radius_m = law.contact_radius(impact.max_overlap_m);
@@ -298,21 +309,26 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
     said.push_back(
         "The thickness equals the Hertz delta_max so the design impact just compresses the layer fully "
         "(strain 1 under the sphere's tip): a first sizing beyond linear elasticity, to be checked in the "
-        "DEM.");
+        "DEM. The allowable strain (" +
+        number(input.allowable_strain, 4) + ") is not used by this rule (model layered sizes to it).");
   } else {
+    const double strain = design.allowable_strain;
     said.push_back(
         "Model layered: sphere on an elastic layer of thickness t bonded to the rigid wall (exact linear "
         "elasticity for any a/t, Hertz for a/t -> 0, thin-layer limits for a/t >> 1; "
         "docs/hertz_and_buffer.md). The thickness t = " +
-        number(thickness, 4) + " m is the one whose full compression (delta_max = t, nominal strain 1 "
-        "under the sphere's tip) the design impact just reaches: 1/2 m* v^2 = integral_0^t F(delta; t) "
-        "ddelta. The half-space sizing would give " +
+        number(thickness, 4) + " m is the one whose tip strain at the design impact is the allowable strain " +
+        number(strain, 4) + " (delta_max = " + number(design.max_penetration_m, 4) +
+        " m, the compression under the sphere's tip over the thickness): 1/2 m* v^2 = integral_0^(eps_a t) "
+        "F(delta; t) ddelta. The half-space sizing would give " +
         number(half_space_thickness, 4) + " m, which this impact compresses to only " +
         number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
     said.push_back(
-        "At full compression the contact radius is a = " + number(a, 4) + " m, a/t = " + number(a / thickness, 3) +
-        "; the strain of 1 at the tip is far beyond linear elasticity (and the paraboloid needs a << r): a "
-        "sizing estimate, to be checked in the DEM with the layered law.");
+        "At the design impact the contact radius is a = " + number(a, 4) + " m, a/t = " + number(a / thickness, 3) +
+        "; a tip strain of " + number(strain, 3) +
+        (strain >= 1.0 ? " (full compression: the layer bottoms out) is far beyond linear elasticity"
+                       : " is beyond the small strains of linear elasticity") +
+        " (and the paraboloid needs a << r): a sizing estimate, to be checked in the DEM with the layered law.");
   }
   auto& warn = design.warnings;
   if (design.contact_time_over_period > kMaxContactTimeOverPeriod) {
@@ -330,8 +346,10 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
         "stiffer, and the design impact compresses it to only " +
         number(design.layered_compression_of_half_space_design, 3) + " of its thickness (model layered)");
   }
-  if (!half_space && std::sqrt(r / thickness) > LayeredContact::kMaxTabulatedOverlapParameter) {
-    warn.push_back("layered law: sqrt(r/t) = " + number(std::sqrt(r / thickness), 3) + " exceeds the tabulated " +
+  // χ = √(r δ_max)/t at the design impact (√(r/t) at full compression).
+  const double chi = std::sqrt(r * design.max_penetration_m) / thickness;
+  if (!half_space && chi > LayeredContact::kMaxTabulatedOverlapParameter) {
+    warn.push_back("layered law: sqrt(r*delta_max)/t = " + number(chi, 3) + " exceeds the tabulated " +
                    "exact solution (" + number(LayeredContact::kMaxTabulatedOverlapParameter, 3) +
                    "): the force continues as the table's end power law (thin-layer regime)");
   }

@@ -23,6 +23,9 @@ constexpr double kFitsTolerance = 1e-9;   // as formulas::collected_lattice's "f
 constexpr double kEmptyLayerSlabs = 1e-9; // below: the layer holds nothing and is left out
 constexpr double kWholeTolerance = 1e-6;  // a relaxed n_k this close to a whole number is that number
 constexpr int kMaxLayers = 10;
+/// The single-compartment reference: clearances scanned, then golden-section steps.
+constexpr std::size_t kSingleCompartmentScan = 41;
+constexpr int kSingleCompartmentRefinements = 20;
 
 std::string number(double value) {
   std::ostringstream out;
@@ -139,29 +142,14 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
   return damper;
 }
 
-FillingDesign evaluate_filling_design(const structure::ModalModel& model, const FillingRatioOptions& options,
-                                      std::span<const double> slabs) {
-  FillingDesign design;
-  std::vector<structure::Damper> dampers = {filling_damper(options, slabs)};
-  dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
-  for (std::size_t k = 0; k < slabs.size(); ++k) {
-    const auto& l = options.layers[k];
-    LayerDesign d;
-    d.name = l.name;
-    d.slabs = slabs[k];
-    d.clearance_m = l.clearance_m(slabs[k]);
-    d.filling_ratio = 1.0 - d.clearance_m / l.inner_length_m;
-    d.bed_mass_kg = slabs[k] * l.slab_mass_kg();
-    d.particles = slabs[k] * l.spheres_per_slab;
-    d.volume_fraction = l.cross_section_m2 > 0.0
-                            ? d.particles * l.sphere_volume_m3 / (l.inner_length_m * l.cross_section_m2)
-                            : 0.0;
-    design.total_slabs += static_cast<int>(std::lround(slabs[k]));
-    design.layers.push_back(std::move(d));
-  }
-  design.total_mass_kg = total_mass(options, slabs);
-  design.feasible = feasible(options, slabs);
+namespace {
 
+/// The free decay of `damper` (with the fixed dampers) scored by the objective: settled,
+/// settling time, ½∫e² dt and the objective of `design`.
+void score_decay(const structure::ModalModel& model, const FillingRatioOptions& options, structure::Damper damper,
+                 FillingDesign& design) {
+  std::vector<structure::Damper> dampers = {std::move(damper)};
+  dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
   structure::FreeDecayOptions decay = options.decay;
   const bool integral = options.objective == FillingObjective::kIntegralSquare;
   decay.sample_times_s = structure::uniform_sample_times(decay.duration_s, integral ? options.integral_samples : 2);
@@ -182,8 +170,98 @@ FillingDesign evaluate_filling_design(const structure::ModalModel& model, const 
     const double end = result.samples.back().threshold_measure_m;
     design.objective = decay.duration_s * (1.0 + std::log(std::max(end / result.threshold_used_m, 1.0)));
   }
+}
+
+}  // namespace
+
+FillingDesign evaluate_filling_design(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                      std::span<const double> slabs) {
+  FillingDesign design;
+  for (std::size_t k = 0; k < slabs.size(); ++k) {
+    const auto& l = options.layers[k];
+    LayerDesign d;
+    d.name = l.name;
+    d.slabs = slabs[k];
+    d.clearance_m = l.clearance_m(slabs[k]);
+    d.filling_ratio = 1.0 - d.clearance_m / l.inner_length_m;
+    d.bed_mass_kg = slabs[k] * l.slab_mass_kg();
+    d.particles = slabs[k] * l.spheres_per_slab;
+    d.volume_fraction = l.cross_section_m2 > 0.0
+                            ? d.particles * l.sphere_volume_m3 / (l.inner_length_m * l.cross_section_m2)
+                            : 0.0;
+    design.total_slabs += static_cast<int>(std::lround(slabs[k]));
+    design.layers.push_back(std::move(d));
+  }
+  design.total_mass_kg = total_mass(options, slabs);
+  design.feasible = feasible(options, slabs);
+  score_decay(model, options, filling_damper(options, slabs), design);
   return design;
 }
+
+FillingDesign evaluate_single_compartment(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                          double mass_kg, double particles, double clearance_m) {
+  FillingDesign design;
+  LayerDesign d;
+  d.name = kSingleCompartment;
+  d.slabs = std::numeric_limits<double>::quiet_NaN();
+  d.filling_ratio = std::numeric_limits<double>::quiet_NaN();
+  d.clearance_m = clearance_m;
+  d.bed_mass_kg = mass_kg;
+  d.particles = particles;
+  design.layers.push_back(std::move(d));
+  design.total_mass_kg = mass_kg;
+  design.feasible = options.mass_budget_kg <= 0.0 || mass_kg <= options.mass_budget_kg * (1.0 + 1e-9);
+  structure::Damper damper = options.damper;
+  damper.layers.clear();
+  structure::DamperLayer layer;
+  layer.name = kSingleCompartment;
+  layer.bed_mass_kg = mass_kg;
+  layer.loss_model = std::make_shared<surrogate::ClosedFormLossModel>(options.model, clearance_m, options.model_options);
+  damper.layers.push_back(std::move(layer));
+  score_decay(model, options, std::move(damper), design);
+  return design;
+}
+
+namespace {
+
+/// The design's particle mass in one compartment, its clearance chosen for the best
+/// objective: a scan of kSingleCompartmentScan clearances, log-spaced from the smallest
+/// candidate's sphere diameter (one sphere of travel) to the longest candidate's inner
+/// length, then a golden-section search between the best scanned clearance's neighbours
+/// (the objective is piecewise smooth in h: the onset's cliff moves with it).
+FillingDesign best_single_compartment(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                      const FillingDesign& design, int& evaluations) {
+  double particles = 0.0;
+  for (const auto& l : design.layers) particles += l.particles;
+  double h_lo = std::numeric_limits<double>::infinity(), h_hi = 0.0;
+  for (const auto& l : options.layers) h_lo = std::min(h_lo, l.slab_length_m), h_hi = std::max(h_hi, l.inner_length_m);
+  const auto at = [&](double h) {
+    ++evaluations;
+    return evaluate_single_compartment(model, options, design.total_mass_kg, particles, h);
+  };
+  std::vector<double> h(kSingleCompartmentScan);
+  FillingDesign best;
+  best.objective = std::numeric_limits<double>::infinity();
+  std::size_t best_k = 0;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    h[k] = h_lo * std::pow(h_hi / h_lo, static_cast<double>(k) / static_cast<double>(h.size() - 1));
+    auto d = at(h[k]);
+    if (d.objective < best.objective) best = std::move(d), best_k = k;
+  }
+  double a = std::log(h[best_k == 0 ? 0 : best_k - 1]), b = std::log(h[std::min(best_k + 1, h.size() - 1)]);
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int i = 0; i < kSingleCompartmentRefinements && b - a > 1e-6; ++i) {
+    const double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a);
+    auto d1 = at(std::exp(x1)), d2 = at(std::exp(x2));
+    if (d1.objective < best.objective) best = d1;
+    if (d2.objective < best.objective) best = d2;
+    if (d1.objective < d2.objective) b = x2;
+    else a = x1;
+  }
+  return best;
+}
+
+}  // namespace
 
 FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, const FillingRatioOptions& options,
                                            const Options& solver) {
@@ -284,6 +362,11 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
       }
     }
   }
+  // 4. The references every result states: the structure with its containers empty, and
+  // the chosen design's particle mass in one compartment at its own best clearance (what
+  // the layering adds beyond the mass).
+  out.bare = evaluate(std::vector<double>(n_layers, 0.0));
+  out.same_mass = best_single_compartment(model, options, out.chosen, out.decay_evaluations);
   if (out.baseline_evaluations > 0 && out.baseline.objective < out.chosen.objective)
     out.warnings.push_back("the best single-layer design (" + out.baseline_layer + ", objective " +
                            number(out.baseline.objective) + ") beats the chosen multi-layer design (objective " +

@@ -235,7 +235,8 @@ Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
   csv.precision(10);
   csv << "design,layer,slabs,particles,filling_ratio,volume_fraction,clearance_m,bed_mass_kg,settling_time_s,objective\n";
   const std::vector<std::pair<std::string, const opt::FillingDesign*>> designs = {
-      {"chosen", &r.chosen}, {"relaxed", &r.relaxed}, {"baseline", &r.baseline}, {"initial", &r.initial}};
+      {"chosen", &r.chosen},   {"relaxed", &r.relaxed}, {"baseline", &r.baseline},
+      {"initial", &r.initial}, {"bare", &r.bare},       {"same_mass", &r.same_mass}};
   for (const auto& [name, d] : designs)
     for (const auto& l : d->layers)
       csv << name << ',' << l.name << ',' << l.slabs << ',' << l.particles << ',' << l.filling_ratio << ','

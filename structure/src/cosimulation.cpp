@@ -1,18 +1,19 @@
-// Co-simulation of a modal model with one reference-DEM World per damper (docs/cosimulation.md).
+// Co-simulation of a modal model with one reference-DEM World per damper (docs/cosimulation.md):
+// input checks, planning, the free functions over the Cosimulation class, checkpoints.
 #include "pdamp/structure/cosimulation.hpp"
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
+#include "cosimulation_plan.hpp"
 #include "numbers.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
+#include "pdamp/structure/cosimulation_run.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 
 namespace pdamp::structure {
@@ -20,26 +21,22 @@ namespace pdamp::structure {
 namespace {
 
 namespace dem = pdamp::dem_reference;
+using detail::energy_terms;
+using detail::harmonic;
+using detail::join;
 using detail::kTwoPi;
+using detail::ledger_error;
 using detail::number;
-using Clock = std::chrono::steady_clock;
+using detail::plan_step;
+using detail::Prepared;
+using detail::prepare;
+using detail::start_vector;
+using detail::StepPlan;
+using detail::sweeping;
+using detail::validate_inputs;
 
 /// Unit vectors to this relative tolerance (inputs from JSON carry ~1e-9).
 constexpr double kUnitTolerance = 1e-6;
-/// The structure's Verlet step: ω_max·dt at most this (frequency error (ωdt)²/24 = 1.7e-4 at
-/// the limit); the automatic step is shortened to kStructureStepTarget/ω_max, whose frequency
-/// error (ωdt)²/24 is 1e-4 of that at 0.2 — far below the beds' own.
-constexpr double kStructureStepLimit = 0.2;
-constexpr double kStructureStepTarget = 0.05;
-/// A continuation warns when its frequency moves by more than this fraction to fit whole
-/// steps of the carried dt, or when the carried dt exceeds the run's own automatic step by
-/// more than this fraction (a few per cent fewer steps per contact change nothing measurable;
-/// the automatic step of a continuation also counts the state's energy, which the sweep's
-/// planning from rest does not).
-constexpr double kFrequencyChangeWarning = 1e-4;
-constexpr double kCarriedStepMargin = 0.1;
-/// The progress clock is read every this many steps.
-constexpr std::int64_t kProgressStride = 256;
 
 const PointModeShape* find_point(const ModalModel& model, const std::string& name) {
   for (const auto& p : model.points)
@@ -63,17 +60,14 @@ std::string vec2(const Eigen::Vector2d& v) {
   return out.str();
 }
 
-bool harmonic(const CosimulationExcitation& e) { return e.kind != CosimulationExcitationKind::kFreeDecay; }
-bool sweeping(const CosimulationOptions& o) { return harmonic(o.excitation) && o.sweep_end_frequency_hz > 0.0; }
+}  // namespace
 
-/// Time τ at which a linear sweep from f₀ at rate r (Hz/s) has run `cycles` cycles:
-/// f₀τ + ½rτ² = k, rationalised (τ = 2k/(f₀ + √(f₀² + 2rk))) so that r → 0 needs no case.
+namespace detail {
+
 double sweep_cycle_time(double f0, double rate, double cycles) {
   return 2.0 * cycles / (f0 + std::sqrt(std::max(0.0, f0 * f0 + 2.0 * rate * cycles)));
 }
 
-/// A bed's η* and m_app/m_bed from its force and site amplitudes at ω (the Level II measure,
-/// docs/physics.md §1): P = ½F̂ conj V̂, V̂ = iωŷ; NaN for an empty bed or a still site.
 void bed_measures(std::complex<double> force_hat, std::complex<double> y, double omega, double m_bed,
                   std::vector<double>& eta_star, std::vector<double>& apparent_mass_fraction) {
   const std::complex<double> velocity = std::complex<double>(0.0, omega) * y;
@@ -85,14 +79,13 @@ void bed_measures(std::complex<double> force_hat, std::complex<double> y, double
   apparent_mass_fraction.push_back(defined ? f_conj_v.imag() / (omega * v2 * m_bed) : undefined);
 }
 
-/// Joins violations into one message.
 std::string join(const std::vector<std::string>& lines) {
   std::string out;
   for (const auto& l : lines) out += (out.empty() ? "" : "\n") + l;
   return out;
 }
 
-}  // namespace
+}  // namespace detail
 
 bool amplitudes_settled(const std::vector<double>& period_amplitudes, double tolerance) {
   constexpr std::size_t w = kSettledWindowPeriods;
@@ -202,22 +195,7 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
   return p;
 }
 
-namespace {
-
-/// Everything a run needs before its worlds: modal arrays with the empty containers, the
-/// excitation's shapes and the assumed peak site speeds.
-struct Prepared {
-  CoupledModel coupled;
-  Eigen::MatrixXd M, M_inv, B, R;
-  Eigen::MatrixXd T;  ///< modes x dampers: the sites' translation across the drive, t_d = z × n_d
-  Eigen::VectorXd w, K, C;
-  double omega = 0.0, U = 0.0;
-  /// The modal load per unit drive factor: F·Φ_pᵀe (force, factor sin ψ) or U·P_e (base,
-  /// factor −ü_b/U = ψ̇² sin ψ − ψ̈ cos ψ).
-  Eigen::VectorXd load_shape, base_shape, force_shape;
-  std::vector<double> drive_dot_e, across_dot_e, peak_speed;
-  std::vector<std::string> warnings;
-};
+namespace detail {
 
 /// Every violation of the inputs, one per line (a continuation drops the free decay's
 /// need of a non-zero start: it starts from the state).
@@ -384,13 +362,6 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   return P;
 }
 
-/// The common time step of a fresh start and the worlds' options (time_step_s still theirs).
-struct StepPlan {
-  double dt = 0.0;
-  std::int64_t steps_per_period = 0;
-  std::vector<dem::WorldOptions> world_options;
-  std::vector<std::string> warnings;
-};
 StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const CosimulationOptions& options,
                    double f_hz) {
   StepPlan plan;
@@ -460,7 +431,7 @@ Eigen::VectorXd start_vector(const Eigen::VectorXd& given, Eigen::Index n) {
   return given.size() ? given : Eigen::VectorXd::Zero(n);
 }
 
-}  // namespace
+}  // namespace detail
 
 CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                                             const CosimulationOptions& options) {
@@ -482,501 +453,10 @@ CosimulationResult cosimulate(const ModalModel& model, const std::vector<Cosimul
 CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                               const CosimulationOptions& options, CosimulationState& state,
                               const CosimulationProgressCallback& progress) {
-  const auto wall_start = Clock::now();
-  const bool continuation = state.started();
-  // --- Validation: every violation, one per line.
-  validate_inputs(model, dampers, options, continuation);
-  if (continuation) validate_state(model, dampers, options, state);
-
-  CosimulationResult result;
-  result.continued = continuation;
-  const auto& exc = options.excitation;
-  const bool is_harmonic = harmonic(exc);
-  const bool is_sweep = sweeping(options);
-  const bool is_base = exc.kind == CosimulationExcitationKind::kBaseTranslation;
-  const Eigen::Index n = model.mode_count();
-  const std::size_t dcount = dampers.size();
-
-  Eigen::VectorXd q = continuation ? state.modal_displacements : start_vector(options.initial_modal_displacements, n);
-  Eigen::VectorXd v = continuation ? state.modal_velocities : start_vector(options.initial_modal_velocities, n);
-
-  // --- Frequency, step and steps per period. A continuation keeps the worlds' step: the
-  // period takes the nearest whole number of them (the frequency run is 1/(N dt)).
-  double f_run = is_harmonic ? exc.frequency_hz : 0.0;
-  // A sweep plans its step at its highest frequency (the drive's step rule is per period).
-  const double f_plan = is_sweep ? std::max(exc.frequency_hz, options.sweep_end_frequency_hz) : f_run;
-  double dt = 0.0;
-  std::int64_t steps_per_period = 0;
-  std::vector<dem::WorldOptions> world_options;
-  if (continuation) {
-    dt = state.time_step_s;
-    if (is_harmonic && !is_sweep) {
-      steps_per_period = std::max<std::int64_t>(1, std::llround(1.0 / (exc.frequency_hz * dt)));
-      if (steps_per_period < 8)
-        throw std::invalid_argument("cosimulation.excitation.frequency_hz = " + number(exc.frequency_hz) +
-                                    ": a period of the state's step " + number(dt) + " s is only " +
-                                    std::to_string(steps_per_period) + " steps (at least 8)");
-      const double whole = 1.0 / (static_cast<double>(steps_per_period) * dt);
-      if (std::abs(whole - exc.frequency_hz) > 1e-12 * exc.frequency_hz) f_run = whole;
-      if (std::abs(whole - exc.frequency_hz) > kFrequencyChangeWarning * exc.frequency_hz)
-        result.warnings.push_back("frequency " + number(exc.frequency_hz) + " Hz run as " + number(whole) + " Hz: " +
-                                  std::to_string(steps_per_period) + " whole steps of the carried-over step " +
-                                  number(dt) + " s per period");
-    }
-  }
-  const Prepared P = prepare(model, dampers, options, f_run, q, v);
-  for (const auto& wline : P.warnings) result.warnings.push_back(wline);
-  if (continuation) {
-    // The step this frequency would take on its own: a warning if the carried one is longer.
-    CosimulationOptions automatic = options;
-    automatic.time_step_s = 0.0;
-    const StepPlan own = plan_step(P, dampers, automatic, f_plan);
-    if (dt > own.dt * (1.0 + kCarriedStepMargin))
-      result.warnings.push_back("the carried-over step " + number(dt) + " s is above the automatic step " +
-                                number(own.dt) + " s" + (is_harmonic ? " at " + number(f_plan) + " Hz" : std::string()) +
-                                ": contacts are resolved more coarsely (plan the sweep's step with "
-                                "cosimulation_time_step at its most demanding frequency)");
-    if (P.w.maxCoeff() * dt > kStructureStepLimit)
-      throw std::invalid_argument("cosimulation state: time_step_s = " + number(dt) + ": the highest mode needs ω·dt <= 0.2");
-  } else {
-    StepPlan plan = plan_step(P, dampers, options, f_plan);
-    for (auto& wline : plan.warnings) result.warnings.push_back(std::move(wline));
-    dt = plan.dt;
-    steps_per_period = is_sweep ? 0 : plan.steps_per_period;
-    world_options = std::move(plan.world_options);
-    for (auto& wo : world_options) wo.integration.time_step_s = dt;
-  }
-  const CoupledModel& coupled = P.coupled;
-  const Eigen::MatrixXd& M = P.M;
-  const Eigen::MatrixXd& M_inv = P.M_inv;
-  const Eigen::VectorXd& K = P.K;
-  const Eigen::VectorXd& C = P.C;
-  const Eigen::MatrixXd& B = P.B;
-  const Eigen::MatrixXd& R = P.R;
-  const double omega = P.omega;
-  const double U = P.U;
-  const Eigen::VectorXd& load_shape = P.load_shape;
-  const Eigen::VectorXd& base_shape = P.base_shape;
-  const Eigen::VectorXd& force_shape = P.force_shape;
-  const std::vector<double>& drive_dot_e = P.drive_dot_e;
-  const Eigen::MatrixXd& T = P.T;
-  const std::vector<double>& across_dot_e = P.across_dot_e;
-  // The container axis that follows t_d = z × n_d: c = k × a (a ↔ n, k ↔ z, right-handed).
-  std::vector<dem::Vec3> across_axis(dcount);
-  for (std::size_t d = 0; d < dcount; ++d) {
-    const dem::Vec3& k = dampers[d].container_rotation_axis;
-    const dem::Vec3& a = dampers[d].container_drive_axis;
-    across_axis[d] = {k[1] * a[2] - k[2] * a[1], k[2] * a[0] - k[0] * a[2], k[0] * a[1] - k[1] * a[0]};
-  }
-  result.frequencies_with_containers_hz = natural_frequencies_with_containers_hz(coupled);
-  result.time_step_s = dt;
-  result.steps_per_period = steps_per_period;
-  // The drive's phase at the start: a harmonic continuation goes on where the last run ended.
-  const double phase0 = continuation ? state.excitation_phase_rad : (is_harmonic ? options.excitation_phase_rad : 0.0);
-  // Times are whole steps since the first run's start, (steps0 + k)·dt: a run continued in
-  // segments samples the same instants, to the bit, as one run (its dt never changes).
-  const std::int64_t steps0 = continuation ? state.steps : 0;
-  const auto time_at = [&](std::int64_t k) { return static_cast<double>(steps0 + k) * dt; };
-  const double t0 = time_at(0);
-  result.start_time_s = t0;
-
-
-  // --- Planned length.
-  const bool periodic = is_harmonic && !is_sweep;  // one frequency, whole periods
-  const std::int64_t transient_steps = periodic ? options.transient_periods * steps_per_period : 0;
-  const std::int64_t planned_steps =
-      periodic ? transient_steps + options.analysed_periods * steps_per_period
-               : static_cast<std::int64_t>(std::llround(options.duration_s / dt));
-  double interval = options.sample_interval_s;
-  if (interval == 0.0) interval = is_harmonic ? 1.0 / (64.0 * f_plan) : options.duration_s / 2000.0;
-  const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(interval / dt));
-  const std::int64_t max_samples = planned_steps / sample_every + 1;
-
-  // --- Container kinematics of damper d for modal state q at drive time t.
-  std::vector<double> site_y(dcount), site_across(dcount), site_theta(dcount);
-  const auto site_state = [&](std::size_t d, const Eigen::VectorXd& qq, double base, double base_velocity,
-                              const Eigen::VectorXd& qdot, dem::ContainerState& s) {
-    const auto col = static_cast<Eigen::Index>(d);
-    const auto& cd = dampers[d];
-    const double y = B.col(col).dot(qq) + drive_dot_e[d] * base;
-    const double ydot = B.col(col).dot(qdot) + drive_dot_e[d] * base_velocity;
-    const double x = T.col(col).dot(qq) + across_dot_e[d] * base;  // across the drive
-    const double xdot = T.col(col).dot(qdot) + across_dot_e[d] * base_velocity;
-    const double theta = R.col(col).dot(qq);
-    const double theta_dot = R.col(col).dot(qdot);
-    for (int a = 0; a < 3; ++a) {
-      s.position_m[a] = cd.container_drive_axis[a] * y + across_axis[d][a] * x;
-      s.velocity_m_s[a] = cd.container_drive_axis[a] * ydot + across_axis[d][a] * xdot;
-      s.angular_velocity_rad_s[a] = cd.container_rotation_axis[a] * theta_dot;
-    }
-    s.orientation = theta == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, theta);
-    site_y[d] = y;
-    site_across[d] = x;
-    site_theta[d] = theta;
-  };
-
-  // sin ψ and cos ψ, ψ = 2πk/N + φ, at the steps of a period (one frequency), tabulated once.
-  std::vector<double> sin_table, cos_table;
-  if (periodic) {
-    sin_table.resize(static_cast<std::size_t>(steps_per_period));
-    cos_table.resize(static_cast<std::size_t>(steps_per_period));
-    for (std::int64_t k = 0; k < steps_per_period; ++k) {
-      const double phase = kTwoPi * static_cast<double>(k) / static_cast<double>(steps_per_period) + phase0;
-      sin_table[static_cast<std::size_t>(k)] = std::sin(phase);
-      cos_table[static_cast<std::size_t>(k)] = std::cos(phase);
-    }
-  }
-  // The drive at step k of this run: sin ψ, cos ψ, ψ̇, ψ̈ and ψ − φ (a sweep: ψ = φ +
-  // 2π(f₀τ + ½rτ²), τ = k dt, computed per step; its cost is nothing next to a DEM step).
-  struct Drive {
-    double s = 0.0, c = 0.0, rate = 0.0, acceleration = 0.0, phase = 0.0;
-  };
-  const double f0 = exc.frequency_hz;
-  const double sweep_rate = is_sweep ? (options.sweep_end_frequency_hz - f0) / options.duration_s : 0.0;  // Hz/s
-  const auto drive_at = [&](std::int64_t k) -> Drive {
-    if (!is_harmonic) return {};
-    if (!is_sweep) {
-      const auto i = static_cast<std::size_t>(k % steps_per_period);
-      return {sin_table[i], cos_table[i], omega, 0.0, 0.0};
-    }
-    const double tau = static_cast<double>(k) * dt;
-    const double phase = kTwoPi * tau * (f0 + 0.5 * sweep_rate * tau);
-    return {std::sin(phase0 + phase), std::cos(phase0 + phase), kTwoPi * (f0 + sweep_rate * tau), kTwoPi * sweep_rate,
-            phase};
-  };
-  // The factor of load_shape: sin ψ for a force, −ü_b/U = ψ̇² sin ψ − ψ̈ cos ψ for the base.
-  const auto load_factor = [&](const Drive& a) {
-    return is_base ? a.rate * a.rate * a.s - a.acceleration * a.c : a.s;
-  };
-
-  // --- Worlds, built at the start pose, and the beds settled with the structure held;
-  // a continuation takes the state's worlds as they are.
-  if (!continuation) {
-    state.worlds.clear();
-    state.worlds.reserve(dcount);
-  }
-  std::vector<dem::World>& worlds = state.worlds;
-  const Drive drive0 = drive_at(0);
-  const double base0 = U * drive0.s;                              // u_b = U sin ψ
-  const double base_velocity0 = U * drive0.rate * drive0.c;  // u̇_b = Uψ̇ cos ψ
-  std::vector<dem::ContainerState> states(dcount);
-  for (std::size_t d = 0; d < dcount; ++d) {
-    site_state(d, q, base0, base_velocity0, v, states[d]);
-    if (!continuation) worlds.emplace_back(world_options[d], states[d]);
-  }
-  for (std::size_t d = 0; d < dcount && !continuation; ++d) {
-    const double settling = options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
-                                                               : dem::automatic_settling_time_s(world_options[d]);
-    const auto steps = static_cast<std::int64_t>(std::llround(settling / dt));
-    result.settling_steps = std::max(result.settling_steps, steps);
-    if (progress) progress(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps) * dt, 0.0});
-    if (!dem::settle(worlds[d], states[d], steps)) {
-      result.outcome = worlds[d].status().outcome;
-      result.message = "damper " + dampers[d].name + " (settling): " + worlds[d].status().message;
-    }
-  }
-
-  // Bed loads on the structure: F_d along a, G_d along c (across) and M_d about k, what the
-  // container applies to the bed.
-  std::vector<double> force(dcount, 0.0), force_across(dcount, 0.0), moment(dcount, 0.0);
-  const auto read_load = [&](std::size_t d, const dem::ContainerLoad& load) {
-    force[d] = dot3(load.force_n, dampers[d].container_drive_axis);
-    force_across[d] = dot3(load.force_n, across_axis[d]);
-    moment[d] = dot3(load.moment_nm, dampers[d].container_rotation_axis);
-  };
-  for (std::size_t d = 0; d < dcount; ++d) read_load(d, worlds[d].load());
-
-  std::vector<dem::EnergyAccount> opening;
-  for (const auto& world : worlds) opening.push_back(world.energy());
-
-  // --- Preallocated loop state (the step loop allocates nothing).
-  Eigen::VectorXd g(n), tmp(n), acc(n), vh(n), q_new(n), v_new(n), acc_new(n), v_half_dt(n);
-  const Eigen::MatrixXd A_inv = (M + 0.5 * dt * Eigen::MatrixXd(C.asDiagonal())).inverse();
-  const auto modal_load = [&](double factor, const Eigen::VectorXd& qq, Eigen::VectorXd& out) {
-    out = factor * load_shape - K.cwiseProduct(qq);
-    for (std::size_t d = 0; d < dcount; ++d) {
-      const auto col = static_cast<Eigen::Index>(d);
-      out -= force[d] * B.col(col);
-      if (force_across[d] != 0.0) out -= force_across[d] * T.col(col);
-      if (moment[d] != 0.0) out -= moment[d] * R.col(col);
-    }
-  };
-  auto& h = result.history;
-  h.time_s.reserve(static_cast<std::size_t>(max_samples));
-  h.modal_displacements.resize(max_samples, n);
-  h.site_displacement_m.resize(max_samples, static_cast<Eigen::Index>(dcount));
-  h.site_rotation_rad.resize(max_samples, static_cast<Eigen::Index>(dcount));
-  h.container_load_n.resize(max_samples, static_cast<Eigen::Index>(dcount));
-  h.container_moment_nm.resize(max_samples, static_cast<Eigen::Index>(dcount));
-  Eigen::Index samples = 0;
-  const auto record = [&](double t) {
-    if (samples >= max_samples) return;
-    h.time_s.push_back(t);
-    h.modal_displacements.row(samples) = q.transpose();
-    for (std::size_t d = 0; d < dcount; ++d) {
-      const auto col = static_cast<Eigen::Index>(d);
-      h.site_displacement_m(samples, col) = site_y[d];
-      h.site_rotation_rad(samples, col) = site_theta[d];
-      h.container_load_n(samples, col) = -force[d];
-      h.container_moment_nm(samples, col) = -moment[d];
-    }
-    ++samples;
-  };
-
-  // Structural energy in the inertial frame (without ½m_rigid u̇_b²): T' = ½q̇ᵀMq̇ + u̇_b P_eᵀq̇.
-  const auto structure_kinetic = [&](const Eigen::VectorXd& vv, double base_velocity) {
-    tmp.noalias() = M * vv;
-    return 0.5 * vv.dot(tmp) + base_velocity * base_shape.dot(vv);
-  };
-  const auto structure_potential = [&](const Eigen::VectorXd& qq) { return 0.5 * qq.dot(K.cwiseProduct(qq)); };
-  // Base reaction power R'·u̇_b = u̇_b (P_eᵀq̈ + Σ F_d n_d·e).
-  const auto base_power = [&](const Eigen::VectorXd& accel, double base_velocity) {
-    double r = base_shape.dot(accel);
-    for (std::size_t d = 0; d < dcount; ++d) r += force[d] * drive_dot_e[d] + force_across[d] * across_dot_e[d];
-    return r * base_velocity;
-  };
-  const double kinetic0 = structure_kinetic(v, base_velocity0);
-  const double potential0 = structure_potential(q);
-
-  modal_load(load_factor(drive0), q, g);
-  tmp = g - C.cwiseProduct(v);
-  acc.noalias() = M_inv * tmp;
-  double power = is_base ? base_power(acc, base_velocity0) : 0.0;
-  double work = 0.0, damping = 0.0;
-  // The same sums since the first run's start (CosimulationState::energy_since_start).
-  double work_since_start = continuation ? state.energy_since_start.excitation_work_j : 0.0;
-  double damping_since_start = continuation ? state.energy_since_start.structural_damping_j : 0.0;
-  if (!continuation) {
-    state.start_structure_kinetic_j = kinetic0;
-    state.start_structure_potential_j = potential0;
-    state.start_world_energy = opening;
-  }
-  record(t0);
-
-  // DFT accumulators: per period (first damper's site, for the stability test) and analysed.
-  std::complex<double> period_sum(0.0, 0.0);
-  std::vector<std::complex<double>> site_sum(dcount, {0.0, 0.0}), bed_force_sum(dcount, {0.0, 0.0});
-  Eigen::VectorXcd modal_sum = Eigen::VectorXcd::Zero(n);
-  auto& ss = result.steady_state;
-  if (periodic) ss.period_site_amplitudes_m.reserve(static_cast<std::size_t>(options.transient_periods +
-                                                                                options.analysed_periods));
-  bool analysing = periodic && (options.transient_periods == 0);
-  // A sweep's current cycle: its first-harmonic sums and the phase ψ − φ where it ends.
-  std::vector<std::complex<double>> cycle_site(dcount, {0.0, 0.0}), cycle_force(dcount, {0.0, 0.0});
-  double cycle_end_phase = kTwoPi;
-  Drive drive_now = drive0;
-  std::int64_t analysis_start = analysing ? 0 : -1;
-  int calm_periods = 0;
-  std::int64_t end_step = planned_steps;
-  const std::string_view decay_stage = "decay", transient_stage = "transient", analysis_stage = "analysis",
-                         sweep_stage = "sweep";
-
-  auto last_report = Clock::now();
-  std::int64_t last_report_step = 0;
-  std::int64_t step = 0;
-  const double half_dt = 0.5 * dt;
-  while (step < end_step && result.outcome == dem::Outcome::kCompleted) {
-    // Kick and drift of the modes (velocity Verlet; damping trapezoidal, solved exactly).
-    vh = v + half_dt * acc;
-    q_new = q + dt * vh;
-    const std::int64_t next = step + 1;
-    const double t_next = time_at(next);
-    const Drive drive_next = drive_at(next);
-    const double base_next = U * drive_next.s;
-    const double base_velocity_next = U * drive_next.rate * drive_next.c;
-    // The beds: each container at its new state; the half-step velocities are the Verlet ones.
-    for (std::size_t d = 0; d < dcount; ++d) {
-      const double y_old = site_y[d], x_old = site_across[d], theta_old = site_theta[d];
-      site_state(d, q_new, base_next, 0.0, vh, states[d]);
-      const double y_rate = (site_y[d] - y_old) / dt, x_rate = (site_across[d] - x_old) / dt;
-      const double theta_rate = (site_theta[d] - theta_old) / dt;
-      for (int a = 0; a < 3; ++a) {
-        states[d].velocity_m_s[a] = dampers[d].container_drive_axis[a] * y_rate + across_axis[d][a] * x_rate;
-        states[d].angular_velocity_rad_s[a] = dampers[d].container_rotation_axis[a] * theta_rate;
-      }
-      const dem::ContainerLoad& load = worlds[d].step(states[d]);
-      if (worlds[d].status().outcome != dem::Outcome::kCompleted) {
-        result.outcome = worlds[d].status().outcome;
-        result.message = "damper " + dampers[d].name + " at t = " + number(t_next) + " s: " +
-                         worlds[d].status().message;
-      }
-      read_load(d, load);
-    }
-    if (result.outcome != dem::Outcome::kCompleted) break;
-    // The closing kick with the new loads: (M + dt/2 C) v_new = M vh + dt/2 g_new. Lazy
-    // (coefficient-wise) products: a few modes make the blocked GEMV's dispatch the larger
-    // cost, measurable next to a small bed's step (bench_cosimulation).
-    modal_load(load_factor(drive_next), q_new, g);
-    tmp.noalias() = M.lazyProduct(vh);
-    tmp += half_dt * g;
-    v_new.noalias() = A_inv.lazyProduct(tmp);
-    tmp = g - C.cwiseProduct(v_new);
-    acc_new.noalias() = M_inv.lazyProduct(tmp);
-    // Ledger, trapezoidal over the step (the worlds account their work the same way).
-    tmp = q_new - q;
-    const double damped = 0.5 * (C.cwiseProduct(v) + C.cwiseProduct(v_new)).dot(tmp);
-    damping += damped;
-    damping_since_start += damped;
-    double worked = 0.0;
-    if (exc.kind == CosimulationExcitationKind::kPointForce) {
-      worked = 0.5 * exc.amplitude * (drive_now.s + drive_next.s) * force_shape.dot(tmp);
-    } else if (is_base) {
-      const double power_next = base_power(acc_new, base_velocity_next);
-      worked = half_dt * (power + power_next);
-      power = power_next;
-    }
-    work += worked;
-    work_since_start += worked;
-    q.swap(q_new);
-    v.swap(v_new);
-    acc.swap(acc_new);
-    step = next;
-
-    if (is_sweep) {
-      // (1/π)·i·e^{−iψ} dψ over the step, dψ exact; a cycle closes once ψ − φ passes 2π(k + 1).
-      const double dpsi = drive_next.phase - drive_now.phase;
-      const std::complex<double> kernel(drive_next.s * dpsi, drive_next.c * dpsi);
-      for (std::size_t d = 0; d < dcount; ++d) cycle_site[d] += site_y[d] * kernel, cycle_force[d] += force[d] * kernel;
-      if (drive_next.phase >= cycle_end_phase * (1.0 - 1e-14)) {  // the sweep's last step ends a cycle to round-off
-        const double k = cycle_end_phase / kTwoPi;  // cycles ended
-        const double t_a = sweep_cycle_time(f0, sweep_rate, k - 1.0), t_b = sweep_cycle_time(f0, sweep_rate, k);
-        CosimulationSweepCycle cycle;
-        cycle.time_s = t0 + 0.5 * (t_a + t_b);
-        cycle.frequency_hz = 1.0 / (t_b - t_a);
-        for (std::size_t d = 0; d < dcount; ++d) {
-          const std::complex<double> y = cycle_site[d] / std::numbers::pi, force_hat = cycle_force[d] / std::numbers::pi;
-          cycle.site_amplitudes_m.push_back(y);
-          cycle.site_amplitude_per_excitation.push_back(std::abs(y) / exc.amplitude);
-          cycle.bed_force_amplitudes_n.push_back(force_hat);
-          bed_measures(force_hat, y, kTwoPi * cycle.frequency_hz, worlds[d].bed_mass_kg(), cycle.bed_reduced_loss_factor,
-                       cycle.bed_apparent_mass_fraction);
-          cycle_site[d] = cycle_force[d] = {0.0, 0.0};
-        }
-        result.sweep_cycles.push_back(std::move(cycle));
-        cycle_end_phase += kTwoPi;
-      }
-    } else if (is_harmonic) {
-      // e^{−iΩt}·i·(2/N): amplitude against sin Ωt.
-      const std::complex<double> kernel(drive_next.s, drive_next.c);  // i·e^{−iΩt} = sin + i cos
-      period_sum += site_y[0] * kernel;
-      if (analysing) {
-        for (std::size_t d = 0; d < dcount; ++d) site_sum[d] += site_y[d] * kernel, bed_force_sum[d] += force[d] * kernel;
-        for (Eigen::Index j = 0; j < n; ++j) modal_sum[j] += q[j] * kernel;
-      }
-      if (step % steps_per_period == 0) {
-        const double amplitude = std::abs(period_sum) * 2.0 / static_cast<double>(steps_per_period);
-        period_sum = {0.0, 0.0};
-        if (ss.period_site_amplitudes_m.size() < ss.period_site_amplitudes_m.capacity())
-          ss.period_site_amplitudes_m.push_back(amplitude);
-        if (!analysing) {
-          const auto& a = ss.period_site_amplitudes_m;
-          if (options.settle_until_stable) {
-            calm_periods = amplitudes_settled(a, options.stable_tolerance) ? calm_periods + 1 : 0;
-            if (calm_periods >= 2) ss.stable = true;
-          }
-          if (ss.stable || step >= transient_steps) {
-            analysing = true;
-            analysis_start = step;
-            end_step = step + options.analysed_periods * steps_per_period;
-          }
-        }
-      }
-    }
-    drive_now = drive_next;
-    if (step % sample_every == 0) record(t_next);
-    if (progress && step % kProgressStride == 0) {
-      const auto now = Clock::now();
-      const double since = std::chrono::duration<double>(now - last_report).count();
-      if (since >= options.progress_interval_s) {
-        progress(CosimulationProgress{!is_harmonic ? decay_stage
-                                                   : (is_sweep ? sweep_stage : (analysing ? analysis_stage : transient_stage)),
-                                      static_cast<double>(step) * dt, static_cast<double>(end_step) * dt,
-                                      static_cast<double>(step - last_report_step) / since});
-        last_report = now;
-        last_report_step = step;
-      }
-    }
-  }
-
-  // --- Results.
-  result.steps = step;
-  result.final_modal_displacements = q;
-  result.final_modal_velocities = v;
-  result.simulated_time_s = static_cast<double>(step) * dt;
-  h.modal_displacements.conservativeResize(samples, n);
-  h.site_displacement_m.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
-  h.site_rotation_rad.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
-  h.container_load_n.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
-  h.container_moment_nm.conservativeResize(samples, static_cast<Eigen::Index>(dcount));
-
-  if (periodic) {
-    ss.frequency_hz = f_run;
-    ss.transient_periods = static_cast<int>(std::max<std::int64_t>(analysis_start, 0) / steps_per_period);
-    const std::int64_t analysed_steps = analysis_start >= 0 ? step - analysis_start : 0;
-    ss.analysed_periods = static_cast<int>(analysed_steps / steps_per_period);
-    ss.modal_amplitudes = Eigen::VectorXcd::Zero(n);
-    if (analysed_steps > 0 && analysed_steps % steps_per_period == 0) {
-      const double scale = 2.0 / static_cast<double>(analysed_steps);
-      ss.modal_amplitudes = modal_sum * scale;
-      for (std::size_t d = 0; d < dcount; ++d) {
-        const std::complex<double> y = site_sum[d] * scale, force_hat = bed_force_sum[d] * scale;
-        ss.site_amplitudes_m.push_back(y);
-        ss.site_amplitude_per_excitation.push_back(std::abs(y) / exc.amplitude);
-        ss.bed_force_amplitudes_n.push_back(force_hat);
-        bed_measures(force_hat, y, kTwoPi * f_run, worlds[d].bed_mass_kg(), ss.bed_reduced_loss_factor,
-                     ss.bed_apparent_mass_fraction);
-      }
-    }
-  }
-
-  const double base_velocity_end = U * drive_now.rate * drive_now.c;
-  const double kinetic_end = structure_kinetic(v, base_velocity_end), potential_end = structure_potential(q);
-  // The ledger from the given start: this run's (kinetic0, opening) or the first run's.
-  const auto ledger = [&](double w, double damped, double kinetic_start, double potential_start,
-                          const std::vector<dem::EnergyAccount>& start) {
-    CosimulationEnergy e;
-    e.excitation_work_j = w;
-    e.structural_damping_j = damped;
-    e.delta_structure_kinetic_j = kinetic_end - kinetic_start;
-    e.delta_structure_potential_j = potential_end - potential_start;
-    for (std::size_t d = 0; d < dcount; ++d) {
-      const dem::EnergyAccount now = worlds[d].energy();
-      e.dem_normal_damping_j += now.normal_damping_j - start[d].normal_damping_j;
-      e.dem_friction_j += now.friction_j - start[d].friction_j;
-      e.dem_rolling_j += now.rolling_j - start[d].rolling_j;
-      e.delta_bed_kinetic_j += now.kinetic_j - start[d].kinetic_j;
-      e.delta_bed_potential_j += now.potential_j - start[d].potential_j;
-      e.delta_bed_elastic_j += now.elastic_j - start[d].elastic_j;
-      e.container_work_j += now.container_work_j - start[d].container_work_j;
-    }
-    e.relative_error = ledger_error(e);
-    return e;
-  };
-  result.energy = ledger(work, damping, kinetic0, potential0, opening);
-  state.energy_since_start = ledger(work_since_start, damping_since_start, state.start_structure_kinetic_j,
-                                    state.start_structure_potential_j, state.start_world_energy);
-  for (std::size_t d = 0; d < dcount; ++d) {
-    result.world_status.push_back(worlds[d].status());
-    result.final_container_states.push_back(worlds[d].container());
-  }
-  // --- The state for the next run.
-  state.modal_displacements = q;
-  state.modal_velocities = v;
-  state.time_s = time_at(step);
-  state.steps += step;
-  state.time_step_s = dt;
-  state.excitation = exc;
-  state.excitation.frequency_hz = is_sweep ? drive_now.rate / kTwoPi : f_run;
-  state.excitation_phase_rad = 0.0;
-  if (is_sweep) {
-    const double phase = std::fmod(phase0 + drive_now.phase, kTwoPi);
-    state.excitation_phase_rad = phase < 0.0 ? phase + kTwoPi : phase;
-  } else if (is_harmonic) {
-    const double phase = std::fmod(phase0 + kTwoPi * static_cast<double>(step % steps_per_period) /
-                                                static_cast<double>(steps_per_period), kTwoPi);
-    state.excitation_phase_rad = phase < 0.0 ? phase + kTwoPi : phase;
-  }
-  result.wall_time_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  Cosimulation run(model, dampers, options, std::move(state), progress);
+  run.advance(std::numeric_limits<std::int64_t>::max());
+  CosimulationResult result = std::move(run).result();
+  state = std::move(run).take_state();
   return result;
 }
 
@@ -1180,6 +660,14 @@ void append_continuation(CosimulationResult& total, const CosimulationResult& ne
   total.steps += next.steps;
   total.simulated_time_s += next.simulated_time_s;
   total.wall_time_s += next.wall_time_s;
+  auto& times = total.stage_times;
+  const auto& more = next.stage_times;
+  times.settling_s += more.settling_s;
+  times.modal_kick_drift_s += more.modal_kick_drift_s;
+  times.bed_steps_s += more.bed_steps_s;
+  times.closing_kick_s += more.closing_kick_s;
+  times.ledger_s += more.ledger_s;
+  times.measures_s += more.measures_s;
   total.outcome = next.outcome;
   total.message = next.message;
   total.final_modal_displacements = next.final_modal_displacements;

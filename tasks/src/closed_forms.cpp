@@ -102,7 +102,8 @@ json to_json(const LossStudy& s) {
 
 json to_json(const fm::BufferDesign& b) {
   return {{"model", b.model == fm::BufferModel::kLayered ? "layered" : "half_space"},
-          {"layer_thickness_m", b.layer_thickness_m},   {"impact_velocity_m_s", b.impact_velocity_m_s},
+          {"layer_thickness_m", b.layer_thickness_m},   {"allowable_strain", b.allowable_strain},
+          {"impact_velocity_m_s", b.impact_velocity_m_s},
           {"max_penetration_m", b.max_penetration_m},   {"contact_time_s", b.contact_time_s},
           {"contact_time_over_period", b.contact_time_over_period},
           {"effective_mass_kg", b.effective_mass_kg},   {"max_force_n", b.max_force_n},

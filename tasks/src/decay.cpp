@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <sstream>
 
 #include "pdamp/dem_reference/checkpoint.hpp"
@@ -10,6 +11,7 @@
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
 #include "pdamp/structure/backbone.hpp"
+#include "pdamp/structure/cosimulation_run.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/tasks/case_checks.hpp"
@@ -63,14 +65,6 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
   return s.str();
 }
 
-void save_decay(const DemDecayCheckpoint& cp, const dem_reference::CheckpointHeader& header,
-                const st::CosimulationState& state, const st::CosimulationResult& sum) {
-  dem_reference::StateWriter out;
-  st::save_cosimulation_state(state, out);
-  st::save_cosimulation_result(sum, out);
-  write_checkpoint(cp.file, header, out.bytes());
-}
-
 /// One co-simulation run of `options`, its refusals as the case's errors.
 st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
                                        const std::vector<st::CosimulationDamper>& dampers,
@@ -85,11 +79,14 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
   return r;
 }
 
-/// The decay of `options` in segments, checkpointed (DemDecayCheckpoint).
+/// The decay of `options` in segments, checkpointed (DemDecayCheckpoint): one run
+/// (structure::Cosimulation) advanced a segment at a time, its state saved between segments
+/// when the hooks say so; segments give the bits of one uninterrupted run.
 st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& modal,
                                           const std::vector<st::CosimulationDamper>& dampers,
                                           const st::CosimulationOptions& options, const std::string& label,
                                           const DemDecayCheckpoint& cp, RunHooks& hooks) {
+  detail::check_cosimulation(c, modal, dampers, options);
   const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
   const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(options.sample_interval_s / dt));
   const std::int64_t total = std::llround(options.duration_s / dt);
@@ -100,76 +97,67 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
   const std::string shown = strict_json::printable(cp.file.path.string());
+  const auto report = [&](const st::CosimulationProgress& p) { report_progress(hooks, label, p); };
 
-  st::CosimulationState state;
-  st::CosimulationResult sum;
-  std::int64_t done = 0;
+  std::optional<st::Cosimulation> run;
   if (cp.file.resume) {
     const std::string payload = read_checkpoint(cp.file, header);
     try {
       dem_reference::StateReader in(payload, "checkpoint state");
-      state = st::restore_cosimulation_state(modal, dampers, in);
-      sum = st::restore_cosimulation_result(in, modal.mode_count(), dampers.size());
+      run.emplace(st::Cosimulation::restore(modal, dampers, options, in, report));
       in.finish();
     } catch (const std::invalid_argument& e) {
       throw InputError(cp.file.path.string(), "", e.what());
     }
-    done = sum.steps;
-    if (done <= 0 || done > total || state.steps != done)
+    const std::int64_t done = run->steps_done();
+    if (done <= 0 || done > total || run->total_steps() != total)
       throw InputError(cp.file.path.string(), "", "its step count " + std::to_string(done) + " does not fit this run's " +
                                                       std::to_string(total) + " steps");
     hooks.note(label + ": resuming at t = " + format_number(static_cast<double>(done) * dt, 6) + " s of " +
                format_number(header.end_time_s, 6) + " s from " + shown);
-  } else if (std::filesystem::exists(cp.file.path)) {
-    hooks.note("pdamp: warning: " + shown + " of an earlier run is replaced (--resume continues it)");
+  } else {
+    if (std::filesystem::exists(cp.file.path))
+      hooks.note("pdamp: warning: " + shown + " of an earlier run is replaced (--resume continues it)");
+    run.emplace(detail::call_dem(c, [&] { return st::Cosimulation(modal, dampers, options, report); }));
   }
 
   auto last_checkpoint = std::chrono::steady_clock::now();
   std::int64_t segment = sample_every * std::max<std::int64_t>(1, std::llround(kFirstSegmentFraction *
                                                                                 static_cast<double>(total / sample_every)));
-  while (done < total) {
-    const std::int64_t steps = std::min(segment, total - done);
-    st::CosimulationOptions o = options;
-    o.duration_s = static_cast<double>(steps) * dt;
-    if (state.started()) o.initial_modal_displacements.resize(0), o.initial_modal_velocities.resize(0);
-    const std::int64_t offset = done;
-    const auto report = [&](const st::CosimulationProgress& p) {
-      st::CosimulationProgress whole = p;
-      whole.simulated_time_s += static_cast<double>(offset) * dt;
-      whole.end_time_s = header.end_time_s;
-      report_progress(hooks, label, whole);
-    };
+  while (!run->finished()) {
     const auto started = std::chrono::steady_clock::now();
-    st::CosimulationResult part = detail::call_dem(c, [&] { return st::cosimulate(modal, dampers, o, state, report); });
-    detail::check_outcome(part.outcome, part.message, label);
-    if (done == 0 && !cp.file.resume) {
-      sum = std::move(part);
-    } else {
-      st::append_continuation(sum, part, state);
+    const std::int64_t steps = run->advance(segment);
+    if (run->finished() && run->steps_done() < total) {  // a World stopped
+      const auto r = run->result();
+      detail::check_outcome(r.outcome, r.message, label);
     }
-    done += steps;
     // The next segment: about kSegmentWallSeconds at this segment's rate, whole sample
     // intervals, at most kSegmentGrowth times this one (a short first segment, settling and
     // all, measures its rate poorly).
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double rate = static_cast<double>(steps) / std::max(wall, 1e-3);
-    // A progress line per segment (the segments' own lines come only from long ones).
-    report_progress(hooks, label, st::CosimulationProgress{"decay", static_cast<double>(done) * dt, header.end_time_s, rate});
-    segment = std::min(kSegmentGrowth * steps,
+    // A progress line per segment (the run's own lines come only from long segments).
+    report_progress(hooks, label,
+                    st::CosimulationProgress{"decay", static_cast<double>(run->steps_done()) * dt, header.end_time_s, rate});
+    segment = std::min(kSegmentGrowth * std::max<std::int64_t>(steps, 1),
                        sample_every * std::max<std::int64_t>(1, std::llround(kSegmentWallSeconds * rate /
                                                                              static_cast<double>(sample_every))));
     segment = std::max(segment, sample_every);
     const int signal = hooks.stop_requested();
     const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
     // At the end a stop still gets a checkpoint: the results are not written yet.
-    if (signal != 0 || (done < total && hooks.checkpoint_due(since))) {
-      header.simulated_time_s = static_cast<double>(done) * dt;
-      save_decay(cp, header, state, sum);
+    if (signal != 0 || (!run->finished() && hooks.checkpoint_due(since))) {
+      header.simulated_time_s = static_cast<double>(run->steps_done()) * dt;
+      dem_reference::StateWriter out;
+      run->save(out);
+      write_checkpoint(cp.file, header, out.bytes());
       last_checkpoint = std::chrono::steady_clock::now();
     }
     if (signal != 0) throw strict_json::Interrupted(signal, resume_advice(cp.file, header));
   }
-  return sum;
+  auto result = std::move(*run).result();
+  detail::check_outcome(result.outcome, result.message, label);
+  return result;
 }
 
 /// The loss models' own sentences (with numbers) at one sample: each layer at its damper's

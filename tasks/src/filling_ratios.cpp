@@ -211,9 +211,9 @@ json design_json(const opt::FillingDesign& d) {
   json layers = json::array();
   for (const auto& l : d.layers)
     layers.push_back({{"name", l.name},
-                      {"slabs", l.slabs},
+                      {"slabs", number_or_null(l.slabs)},
                       {"particles", l.particles},
-                      {"filling_ratio", l.filling_ratio},
+                      {"filling_ratio", number_or_null(l.filling_ratio)},
                       {"volume_fraction", l.volume_fraction},
                       {"clearance_m", l.clearance_m},
                       {"bed_mass_kg", l.bed_mass_kg}});
@@ -365,7 +365,12 @@ json to_json(const FillingRatiosResult& res) {
       {"designs", {{"chosen", design_json(r.chosen)},
                    {"relaxed", design_json(r.relaxed)},
                    {"baseline", design_json(r.baseline)},
-                   {"initial", design_json(r.initial)}}},
+                   {"initial", design_json(r.initial)},
+                   {"bare", design_json(r.bare)},
+                   {"same_mass", design_json(r.same_mass)}}},
+      {"references", {{"baseline", "the best single layer of the case's containers within the budget"},
+                      {"bare", "the structure with the damper's containers empty"},
+                      {"same_mass", "the chosen design's particle mass in one compartment at its own best clearance"}}},
       {"baseline_layer", r.baseline_layer},
       {"baseline_evaluations", r.baseline_evaluations},
       {"rounding", {{"rule", "each relaxed n_k floored and ceiled (one value when within 1e-6 of a whole number); "

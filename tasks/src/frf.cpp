@@ -176,8 +176,10 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   out.branches = run_jobs<st::SteppedSineBranch>(
       executor, directions.size(), out.parallel,
       [&](std::size_t k) {
-        const auto& [sweep, frequencies] = directions.at(k);
-        const auto label = [&, sweep = sweep](std::size_t i) {
+        // Named references, not a structured binding: clang 14 cannot capture bindings in lambdas.
+        const std::string& sweep = directions.at(k).first;
+        const std::vector<double>& frequencies = directions.at(k).second;
+        const auto label = [&](std::size_t i) {
           return "pdamp frf (dem) " + sweep + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
                  format_number(frequencies[i], 5) + " Hz";
         };

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/formulas/hertz_impact.hpp"
 #include "case_file/case_error_check.hpp"
 #include "support/temp_dir.hpp"
 
@@ -59,6 +60,29 @@ TEST_CASE("every shipped format-1 case reads as one damper of one layer", "[case
   CHECK(buffered.dampers.front().layers.front().compartment.layer.thickness_m ==
         read_json(shipped("buffered_wall_60hz.json"))["dem"]["wall_layer"]["thickness_m"].get<double>());
   CHECK(buffered.buffer.has_value());
+  // The shipped layer is the sizing to the allowable strain 0.3 (ν = 0.48: 0.740 mm to the
+  // µm the case gives, docs/hertz_and_buffer.md).
+  CHECK(buffered.buffer->input.allowable_strain == 0.3);
+  CHECK(pdamp::formulas::size_buffer_layer(buffered.buffer->input).layer_thickness_m ==
+        Approx(buffered.dampers.front().layers.front().compartment.layer.thickness_m).margin(1e-6));
+}
+
+TEST_CASE("the buffer's allowable strain defaults to 0.3 and is refused outside (0, 1]", "[case_file]") {
+  const pdamp::test::TempDir dir("case_file_allowable_strain");
+  const auto with_buffer = [&](const std::function<void(json&)>& edit) {
+    return edited(dir, [&](json& c) {
+      c["materials"] = {{"pu", {{"density_kg_m3", 1200.0}, {"youngs_modulus_pa", 60e6}, {"poisson_ratio", 0.48}}}};
+      c["buffer"] = {{"layer_material", "pu"}, {"design_frequency_hz", 60.0}, {"design_intensity", 20.0}};
+      edit(c);
+    });
+  };
+  const Case c = load_case(with_buffer([](json&) {}));
+  CHECK(c.buffer->input.allowable_strain == pdamp::formulas::kDefaultAllowableStrain);
+  CHECK(c.resolved["buffer"]["allowable_strain"] == 0.3);
+  CHECK(load_case(with_buffer([](json& j) { j["buffer"]["allowable_strain"] = 1.0; })).buffer->input.allowable_strain == 1.0);
+  for (const double bad : {0.0, 1.5})
+    require_refused(with_buffer([&](json& j) { j["buffer"]["allowable_strain"] = bad; }), "/buffer/allowable_strain",
+                    "must be a finite number > 0 and <= 1");
 }
 
 TEST_CASE("omitted keys are resolved to their defaults", "[case_file]") {

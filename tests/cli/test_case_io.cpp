@@ -300,12 +300,24 @@ TEST_CASE("buffer sizes a bonded layer by default and keeps the half-space rule 
   REQUIRE(layered.exit_code == 0);
   const json l = json::parse(layered.out);
   CHECK(l["model"] == "layered");
+  // Sized to the default allowable strain 0.3: 0.798 mm (docs/hertz_and_buffer.md), its
+  // tip strain δ_max/t the allowable one.
+  CHECK(l["allowable_strain"].get<double>() == 0.3);
+  CHECK(l["layer_thickness_m"].get<double>() == Approx(0.000798).epsilon(2e-3));
+  CHECK(l["max_penetration_m"].get<double>() / l["layer_thickness_m"].get<double>() == Approx(0.3).epsilon(1e-9));
   // The half-space rule's 0.378 mm (the old design) is reported beside it; a layer bonded
-  // to steel is stiffer, so the layer the design impact bottoms out is thinner, and the
-  // half-space design is compressed only partly (0.4 t in the elastic foundation limit).
+  // to steel is stiffer, so the layer the design impact bottoms out (--allowable-strain 1)
+  // is thinner, and the half-space design is compressed only partly (0.4 t in the elastic
+  // foundation limit).
   CHECK(l["half_space_thickness_m"].get<double>() == Approx(0.000378).epsilon(0.01));
-  CHECK(l["layer_thickness_m"].get<double>() < 0.5 * l["half_space_thickness_m"].get<double>());
+  const auto full = run_pdamp(base + " --allowable-strain 1");
+  REQUIRE(full.exit_code == 0);
+  const json f = json::parse(full.out);
+  CHECK(f["layer_thickness_m"].get<double>() < 0.5 * f["half_space_thickness_m"].get<double>());
+  CHECK(f["max_penetration_m"].get<double>() == Approx(f["layer_thickness_m"].get<double>()).epsilon(1e-9));
   CHECK(l["layered_compression_of_half_space_design"].get<double>() < 0.6);
+  require_one_line_error(run_pdamp(base + " --allowable-strain 1.5"),
+                         "--allowable-strain: '1.5': must be a finite number > 0 and <= 1");
   const auto half_space = run_pdamp(base + " --layer-model half_space");
   REQUIRE(half_space.exit_code == 0);
   const json h = json::parse(half_space.out);

@@ -182,16 +182,17 @@ TEST_CASE("a fast sphere bottoms out the layer and the hard wall stops it", "[de
 }
 
 // Reference: the sizing itself (docs/physics.md §5: the sizing "must be checked in the DEM").
-// formulas::size_buffer_layer (layered model) chooses the thickness t whose full
-// compression (δ = t, a strain of 1) one front-row sphere carrying particles_per_contact
-// spheres just reaches at v = 2XΩ. The DEM gets the designed t and one sphere of that
-// effective mass (density scaled, same radius and moduli) at the design speed, elastic
-// like the sizing: penetration/t within 5% of 1 (the impact is
-// resolved to < 1%). At 80% of the design speed it must not bottom out and must match
-// the layered law's δ_max there (formulas::layered_impact, 1%). The half-space sizing of
-// the source study, labelled as such, gives a thicker layer that the same impact does
-// not nearly compress.
-TEST_CASE("the buffered-wall sizing is just fully compressed by the design impact in the DEM", "[dem_reference]") {
+// formulas::size_buffer_layer (layered model) chooses the thickness t whose tip strain
+// δ_max/t under the design impact (one front-row sphere carrying particles_per_contact
+// spheres at v = 2XΩ) is the allowable strain ε_a. The DEM gets the designed t and one
+// sphere of that effective mass (density scaled, same radius and moduli) at the design
+// speed, elastic like the sizing: penetration/t within 5% of ε_a (the impact is resolved
+// to < 1%), at the default ε_a = 0.3 and at ε_a = 1 (full compression). At 80% of the
+// design speed the fully compressible design must not bottom out and must match the
+// layered law's δ_max there (formulas::layered_impact, 1%). The half-space sizing of the
+// source study, labelled as such, gives a thicker layer than full compression that the
+// same impact does not nearly compress.
+TEST_CASE("the buffered-wall sizing reaches its allowable strain under the design impact in the DEM", "[dem_reference]") {
   fm::BufferDesignInput input;
   input.frequency_hz = 60.0;
   input.amplitude_m = 0.001;
@@ -200,6 +201,9 @@ TEST_CASE("the buffered-wall sizing is just fully compressed by the design impac
   input.layer = fm::Material{kLayerRho, kLayerE, kLayerNu};
   input.particles_per_contact = 4.0;
   input.model = fm::BufferModel::kLayered;
+  const fm::BufferDesign at_default_strain = fm::size_buffer_layer(input);
+  REQUIRE(at_default_strain.allowable_strain == fm::kDefaultAllowableStrain);
+  input.allowable_strain = 1.0;
   const fm::BufferDesign design = fm::size_buffer_layer(input);
   input.model = fm::BufferModel::kHalfSpace;
   const fm::BufferDesign half_space = fm::size_buffer_layer(input);
@@ -223,17 +227,21 @@ TEST_CASE("the buffered-wall sizing is just fully compressed by the design impac
   REQUIRE(dr::World(o).mass(0) == Approx(design.effective_mass_kg).epsilon(1e-12));
 
   const auto at_design = layer_impact(o, v, design.layer_thickness_m);
+  const auto at_strain = layer_impact(world_for(at_default_strain.layer_thickness_m), v, at_default_strain.layer_thickness_m);
   const auto slower = layer_impact(o, 0.8 * v, design.layer_thickness_m);
   const double slower_expected =
       fm::layered_impact(layer_law(design.layer_thickness_m), design.effective_mass_kg, 0.8 * v).max_overlap_m;
   const auto on_half_space_design = layer_impact(world_for(half_space.layer_thickness_m), v, half_space.layer_thickness_m);
-  INFO("designed thickness " << design.layer_thickness_m << " m (half-space sizing " << half_space.layer_thickness_m
+  INFO("designed thickness " << design.layer_thickness_m << " m at strain 1, " << at_default_strain.layer_thickness_m
+                             << " m at strain 0.3 (half-space sizing " << half_space.layer_thickness_m
                              << " m) at v = " << v << " m/s, m* = " << design.effective_mass_kg
                              << " kg: penetration/t = " << at_design.penetration_m / design.layer_thickness_m
-                             << " at v, " << slower.penetration_m / design.layer_thickness_m
-                             << " at 0.8 v; on the half-space design "
+                             << " at v, " << slower.penetration_m / design.layer_thickness_m << " at 0.8 v, "
+                             << at_strain.penetration_m / at_default_strain.layer_thickness_m
+                             << " on the 0.3 design; on the half-space design "
                              << on_half_space_design.penetration_m / half_space.layer_thickness_m);
   CHECK(at_design.penetration_m / design.layer_thickness_m == Approx(1.0).epsilon(0.05));
+  CHECK(at_strain.penetration_m / at_default_strain.layer_thickness_m == Approx(0.3).epsilon(0.05));
   CHECK(slower.penetration_m < design.layer_thickness_m);
   CHECK(slower.penetration_m == Approx(slower_expected).epsilon(0.01));
   CHECK(design.layer_thickness_m < half_space.layer_thickness_m);

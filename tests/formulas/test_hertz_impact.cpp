@@ -243,13 +243,17 @@ TEST_CASE("the half-space buffer layer is as thick as the Hertz penetration of t
 }
 
 // Reference: the layered law itself (layered_contact.hpp, tested against exact elasticity
-// in test_layered_contact.cpp). The sizing's t must satisfy the energy balance
-// ½m*v² = U(t; t) (bisection to 1e-13 in t; U ∝ t^{1..2.5}: 1e-12 in energy), its δ_max
-// equal t, and its t_c and F_max be the layered impact's.
-TEST_CASE("the layered buffer layer is just bottomed out by the design impact", "[formulas]") {
-  const fm::BufferDesignInput in = design_input();  // default model: layered
+// in test_layered_contact.cpp). With the allowable strain 1 (full compression) the sizing's
+// t must satisfy the energy balance ½m*v² = U(t; t) (bisection to 1e-13 in t;
+// U ∝ t^{1..2.5}: 1e-12 in energy), its δ_max equal t, and its t_c and F_max be the
+// layered impact's.
+TEST_CASE("with the allowable strain 1 the layered buffer layer is just bottomed out by the design impact",
+          "[formulas]") {
+  fm::BufferDesignInput in = design_input();  // default model: layered
+  in.allowable_strain = 1.0;
   const fm::BufferDesign design = fm::size_buffer_layer(in);
   CHECK(design.model == fm::BufferModel::kLayered);
+  CHECK(design.allowable_strain == 1.0);
   const double m_star = 6.0 * sphere_mass(0.005, fm::Material{});
   const double v = design.impact_velocity_m_s;
   const double t = design.layer_thickness_m;
@@ -277,6 +281,79 @@ TEST_CASE("the layered buffer layer is just bottomed out by the design impact", 
   CHECK_FALSE(any_contains(design.warnings, "half-space sizing"));
 }
 
+// Independent reference: the design impact integrated in the test, RK4 on
+// m*δ'' = −F(δ; t) with the layered law's force (not the stored energy the sizing's
+// bisection uses: U is the table's own quadrature of G, F its interpolant), step τ/20000
+// with the Hertz time scale τ = (m*²/(R*E*²v))^{1/5} as in integrate_impact; δ_max is
+// read at the turning point. The sizing's t must make δ_max/t the allowable strain: 1e-5
+// (the energy table agrees with ∫F to 2e-6, docs/hertz_and_buffer.md; sampling ~3e-10).
+namespace {
+double layered_max_overlap_ode(const fm::LayeredContact& law, double m, double v) {
+  const double e = law.effective_modulus_pa(), r = law.effective_radius_m();
+  const double h = std::pow(m * m / (r * e * e * v), 0.2) / 20000.0;
+  const auto accel = [&](double delta) { return -law.force(delta) / m; };
+  double x = 0.0, u = v;
+  while (u > 0.0) {
+    const double k1x = u, k1u = accel(x);
+    const double k2x = u + 0.5 * h * k1u, k2u = accel(x + 0.5 * h * k1x);
+    const double k3x = u + 0.5 * h * k2u, k3u = accel(x + 0.5 * h * k2x);
+    const double k4x = u + h * k3u, k4u = accel(x + h * k3x);
+    const double x_next = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+    const double u_next = u + h / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+    if (u_next <= 0.0) {
+      // Turning point inside the step: the parabola through (x, u) with deceleration k1u.
+      return x + u * u / (-2.0 * k1u);
+    }
+    x = x_next;
+    u = u_next;
+  }
+  return x;
+}
+}  // namespace
+
+TEST_CASE("the layered buffer layer's tip strain at the design impact is the allowable strain", "[formulas]") {
+  const fm::BufferDesignInput base = design_input();
+  CHECK(base.allowable_strain == fm::kDefaultAllowableStrain);
+  CHECK(fm::kDefaultAllowableStrain == 0.3);
+  const double m_star = 6.0 * sphere_mass(0.005, fm::Material{});
+  double previous = 0.0;
+  for (const double strain : {1.0, 0.6, 0.3, 0.1}) {
+    CAPTURE(strain);
+    fm::BufferDesignInput in = base;
+    in.allowable_strain = strain;
+    const fm::BufferDesign design = fm::size_buffer_layer(in);
+    const double t = design.layer_thickness_m, v = design.impact_velocity_m_s;
+    CHECK(design.allowable_strain == strain);
+    const fm::LayeredContact law(0.005, 200e6, 0.45, 210e9, 0.3, t);
+    CHECK(layered_max_overlap_ode(law, m_star, v) / t == Approx(strain).epsilon(1e-5));
+    CHECK(design.max_penetration_m == Approx(strain * t).epsilon(1e-10));
+    CHECK(design.max_force_n == Approx(law.force(strain * t)).epsilon(1e-9));
+    CHECK(design.contact_radius_m == Approx(law.contact_radius(strain * t)).epsilon(1e-12));
+    // A smaller allowable strain needs a thicker layer (U(ε t; t) grows with t).
+    CHECK(t > previous);
+    previous = t;
+    CHECK(any_contains(design.assumptions, "allowable strain"));
+  }
+  // Limit ε_a → 0: the layer grows thick against the contact (χ = √(r ε_a δ_max)/t → 0)
+  // and the impact sees Hertz's half-space: ε_a t → t_H from below (the bonded layer is
+  // stiffer, G = 1 + O(χ): at ε_a = 1e-3, χ ≈ 0.005 and G − 1 ≈ 0.3%, so δ_max is 0.1%
+  // short of t_H; 0.5% bounds it).
+  fm::BufferDesignInput thick = base;
+  thick.allowable_strain = 1e-3;
+  const fm::BufferDesign hertz_limit = fm::size_buffer_layer(thick);
+  CHECK(hertz_limit.max_penetration_m == Approx(hertz_limit.half_space_thickness_m).epsilon(5e-3));
+  CHECK(hertz_limit.max_penetration_m < hertz_limit.half_space_thickness_m);
+  // The half-space rule is the source study's, as it was: t = δ_max whatever ε_a.
+  fm::BufferDesignInput half = base;
+  half.model = fm::BufferModel::kHalfSpace;
+  const fm::BufferDesign h03 = fm::size_buffer_layer(half);
+  half.allowable_strain = 1.0;
+  const fm::BufferDesign h1 = fm::size_buffer_layer(half);
+  CHECK(h03.layer_thickness_m == h1.layer_thickness_m);
+  CHECK(h03.allowable_strain == 1.0);
+  CHECK(any_contains(h03.assumptions, "is not used by this rule"));
+}
+
 // The shipped 60 Hz case (README: pdamp buffer --frequency 60 --intensity 20 --radius
 // 0.0025 --layer-modulus 60e6 --particles-per-contact 20). Reference numbers: the old
 // half-space design t = 0.378 mm (ν = 0.45) by hand (Hertz closed form), and the
@@ -293,6 +370,7 @@ TEST_CASE("the shipped 60 Hz buffer case: layered design against the half-space 
   in.particle_radius_m = 0.0025;
   in.layer = fm::Material{1200.0, 60e6, 0.45};
   in.particles_per_contact = 20.0;
+  in.allowable_strain = 1.0;  // the estimates below are of full compression
   const fm::BufferDesign design = fm::size_buffer_layer(in);
   CHECK(design.half_space_thickness_m == Approx(0.378e-3).epsilon(1e-3));
   const double nu = 0.45;
@@ -316,6 +394,38 @@ TEST_CASE("the shipped 60 Hz buffer case: layered design against the half-space 
   CHECK(incompressible.layer_thickness_m < default_nu.layer_thickness_m);
   CHECK(std::isfinite(incompressible.contact_time_s));
   CHECK(fm::BufferDesignInput{}.layer.poisson_ratio == 0.48);
+}
+
+// The shipped 60 Hz case sized to the default allowable strain 0.3 (docs/hertz_and_buffer.md,
+// "The shipped 60 Hz case"): the documented thicknesses and forces (regression values, 0.2%:
+// their printed digits), each design's tip strain checked against the impact integrated in
+// the test (1e-5, as above). Full compression shrinks the layer from 105 to 33 µm as ν goes
+// from 0.45 to 0.5 (the incompressible thin layer stiffens as (a/t)²); at the allowable
+// strain the contact radius is about the thickness (a/t ≈ 1.3–1.5), where the layer is no
+// thin film, and the thickness changes by 13% only.
+TEST_CASE("the shipped 60 Hz buffer case sized to the allowable strain 0.3", "[formulas]") {
+  fm::BufferDesignInput in;
+  in.frequency_hz = 60.0;
+  in.intensity = 20.0;
+  in.particle_radius_m = 0.0025;
+  in.particles_per_contact = 20.0;
+  struct Expected {
+    double nu, thickness_m, force_n;
+  };
+  for (const Expected e : {Expected{0.45, 0.798e-3, 71.0}, Expected{0.48, 0.740e-3, 78.6}, Expected{0.5, 0.691e-3, 86.6}}) {
+    CAPTURE(e.nu);
+    in.layer = fm::Material{1200.0, 60e6, e.nu};
+    const fm::BufferDesign design = fm::size_buffer_layer(in);
+    CHECK(design.layer_thickness_m == Approx(e.thickness_m).epsilon(2e-3));
+    CHECK(design.max_force_n == Approx(e.force_n).epsilon(2e-3));
+    const fm::LayeredContact law(0.0025, 60e6, e.nu, 210e9, 0.3, design.layer_thickness_m);
+    CHECK(layered_max_overlap_ode(law, design.effective_mass_kg, design.impact_velocity_m_s) /
+              design.layer_thickness_m ==
+          Approx(0.3).epsilon(1e-5));
+    // Thicker than the half-space rule's t = δ_max: 0.3 t is below Hertz's δ_max.
+    CHECK(design.layer_thickness_m > design.half_space_thickness_m);
+    CHECK(design.contact_radius_over_thickness == Approx(1.3).margin(0.2));
+  }
 }
 
 TEST_CASE("the buffer sizing takes the stroke or an impact speed when given", "[formulas]") {
@@ -381,4 +491,10 @@ TEST_CASE("invalid buffer inputs are reported one line per violation", "[formula
   CHECK_THROWS_WITH(fm::size_buffer_layer(in), Catch::StartsWith("size_buffer_layer: frequency_hz = -60") &&
                                                    Catch::Contains("\nlayer.poisson_ratio = 0.6"));
   CHECK(design_input().validate().empty());
+  for (const double strain : {0.0, -0.1, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    in = design_input();
+    in.allowable_strain = strain;
+    REQUIRE(in.validate().size() == 1);
+    CHECK_THAT(in.validate().front(), Catch::StartsWith("allowable_strain = ") && Catch::EndsWith(": must be in (0, 1]"));
+  }
 }

@@ -30,8 +30,29 @@ TEST_CASE("filling ratios: the chosen design is within the budget and its decay 
   REQUIRE(r.comparison.decays.size() == 3);
   CHECK(r.comparison.decays[0].settling_time_s == Approx(chosen.settling_time_s).epsilon(1e-6));
   CHECK(r.comparison.decays[1].settling_time_s == Approx(r.optimum.baseline.settling_time_s).epsilon(1e-6));
+  // The references: without particles only the structure damps (its decay is slower than
+  // any design's); the same mass in one compartment is scored at its own best clearance.
+  CHECK(r.optimum.bare.total_mass_kg == 0.0);
+  CHECK(r.optimum.bare.objective > chosen.objective);
+  CHECK(r.optimum.bare.objective > r.optimum.baseline.objective);
+  CHECK(r.optimum.same_mass.total_mass_kg == chosen.total_mass_kg);
+  // Its clearance is searched from one sphere diameter of travel (the candidates' smallest)
+  // up: nearby clearances inside that range are no better.
+  const double h = r.optimum.same_mass.layers.front().clearance_m;
+  double smallest = INFINITY;
+  for (const auto& l : r.problem.options.layers) smallest = std::min(smallest, l.slab_length_m);
+  CHECK(h >= smallest * (1.0 - 1e-12));
+  for (const double factor : {0.95, 1.05}) {
+    if (h * factor < smallest) continue;
+    double particles = 0.0;
+    for (const auto& l : chosen.layers) particles += l.particles;
+    const auto nearby = optimizer::evaluate_single_compartment(r.problem.modal, r.problem.options, chosen.total_mass_kg,
+                                                               particles, h * factor);
+    CHECK(nearby.objective >= r.optimum.same_mass.objective);
+  }
   const auto j = tasks::to_json(r);
   CHECK(j["verification"].is_null());
+  CHECK(j["designs"]["same_mass"]["layers"][0]["slabs"].is_null());
   CHECK(j["design"]["total_mass_kg"] == chosen.total_mass_kg);
 }
 

@@ -66,6 +66,9 @@ inline constexpr Range kRotaryInertia{0.0, 1e6};
 inline constexpr Range kGravity{-dem_reference::limits::kMaxGravity_m_s2, dem_reference::limits::kMaxGravity_m_s2};
 /// Force amplitudes and static loads on a structure, N: |F| <= 1e7 (a 1000 t weight).
 inline constexpr Range kForce{-1e7, 1e7};
+/// Allowable tip strain of a buffer layer δ_max/t: (0, 1] (1: the design impact
+/// compresses the layer fully; formulas::BufferDesignInput::allowable_strain).
+inline constexpr Range kAllowableStrain{0.0, 1.0, true};
 /// Durations of a simulated decay, s: (0, 1e5] (a day of vibration).
 inline constexpr Range kDuration{0.0, 1e5, true};
 }  // namespace limits

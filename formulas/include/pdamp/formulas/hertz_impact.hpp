@@ -63,15 +63,20 @@ enum class BufferModel {
   kHalfSpace,
 };
 
-/// Design of a polymer layer on a container wall that the design impact just
-/// compresses fully ("compression collect-and-collide", docs/physics.md §5): δ_max = t,
-/// "bottoms out" = a nominal strain of 1 under the sphere's tip; beyond it the hard
-/// wall's contact acts in parallel (the DEM's business).
+/// Design of a polymer layer on a container wall (docs/physics.md §5): the thickness t
+/// whose tip strain under the design impact, δ_max/t (the compression of the layer under
+/// the sphere's tip over its thickness), equals the allowable strain ε_a of the polymer:
+/// δ_max(t) = ε_a·t. ε_a = 1 is the layer the design impact just compresses fully
+/// ("bottoms out"; beyond it the hard wall's contact acts in parallel, the DEM's business).
 /// The impact is one sphere of the bed's front row (radius r, particle material) on the
 /// layer, carrying the momentum of particles_per_contact spheres; the wall behind the
 /// layer is rigid and driven.
 /// Layer Poisson ratio for polyurethane-like buffers (0.48–0.5 measured; 0.5 = incompressible).
 inline constexpr double kDefaultLayerPoissonRatio = 0.48;
+/// Allowable tip strain δ_max/t of a polyurethane-like buffer: about 0.3 (an elastomer
+/// stays near its linear, elastic range up to a nominal compression of some tens of per
+/// cent; a layer compressed fully cannot be incompressible and elastic at once).
+inline constexpr double kDefaultAllowableStrain = 0.3;
 struct BufferDesignInput {
   double frequency_hz = 60.0;  ///< design frequency f, Hz, > 0
   double amplitude_m = 0.0;    ///< design stroke X, m, >= 0; 0 = derive from intensity
@@ -90,6 +95,10 @@ struct BufferDesignInput {
   /// Impact speed, m/s, >= 0; 0 = bouncing optimum 2XΩ (impact against the wall moving at −V).
   double impact_velocity_m_s = 0.0;
   BufferModel model = BufferModel::kLayered;  ///< contact law of the sizing
+  /// Allowable tip strain ε_a = δ_max/t at the design impact, in (0, 1] (1: the design
+  /// impact compresses the layer fully). kLayered only: the half-space rule is the
+  /// source study's t = δ_max and ignores it.
+  double allowable_strain = kDefaultAllowableStrain;
   /// One line per violation ("particle_radius_m = -0.005: must be > 0 and finite");
   /// X or Γ (or an impact speed) must be given: amplitude_m = intensity = 0 is a
   /// violation unless impact_velocity_m_s > 0.
@@ -97,11 +106,14 @@ struct BufferDesignInput {
 };
 struct BufferDesign {
   BufferModel model = BufferModel::kLayered;  ///< contact law used
-  /// Layered: the t whose full compression (δ_max = t) the design impact just reaches,
-  /// ½m*v² = ∫₀^t F(δ; t) dδ. Half-space: t = Hertz δ_max. m
+  /// Layered: the t whose tip strain at the design impact is the allowable one,
+  /// δ_max(t) = ε_a·t, i.e. ½m*v² = ∫₀^{ε_a t} F(δ; t) dδ. Half-space: t = Hertz δ_max. m
   double layer_thickness_m = 0.0;
+  /// ε_a the thickness was sized to: the input's (layered), 1 (half-space: t = δ_max).
+  double allowable_strain = 1.0;
   double impact_velocity_m_s = 0.0;       ///< design impact speed v, m/s
-  double max_penetration_m = 0.0;         ///< δ_max at v under the model's law (= layer_thickness_m), m
+  /// δ_max at v under the model's law (= allowable_strain·layer_thickness_m), m
+  double max_penetration_m = 0.0;
   double contact_time_s = 0.0;            ///< elastic contact time at v under the model's law, s
   double contact_time_over_period = 0.0;  ///< t_c·f; the impact picture needs it small (warning above 0.1)
   double effective_mass_kg = 0.0;         ///< m* = particles_per_contact·(4/3)πr³ρ, kg
@@ -118,9 +130,10 @@ struct BufferDesign {
   std::vector<std::string> warnings;      ///< validity-range violations (docs/interface.md)
 };
 /// Sizes the layer: X from Γ if needed, v = 2XΩ unless given, m* from the bed's sharing,
-/// E* from particle and layer; kLayered: t from ½m*v² = U(t; t) with the layered law
-/// (bisection in ln t), t_c from the one-degree-of-freedom impact; kHalfSpace: t = δ_max(v). Throws std::invalid_argument with
-/// all of input.validate()'s lines (newline-separated) for invalid input.
+/// E* from particle and layer; kLayered: t from ½m*v² = U(ε_a t; t) with the layered law
+/// (bisection in ln t), t_c from the one-degree-of-freedom impact; kHalfSpace: t = δ_max(v).
+/// Throws std::invalid_argument with all of input.validate()'s lines (newline-separated)
+/// for invalid input.
 BufferDesign size_buffer_layer(const BufferDesignInput& input);
 
 }  // namespace pdamp::formulas

@@ -114,6 +114,12 @@ struct FillingRatioResult {
   FillingDesign baseline;
   std::string baseline_layer;
   int baseline_evaluations = 0;
+  /// The structure with the damper's containers empty (its own damping only).
+  FillingDesign bare;
+  /// The chosen design's particle mass in one compartment at its own best clearance
+  /// (evaluate_single_compartment; one layer named kSingleCompartment): what the layering
+  /// adds beyond the mass.
+  FillingDesign same_mass;
   Summary summary;               ///< of the relaxed solve (variables "slabs_<layer>")
   int decay_evaluations = 0;     ///< free decays run in total (solve, neighbours, baseline)
   double solve_time_s = 0.0;     ///< wall-clock time of everything, s
@@ -129,8 +135,18 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
 FillingDesign evaluate_filling_design(const structure::ModalModel& model, const FillingRatioOptions& options,
                                       std::span<const double> slabs);
 
+/// The layer name of a single-compartment design.
+inline constexpr const char* kSingleCompartment = "single_compartment";
+
+/// `mass_kg` of the candidates' spheres (`particles` of them) in one compartment of the
+/// damper with clearance `clearance_m`, scored as evaluate_filling_design (slabs and
+/// filling ratio NaN: the compartment is no candidate's).
+FillingDesign evaluate_single_compartment(const structure::ModalModel& model, const FillingRatioOptions& options,
+                                          double mass_kg, double particles, double clearance_m);
+
 /// Relaxed solve (n_k real: mass and clearance linear in n_k; optimizer::solve with
-/// `solver`), then every feasible rounded neighbour, then the single-layer baseline.
+/// `solver`), then every feasible rounded neighbour, then the single-layer baseline, the bare
+/// structure and the same mass in one compartment.
 /// Throws std::invalid_argument for invalid options (every violation, one a line) and
 /// what the free decay throws for an invalid model or initial state.
 FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, const FillingRatioOptions& options,

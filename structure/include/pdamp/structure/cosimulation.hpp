@@ -196,6 +196,25 @@ struct CosimulationEnergy {
   double dem_dissipated_j() const { return dem_normal_damping_j + dem_friction_j + dem_rolling_j; }
 };
 
+/// Wall-clock time of each stage of the coupled steps, s (docs/cosimulation.md §8): where a
+/// run's time goes. The stages are timed on every kCosimulationTimingStride-th step and the
+/// times scaled by it (two clock reads per stage on every step would cost about a tenth of a
+/// small bed's step), so they are estimates; they read nothing the run computes and change no
+/// result. A prime stride: no periodic event of the loop (samples, periods, progress every 256
+/// steps) falls on the timed steps more often than on the others, unless its period is a
+/// multiple of it.
+struct CosimulationStageTimes {
+  double settling_s = 0.0;          ///< the beds settling before the coupling (timed whole)
+  double modal_kick_drift_s = 0.0;  ///< v_{k+½} = v_k + ½dt q̈_k, q_{k+1} = q_k + dt v_{k+½}, the drive at t_{k+1}
+  double bed_steps_s = 0.0;         ///< the containers moved to t_{k+1}, World::step of each bed, its load read
+  double closing_kick_s = 0.0;      ///< g_{k+1}, (M + ½dt C) v_{k+1} = M v_{k+½} + ½dt g_{k+1}, q̈_{k+1}
+  double ledger_s = 0.0;            ///< the step's structural damping and excitation work (trapezoid, §4)
+  double measures_s = 0.0;          ///< the sampled histories and the first harmonics (steady state, sweep cycles)
+  double coupled_s() const { return modal_kick_drift_s + bed_steps_s + closing_kick_s + ledger_s + measures_s; }
+};
+/// Steps per timed step of CosimulationStageTimes.
+inline constexpr std::int64_t kCosimulationTimingStride = 31;
+
 struct CosimulationResult {
   /// kCompleted; kUnstable / kFailed when a World stopped (message: the damper and the
   /// World's own reason and advice); the histories end there.
@@ -222,6 +241,8 @@ struct CosimulationResult {
   std::vector<dem_reference::WorldStatus> world_status;            ///< per damper
   std::vector<dem_reference::ContainerState> final_container_states;  ///< per damper
   std::vector<std::string> warnings;
+  /// Where the wall time went, s (not in checkpoints: a restored run's are its own process's).
+  CosimulationStageTimes stage_times;
 };
 
 struct CosimulationProgress {
@@ -267,7 +288,8 @@ struct CosimulationState {
 /// velocity Verlet with the damping term trapezoidal (implicit, exact solve): the structure
 /// and the beds form one leapfrog, second order, with no lag in the coupling.
 /// Throws std::invalid_argument for invalid inputs (every violation, one per line) and for a
-/// step the structure cannot take (ω_max·dt > 0.2).
+/// step the structure cannot take (ω_max·dt > 0.2). A Cosimulation (cosimulation_run.hpp)
+/// advanced to its end: use that class to run the steps in segments.
 CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                               const CosimulationOptions& options,
                               const CosimulationProgressCallback& progress = {});
@@ -312,9 +334,10 @@ CosimulationResult restore_cosimulation_result(dem_reference::StateReader& in, E
 /// Appends the result of a continuation to the result of the runs before it (a free decay
 /// run in segments, each continuing the state the last one left): the histories without the
 /// continuation's first sample (the last one's final sample again), the counters summed, the
-/// continuation's outcome, final states and warnings not yet listed, and the energy account
-/// of `state` since the first start (CosimulationState::energy_since_start: a sum of the
-/// runs' own accounts would differ from one run's in the last bits). Segments of whole
+/// continuation's outcome, final states and warnings not yet listed, the stage times summed,
+/// and the energy account of `state` since the first start (CosimulationState::
+/// energy_since_start: a sum of the runs' own accounts would differ from one run's in the
+/// last bits). Segments of whole
 /// sample intervals (options.sample_interval_s fixed) give the histories one run records.
 void append_continuation(CosimulationResult& total, const CosimulationResult& next, const CosimulationState& state);
 

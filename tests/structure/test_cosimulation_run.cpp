@@ -1,0 +1,247 @@
+// Tests of the co-simulation as an object (structure::Cosimulation): a free decay advanced in
+// uneven segments with a checkpoint between them, and a harmonic run advanced in segments,
+// equal one cosimulate() call bit for bit; the stage times; refusals of what does not fit.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "pdamp/structure/cosimulation_run.hpp"
+#include "structure/cosimulation_support.hpp"
+
+namespace {
+
+using namespace pdamp::structure;
+using pdamp::test::bed;
+using pdamp::test::tip_damper;
+namespace dem = pdamp::dem_reference;
+
+/// Two modes (10 and 27 Hz) that both move the tip along the drive y, so that the modal
+/// products of the step are true matrix products.
+ModalModel two_modes() {
+  ModalModel m;
+  m.natural_frequencies_hz = Eigen::Vector2d(10.0, 27.0);
+  m.damping_ratios = Eigen::Vector2d(0.01, 0.02);
+  m.modal_masses_kg = Eigen::Vector2d(0.1, 0.05);
+  Eigen::MatrixXd shape(2, 2);
+  shape << 0.0, 0.0, 1.0, 0.6;
+  m.points = {{"tip", shape, Eigen::RowVectorXd::Zero(2)}};
+  return m;
+}
+
+/// One mode with base participation (the ledger test's forced case).
+ModalModel one_mode_on_a_base() {
+  ModalModel m;
+  m.natural_frequencies_hz = Eigen::VectorXd::Constant(1, 10.0);
+  m.damping_ratios = Eigen::VectorXd::Constant(1, 0.01);
+  m.modal_masses_kg = Eigen::VectorXd::Constant(1, 0.1);
+  Eigen::MatrixXd shape(2, 1);
+  shape << 0.0, 1.0;
+  m.points = {{"tip", shape, Eigen::RowVectorXd::Zero(1)}};
+  m.base_participation = Eigen::MatrixXd(1, 2);
+  m.base_participation << 0.0, 0.08;
+  return m;
+}
+
+/// Four spheres impacting in a box at the tip.
+std::vector<CosimulationDamper> impacting_bed() {
+  return {tip_damper(bed(0.005, {0.03, 0.0201, 0.0201}, {1, 2, 2}, 2e8, {0.0, 0.0, -9.80665},
+                         dem::InitialPlacement::kCollectedLattice),
+                     0.02)};
+}
+
+CosimulationOptions decay(double duration_s) {
+  CosimulationOptions o;
+  o.initial_modal_displacements = Eigen::Vector2d(0.01, 0.003);
+  o.duration_s = duration_s;
+  o.sample_interval_s = 0.002;
+  return o;
+}
+
+void check_same_energy(const CosimulationEnergy& a, const CosimulationEnergy& b) {
+  CHECK(a.excitation_work_j == b.excitation_work_j);
+  CHECK(a.structural_damping_j == b.structural_damping_j);
+  CHECK(a.delta_structure_kinetic_j == b.delta_structure_kinetic_j);
+  CHECK(a.delta_structure_potential_j == b.delta_structure_potential_j);
+  CHECK(a.dem_normal_damping_j == b.dem_normal_damping_j);
+  CHECK(a.dem_friction_j == b.dem_friction_j);
+  CHECK(a.dem_rolling_j == b.dem_rolling_j);
+  CHECK(a.delta_bed_kinetic_j == b.delta_bed_kinetic_j);
+  CHECK(a.delta_bed_potential_j == b.delta_bed_potential_j);
+  CHECK(a.delta_bed_elastic_j == b.delta_bed_elastic_j);
+  CHECK(a.container_work_j == b.container_work_j);
+  CHECK(a.relative_error == b.relative_error);
+}
+
+void check_same_history(const CosimulationHistory& a, const CosimulationHistory& b) {
+  REQUIRE(a.time_s.size() == b.time_s.size());
+  CHECK(a.time_s == b.time_s);
+  CHECK(a.modal_displacements == b.modal_displacements);
+  CHECK(a.site_displacement_m == b.site_displacement_m);
+  CHECK(a.site_rotation_rad == b.site_rotation_rad);
+  CHECK(a.container_load_n == b.container_load_n);
+  CHECK(a.container_moment_nm == b.container_moment_nm);
+}
+
+}  // namespace
+
+// Reference: one cosimulate() call of a 0.3 s decay with real impacts, on two modes. The run
+// advanced in segments of 1, 777 and 4321 steps (none a whole number of sample intervals),
+// saved, the object destroyed, restored from the bytes into new worlds and advanced by 0, 3,
+// 10007 steps and then beyond its end must give the same bits: history, final modes and
+// particles, the energy ledger of the result and of the state, the counters. A segment
+// shares every running sum with the next; the restore recomputes the opening acceleration
+// with the closing kick's own products.
+TEST_CASE("a free decay advanced in uneven segments with a checkpoint between them equals one cosimulate call",
+          "[cosimulation]") {
+  const ModalModel model = two_modes();
+  const auto dampers = impacting_bed();
+  const CosimulationOptions options = decay(0.3);
+  CosimulationState whole_state;
+  const CosimulationResult whole = cosimulate(model, dampers, options, whole_state);
+  REQUIRE(whole.outcome == dem::Outcome::kCompleted);
+  CHECK(whole.energy.dem_dissipated_j() > 0.1 * whole.energy.structural_damping_j);  // real impacts
+
+  std::string bytes;
+  std::int64_t done = 0;
+  {
+    Cosimulation run(model, dampers, options);
+    CHECK(run.time_step_s() == whole.time_step_s);
+    CHECK(run.total_steps() == whole.steps);
+    CHECK(run.steps_done() == 0);
+    for (const std::int64_t steps : {1, 777, 4321}) {
+      CHECK(run.advance(steps) == steps);
+      done += steps;
+    }
+    CHECK(run.steps_done() == done);
+    CHECK(!run.finished());
+    CHECK(run.result().steps == done);
+    dem::StateWriter out;
+    run.save(out);
+    bytes = out.take();
+  }
+  dem::StateReader in(bytes, "checkpoint");
+  Cosimulation run = Cosimulation::restore(model, dampers, options, in);
+  in.finish();
+  CHECK(run.steps_done() == done);
+  CHECK(run.total_steps() == whole.steps);
+  CHECK(run.advance(0) == 0);
+  CHECK(run.advance(-3) == 0);
+  CHECK(run.advance(3) == 3);
+  CHECK(run.advance(10007) == 10007);
+  const std::int64_t left = run.total_steps() - run.steps_done();
+  CHECK(run.advance(left + 100) == left);
+  CHECK(run.finished());
+  CHECK(run.advance(1) == 0);
+
+  const CosimulationResult r = run.result();
+  REQUIRE(r.outcome == dem::Outcome::kCompleted);
+  CHECK(r.steps == whole.steps);
+  CHECK(r.simulated_time_s == whole.simulated_time_s);
+  CHECK(r.start_time_s == whole.start_time_s);
+  CHECK(r.settling_steps == whole.settling_steps);
+  CHECK(!r.continued);
+  CHECK(r.warnings == whole.warnings);
+  check_same_history(r.history, whole.history);
+  CHECK(r.final_modal_displacements == whole.final_modal_displacements);
+  CHECK(r.final_modal_velocities == whole.final_modal_velocities);
+  check_same_energy(r.energy, whole.energy);
+  const CosimulationState& state = run.state();
+  CHECK(state.worlds[0].state_hash() == whole_state.worlds[0].state_hash());
+  CHECK(state.steps == whole_state.steps);
+  CHECK(state.time_s == whole_state.time_s);
+  check_same_energy(state.energy_since_start, whole_state.energy_since_start);
+
+  // The stage times: a fresh run's settling and every stage took time; a restored run's are
+  // its own process's (no settling).
+  const auto& t = whole.stage_times;
+  CHECK(t.settling_s > 0.0);
+  for (const double s : {t.modal_kick_drift_s, t.bed_steps_s, t.closing_kick_s, t.ledger_s, t.measures_s})
+    CHECK(s > 0.0);
+  CHECK(r.stage_times.settling_s == 0.0);
+  CHECK(r.stage_times.bed_steps_s > 0.0);
+}
+
+// Reference: one cosimulate() call of a base-driven run that settles early (its transient
+// ends after fewer than the 30 periods allowed) with impacting spheres. Segments of 9973
+// steps (not a period) give the same steady state and ledger to the bit, the planned end
+// moves to the settled one, and the state continues as cosimulate's. A harmonic run has no
+// checkpoint (its measures' sums are not in it).
+TEST_CASE("a harmonic run advanced in segments equals one call, and its end moves once it has settled",
+          "[cosimulation]") {
+  const ModalModel model = one_mode_on_a_base();
+  const auto dampers = impacting_bed();
+  CosimulationOptions o;
+  o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
+  o.excitation.direction = {0.0, 1.0};
+  o.excitation.amplitude = 1e-3;
+  o.excitation.frequency_hz = 9.0;
+  o.transient_periods = 30;
+  o.analysed_periods = 2;
+  o.settle_until_stable = true;
+  o.stable_tolerance = 0.05;
+  CosimulationState whole_state;
+  const CosimulationResult whole = cosimulate(model, dampers, o, whole_state);
+  REQUIRE(whole.outcome == dem::Outcome::kCompleted);
+  REQUIRE(whole.steady_state.stable);
+
+  Cosimulation run(model, dampers, o);
+  CHECK(run.total_steps() == 32 * whole.steps_per_period);
+  while (!run.finished()) CHECK(run.advance(9973) > 0);
+  CHECK(run.total_steps() == whole.steps);
+  CHECK(run.total_steps() < 32 * whole.steps_per_period);
+  const CosimulationResult r = run.result();
+  CHECK(r.steps == whole.steps);
+  CHECK(r.steady_state.transient_periods == whole.steady_state.transient_periods);
+  CHECK(r.steady_state.analysed_periods == 2);
+  CHECK(r.steady_state.period_site_amplitudes_m == whole.steady_state.period_site_amplitudes_m);
+  CHECK(r.steady_state.site_amplitudes_m == whole.steady_state.site_amplitudes_m);
+  CHECK(r.steady_state.bed_force_amplitudes_n == whole.steady_state.bed_force_amplitudes_n);
+  CHECK(r.steady_state.modal_amplitudes == whole.steady_state.modal_amplitudes);
+  check_same_history(r.history, whole.history);
+  check_same_energy(r.energy, whole.energy);
+  dem::StateWriter out;
+  CHECK_THROWS_AS(run.save(out), std::logic_error);
+  const CosimulationState state = std::move(run).take_state();
+  CHECK(state.worlds[0].state_hash() == whole_state.worlds[0].state_hash());
+  CHECK(state.excitation_phase_rad == whole_state.excitation_phase_rad);
+  CHECK_THROWS_AS(run.advance(1), std::logic_error);
+}
+
+TEST_CASE("a restore refuses a checkpoint of other settings, and a continuation that does not fit keeps the state",
+          "[cosimulation]") {
+  const ModalModel model = two_modes();
+  const auto dampers = impacting_bed();
+  Cosimulation run(model, dampers, decay(0.01));
+  run.advance(100);
+  dem::StateWriter out;
+  run.save(out);
+  const std::string bytes = out.take();
+  SECTION("another step") {
+    CosimulationOptions other = decay(0.01);
+    other.time_step_s = 0.5 * run.time_step_s();
+    dem::StateReader in(bytes, "checkpoint");
+    CHECK_THROWS_WITH(Cosimulation::restore(model, dampers, other, in),
+                      Catch::Contains("cosimulation checkpoint: time_step_s = ") &&
+                          Catch::Contains("a checkpoint of other settings"));
+  }
+  SECTION("a harmonic run") {
+    CosimulationOptions forced;
+    forced.excitation.kind = CosimulationExcitationKind::kPointForce;
+    forced.excitation.point = "tip";
+    forced.excitation.amplitude = 0.1;
+    forced.excitation.frequency_hz = 9.0;
+    dem::StateReader in(bytes, "checkpoint");
+    CHECK_THROWS_WITH(Cosimulation::restore(model, dampers, forced, in),
+                      Catch::Contains("continues a free decay only"));
+  }
+  SECTION("a continuation with initial values") {
+    CosimulationState state = std::move(run).take_state();
+    const auto hash = state.worlds[0].state_hash();
+    CHECK_THROWS_WITH(Cosimulation(model, dampers, decay(0.01), std::move(state)),
+                      Catch::Contains("must be empty when continuing"));
+    REQUIRE(state.started());
+    CHECK(state.worlds[0].state_hash() == hash);
+  }
+}
