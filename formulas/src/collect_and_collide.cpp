@@ -424,6 +424,10 @@ void rebounding_loss(LossResult& result, double inertia_factor, double clearance
   }
 }
 
+/// Largest base friction at which the DEM held a nested bed up to Γ = μ (docs/physics.md §3.3,
+/// tests/dem_reference/test_bed_models.cpp: μ = 0.1 and 0.2 held; 0.35 and 0.5 moved below μ).
+constexpr double kMaxHeldNestedFriction = 0.2;
+
 /// The nested bed: the Coulomb block on its base (docs/physics.md §3.3).
 template <class Warn>
 void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const ModelOptions& options,
@@ -440,9 +444,15 @@ void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const
   if (block.regime == MotionRegime::kSliding) {
     warn([&] { return std::string(
         "nested bed at Gamma = " + format(result.intensity) + " > mu = " + format(mu) + ": the Coulomb block slides "
-        "(eta* = " + format(result.eta_star) + "), but the DEM of a nested bed, whose upper spheres wedge between the "
-        "bed and the far wall, mostly stays held and gives eta* = 0.03-0.14 at Gamma = 1-2.7 mu where the block "
-        "gives 0.02-0.40 (docs/physics.md section 3.3): an estimate, check with pdamp dem"); });
+        "(eta* = " + format(result.eta_star) + "), an estimate: the DEM of a nested bed (docs/physics.md section 3.3) "
+        "gives 0.24-0.26 at Gamma = 3 mu where the block gives 0.15-0.31, and is still held at Gamma = 1.5 mu for "
+        "mu = 0.1 where the block gives 0.23: check with pdamp dem"); });
+  } else if (mu > kMaxHeldNestedFriction) {
+    warn([&] { return std::string(
+        "nested bed held by its base (eta* = 0) up to Gamma = mu = " + format(mu) + ": the DEM holds a nested bed "
+        "so only at low friction (mu <= " + format(kMaxHeldNestedFriction) + "); at mu = 0.35 and 0.5 it moved from "
+        "Gamma = 0.28 and 0.1 with eta* = 0.3-0.75 (docs/physics.md section 3.3), so eta* = 0 at Gamma = " +
+        format(result.intensity) + " may be far too low: check with pdamp dem"); });
   }
   if (block.outside_domain) {
     warn([&] { return std::string(
