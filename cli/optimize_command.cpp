@@ -51,6 +51,11 @@ std::string design_row(const opt::FillingDesign& d, bool whole) {
          ", objective " + format_number(d.objective, 6);
 }
 
+std::string difference_text(const tasks::Agreement& a) {
+  return a.compared == "settled_only_one" ? std::string("only one settled")
+                                          : "difference " + format_number(100.0 * a.relative_difference, 3) + " %";
+}
+
 Rows verification_rows(const tasks::Verification& v) {
   Rows rows;
   const bool settling = v.settling_objective;
@@ -61,14 +66,22 @@ Rows verification_rows(const tasks::Verification& v) {
     line += "; end envelope predicted " + format_number(d.predicted_end_envelope_m * 1e3, 4) + " mm, DEM " +
             format_number(d.dem_end_envelope_m * 1e3, 4) + " mm; energy error " + format_number(d.dem.energy_error, 2) +
             "; " +
-            (d.compared == "settled_only_one" ? std::string("only one settled")
-                                              : "difference " + format_number(100.0 * d.relative_difference, 3) + " %") +
-            ": " + (d.passed ? "pass" : "FAIL");
+            difference_text(d.agreement) + ": " + (d.agreement.within ? "pass" : "FAIL");
     rows.push_back({"verify " + d.name, line});
+    if (const auto& s = d.softening_check)
+      rows.push_back({"verify " + d.name + " stiffer",
+                      "softening " + format_number(s->stiffness_softening, 3) + ": DEM " +
+                          (settling ? seconds_or_not_settled(s->dem_objective) : format_number(s->dem_objective, 4) + " m2 s") +
+                          "; judged run " + difference_text(s->agreement) + ": " +
+                          (s->agreement.within ? "converged" : "NOT CONVERGED")});
   }
   rows.push_back({"verify ranking", std::string("chosen ahead of baseline: predicted ") +
                                         (v.predicted_chosen_ahead ? "yes" : "no") + ", DEM " +
                                         (v.dem_chosen_ahead ? "yes" : "no") + (v.ranking_passed ? ": pass" : ": FAIL")});
+  rows.push_back({"verify softening", v.softening_check == "two_softenings"
+                                          ? std::string(v.softening_converged ? "converged" : "NOT CONVERGED") +
+                                                " (each design also ten times stiffer)"
+                                          : v.softening_check == "full_stiffness" ? "full stiffness" : "not checked"});
   rows.push_back({"verification", std::string(v.passed ? "PASS" : "FAIL") + " (tolerance " +
                                       format_number(100.0 * v.spec.tolerance_relative, 3) + " %, " +
                                       format_number(v.spec.duration_s, 4) + " s simulated each, " +

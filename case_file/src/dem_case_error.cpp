@@ -84,6 +84,7 @@ CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::str
       {std::regex(R"(^pairs\.(\d+)\.(\w+)$)"), "/dem/pairs/$1/$2"},
       {std::regex(R"(^gravity_m_s2\.(\d+)$)"), "{damper}/gravity_m_s2/$1"},
       {std::regex(R"(^(amplitude_m|frequency_hz)$)"), "/excitation/$1"},
+      {std::regex(R"(^approach_(amplitude_m|hold_periods|ramp_periods)$)"), "/dem/approach/$1"},
       {std::regex(R"(^drive_axis$)"), "{damper}/drive_axis"},
       {std::regex(R"(^(\w+)$)"), "/dem/$1"},
   };

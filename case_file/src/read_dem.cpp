@@ -163,6 +163,15 @@ void read_dem(ObjectReader& r, Case& c) {
   sim.settling_time_s =
       r.number("settling_time_s", defaults.settling_time_s, {-1.0, dr::limits::kMaxSettlingTime_s}, " s (-1 = automatic)");
   if (sim.settling_time_s < 0.0 && sim.settling_time_s != -1.0) r.fail("settling_time_s", "must be -1 (automatic) or >= 0");
+  // The approach from above (absent: from rest, and nothing added to the resolved case, so
+  // the physics hash of every case without it is what it was).
+  r.object("approach", false, [&](ObjectReader& a) {
+    sim.approach_amplitude_m = a.number("amplitude_m", std::nullopt, {0.0, dr::limits::kMaxAmplitude_m, true}, " m");
+    sim.approach_hold_periods =
+        a.integer("hold_periods", defaults.approach_hold_periods, 0, dr::limits::kMaxPeriods);
+    sim.approach_ramp_periods =
+        a.integer("ramp_periods", defaults.approach_ramp_periods, 1, dr::limits::kMaxPeriods);
+  });
   sim.transient_periods = r.integer("transient_periods", defaults.transient_periods, 0, dr::limits::kMaxPeriods);
   sim.analysed_periods = r.integer("analysed_periods", defaults.analysed_periods, 1, dr::limits::kMaxPeriods);
   sim.samples_per_period = r.integer("samples_per_period", defaults.samples_per_period, dr::limits::kMinSamplesPerPeriod,

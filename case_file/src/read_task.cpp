@@ -105,6 +105,7 @@ VerifySpec read_verify(ObjectReader& r, const DecayTask& decay) {
   v.duration_s = r.number("duration_s", decay.duration_s, limits::kDuration, " s");
   v.stiffness_softening = r.number("stiffness_softening", VerifySpec{}.stiffness_softening, {1e-6, 1.0});
   v.require_ranking = r.boolean("require_ranking", VerifySpec{}.require_ranking);
+  v.softening_check = r.boolean("softening_check", VerifySpec{}.softening_check);
   return v;
 }
 

@@ -86,12 +86,23 @@ class ProgressReporter {
 
 /// The harmonic drive's peak container speed V = X·2πf, m/s (in this order of operations:
 /// the impact speed, and so the time step, depend on its last bit).
-double harmonic_peak_speed(const DamperSimulationOptions& o) { return o.amplitude_m * 2.0 * kPi * o.frequency_hz; }
+/// The drive's largest velocity amplitude: XΩ, or X_aΩ when the run approaches from X_a > X.
+/// (The ramp's A' sin Ωt adds at most (X_a − X)/(N_ramp T) < X_aΩ/(2π N_ramp): 1.6 % of X_aΩ
+/// for the default 10 ramp periods, inside the margin of the contact's steps.)
+double harmonic_peak_speed(const DamperSimulationOptions& o) {
+  return std::max(o.amplitude_m, o.approach_amplitude_m) * 2.0 * kPi * o.frequency_hz;
+}
+
+/// Steps of the approach from above (DamperSimulationOptions::approach_amplitude_m).
+std::int64_t approach_periods(const DamperSimulationOptions& o) {
+  return o.approach_amplitude_m > 0.0 ? o.approach_hold_periods + o.approach_ramp_periods : 0;
+}
 
 /// What run_harmonic and estimate_run derive from the options before building a world.
 struct RunPlan {
   DriveTimeStep step;  ///< time step, step counts per block and period, the world options to build
   std::int64_t settle_steps = 0;
+  std::int64_t approach_steps = 0;
   std::int64_t transient_steps = 0;
   std::int64_t analysed_steps = 0;
   std::int64_t total_steps = 0;
@@ -112,9 +123,10 @@ RunPlan plan_run(const DamperSimulationOptions& options) {
   const double settling =
       options.settling_time_s < 0.0 ? automatic_settling_time_s(plan.step.world) : options.settling_time_s;
   plan.settle_steps = static_cast<std::int64_t>(std::ceil(settling / plan.step.time_step_s));
+  plan.approach_steps = plan.step.steps_per_period * approach_periods(options);
   plan.transient_steps = plan.step.steps_per_period * options.transient_periods;
   plan.analysed_steps = plan.step.steps_per_period * options.analysed_periods;
-  plan.total_steps = plan.settle_steps + plan.transient_steps + plan.analysed_steps;
+  plan.total_steps = plan.settle_steps + plan.approach_steps + plan.transient_steps + plan.analysed_steps;
   for (const auto& c : plan.step.world.compartments) {
     for (const auto& g : c.particles) plan.particles += g.count;
   }
@@ -151,6 +163,14 @@ std::vector<std::string> DamperSimulationOptions::validate(const std::string& pr
   const std::string periods = std::to_string(limits::kMaxPeriods);
   add(transient_periods >= 0 && transient_periods <= limits::kMaxPeriods, "transient_periods", transient_periods,
       "must be in [0, " + periods + "]");
+  add(approach_amplitude_m == 0.0 || (in(approach_amplitude_m, 0.0, limits::kMaxAmplitude_m) &&
+                                      (!amplitude_ok || approach_amplitude_m > amplitude_m)),
+      "approach_amplitude_m", approach_amplitude_m,
+      "must be 0 (from rest) or > amplitude_m and <= " + std::to_string(static_cast<int>(limits::kMaxAmplitude_m)) + " m");
+  add(approach_hold_periods >= 0 && approach_hold_periods <= limits::kMaxPeriods, "approach_hold_periods",
+      approach_hold_periods, "must be in [0, " + periods + "]");
+  add(approach_ramp_periods >= 1 && approach_ramp_periods <= limits::kMaxPeriods, "approach_ramp_periods",
+      approach_ramp_periods, "must be in [1, " + periods + "]");
   add(analysed_periods >= 1 && analysed_periods <= limits::kMaxPeriods, "analysed_periods", analysed_periods,
       "must be in [1, " + periods + "]");
   const bool samples_ok =
@@ -243,6 +263,7 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   e.warnings = plan.step.warnings;
   e.steps_per_period = plan.step.steps_per_period;
   e.settling_steps = plan.settle_steps;
+  e.approach_steps = plan.approach_steps;
   e.transient_steps = plan.transient_steps;
   e.analysed_steps = plan.analysed_steps;
   e.total_steps = plan.total_steps;
@@ -269,6 +290,42 @@ void check_initial_placement(const DamperSimulationOptions& options) {
   // in the body frame is gravity itself.
   (void)detail::place_particles(options.world, detail::build_walls(options.world), options.world.gravity_m_s2);
 }
+
+namespace {
+
+/// The approach from above (DamperSimulationOptions::approach_amplitude_m): hold periods at
+/// X_a, then the stroke lowered linearly to X over the ramp periods, x_c = A(t) sin Ωt. It
+/// ends after whole periods, at x_c = 0 with velocity XΩ: the state the transient's
+/// x_c = X sin Ωt starts from, so the drive is continuous there. False when the world halted.
+bool approach(World& world, const DamperSimulationOptions& o, const RunPlan& plan,
+              const std::function<void(std::int64_t)>& report) {
+  const HarmonicMotion unit(o.drive_axis, 1.0, o.frequency_hz);
+  const Vec3& axis = unit.axis();
+  const double omega = unit.angular_frequency_rad_s();
+  const double dt = plan.step.time_step_s;
+  const std::int64_t hold_steps = plan.step.steps_per_period * o.approach_hold_periods;
+  const std::int64_t ramp_steps = plan.approach_steps - hold_steps;
+  const double slope_m_s = (o.amplitude_m - o.approach_amplitude_m) / (static_cast<double>(ramp_steps) * dt);  // A'
+  for (std::int64_t k = 1; k <= plan.approach_steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    const bool ramping = k > hold_steps;
+    const double a = ramping ? o.approach_amplitude_m + slope_m_s * static_cast<double>(k - hold_steps) * dt
+                             : o.approach_amplitude_m;
+    const double x = a * std::sin(omega * t);
+    const double v = a * omega * std::cos(omega * t) + (ramping ? slope_m_s * std::sin(omega * t) : 0.0);
+    ContainerState state;
+    for (std::size_t i = 0; i < 3; ++i) {
+      state.position_m[i] = x * axis[i];
+      state.velocity_m_s[i] = v * axis[i];
+    }
+    world.step(state);
+    if (world.status().outcome != Outcome::kCompleted) return false;
+    report(k);
+  }
+  return true;
+}
+
+}  // namespace
 
 DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress,
                           const HarmonicCheckpoints* checkpoints) {
@@ -374,8 +431,17 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
                               std::to_string(transient_steps + plan.analysed_steps) + " drive steps");
     wall_before_s = saved->finite("wall_time_s");
     world.restore_state(*saved);
-  } else if (!settle(world, start, settle_steps, report_settling) && halted()) {  // false exactly when the world halted
-    return result;
+  } else {
+    // The settled bed starts with the drive's velocity at t = 0 (X_aΩ when it approaches from X_a).
+    const ContainerState drive_start =
+        plan.approach_steps > 0 ? HarmonicMotion(axis, options.approach_amplitude_m, options.frequency_hz).state(0.0)
+                                : start;
+    if (!settle(world, drive_start, settle_steps, report_settling) && halted()) return result;  // false exactly when halted
+    if (plan.approach_steps > 0 && !approach(world, options, plan, [&](std::int64_t k) {
+          reporter.maybe_report("approach", settle_steps + k, total_steps,
+                                static_cast<double>(k - plan.approach_steps) * dt);
+        }) && halted())
+      return result;
   }
   // Built on the settled bed: its base contacts are the rolling criterion's reference.
   MotionModeAccumulator motion_modes(world, plan.step.world, axis);

@@ -162,6 +162,15 @@ std::string verification_section(const json& result) {
                     d["relative_difference"].is_number() ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
                                                          : "only one settled",
                     d["passed"].get<bool>() ? "pass" : "FAIL"});
+    if (d.contains("softening_check")) {
+      const json& s = d["softening_check"];
+      rows.push_back({std::string(name) + ", check at softening " + scalar_text(s["stiffness_softening"]), "",
+                      objective(s["dem"]), "", mm(s["dem"]["end_envelope_m"]), scalar_text(s["dem"]["energy_error"]),
+                      s["relative_difference"].is_number()
+                          ? "judged run " + format_number(100.0 * s["relative_difference"].get<double>(), 3) + " %"
+                          : "only one settled",
+                      s["converged"].get<bool>() ? "converged" : "NOT CONVERGED"});
+    }
   }
   const std::string unit = settling ? "settling time / s" : "½∫e² dt / m² s";
   std::ostringstream out;

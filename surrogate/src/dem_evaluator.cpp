@@ -10,6 +10,8 @@ PointEvaluator dem_evaluator(const dem_reference::DamperSimulationOptions& base)
     auto options = base;
     options.frequency_hz = frequency_hz;
     options.amplitude_m = amplitude_m;
+    // Approached from above only below the approach stroke; at and above it from rest.
+    if (amplitude_m >= options.approach_amplitude_m) options.approach_amplitude_m = 0.0;
     const auto result = dem_reference::run_harmonic(options);
     FieldPoint point;
     if (result.summary.outcome != dem_reference::Outcome::kCompleted) {

@@ -150,6 +150,11 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
   out.case_name = c.name;
   out.amplitude_m = x;
   out.frequency_hz = f;
+  if (options.approach_amplitude_m > 0.0) {
+    out.approach_amplitude_m = options.approach_amplitude_m;
+    out.approach_hold_periods = options.approach_hold_periods;
+    out.approach_ramp_periods = options.approach_ramp_periods;
+  }
   try {
     out.dem = dem_reference::run_harmonic(
         options,
@@ -216,6 +221,9 @@ json to_json(const dem_reference::DamperResult& r) {
 json to_json(const DemRunResult& r) {
   json out = to_json(r.dem);
   out.update({{"case", r.case_name}, {"amplitude_m", r.amplitude_m}, {"frequency_hz", r.frequency_hz}});
+  if (r.approach_amplitude_m > 0.0)
+    out["approach"] = {{"from_amplitude_m", r.approach_amplitude_m}, {"hold_periods", r.approach_hold_periods},
+                       {"ramp_periods", r.approach_ramp_periods}};
   out["closed_form"] = {{"eta_star", r.closed_form.eta_star}, {"model_used", fm::to_string(r.closed_form.model_used)},
                         {"regime", fm::to_string(r.closed_form.regime)}};
   return out;

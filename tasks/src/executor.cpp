@@ -1,6 +1,9 @@
 // The local executor and the concurrency helper of executor.hpp.
 #include "pdamp/tasks/executor.hpp"
 
+#include <algorithm>
+#include <atomic>
+
 namespace pdamp::tasks {
 
 namespace {
@@ -21,19 +24,24 @@ LocalExecutor& local_executor() {
   return executor;
 }
 
-void for_each_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& body) {
-  if (!parallel) {
+void for_each_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& body,
+                           std::size_t max_threads) {
+  if (!parallel || max_threads < 2) {
     for (std::size_t k = 0; k < count; ++k) body(k);
     return;
   }
+  // Each thread takes the next job in order until none is left.
   std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
   std::vector<std::thread> threads;
-  for (std::size_t k = 0; k < count; ++k)
-    threads.emplace_back([&, k] {
-      try {
-        body(k);
-      } catch (...) {
-        errors[k] = std::current_exception();
+  for (std::size_t t = 0; t < std::min(count, max_threads); ++t)
+    threads.emplace_back([&] {
+      for (std::size_t k = next++; k < count; k = next++) {
+        try {
+          body(k);
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
       }
     });
   for (auto& t : threads) t.join();

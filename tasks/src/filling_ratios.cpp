@@ -1,6 +1,7 @@
 // Task kind filling_ratios (filling_ratios.hpp).
 #include "pdamp/tasks/filling_ratios.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 
@@ -83,6 +84,13 @@ VerifiedDecay verified_decay(const DemDecay& d) {
   return v;
 }
 
+/// The design's slabs as whole numbers (the optimiser's are whole already).
+std::vector<long> whole_slabs(const opt::FillingDesign& design) {
+  std::vector<long> slabs;
+  for (const auto& l : design.layers) slabs.push_back(std::lround(l.slabs));
+  return slabs;
+}
+
 /// The design's slabs as one number, exact for up to five layers of < 1000 slabs: a process
 /// asked to verify a design checks that its own optimisation chose the same.
 double design_fingerprint(const opt::FillingDesign& design) {
@@ -91,44 +99,92 @@ double design_fingerprint(const opt::FillingDesign& design) {
   return fingerprint;
 }
 
-/// The checkpoint of design `name`'s verification decay.
-DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const case_file::VerifySpec& verify,
-                                           const std::string& name, const opt::FillingDesign& design, RunHooks& hooks) {
+/// The checkpoint of design `name`'s verification decay at verify softening `softening`
+/// (`suffix` "" for the judged run, "_stiffer" for the softening check's).
+DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const std::string& name,
+                                           const std::string& suffix, const opt::FillingDesign& design,
+                                           double softening, RunHooks& hooks) {
   DemDecayCheckpoint checkpoint;
   if (o.checkpoint_dir.empty()) return checkpoint;
-  checkpoint.file = {o.checkpoint_dir / ("verify_" + name + ".checkpoint"), o.resume};
-  checkpoint.kind = "verify_" + name;
+  checkpoint.file = {o.checkpoint_dir / ("verify_" + name + suffix + ".checkpoint"), o.resume};
+  checkpoint.kind = "verify_" + name + suffix;
   std::ostringstream design_text;
   for (double n : slabs_of(design)) design_text << ' ' << n;
-  design_text << "; softening " << verify.stiffness_softening;
+  design_text << "; softening " << softening;
   checkpoint.settings = "design" + design_text.str();
   // A design that completed before the interruption left no checkpoint: it runs again.
   if (checkpoint.file.resume && !std::filesystem::exists(checkpoint.file.path)) {
     checkpoint.file.resume = false;
-    hooks.note("pdamp: warning: no checkpoint of the " + name + " design's verification: it runs from the start");
+    hooks.note("pdamp: warning: no checkpoint of the " + name + suffix + " design's verification: it runs from the start");
   }
   return checkpoint;
 }
 
+/// A design's modal model and release state (from rest at q(0)).
+struct DesignModes {
+  st::ModalModel modal;
+  Eigen::VectorXd initial_modal_displacements;
+};
+
+/// The modes of `design`: under axial gravity its own beds' weights load the beam's geometric
+/// stiffness (the beam analysed anew with them, and the static release computed on it);
+/// otherwise the modes do not depend on the beds and are the problem's, exactly.
+DesignModes design_modes(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingDesign& design) {
+  if (!c.structure || c.structure->kind != case_file::StructureSpec::Kind::kBeam ||
+      !c.structure->beam.geometric_stiffness || c.structure->beam.axial_gravity_m_s2 == 0.0)
+    return {p.modal, p.initial_modal_displacements};
+  const Case dc = case_file::with_design(c, whole_slabs(design));
+  const case_file::StructureSetup setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
+  return {setup.modal, case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay)};
+}
+
 /// The DEM-in-the-loop decay of `design` over the verification's duration (the task's
-/// decay from its initial state, the verification's softening).
+/// decay from its initial state, on the design's modes) at verify softening `softening`.
 VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                                 const std::string& name, const opt::FillingDesign& design,
-                                 const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
-  std::vector<long> slabs;
-  for (const auto& l : design.layers) slabs.push_back(std::lround(l.slabs));
-  const Case dc = case_file::with_design(c, slabs, verify.stiffness_softening);
+                                 const std::string& label, const opt::FillingDesign& design, const DesignModes& modes,
+                                 double softening, const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+  const Case dc = case_file::with_design(c, whole_slabs(design), softening);
   std::vector<st::Damper> containers = {p.options.damper};
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
   case_file::DecayTask decay = c.task.filling_ratios->decay;
   decay.duration_s = verify.duration_s;
-  return verified_decay(dem_decay(dc, p.modal, containers, detail::dem_dampers(dc), p.initial_modal_displacements, decay,
-                                  "pdamp optimize --verify (" + name + ")", "/task/verify/duration_s", checkpoint, hooks));
+  return verified_decay(dem_decay(dc, modes.modal, containers, detail::dem_dampers(dc), modes.initial_modal_displacements,
+                                  decay, "pdamp optimize --verify (" + label + ")", "/task/verify/duration_s", checkpoint,
+                                  hooks));
 }
 
-/// The design against its DEM decay `dem`.
+/// How `objective` (with `end_envelope_m`) agrees with a reference: the objectives when both
+/// are finite (settled), the envelopes at the end when neither is, else not comparable.
+Agreement agreement(double objective, double end_envelope_m, double reference_objective,
+                    double reference_end_envelope_m, double tolerance) {
+  Agreement out;
+  if (std::isfinite(reference_objective) && std::isfinite(objective)) {
+    out.compared = "objective";
+    out.relative_difference = (objective - reference_objective) / reference_objective;
+  } else if (!std::isfinite(reference_objective) && !std::isfinite(objective)) {
+    out.compared = "end_envelope";  // neither settled: how far each got
+    out.relative_difference = (end_envelope_m - reference_end_envelope_m) / reference_end_envelope_m;
+  } else {
+    out.compared = "settled_only_one";
+  }
+  out.within = std::isfinite(out.relative_difference) && std::abs(out.relative_difference) <= tolerance;
+  return out;
+}
+
+/// The DEM objective of a verification decay: its settling time, or ½∫e² dt of its envelope.
+double dem_objective(const case_file::FillingRatioProblem& p, const VerifiedDecay& dem) {
+  return settling_objective(p) ? dem.settling.settling_time_s
+                               : st::half_integral_square(dem.time_s, dem.settling.sample_envelope_m);
+}
+
+double end_envelope(const VerifiedDecay& dem) {
+  return dem.settling.envelope_m.empty() ? NAN : dem.settling.envelope_m.back();
+}
+
+/// The design against its DEM decay `dem` (and, if run, the same decay ten times stiffer).
 DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                         const std::string& name, const opt::FillingDesign& design, VerifiedDecay dem) {
+                         const std::string& name, const opt::FillingDesign& design, const DesignModes& modes,
+                         VerifiedDecay dem, std::optional<SofteningCheck> stiffer) {
   DesignCheck out;
   out.name = name;
   out.design = design;
@@ -136,13 +192,12 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   const std::vector<double> slabs = slabs_of(design);
   opt::FillingRatioOptions options = p.options;
   options.decay.duration_s = verify.duration_s;
-  out.predicted = opt::evaluate_filling_design(p.modal, options, slabs);
+  options.decay.initial_modal_amplitudes = modes.initial_modal_displacements.cwiseAbs();  // released from rest
+  out.predicted = opt::evaluate_filling_design(modes.modal, options, slabs);
   out.predicted_objective = settling_objective(p) ? out.predicted.settling_time_s : out.predicted.integral_square_m2_s;
   out.dem = std::move(dem);
-  const auto& settle = out.dem.settling;
-  out.dem_end_envelope_m = settle.envelope_m.empty() ? NAN : settle.envelope_m.back();
-  out.dem_objective = settling_objective(p) ? settle.settling_time_s
-                                            : st::half_integral_square(out.dem.time_s, settle.sample_envelope_m);
+  out.dem_end_envelope_m = end_envelope(out.dem);
+  out.dem_objective = dem_objective(p, out.dem);
 
   // The prediction at the DEM's instants (its envelope for the plot and the end value).
   st::FreeDecayOptions at_samples = options.decay;
@@ -152,50 +207,75 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   at_samples.sample_times_s.back() = verify.duration_s;
   std::vector<st::Damper> dampers = {opt::filling_damper(options, slabs)};
   dampers.insert(dampers.end(), options.fixed_dampers.begin(), options.fixed_dampers.end());
-  const st::FreeDecay curve = st::free_decay(p.modal, dampers, at_samples);
+  const st::FreeDecay curve = st::free_decay(modes.modal, dampers, at_samples);
   for (const auto& s : curve.samples) out.predicted_envelope_m.push_back(s.threshold_measure_m);
   out.predicted_end_envelope_m = out.predicted_envelope_m.empty() ? NAN : out.predicted_envelope_m.back();
 
-  const double predicted = out.predicted_objective;
-  if (std::isfinite(predicted) && std::isfinite(out.dem_objective)) {
-    out.compared = "objective";
-    out.relative_difference = (out.dem_objective - predicted) / predicted;
-  } else if (!std::isfinite(predicted) && !std::isfinite(out.dem_objective)) {
-    out.compared = "end_envelope";  // neither settled: how far each got
-    out.relative_difference = (out.dem_end_envelope_m - out.predicted_end_envelope_m) / out.predicted_end_envelope_m;
-  } else {
-    out.compared = "settled_only_one";
+  out.agreement = agreement(out.dem_objective, out.dem_end_envelope_m, out.predicted_objective,
+                            out.predicted_end_envelope_m, verify.tolerance_relative);
+  out.passed = out.agreement.within;
+  if (stiffer) {
+    stiffer->dem_objective = dem_objective(p, stiffer->dem);
+    stiffer->dem_end_envelope_m = end_envelope(stiffer->dem);
+    stiffer->agreement = agreement(out.dem_objective, out.dem_end_envelope_m, stiffer->dem_objective,
+                                   stiffer->dem_end_envelope_m, verify.tolerance_relative);
+    out.passed = out.passed && stiffer->agreement.within;
+    out.softening_check = std::move(stiffer);
   }
-  out.passed = std::isfinite(out.relative_difference) && std::abs(out.relative_difference) <= verify.tolerance_relative;
   return out;
 }
 
-/// The DEM verification of the chosen and baseline designs: two independent DEM runs (one
-/// World each, single-threaded by default), jobs of `executor` on two threads or two
-/// processes. Every process optimised the same way (NLopt's seed is fixed); a job carries
-/// the design it verifies, so a process that chose another design refuses it.
+/// The DEM verification of the chosen and baseline designs: independent DEM runs (one World
+/// each, single-threaded by default), jobs of `executor` on two threads or over processes:
+/// each design at the verification's softening, then (softening check) each ten times
+/// stiffer. Every process optimised the same way (NLopt's seed is fixed); a job carries the
+/// design it verifies, so a process that chose another design refuses it.
 Verification verify_designs(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r,
                             const case_file::VerifySpec& verify, const FillingRatiosOptions& o, RunHooks& hooks,
                             Executor& executor, std::vector<std::filesystem::path>& checkpoints) {
   const auto start = std::chrono::steady_clock::now();
-  const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
-  DemDecayCheckpoint files[2];
-  for (std::size_t k = 0; k < 2; ++k) {
-    files[k] = verification_checkpoint(o, verify, designs[k].first, *designs[k].second, hooks);
-    if (!files[k].file.path.empty()) checkpoints.push_back(files[k].file.path);
-  }
   Verification v;
   v.spec = verify;
   v.dem_stiffness_softening = c.dem.stiffness_softening;
   v.settling_objective = settling_objective(p);
+  // Ten times stiffer, at most full stiffness (E·dem·verify <= E).
+  const double stiffer_softening = std::min(10.0 * verify.stiffness_softening, 1.0 / c.dem.stiffness_softening);
+  const bool full_stiffness = c.dem.stiffness_softening * verify.stiffness_softening >= 1.0;
+  v.softening_check = !verify.softening_check ? "off" : full_stiffness ? "full_stiffness" : "two_softenings";
+  const std::size_t softenings = v.softening_check == "two_softenings" ? 2 : 1;
+
+  // Job k: design k % 2 at softening k / 2 (the judged runs first).
+  const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
+  const std::size_t jobs = 2 * softenings;
+  std::vector<DemDecayCheckpoint> files(jobs);
+  const DesignModes modes[] = {design_modes(c, p, r.chosen), design_modes(c, p, r.baseline)};
+  const auto softening_of = [&](std::size_t k) { return k < 2 ? verify.stiffness_softening : stiffer_softening; };
+  const auto suffix_of = [](std::size_t k) { return std::string(k < 2 ? "" : "_stiffer"); };
+  for (std::size_t k = 0; k < jobs; ++k) {
+    files[k] = verification_checkpoint(o, designs[k % 2].first, suffix_of(k), *designs[k % 2].second, softening_of(k), hooks);
+    if (!files[k].file.path.empty()) checkpoints.push_back(files[k].file.path);
+  }
   const auto decays = run_jobs<VerifiedDecay>(
-      executor, 2, true,
+      executor, jobs, true,
       [&](std::size_t k) {
-        return verification_decay(c, p, verify, designs[k].first, *designs[k].second, files[k], hooks);
+        const std::string label = designs[k % 2].first + (k < 2 ? "" : ", softening " + format_number(softening_of(k), 3));
+        return verification_decay(c, p, verify, label, *designs[k % 2].second, modes[k % 2], softening_of(k), files[k],
+                                  hooks);
       },
-      &v.mpi, [&](std::size_t k) { return design_fingerprint(*designs[k].second); });
-  for (std::size_t k = 0; k < 2; ++k)
-    v.designs.push_back(check_design(p, verify, designs[k].first, *designs[k].second, decays[k]));
+      &v.mpi, [&](std::size_t k) { return design_fingerprint(*designs[k % 2].second); },
+      static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
+  v.softening_converged = true;
+  for (std::size_t k = 0; k < 2; ++k) {
+    std::optional<SofteningCheck> stiffer;
+    if (softenings == 2) {
+      stiffer.emplace();
+      stiffer->stiffness_softening = stiffer_softening;
+      stiffer->dem = decays[k + 2];
+    }
+    v.designs.push_back(
+        check_design(p, verify, designs[k].first, *designs[k].second, modes[k], decays[k], std::move(stiffer)));
+    if (v.designs.back().softening_check) v.softening_converged &= v.designs.back().softening_check->agreement.within;
+  }
   const DesignCheck& a = v.designs[0];
   const DesignCheck& b = v.designs[1];
   v.predicted_chosen_ahead = ahead(a.predicted_objective, a.predicted_end_envelope_m, b.predicted_objective,
@@ -251,9 +331,23 @@ json verification_json(const Verification& v) {
                  {"steps", d.dem.steps},
                  {"time_step_s", d.dem.time_step_s},
                  {"solve_time_s", d.dem.wall_time_s}}},
-        {"compared", d.compared},
-        {"relative_difference", number_or_null(d.relative_difference)},
+        {"compared", d.agreement.compared},
+        {"relative_difference", number_or_null(d.agreement.relative_difference)},
         {"passed", d.passed}};
+    if (const auto& s = d.softening_check)
+      designs[d.name]["softening_check"] = {
+          {"stiffness_softening", s->stiffness_softening},
+          {"dem", {{"settled", std::isfinite(s->dem.settling.settling_time_s)},
+                   {"settling_time_s", number_or_null(s->dem.settling.settling_time_s)},
+                   {"objective", number_or_null(s->dem_objective)},
+                   {"end_envelope_m", number_or_null(s->dem_end_envelope_m)},
+                   {"energy_error", s->dem.energy_error},
+                   {"steps", s->dem.steps},
+                   {"time_step_s", s->dem.time_step_s},
+                   {"solve_time_s", s->dem.wall_time_s}}},
+          {"compared", s->agreement.compared},
+          {"relative_difference", number_or_null(s->agreement.relative_difference)},
+          {"converged", s->agreement.within}};
   }
   const auto& verify = v.spec;
   json out = {{"method", "dem"},
@@ -266,6 +360,10 @@ json verification_json(const Verification& v) {
               {"dem_stiffness_softening", v.dem_stiffness_softening},
               {"effective_stiffness_softening", v.dem_stiffness_softening * verify.stiffness_softening},
               {"require_ranking", verify.require_ranking},
+              {"softening_check", {{"kind", v.softening_check},
+                                   {"rule", "each design again with contacts ten times stiffer (at most full stiffness); "
+                                            "converged when the two DEM objectives agree within tolerance_relative"},
+                                   {"converged", v.softening_converged}}},
               {"designs", designs},
               {"ranking", {{"predicted_chosen_ahead", v.predicted_chosen_ahead},
                            {"dem_chosen_ahead", v.dem_chosen_ahead},
@@ -329,8 +427,16 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   if (o.skip_verify) verify.reset();
   if (verify) {
     out.verification = verify_designs(c, p, r, *verify, o, hooks, executor, out.checkpoints);
-    for (const auto& d : out.verification->designs)
+    for (const auto& d : out.verification->designs) {
       for (const auto& w : d.dem.warnings) out.warnings.push_back("verify (" + d.name + "): " + w);
+      if (d.softening_check && !d.softening_check->agreement.within)
+        out.warnings.push_back("verify (" + d.name + "): the softening has not converged: ten times stiffer contacts " +
+                               "change the DEM objective by " +
+                               (d.softening_check->agreement.compared == "settled_only_one"
+                                    ? std::string("settling in one run only")
+                                    : format_number(100.0 * d.softening_check->agreement.relative_difference, 3) + " %") +
+                               ": raise /task/verify/stiffness_softening towards 1");
+    }
     if (!out.verification->passed)
       out.warnings.push_back("the DEM verification failed (tolerance " + format_number(verify->tolerance_relative, 3) +
                              (out.verification->ranking_passed ? "" : "; the DEM does not rank the chosen design ahead of the baseline") +

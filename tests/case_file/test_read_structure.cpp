@@ -167,19 +167,22 @@ TEST_CASE("a filling_ratios task reads its verify block, with defaults for the k
   CHECK(v.duration_s == 40.0);
   CHECK(v.stiffness_softening == 1.0);
   CHECK(v.require_ranking);
+  CHECK(v.softening_check);
+  CHECK(defaults.resolved["task"]["verify"]["softening_check"] == true);
   CHECK(defaults.resolved["task"]["verify"]["tolerance_relative"] == 0.3);
   CHECK(defaults.resolved["task"]["verify"]["duration_s"] == 40.0);
   CHECK(defaults.resolved["task"]["verify"]["require_ranking"] == true);
 
   const Case given = load_case(edited_optimize_case(dir, [](json& t) {
     t["verify"] = {{"tolerance_relative", 0.5}, {"duration_s", 12.5}, {"stiffness_softening", 0.01},
-                   {"require_ranking", false}};
+                   {"require_ranking", false}, {"softening_check", false}};
   }));
   const auto& g = *given.task.filling_ratios->verify;
   CHECK(g.tolerance_relative == 0.5);
   CHECK(g.duration_s == 12.5);
   CHECK(g.stiffness_softening == 0.01);
   CHECK_FALSE(g.require_ranking);
+  CHECK_FALSE(g.softening_check);
 
   // Absent: no verification asked.
   const Case none = load_case(edited_optimize_case(dir, [](json& t) { t.erase("verify"); }));
@@ -198,6 +201,7 @@ TEST_CASE("a bad verify block is refused naming its key and the allowed range", 
   refused({{"stiffness_softening", 0.0}}, "/task/verify/stiffness_softening", ">= 1e-06 and <= 1");
   refused({{"stiffness_softening", 2.0}}, "/task/verify/stiffness_softening", "<= 1");
   refused({{"require_ranking", "yes"}}, "/task/verify/require_ranking", "must be true or false");
+  refused({{"softening_check", 1}}, "/task/verify/softening_check", "must be true or false");
   refused({{"tolerance", 0.3}}, "/task/verify/tolerance", "tolerance_relative");  // unknown key: the allowed ones named
   refused(json::array(), "/task/verify", "must be a JSON object");
 }

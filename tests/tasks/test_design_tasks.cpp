@@ -3,9 +3,11 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <fstream>
 
 #include "cli/cli_support.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/placement.hpp"
 
@@ -66,4 +68,99 @@ TEST_CASE("placement: the chosen site damps at least as much as every scanned si
   REQUIRE(r.current.has_value());
   CHECK(r.best.objective >= r.current->objective);
   CHECK(tasks::to_json(s)["design"]["objective"] == r.best.objective);
+}
+
+namespace {
+
+/// The shipped optimisation cut short (fewer evaluations, a 1 s verification of contacts
+/// softened 1e-4) with its softening check on or off.
+case_file::Case short_verification(bool softening_check, double axial_gravity_m_s2 = 0.0) {
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  nlohmann::json c = nlohmann::json::parse(in);
+  c["task"]["global_evaluations"] = 30;
+  c["task"]["max_evaluations"] = 120;
+  c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}, {"softening_check", softening_check}};
+  if (axial_gravity_m_s2 != 0.0) {
+    c["structure"]["axial_gravity_m_s2"] = axial_gravity_m_s2;
+    c["structure"]["geometric_stiffness"] = true;
+  }
+  return case_file::load_case_document(c, "short_verification.json");
+}
+
+}  // namespace
+
+// Reference: the check's definition: each design's DEM decay runs again with contacts ten
+// times stiffer, and the judged run is compared with it as the prediction is with the DEM
+// (objectives, or the envelopes at the end when neither settled); a design passes only
+// when both comparisons agree within the tolerance. Without the check the judged runs are
+// the same runs (same seed and settings): equal to the bit.
+TEST_CASE("the DEM verification checks its softening against contacts ten times stiffer", "[tasks]") {
+  tasks::FillingRatiosOptions options;
+  const auto checked = tasks::run_filling_ratios(short_verification(true), options, tasks::silent_hooks(),
+                                                 tasks::local_executor());
+  REQUIRE(checked.verification);
+  const auto& v = *checked.verification;
+  CHECK(v.softening_check == "two_softenings");
+  bool converged = true;
+  for (const auto& d : v.designs) {
+    INFO(d.name);
+    REQUIRE(d.softening_check);
+    const auto& s = *d.softening_check;
+    CHECK(s.stiffness_softening == Approx(1e-3).epsilon(1e-12));
+    // A stiffer contact takes a smaller step (t_c ∝ E^(−2/5)): 10^(2/5) = 2.5 times.
+    CHECK(s.dem.time_step_s / d.dem.time_step_s == Approx(std::pow(10.0, -0.4)).epsilon(1e-6));
+    CHECK(s.dem.steps > 2 * d.dem.steps);
+    // 1 s does not settle: the envelopes at the end are compared.
+    REQUIRE(s.agreement.compared == "end_envelope");
+    CHECK(s.agreement.relative_difference ==
+          Approx((d.dem_end_envelope_m - s.dem_end_envelope_m) / s.dem_end_envelope_m).epsilon(1e-12));
+    CHECK(s.agreement.within == (std::abs(s.agreement.relative_difference) <= v.spec.tolerance_relative));
+    CHECK(d.passed == (d.agreement.within && s.agreement.within));
+    converged = converged && s.agreement.within;
+  }
+  CHECK(v.softening_converged == converged);
+  const auto j = tasks::to_json(checked);
+  CHECK(j["verification"]["softening_check"]["kind"] == "two_softenings");
+  CHECK(j["verification"]["designs"]["chosen"]["softening_check"]["stiffness_softening"] == Approx(1e-3));
+
+  const auto unchecked = tasks::run_filling_ratios(short_verification(false), options, tasks::silent_hooks(),
+                                                   tasks::local_executor());
+  REQUIRE(unchecked.verification);
+  CHECK(unchecked.verification->softening_check == "off");
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& d = unchecked.verification->designs[k];
+    CHECK_FALSE(d.softening_check);
+    CHECK(d.dem.site_displacement_m == v.designs[k].dem.site_displacement_m);
+    CHECK(d.passed == d.agreement.within);
+  }
+}
+
+// Reference: the beam analysed anew with the design's own bed weights (case_file::with_design,
+// then structure_setup and the static release on it): a link standing under axial gravity,
+// whose geometric stiffness the beds' weights load. The verification scores each design on
+// those modes; the search's modes (the case's starting design's) differ where the mass does.
+TEST_CASE("under axial gravity the verification scores each design on its own modes", "[tasks]") {
+  const case_file::Case c = short_verification(false, -9.80665);
+  tasks::FillingRatiosOptions options;
+  const auto r = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(r.verification);
+  bool warned = false;
+  for (const auto& w : r.warnings) warned = warned || w.find("its own") != std::string::npos;
+  CHECK(warned);
+  for (const auto& d : r.verification->designs) {
+    INFO(d.name);
+    std::vector<long> slabs;
+    for (const auto& l : d.design.layers) slabs.push_back(std::lround(l.slabs));
+    const case_file::Case dc = case_file::with_design(c, slabs);
+    const auto setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
+    // Another bed mass than the starting design's, other modes (the baseline may weigh the same).
+    const bool other_mass = std::abs(d.design.total_mass_kg - r.optimum.initial.total_mass_kg) > 1e-9;
+    CHECK((setup.modal.natural_frequencies_hz(0) != r.problem.modal.natural_frequencies_hz(0)) == other_mass);
+    auto own = r.problem.options;
+    own.decay.duration_s = r.verification->spec.duration_s;
+    own.decay.initial_modal_amplitudes =
+        case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay).cwiseAbs();
+    const auto expected = optimizer::evaluate_filling_design(setup.modal, own, tasks::slabs_of(d.design));
+    CHECK(d.predicted.objective == expected.objective);
+  }
 }

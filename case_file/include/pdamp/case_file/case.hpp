@@ -172,6 +172,11 @@ struct VerifySpec {
   /// true: the verification fails unless the DEM ranks the designs as the prediction does
   /// (the chosen design ahead of the baseline).
   bool require_ranking = true;
+  /// true: each design's DEM decay runs again with contacts ten times stiffer (the
+  /// verification's softening times 10, at most full stiffness), and the verification fails
+  /// unless the two objectives agree within tolerance_relative: the softening has converged
+  /// on the quantity judged. Skipped when the runs are at full stiffness already.
+  bool softening_check = true;
 };
 
 /// `task` kind filling_ratios: the whole slabs each layer of the first

@@ -51,6 +51,15 @@ struct DamperSimulationOptions {
   /// Settling under gravity with the container at rest before the drive starts, s, in
   /// [0, 100]; −1 = automatic (lattice: 0.01 s; random: 2√(2L/|g|) + 0.02 s; no gravity: 0).
   double settling_time_s = -1.0;
+  /// How the drive reaches the stroke X (docs/dem.md "Approach"): 0 (default) from rest,
+  /// the bed settled and then driven at X; a stroke X_a > X: from above, as in a decay,
+  /// the drive runs approach_hold_periods at X_a, then lowers its stroke linearly to X over
+  /// approach_ramp_periods (x_c = A(t) sin Ωt, A linear, the velocity A'sin Ωt + AΩ cos Ωt),
+  /// then the transient and analysed periods at X. Below the collect-and-collide onset the
+  /// state a bed keeps depends on this history. In [0, 10] m; 0 or > amplitude_m.
+  double approach_amplitude_m = 0.0;
+  int approach_hold_periods = 5;   ///< periods at X_a, in [0, 100000] (approach only)
+  int approach_ramp_periods = 10;  ///< periods of the linear ramp X_a -> X, in [1, 100000] (approach only)
   int transient_periods = 5;       ///< periods discarded before the analysis, in [0, 100000]
   int analysed_periods = 10;       ///< whole periods analysed, in [1, 100000]
   /// Samples per period of the recorded signals (block averages of whole steps; the
@@ -144,9 +153,10 @@ struct RunEstimate {
   std::vector<std::string> warnings;   ///< as run_harmonic will add them (a user step above the automatic bound)
   std::int64_t steps_per_period = 0;
   std::int64_t settling_steps = 0;
+  std::int64_t approach_steps = 0;     ///< hold and ramp at and from approach_amplitude_m (0 from rest)
   std::int64_t transient_steps = 0;
   std::int64_t analysed_steps = 0;
-  std::int64_t total_steps = 0;        ///< settling + transient + analysed (= Summary::steps of a completed run)
+  std::int64_t total_steps = 0;        ///< settling + approach + transient + analysed (= Summary::steps of a completed run)
   double particle_steps = 0.0;         ///< total_steps × particles (double: may exceed 2^63 for hostile input)
   /// analysed_periods × samples_per_period: the length of every TimeSeries column.
   std::int64_t recorded_samples = 0;

@@ -64,6 +64,9 @@ struct DemRunResult {
   double amplitude_m = 0.0;
   double frequency_hz = 0.0;
   dem_reference::DamperResult dem;
+  /// The drive's approach (/dem/approach): 0 from rest, else the stroke it came down from.
+  double approach_amplitude_m = 0.0;
+  int approach_hold_periods = 0, approach_ramp_periods = 0;
   formulas::LossResult closed_form;  ///< the case's model at the same point and the DEM's clearance
   std::vector<std::string> warnings;
 };

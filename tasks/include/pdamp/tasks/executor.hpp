@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -114,19 +115,22 @@ class Jobs {
   std::unique_ptr<JobChannel> channel_;
 };
 
-/// Runs body(k) for k < count, on a thread each when `parallel`, else one after the other.
-/// An exception in a thread is carried to this one and rethrown after all end (the first
-/// in order).
-void for_each_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& body);
+/// Runs body(k) for k < count, when `parallel` on up to `max_threads` threads (a thread per
+/// job by default), each taking the next k in order; else one after the other. An exception
+/// in a thread is carried to this one and rethrown after all end (the first in order).
+void for_each_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& body,
+                           std::size_t max_threads = std::numeric_limits<std::size_t>::max());
 
 /// Every job of a task, its results in order: jobs 0..count-1 through `executor`, at once
-/// (a thread each) when `parallel`. `balance`, if given, receives Jobs::balance().
+/// (a thread each, at most `max_threads`) when `parallel`. `balance`, if given, receives
+/// Jobs::balance().
 template <class T>
 std::vector<T> run_jobs(Executor& executor, std::size_t count, bool parallel, std::function<T(std::size_t)> job,
-                        nlohmann::json* balance = nullptr, typename Jobs<T>::Fingerprint fingerprint = {}) {
+                        nlohmann::json* balance = nullptr, typename Jobs<T>::Fingerprint fingerprint = {},
+                        std::size_t max_threads = std::numeric_limits<std::size_t>::max()) {
   Jobs<T> jobs(executor, std::move(job), std::move(fingerprint));
   std::vector<T> results(count);
-  for_each_concurrently(count, parallel, [&](std::size_t k) { results[k] = jobs(k); });
+  for_each_concurrently(count, parallel, [&](std::size_t k) { results[k] = jobs(k); }, max_threads);
   if (balance) *balance = jobs.balance();
   return results;
 }

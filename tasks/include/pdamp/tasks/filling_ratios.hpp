@@ -46,6 +46,24 @@ struct VerifiedDecay {
   std::vector<std::string> warnings;
 };
 
+/// How one objective agrees with a reference: the objectives (settling time or ½∫e² dt),
+/// or, when neither settled, the envelopes at the end.
+struct Agreement {
+  std::string compared;              ///< "objective", "end_envelope" or "settled_only_one"
+  double relative_difference = NAN;  ///< (value − reference)/reference
+  bool within = false;               ///< |relative_difference| <= the tolerance
+};
+
+/// The same DEM decay with contacts ten times stiffer (VerifySpec::softening_check): the
+/// softening has converged on the objective when the two agree within the tolerance.
+struct SofteningCheck {
+  double stiffness_softening = NAN;  ///< the stiffer run's verify softening (10x, at most full)
+  VerifiedDecay dem;
+  double dem_objective = NAN;
+  double dem_end_envelope_m = NAN;
+  Agreement agreement;               ///< the judged run against the stiffer one
+};
+
 /// One design checked by the DEM: the prediction over the verification's duration and the
 /// DEM's decay over the same time.
 struct DesignCheck {
@@ -58,9 +76,9 @@ struct DesignCheck {
   VerifiedDecay dem;
   double dem_objective = NAN;     ///< settling time (NaN: not settled) or ½∫e² dt
   double dem_end_envelope_m = NAN;
-  std::string compared;           ///< "objective", "end_envelope" or "settled_only_one"
-  double relative_difference = NAN;
-  bool passed = false;
+  Agreement agreement;            ///< the DEM against the prediction
+  bool passed = false;            ///< agreement.within, and the softening check's if run
+  std::optional<SofteningCheck> softening_check;
   int particles = 0;
 };
 
@@ -72,6 +90,10 @@ struct Verification {
   bool predicted_chosen_ahead = false;
   bool dem_chosen_ahead = false;
   bool ranking_passed = false;
+  /// "two_softenings" (each design also ran ten times stiffer), "full_stiffness" (nothing to
+  /// check) or "off" (VerifySpec::softening_check false).
+  std::string softening_check = "off";
+  bool softening_converged = false;  ///< every design's check agreed (true at full stiffness)
   bool passed = false;
   double wall_time_s = 0.0;
   nlohmann::json mpi;  ///< how the two decays spread over processes, or null
