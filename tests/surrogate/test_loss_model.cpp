@@ -277,7 +277,7 @@ TEST_CASE("the bed models' responses: rebounding orbit, impact map and Coulomb b
     double frequency_hz;
     fm::ModelOptions options;
   };
-  for (const Case c : {Case{fm::DamperModel::kRolling, 2.0, rebounding}, Case{fm::DamperModel::kAuto, 60.0, rebounding},
+  for (const Case& c : {Case{fm::DamperModel::kRolling, 2.0, rebounding}, Case{fm::DamperModel::kAuto, 60.0, rebounding},
                        Case{fm::DamperModel::kRolling, 2.0, map}, Case{fm::DamperModel::kAuto, 10.0, nested}}) {
     const ClosedFormLossModel loss(c.model, h, c.options);
     const auto jumps = loss.discontinuities_stroke_m(c.frequency_hz);
