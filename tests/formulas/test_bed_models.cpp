@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -505,22 +506,30 @@ TEST_CASE("auto takes the Coulomb block for a nested bed with gravity across the
 
 // ---- Below the onset: the impact map -------------------------------------------------------
 
-// The map's table against the event-driven block above (e_b = 0, κ = 0), run separately: in
-// the periodic window around ξ = 0.15 both settle on the same orbit (1e-6); in the chaotic
-// strokes the two simulations part after a few impacts, so their 1000-cycle averages agree
-// only statistically: within 0.08 absolute, about three times the cycle-to-cycle scatter of
-// such an average seen between neighbouring strokes of the raw table.
+// The map's table against the event-driven block above (e_b = 0, κ = 0), run separately.
+// Below the onset the block's motion is irregular (long quasi-periodic or chaotic orbits):
+// a 1000-cycle average depends on where it starts. The separate simulation's averages after
+// 100-399 warm-up cycles spread by 1-6e-4 (measured at ξ/ξ_on = 0.2-0.8 and at ξ = 0.15; with
+// the map's own 100 warm-up cycles the two agree to 1e-9 at three of these four strokes);
+// the map's point must lie in that spread widened by 1e-3 (about three times it).
 TEST_CASE("the plastic block's impact map matches a separate event-driven simulation below the onset",
           "[formulas]") {
   const double onset = 1.0 / std::sqrt(kPi * kPi + 4.0);
   for (const double xi : {0.15, 0.3 * onset, 0.6 * onset, 0.9 * onset}) {
     CAPTURE(xi);
     const auto point = fm::simulate_impact_map(xi);
-    ReboundingBlock block(1.0, 0.0, 1.0 / xi);
-    const BlockMeasure m = block.run(fm::kImpactMapWarmCycles, fm::kImpactMapCycles);
+    double lo = 1e9, hi = -1e9;
+    for (const int warm : {100, 177, 257, 399}) {
+      ReboundingBlock block(1.0, 0.0, 1.0 / xi);
+      const double e = block.run(warm, fm::kImpactMapCycles).eta_star;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    CAPTURE(point.eta_star, lo, hi);
     CHECK(point.eta_star >= 0.0);
     CHECK(point.eta_star < 4.0 / kPi);
-    CHECK(m.eta_star == Approx(point.eta_star).margin(0.08));
+    CHECK(point.eta_star >= lo - 1e-3);
+    CHECK(point.eta_star <= hi + 1e-3);
   }
   const auto& table = fm::impact_map_table();
   REQUIRE(table.stroke_over_clearance.size() == static_cast<std::size_t>(fm::kImpactMapPoints));
@@ -538,3 +547,4 @@ TEST_CASE("the plastic block's impact map matches a separate event-driven simula
   CHECK(fm::below_onset_model_from_string("impact_map") == fm::BelowOnsetModel::kImpactMap);
   CHECK_FALSE(fm::below_onset_model_from_string("map").has_value());
 }
+
