@@ -446,10 +446,12 @@ TEST_CASE("fit_bed_restitution recovers e_b from a consistent jump and peak and 
 
 // ---- Nested bed ----------------------------------------------------------------------------
 
-// The Coulomb block against the stepped simulation (steps of 2e-5 rad: η* and the slide to
-// 1e-3 relative, the impact inside a step costing O(step) of travel; m_app to 2e-3): stuck
-// at r = μ/Γ >= 1, stick-slip (r = 0.7, 0.9), sliding without sticking (r = 0.3, 0.45: Den
-// Hartog) with walls far away, and wall to wall (r = 0.5, 0.8 with H = 0.3, 0.05).
+// The Coulomb block against the stepped simulation (steps of 2e-5 rad, the impact inside a
+// step costing O(step) of travel): stuck at r = μ/Γ >= 1, stick-slip (r = 0.7, 0.9), sliding
+// without sticking (r = 0.3, 0.45: Den Hartog) with walls far away, and wall to wall
+// (r = 0.5, 0.8 with H = 0.3, 0.05). Measured: η* and the slide agree to 3e-5 relative (1e-8
+// in stick-slip), m_app to 1.8e-4 (Den Hartog at r = 0.3; 2e-6 elsewhere): tolerances 1e-4
+// and 5e-4.
 TEST_CASE("the Coulomb block's stuck, stick-slip, sliding and wall-to-wall eta* and m_app match a stepped simulation",
           "[formulas]") {
   const auto stuck = fm::coulomb_block(0.3, 0.25, 1.0);
@@ -469,9 +471,9 @@ TEST_CASE("the Coulomb block's stuck, stick-slip, sliding and wall-to-wall eta* 
     REQUIRE_FALSE(block.outside_domain);
     CHECK(block.wall_to_wall == k.wall_to_wall);
     const CoulombMeasure m = simulate_coulomb(k.r, k.h, 3, 4);
-    CHECK(m.eta_star == Approx(block.eta_star).epsilon(1e-3));
-    CHECK(m.slide_per_half_cycle == Approx(block.slide_over_stroke).epsilon(1e-3));
-    CHECK(m.apparent_mass_fraction == Approx(block.apparent_mass_fraction).margin(2e-3));
+    CHECK(m.eta_star == Approx(block.eta_star).epsilon(1e-4));
+    CHECK(m.slide_per_half_cycle == Approx(block.slide_over_stroke).epsilon(1e-4));
+    CHECK(m.apparent_mass_fraction == Approx(block.apparent_mass_fraction).margin(5e-4));
   }
   // Wall to wall: 2μ m g h per cycle in friction plus the two impacts.
   const auto w = fm::coulomb_block(0.5, 1.0, 0.3);
