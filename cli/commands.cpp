@@ -52,6 +52,13 @@ fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
     if (model == fm::DamperModel::kBouncing) options.bouncing_calibration = *c;
     else options.rolling_calibration = *c;
   }
+  if (const auto e_b = args.optional_number("--bed-restitution", Range{0.0, fm::kMaxBedRestitution}))
+    options.bed_restitution = *e_b;
+  if (const auto law = args.optional_text("--below-onset")) {
+    const auto below = fm::below_onset_model_from_string(*law);
+    if (!below) throw InputError("--below-onset", "", "'" + *law + "' is not allowed (one of: scattered_fit impact_map)");
+    options.below_onset = *below;
+  }
   if (const auto file = args.optional_text("--scattered-fit")) {
     try {
       options.scattered = surrogate::read_scattered_fit(*file).fit;
@@ -96,7 +103,7 @@ int run_size(const ParsedArgs& args, CommandContext&) {
 
 int run_loss(const ParsedArgs& args, CommandContext& context) {
   tasks::LossOptions options;
-  options.model = model_flag(args, {"rolling", "bouncing", "scattered", "auto"});
+  options.model = model_flag(args, {"rolling", "bouncing", "scattered", "auto", "coulomb_block"});
   options.clearance_m = args.number("--clearance", limits::kClearance);
   options.amplitude_m = args.number("--amplitude", limits::kStroke);
   options.frequency_hz = args.number("--frequency", limits::kFrequency);
@@ -513,7 +520,8 @@ int run_validate(const ParsedArgs& args, CommandContext&) {
 const FlagSpec kModelOverrides[] = {
     {"--calibration", "C", "design factor c in x_opt = c*x_opt_ideal (default 0.8976 rolling, 1.0 bouncing)"},
     {"--inertia-factor", "K", "rolling spheres' I/(m r^2) (default 0.4, solid spheres)"},
-    {"--friction", "MU", "sphere-base friction: auto rolls up to Gamma = MU(1+K)/K (default 0.3)"}};
+    {"--friction", "MU", "sphere-base friction: auto rolls up to Gamma = MU(1+K)/K (default 0.3)"},
+    {"--bed-restitution", "E", "collective restitution e_b of the bed at a wall, [0, 0.9] (default 0: plastic)"}};
 
 }  // namespace
 
@@ -530,24 +538,26 @@ const std::vector<Command>& commands() {
         "optimal container stroke for a clearance: design value, ideal peak and onset",
         {{"--model", "MODEL", "rolling (low intensity, A < g) or bouncing (high intensity)"},
          {"--clearance", "M", "free travel h of the collected bed, m (> 0)"}, kModelOverrides[0], kModelOverrides[1], kModelOverrides[2],
-         kJsonFlag}},
+         kModelOverrides[3], kJsonFlag}},
        run_optimum},
       {{"size", "pdamp size --model rolling|bouncing --stroke M [--json]",
         "clearance h whose design stroke equals the target stroke (inverse of optimum)",
         {{"--model", "MODEL", "rolling or bouncing"}, {"--stroke", "M", "target container stroke X, m (> 0)"},
-         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kJsonFlag}},
+         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kModelOverrides[3], kJsonFlag}},
        run_size},
       {{"loss", "pdamp loss --model M --clearance M --amplitude M --frequency HZ [--bed-mass KG] [-o DIR] [--json]",
         "closed-form reduced loss factor eta* at one operating point (with -o: eta* over stroke)",
-        {{"--model", "MODEL", "rolling | bouncing | scattered | auto (auto: Gamma < 1 rolling, else bouncing;\n"
-                              "                          below the onset the scattered fit)"},
+        {{"--model", "MODEL", "rolling | bouncing | scattered | auto | coulomb_block (auto: Gamma < 1 rolling,\n"
+                              "                          else bouncing; below the onset the scattered fit;\n"
+                              "                          coulomb_block: a nested bed on its base, friction --friction)"},
          {"--clearance", "M", "free travel h of the collected bed, m (> 0)"},
          {"--amplitude", "M", "container stroke X, m (> 0)"},
          {"--frequency", "HZ", "drive frequency f, Hz (> 0)"},
          {"--bed-mass", "KG", "bed mass for e_diss_j and energy_per_cycle_j, kg (default 1)"},
          {"--scattered-fit", "FILE", "fitted scattered-state coefficients (scattered_fit.json of\n"
                                      "                          pdamp field --source dem); default: provisional"},
-         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kOutFlag, kJsonFlag}},
+         {"--below-onset", "LAW", "scattered_fit (default) or impact_map (the plastic block's map)"},
+         kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kModelOverrides[3], kOutFlag, kJsonFlag}},
        run_loss},
       {{"buffer",
         "pdamp buffer --frequency HZ (--amplitude M | --intensity G) --radius M --layer-modulus PA [options] [--json]",

@@ -1,6 +1,8 @@
 // load_case(): the top level of a case file (formats 1 and 2) and the section order.
 #include "pdamp/case_file/case.hpp"
 
+#include <cmath>
+
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "readers.hpp"
@@ -213,11 +215,37 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
   return options;
 }
 
+formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer) {
+  formulas::ModelOptions options = damper.model_options;
+  options.nested_bed = layer.bed.settled_upper_spheres > 0;
+  return options;
+}
+
 std::vector<std::string> settled_bed_warnings(const Case& c) {
   std::vector<std::string> out;
   for (const DamperSpec& d : c.dampers) {
     for (const LayerSpec& layer : d.layers) {
       const auto& bed = layer.bed;
+      // A lone sphere per lane, or a few spheres: no collected bed that moves as a block. The
+      // collected-bed closed forms do not depend on restitution; such spheres rebound from the
+      // walls (the one-sphere bound of bed_restitution, docs/physics.md §3.1).
+      if (bed.slabs == 1 || layer.particle_count <= kFewParticles) {
+        std::ostringstream text;
+        text.precision(3);
+        text << d.name << "/" << layer.name << ": "
+             << (layer.particle_count <= kFewParticles ? std::to_string(layer.particle_count) + " particles"
+                                                       : std::string("one particle per lane along the drive"))
+             << ": the closed forms model a collected bed moving as one block, whose orbits do not depend on "
+                "restitution; single spheres rebound from the walls";
+        if (std::isfinite(d.model_options.particle_restitution))
+          text << " (with eps = " << d.model_options.particle_restitution
+               << " up to bed_restitution = (eps - kappa)/(1 + kappa) = "
+               << formulas::bed_restitution_bound(d.model_options.particle_restitution,
+                                                  d.model_options.rolling_inertia_factor)
+               << " for rolling)";
+        text << ": set model_options.bed_restitution (docs/physics.md §3.1) or use the layer's DEM field";
+        out.push_back(text.str());
+      }
       if (bed.settled_clearance_m == bed.clearance_m) continue;
       std::ostringstream text;
       text.precision(4);
@@ -226,8 +254,11 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
            << " mm, not the lattice's " << bed.clearance_m * 1e3 << " mm";
       if (bed.settled_upper_spheres > 0)
         text << "; " << bed.settled_upper_spheres
-             << " spheres stay above the bottom rows, which the closed forms (one rolling layer) do not model: "
-                "use the layer's DEM field (docs/collect_and_collide.md §8)";
+             << " spheres stay above the bottom rows, resting on two or more others: a nested bed, which does not "
+                "roll; model auto takes it as a Coulomb block held by its base up to Gamma = mu = "
+             << d.model_options.base_friction
+             << " (docs/physics.md §3.3); the DEM holds a nested bed so only at low friction (mu <= 0.2) and moves "
+                "differently from the block above it: use the layer's DEM field (docs/collect_and_collide.md §8)";
       out.push_back(text.str());
     }
   }

@@ -23,7 +23,7 @@ void check_model_options(const ObjectReader& r, const fm::ModelOptions& options)
   for (const auto& line : options.validate()) {
     const auto cut = line.find(" = ");
     std::string field = line.substr(0, cut);
-    if (field == "base_friction") continue;
+    if (field == "base_friction" || field == "particle_restitution") continue;  // the DEM contact's, checked there
     for (auto& ch : field)
       if (ch == '.') ch = '/';
     r.fail("model_options/" + field, line.substr(cut + 1));
@@ -46,6 +46,12 @@ void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
     options.scattered.source =
         s.text("source", options.scattered.provisional ? defaults.scattered.source : std::string("case file"));
   });
+  // The rebounding bed and the law below the onset (docs/physics.md §3.1, §4.2): read only
+  // when given, so that a case without them keeps its resolved form and physics hash.
+  if (const auto e_b = r.optional_number("bed_restitution", Range{})) options.bed_restitution = *e_b;
+  if (r.has("below_onset"))
+    options.below_onset =
+        *fm::below_onset_model_from_string(r.text("below_onset", std::nullopt, {"scattered_fit", "impact_map"}));
   if (!r.has("scattered")) {
     auto& s = r.resolved()["scattered"];
     s["jump_fraction"] = defaults.scattered.jump_fraction;

@@ -47,6 +47,19 @@ double base_friction(const dr::WorldOptions& world, const LayerSpec& layer) {
   return mu;
 }
 
+/// ε of the spheres on the walls of a layer when it is a constant (a table or a law: NaN),
+/// for the one-sphere bound of the closed forms' bed_restitution (docs/physics.md §3.1).
+double particle_restitution(const dr::WorldOptions& world, const LayerSpec& layer) {
+  const int particles = layer.compartment.particles.front().material;
+  const int wall = layer.compartment.wall_material;
+  const dr::RestitutionOptions* restitution = &world.default_pair.restitution;
+  for (const auto& pair : world.pairs)
+    if ((pair.material_a == particles && pair.material_b == wall) || (pair.material_b == particles && pair.material_a == wall))
+      restitution = &pair.restitution;
+  if (restitution->model || !restitution->table_values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return restitution->constant;
+}
+
 }  // namespace
 
 int material_index(const ObjectReader& r, const std::string& key, const std::string& name, const Case& c) {
@@ -134,6 +147,7 @@ void read_dem(ObjectReader& r, Case& c) {
   for (std::size_t i = 0; i < c.dampers.size(); ++i) {
     auto& damper = c.dampers[i];
     damper.model_options.base_friction = base_friction(world, damper.layers.front());
+    damper.model_options.particle_restitution = particle_restitution(world, damper.layers.front());
     auto& resolved_damper = c.format_version == 1 ? c.resolved["damper"] : c.resolved["dampers"][i];
     resolved_damper["derived"]["base_friction"] = damper.model_options.base_friction;
   }

@@ -168,6 +168,7 @@ std::string_view to_string(DamperModel model) {
     case DamperModel::kBouncing: return "bouncing";
     case DamperModel::kScattered: return "scattered";
     case DamperModel::kAuto: return "auto";
+    case DamperModel::kCoulombBlock: return "coulomb_block";
   }
   return "unknown";
 }
@@ -177,6 +178,7 @@ std::optional<DamperModel> damper_model_from_string(std::string_view name) {
   if (name == "bouncing") return DamperModel::kBouncing;
   if (name == "scattered") return DamperModel::kScattered;
   if (name == "auto") return DamperModel::kAuto;
+  if (name == "coulomb_block") return DamperModel::kCoulombBlock;
   return std::nullopt;
 }
 
@@ -185,8 +187,24 @@ std::string_view to_string(MotionRegime regime) {
     case MotionRegime::kCollectAndCollide: return "collect_and_collide";
     case MotionRegime::kSubPeak: return "sub_peak";
     case MotionRegime::kScattered: return "scattered";
+    case MotionRegime::kStuck: return "stuck";
+    case MotionRegime::kSliding: return "sliding";
   }
   return "unknown";
+}
+
+std::string_view to_string(BelowOnsetModel model) {
+  switch (model) {
+    case BelowOnsetModel::kScatteredFit: return "scattered_fit";
+    case BelowOnsetModel::kImpactMap: return "impact_map";
+  }
+  return "unknown";
+}
+
+std::optional<BelowOnsetModel> below_onset_model_from_string(std::string_view name) {
+  if (name == "scattered_fit") return BelowOnsetModel::kScatteredFit;
+  if (name == "impact_map") return BelowOnsetModel::kImpactMap;
+  return std::nullopt;
 }
 
 std::vector<std::string> ScatteredFit::validate() const {
@@ -214,6 +232,11 @@ std::vector<std::string> ModelOptions::validate() const {
                     bouncing_calibration > 0.0 && bouncing_calibration <= 2.0, "in (0, 2]");
   append_range_rule(problems, "base_friction", base_friction, base_friction >= 0.0 && base_friction <= 10.0,
                     "in [0, 10]");
+  append_range_rule(problems, "bed_restitution", bed_restitution,
+                    bed_restitution >= 0.0 && bed_restitution <= kMaxBedRestitution, "in [0, 0.9]");
+  append_range_rule(problems, "particle_restitution", particle_restitution,
+                    std::isnan(particle_restitution) || (particle_restitution > 0.0 && particle_restitution <= 1.0),
+                    "in (0, 1] (or NaN: unknown)");
   for (const std::string& line : scattered.validate()) problems.push_back("scattered." + line);
   return problems;
 }
@@ -299,6 +322,20 @@ OptimumStroke optimum_stroke(DamperModel model, double clearance_m, const ModelO
   result.x_onset_m = onset_stroke(effective_clearance_m);
   result.eta_star_peak = 4.0 / (kPi * (1.0 + inertia_factor));
   result.eta_star_onset = onset_eta_star(inertia_factor);
+  const double e_b = options.bed_restitution;
+  if (e_b > 0.0) {
+    // The rebounding bed (docs/physics.md §3.1): onset and peak move together toward small
+    // strokes and closer to each other (X_on/X_pk = πK/√(π²K²+4)). The calibration keeps
+    // its meaning, where between the plastic onset and peak the design stroke sits:
+    // t = (c − π/R)/(1 − π/R), so x_opt = X_on + t(X_pk − X_on) (c·X_pk for e_b = 0).
+    result.x_opt_ideal_m = peak_stroke_m(inertia_factor, clearance_m, e_b);
+    result.x_onset_m = onset_stroke_m(inertia_factor, clearance_m, e_b);
+    const double plastic_onset_over_peak = kPi / kOnsetRadius;
+    const double t = (result.calibration_factor - plastic_onset_over_peak) / (1.0 - plastic_onset_over_peak);
+    result.x_opt_m = result.x_onset_m + t * (result.x_opt_ideal_m - result.x_onset_m);
+    result.eta_star_peak = peak_reduced_loss_factor(inertia_factor, e_b);
+    result.eta_star_onset = onset_reduced_loss_factor(inertia_factor, e_b);
+  }
   return result;
 }
 
@@ -306,6 +343,8 @@ double clearance_for_stroke(DamperModel model, double stroke_m, const ModelOptio
   require_family(model, "clearance_for_stroke");
   require_positive("stroke_m", stroke_m);
   require_valid(options);
+  // x_opt is proportional to h: with e_b the landmarks of h = 1 m give the factor.
+  if (options.bed_restitution > 0.0) return stroke_m / optimum_stroke(model, 1.0, options).x_opt_m;
   // x_opt = c(1+κ)h/π, solved for h.
   return kPi * (stroke_m / calibration_of(model, options)) /
          (1.0 + inertia_factor_of(model, options));
@@ -330,6 +369,100 @@ double onset_reduced_loss_factor(double inertia_factor) { return onset_eta_star(
 
 namespace {
 
+/// The warnings every model shares: gravity along the drive and X/h > 10.
+template <class Warn>
+void common_warnings(const LossResult& result, double clearance_m, double stroke_m, const ModelOptions& options,
+                     const Warn& warn) {
+  if (options.gravity_along_drive) {
+    warn([&] { return std::string(
+        "gravity along the drive is not in the ideal models (docs/physics.md section 2): it moves "
+        "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
+        " is an optimistic estimate"); });
+  }
+  if (stroke_m > kMaxStrokeOverClearance * clearance_m) {
+    warn([&] {
+      const std::string impact =
+          std::isfinite(result.impact_phase_rad)
+              ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
+              : std::string();
+      return std::string("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
+                         " > " + format(kMaxStrokeOverClearance) +
+                         ": the bed barely separates from the wall" + impact +
+                         ", where the one-block model is outside its range");
+    });
+  }
+}
+
+/// Largest X/h at which the rebounding bed's tail η*_pk X_pk/X has been compared with the DEM
+/// (docs/physics.md §3.1: the one-high layer of tests/dem_reference/test_bed_models.cpp at
+/// X/h = 0.55, 0.7 and 1.0, 10-13 % below the tail).
+constexpr double kMaxTailStrokeOverClearance = 1.0;
+
+/// The rebounding bed (e_b > 0) at or above its onset (docs/physics.md §3.1): the orbit
+/// below the peak, the DEM's tail η*_pk X_pk/X = 4h/(π²X) above it.
+template <class Warn>
+void rebounding_loss(LossResult& result, double inertia_factor, double clearance_m, double stroke_m, double e_b,
+                     const Warn& warn) {
+  const double peak_m = peak_stroke_m(inertia_factor, clearance_m, e_b);
+  if (stroke_m < peak_m) {
+    const ReboundingOrbit orbit = rebounding_orbit(inertia_factor, e_b, clearance_m, stroke_m);
+    result.regime = MotionRegime::kSubPeak;
+    result.eta_star = orbit.eta_star;
+    result.impact_phase_rad = kPi + std::max(orbit.psi_rad, 0.0);
+    return;
+  }
+  // Above the peak the rebounding block's own orbit (ψ < 0) dissipates 15-40% more than the
+  // DEM of the rebounding layers, which follow η*_pk·X_pk/X (an observation, not derived).
+  result.regime = MotionRegime::kCollectAndCollide;
+  result.eta_star = peak_reduced_loss_factor(inertia_factor, e_b) * peak_m / stroke_m;
+  result.impact_phase_rad = kNaN;
+  if (stroke_m > kMaxTailStrokeOverClearance * clearance_m) {
+    warn([&] { return std::string(
+        "rebounding bed (bed_restitution = " + format(e_b) + ") at X/h = " + format(stroke_m / clearance_m) +
+        ": above its peak eta* = eta*_pk X_pk/X = " + format(result.eta_star) + " is what the DEM of rebounding "
+        "layers shows up to X/h = " + format(kMaxTailStrokeOverClearance) + " (docs/physics.md section 3.1); "
+        "beyond it is extrapolated"); });
+  }
+}
+
+/// Largest base friction at which the DEM held a nested bed up to Γ = μ (docs/physics.md §3.3,
+/// tests/dem_reference/test_bed_models.cpp: μ = 0.1 and 0.2 held; 0.35 and 0.5 moved below μ).
+constexpr double kMaxHeldNestedFriction = 0.2;
+
+/// The nested bed: the Coulomb block on its base (docs/physics.md §3.3).
+template <class Warn>
+void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const ModelOptions& options,
+                  const Warn& warn) {
+  const double mu = options.base_friction;
+  result.model_used = DamperModel::kCoulombBlock;
+  result.inertia_factor = 0.0;  // the spheres do not rotate
+  result.impact_phase_rad = kNaN;
+  // The onset of motion: Γ = μ, X_st = μg/Ω², so s = Γ/μ.
+  result.stroke_over_onset = mu > 0.0 ? result.intensity / mu : std::numeric_limits<double>::infinity();
+  const CoulombBlock block = coulomb_block(mu, result.intensity, clearance_m / stroke_m);
+  result.regime = block.regime;
+  result.eta_star = block.eta_star;
+  if (block.regime == MotionRegime::kSliding) {
+    warn([&] { return std::string(
+        "nested bed at Gamma = " + format(result.intensity) + " > mu = " + format(mu) + ": the Coulomb block slides "
+        "(eta* = " + format(result.eta_star) + "), an estimate: the DEM of a nested bed (docs/physics.md section 3.3) "
+        "gives 0.24-0.26 at Gamma = 3 mu where the block gives 0.15-0.31, and is still held at Gamma = 1.5 mu for "
+        "mu = 0.1 where the block gives 0.23: check with pdamp dem"); });
+  } else if (mu > kMaxHeldNestedFriction) {
+    warn([&] { return std::string(
+        "nested bed held by its base (eta* = 0) up to Gamma = mu = " + format(mu) + ": the DEM holds a nested bed "
+        "so only at low friction (mu <= " + format(kMaxHeldNestedFriction) + "); at mu = 0.35 and 0.5 it moved from "
+        "Gamma = 0.28 and 0.1 with eta* = 0.3-0.75 (docs/physics.md section 3.3), so eta* = 0 at Gamma = " +
+        format(result.intensity) + " may be far too low: check with pdamp dem"); });
+  }
+  if (block.outside_domain) {
+    warn([&] { return std::string(
+        "Coulomb block at Gamma = " + format(result.intensity) + ", X/h = " + format(stroke_m / clearance_m) +
+        ": its slide (" + format(block.slide_over_stroke * stroke_m) + " m per half cycle) neither stays inside the "
+        "clearance nor runs from wall to wall before the drive reverses; eta* is that of the slide without walls"); });
+  }
+}
+
 /// reduced_loss_factor's body. kSentences: write the warning sentences (else only count
 /// them: no allocation, no formatting). Options are checked by the callers.
 template <bool kSentences>
@@ -351,6 +484,12 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
   const double slip = slip_intensity(options);
   const bool rolls = options.gravity_across_drive && result.intensity <= slip;
   const bool explicit_family = model == DamperModel::kRolling || model == DamperModel::kBouncing;
+  if (model == DamperModel::kCoulombBlock ||
+      (model == DamperModel::kAuto && options.nested_bed && options.gravity_across_drive)) {
+    coulomb_loss(result, clearance_m, stroke_m, options, warn);
+    common_warnings(result, clearance_m, stroke_m, options, warn);
+    return result;
+  }
   const double inertia_factor = explicit_family ? inertia_factor_of(model, options)
                                                 : auto_inertia_factor(result.intensity, options);
   result.inertia_factor = inertia_factor;
@@ -359,21 +498,40 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
                       : 2.0 * inertia_factor >= options.rolling_inertia_factor ? DamperModel::kRolling
                                                                                 : DamperModel::kBouncing;
   const bool rolling = result.model_used == DamperModel::kRolling;
-  const double onset_m = onset_stroke((1.0 + inertia_factor) * clearance_m);
+  const double e_b = options.bed_restitution;
+  const double onset_m = e_b > 0.0 ? onset_stroke_m(inertia_factor, clearance_m, e_b)
+                                   : onset_stroke((1.0 + inertia_factor) * clearance_m);
   const double s = stroke_m / onset_m;
   result.stroke_over_onset = s;
   const char* family_name = rolling ? "rolling" : "bouncing";
+  const bool impact_map = options.below_onset == BelowOnsetModel::kImpactMap && model != DamperModel::kScattered;
 
-  if (model != DamperModel::kScattered && stroke_m >= onset_m) {
+  if (model != DamperModel::kScattered && stroke_m >= onset_m && e_b > 0.0) {
+    rebounding_loss(result, inertia_factor, clearance_m, stroke_m, e_b, warn);
+  } else if (model != DamperModel::kScattered && stroke_m >= onset_m) {
     const IdealOrbit orbit = orbit_of(inertia_factor, clearance_m, stroke_m);
     result.regime = orbit.regime;
     result.eta_star = orbit.eta_star;
     result.impact_phase_rad = orbit.impact_phase_rad;
+  } else if (impact_map) {
+    // The plastic block's map in ξ = cX/h, c = 1/(1+κ) (docs/physics.md §4.2): η* = c·η*_map(ξ).
+    const double c = 1.0 / (1.0 + inertia_factor);
+    result.regime = MotionRegime::kScattered;
+    result.impact_phase_rad = kNaN;
+    result.eta_star = c * impact_map_reduced_loss_factor(c * stroke_m / clearance_m);
+    if (explicit_family) {
+      warn([&] { return std::string(
+          std::string(family_name) + " model at stroke X = " + format(stroke_m) +
+          " m below its onset X_onset = " + format(onset_m) + " m (s = " + format(s) +
+          "): the collect-and-collide orbit does not exist there, so eta* comes from the plastic block's "
+          "impact map"); });
+    }
   } else {
     const ScatteredFit& fit = options.scattered;
     result.regime = MotionRegime::kScattered;
     result.impact_phase_rad = kNaN;
-    result.eta_star = fit.jump_fraction * onset_eta_star(inertia_factor) * std::pow(s, fit.exponent);
+    const double eta_onset = e_b > 0.0 ? onset_reduced_loss_factor(inertia_factor, e_b) : onset_eta_star(inertia_factor);
+    result.eta_star = fit.jump_fraction * eta_onset * std::pow(s, fit.exponent);
     if (explicit_family) {
       warn([&] { return std::string(
           std::string(family_name) + " model at stroke X = " + format(stroke_m) +
@@ -441,24 +599,23 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
         "state; the shipped cylinder case with gravity gives eta* ~ 0.02 from 0.45 h to 0.8 h), so eta* = " +
         format(result.eta_star) + " holds only if the bed is thrown off its base: check with pdamp dem"); });
   }
-  if (options.gravity_along_drive) {
+  if (explicit_family && options.nested_bed && options.gravity_across_drive) {
     warn([&] { return std::string(
-        "gravity along the drive is not in the ideal models (docs/physics.md section 2): it moves "
-        "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
-        " is an optimistic estimate"); });
+        std::string(to_string(model)) + " model for a nested bed (spheres resting on two or more others cannot "
+        "rotate, docs/physics.md section 3.3): the bed does not roll but is held by its base up to Gamma = mu = " +
+        format(options.base_friction) + " (Gamma = " + format(result.intensity) +
+        " here) and then slides; the auto model takes that Coulomb block"); });
   }
-  if (stroke_m > kMaxStrokeOverClearance * clearance_m) {
-    warn([&] {
-      const std::string impact =
-          std::isfinite(result.impact_phase_rad)
-              ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
-              : std::string();
-      return std::string("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
-                         " > " + format(kMaxStrokeOverClearance) +
-                         ": the bed barely separates from the wall" + impact +
-                         ", where the one-block model is outside its range");
-    });
+  if (options.bed_restitution > 0.0 && std::isfinite(options.particle_restitution) &&
+      options.bed_restitution > bed_restitution_bound(options.particle_restitution, inertia_factor)) {
+    warn([&] { return std::string(
+        "bed_restitution e_b = " + format(options.bed_restitution) + " exceeds what one sphere can give, (eps - kappa)/"
+        "(1+kappa) = " + format(bed_restitution_bound(options.particle_restitution, inertia_factor)) + " for eps = " +
+        format(options.particle_restitution) + " and kappa = " + format(inertia_factor) +
+        " (docs/physics.md section 3.1): a bed rebounds less than its front sphere, so the onset and peak are placed "
+        "too low"); });
   }
+  common_warnings(result, clearance_m, stroke_m, options, warn);
   return result;
 }
 

@@ -146,7 +146,7 @@ std::vector<std::string> write_field_pictures(OutputDir& out, const surrogate::E
       surrogate::Grid one{{g.axis0.quantity, g.axis0.spacing, {g.axis0.values[i0]}}, {g.axis1.quantity, g.axis1.spacing, {v1}}};
       const auto drive = surrogate::drive_point(one, 0, field.clearance_m);
       const auto loss = fm::reduced_loss_factor(damper.model, field.clearance_m, drive.amplitude_m, drive.frequency_hz,
-                                                damper.model_options);
+                                                case_file::layer_model_options(damper, damper.layers.front()));
       formula << g.axis0.values[i0] << ',' << v1 << ',' << loss.eta_star << '\n';
     }
     formula << "\n\n";

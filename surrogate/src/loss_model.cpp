@@ -55,6 +55,16 @@ BlockSlopes block_slopes(formulas::MotionRegime regime, double impact_phase_rad)
           -4.0 * std::cos(2.0 * psi) / kPi * d_psi_d_r};
 }
 
+/// The rebounding block's η*, m_app/m and their derivatives with respect to r = h_eff/X on
+/// its orbit (ψ from the departure phase), K = (1+e_b)/(1−e_b) (docs/physics.md §3.1):
+/// r = πK cos ψ + 2 sin ψ ⇒ dψ/dr = 1/(2 cos ψ − πK sin ψ); η_b = (4/π)K cos²ψ,
+/// m_b = −(2/π)K sin 2ψ.
+BlockSlopes rebounding_slopes(double psi, double k) {
+  const double d_psi_d_r = 1.0 / (2.0 * std::cos(psi) - kPi * k * std::sin(psi));
+  return {-2.0 * k * std::sin(2.0 * psi) / kPi, -4.0 * k * std::sin(2.0 * psi) / kPi * d_psi_d_r,
+          -4.0 * k * std::cos(2.0 * psi) / kPi * d_psi_d_r};
+}
+
 }  // namespace
 
 std::vector<double> LossModel::discontinuities_stroke_m(double /*frequency_hz*/) const { return {}; }
@@ -98,7 +108,26 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
   const double kappa = loss.inertia_factor;
   const double scale = 1.0 + kappa;
   const double d_kappa = d_inertia_factor_d_stroke(model_, options_, loss.intensity, stroke_m);
+  if (loss.regime == formulas::MotionRegime::kStuck || loss.regime == formulas::MotionRegime::kSliding)
+    return coulomb_response(loss, frequency_hz, stroke_m);
   const bool scattered = loss.regime == formulas::MotionRegime::kScattered;
+  const bool explicit_family =
+      model_ == formulas::DamperModel::kRolling || model_ == formulas::DamperModel::kBouncing;
+  if (scattered && options_.below_onset == formulas::BelowOnsetModel::kImpactMap &&
+      model_ != formulas::DamperModel::kScattered) {
+    // η* = c·E(ξ), ξ = cX/h, c = 1/(1+κ) (docs/physics.md §4.2); dc/dX = −c² dκ/dX.
+    const double c = 1.0 / scale;
+    const double dc = -c * c * d_kappa;
+    const double xi = c * stroke_m / clearance_m_;
+    const double map = formulas::impact_map_reduced_loss_factor(xi);
+    const double slope = formulas::impact_map_reduced_loss_factor_slope(xi);
+    response.d_eta_star_d_stroke_1_m = dc * map + c * slope * (c + stroke_m * dc) / clearance_m_;
+    response.apparent_mass_fraction = kappa / scale;
+    response.d_apparent_mass_fraction_d_stroke_1_m = d_kappa / (scale * scale);
+    response.warnings |= kLossScatteredState | kLossApparentMassAssumed;
+    if (loss.warning_count > (explicit_family ? 1u : 0u)) response.warnings |= kLossOutsideClosedForm;
+    return response;
+  }
   if (scattered) {
     // η* = j·η*_onset(κ)·(X/X_onset(κ))^p with η*_onset, X_onset ∝ 1/(1+κ), (1+κ):
     // d ln η* = p dX/X − (1+p) dκ/(1+κ). Apparent mass: the no-impact limit κ/(1+κ).
@@ -109,14 +138,13 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
     response.warnings |= kLossScatteredState | kLossApparentMassAssumed;
     // The scattered state's own warnings (provisional or extrapolated fit) are expected
     // there; only the others mean the closed form is outside its validity.
-    const bool explicit_family =
-        model_ == formulas::DamperModel::kRolling || model_ == formulas::DamperModel::kBouncing;
     std::size_t expected = (explicit_family ? 1u : 0u) + (options_.scattered.provisional ? 1u : 0u);
     const double s = loss.stroke_over_onset;
     if (s < options_.scattered.s_min || s > options_.scattered.s_max || s >= 1.0) ++expected;
     if (loss.warning_count > expected) response.warnings |= kLossOutsideClosedForm;
     return response;
   }
+  if (options_.bed_restitution > 0.0) return rebounding_response(loss, stroke_m, d_kappa);
   // On an orbit: η* = η_b(r)/(1+κ), m_app/m = (κ + m_b(r))/(1+κ), r = (1+κ)h/X, so
   // dr/dX = −r/X + (h/X)·dκ/dX and ∂/∂κ at fixed r of the two are −η*/(1+κ) and
   // (1 − m_b)/(1+κ)².
@@ -131,11 +159,77 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
   return response;
 }
 
+DamperResponse ClosedFormLossModel::rebounding_response(const formulas::LossResult& loss, double stroke_m,
+                                                       double d_kappa) const {
+  // η* = η_b/(1+κ) and m_app/m = (κ + m_b)/(1+κ) on the rebounding orbit below the peak; above
+  // it η* = 4h/(π²X) (the DEM's tail, docs/physics.md §3.1: independent of κ and e_b) with the
+  // apparent mass of the orbit continued (ψ < 0), held at its last value ψ = −acos(1/K) where
+  // that orbit ends, and flagged as assumed.
+  DamperResponse response;
+  response.eta_star = loss.eta_star;
+  response.regime = formulas::to_string(loss.regime);
+  const double kappa = loss.inertia_factor;
+  const double scale = 1.0 + kappa;
+  const double k = formulas::rebound_factor(options_.bed_restitution);
+  const double r = scale * clearance_m_ / stroke_m;
+  const double dr = -r / stroke_m + clearance_m_ / stroke_m * d_kappa;
+  const bool tail = loss.regime == formulas::MotionRegime::kCollectAndCollide;
+  double psi = loss.impact_phase_rad - kPi;
+  bool on_orbit = true;
+  if (tail) {
+    const auto orbit = formulas::rebounding_orbit(kappa, options_.bed_restitution, clearance_m_, stroke_m);
+    on_orbit = orbit.exists;
+    psi = orbit.exists ? orbit.psi_rad : -std::acos(1.0 / k);
+  }
+  const BlockSlopes block = rebounding_slopes(psi, k);
+  response.apparent_mass_fraction = (kappa + block.apparent_mass_fraction) / scale;
+  response.d_apparent_mass_fraction_d_stroke_1_m =
+      (on_orbit ? block.d_apparent_d_r * dr / scale : 0.0) +
+      (1.0 - block.apparent_mass_fraction) * d_kappa / (scale * scale);
+  response.d_eta_star_d_stroke_1_m =
+      tail ? -loss.eta_star / stroke_m : block.d_eta_d_r * dr / scale - loss.eta_star * d_kappa / scale;
+  if (tail) response.warnings |= kLossApparentMassAssumed;
+  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
+  return response;
+}
+
+DamperResponse ClosedFormLossModel::coulomb_response(const formulas::LossResult& loss, double frequency_hz,
+                                                     double stroke_m) const {
+  // The nested bed as a Coulomb block (docs/physics.md §3.3): η* and m_app from
+  // formulas::coulomb_block; the stroke derivatives by central differences (the block's
+  // η* and m_app are smooth in X inside each of its regimes; 1e-6 X keeps the truncation
+  // error near 1e-12 and the rounding error near 1e-10 relative).
+  DamperResponse response;
+  response.eta_star = loss.eta_star;
+  response.regime = formulas::to_string(loss.regime);
+  const double omega = 2.0 * kPi * frequency_hz;
+  const double mu = options_.base_friction;
+  const auto block_at = [&](double x) {
+    return formulas::coulomb_block(mu, x * omega * omega / formulas::kStandardGravity, clearance_m_ / x);
+  };
+  const auto here = block_at(stroke_m);
+  response.apparent_mass_fraction = here.apparent_mass_fraction;
+  if (loss.regime == formulas::MotionRegime::kSliding) {
+    const double step = 1e-6 * stroke_m;
+    const auto up = block_at(stroke_m + step);
+    const auto down = block_at(stroke_m - step);
+    response.d_eta_star_d_stroke_1_m = (up.eta_star - down.eta_star) / (2.0 * step);
+    response.d_apparent_mass_fraction_d_stroke_1_m =
+        (up.apparent_mass_fraction - down.apparent_mass_fraction) / (2.0 * step);
+  }
+  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
+  return response;
+}
+
 std::vector<double> ClosedFormLossModel::discontinuities_stroke_m(double frequency_hz) const {
-  if (model_ == formulas::DamperModel::kScattered) return {};
+  if (model_ == formulas::DamperModel::kScattered || model_ == formulas::DamperModel::kCoulombBlock) return {};
   const auto& options = options_;
+  // A nested bed under auto is the Coulomb block: continuous in X (η* → 0, m_app → m_bed at Γ = μ).
+  if (model_ == formulas::DamperModel::kAuto && options.nested_bed && options.gravity_across_drive) return {};
+  const double e_b = options.bed_restitution;
   if (model_ != formulas::DamperModel::kAuto) {
     const double kappa = model_ == formulas::DamperModel::kRolling ? options.rolling_inertia_factor : 0.0;
+    if (e_b > 0.0) return {formulas::onset_stroke_m(kappa, clearance_m_, e_b)};
     return {formulas::onset_stroke_m(kappa, clearance_m_)};
   }
   // auto: κ_eff(Γ(X)) does not increase with X, so X − X_onset(κ_eff(Γ(X))) increases
@@ -143,11 +237,14 @@ std::vector<double> ClosedFormLossModel::discontinuities_stroke_m(double frequen
   const double omega = 2.0 * kPi * frequency_hz;
   const auto excess = [&](double x) {
     const double kappa = formulas::auto_inertia_factor(x * omega * omega / formulas::kStandardGravity, options);
-    return x - formulas::onset_stroke_m(kappa, clearance_m_);
+    return x - (e_b > 0.0 ? formulas::onset_stroke_m(kappa, clearance_m_, e_b)
+                          : formulas::onset_stroke_m(kappa, clearance_m_));
   };
-  double lo = formulas::onset_stroke_m(0.0, clearance_m_);
-  double hi = formulas::onset_stroke_m(options.gravity_across_drive ? options.rolling_inertia_factor : 0.0,
-                                       clearance_m_);
+  const auto onset = [&](double kappa) {
+    return e_b > 0.0 ? formulas::onset_stroke_m(kappa, clearance_m_, e_b) : formulas::onset_stroke_m(kappa, clearance_m_);
+  };
+  double lo = onset(0.0);
+  double hi = onset(options.gravity_across_drive ? options.rolling_inertia_factor : 0.0);
   if (excess(lo) >= 0.0) return {lo};
   for (int iteration = 0; iteration < 200 && hi - lo > 1e-15 * hi; ++iteration) {
     const double mid = 0.5 * (lo + hi);
@@ -163,7 +260,12 @@ StrokeRange ClosedFormLossModel::stroke_range_m(double /*frequency_hz*/) const {
 std::vector<std::string> ClosedFormLossModel::warning_messages(double frequency_hz, double stroke_m) const {
   auto sentences = formulas::reduced_loss_factor(model_, clearance_m_, stroke_m, frequency_hz, options_).warnings;
   const DamperResponse response = evaluate(frequency_hz, stroke_m);
-  if (response.warnings & kLossApparentMassAssumed)
+  if ((response.warnings & kLossApparentMassAssumed) && response.regime == "collect_and_collide")
+    sentences.push_back("apparent mass above the rebounding bed's peak taken from the rebounding block's orbit, " +
+                        std::to_string(response.apparent_mass_fraction) +
+                        " of the bed mass (the DEM of rebounding layers gives 1.0-1.25 there, docs/physics.md "
+                        "section 3.1)");
+  else if (response.warnings & kLossApparentMassAssumed)
     sentences.push_back("apparent mass below the onset assumed to be the no-impact limit kappa/(1+kappa) = " +
                         std::to_string(response.apparent_mass_fraction) + " of the bed mass (no closed form there)");
   return sentences;

@@ -82,7 +82,11 @@ LossStudy run_loss(const LossOptions& o) {
     out.warnings.push_back("no --bed-mass given: e_diss_j, energy_per_cycle_j and equivalent_damping_n_s_m are for a 1 kg "
                            "bed (they scale with the bed mass; eta* does not)");
   if (o.with_curve) {
-    out.landmarks = fm::optimum_stroke(loss.model_used, o.clearance_m, o.model_options);
+    // A nested bed's Coulomb block has no onset or peak: its curve alone.
+    if (loss.model_used != fm::DamperModel::kCoulombBlock)
+      out.landmarks = fm::optimum_stroke(loss.model_used, o.clearance_m, o.model_options);
+    else
+      out.landmarks.clearance_m = o.clearance_m;
     const double x_max = std::max(1.5 * o.clearance_m, 1.2 * o.amplitude_m);
     out.curve = eta_curve(o.model, o.clearance_m, o.frequency_hz, o.model_options, 0.02 * o.clearance_m, x_max, 301);
   }

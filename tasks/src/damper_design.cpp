@@ -15,7 +15,7 @@ namespace {
 /// design stroke (Γ <= Γ_slip, formulas::slip_intensity), else bouncing.
 fm::DamperModel design_family(const detail::SingleDamper& single, const case_file::Case& c) {
   if (single.damper.model != fm::DamperModel::kAuto) return single.damper.model;
-  const auto& options = single.damper.model_options;
+  const auto options = case_file::layer_model_options(single.damper, single.layer);
   if (!options.gravity_across_drive) return fm::DamperModel::kBouncing;
   const auto rolling = fm::optimum_stroke(fm::DamperModel::kRolling, single.layer.clearance_m, options);
   const double omega = 2.0 * fm::kPi * c.excitation.frequency_hz;
@@ -31,24 +31,25 @@ DamperDesignResult run_damper_design(const case_file::Case& c) {
   try {
     const auto& d = single.damper;
     const auto& layer = single.layer;
+    const auto model_options = case_file::layer_model_options(d, layer);
     out.case_name = c.name;
     out.family = design_family(single, c);
     out.clearance_m = layer.clearance_m;
     out.bed_mass_kg = layer.bed_mass_kg;
     out.frequency_hz = c.excitation.frequency_hz;
     const double f = c.excitation.frequency_hz;
-    out.optimum = fm::optimum_stroke(out.family, layer.clearance_m, d.model_options);
+    out.optimum = fm::optimum_stroke(out.family, layer.clearance_m, model_options);
     out.warnings = case_file::settled_bed_warnings(c);
-    const auto design_point = fm::reduced_loss_factor(out.family, layer.clearance_m, out.optimum.x_opt_m, f, d.model_options);
+    const auto design_point = fm::reduced_loss_factor(out.family, layer.clearance_m, out.optimum.x_opt_m, f, model_options);
     out.eta_star_at_design = design_point.eta_star;
     out.intensity_at_design = design_point.intensity;
     out.warnings.insert(out.warnings.end(), design_point.warnings.begin(), design_point.warnings.end());
     if (c.design.target_stroke_m) {
-      const double h = fm::clearance_for_stroke(out.family, *c.design.target_stroke_m, d.model_options);
+      const double h = fm::clearance_for_stroke(out.family, *c.design.target_stroke_m, model_options);
       out.sizing = DamperDesignResult::Sizing{*c.design.target_stroke_m, h, layer.bed.bed_extent_m + h};
     }
     if (c.excitation.amplitude_m) {
-      const auto op = fm::reduced_loss_factor(d.model, layer.clearance_m, *c.excitation.amplitude_m, f, d.model_options);
+      const auto op = fm::reduced_loss_factor(d.model, layer.clearance_m, *c.excitation.amplitude_m, f, model_options);
       out.operating_point = loss_point(op, layer.bed_mass_kg, f);
       out.operating_amplitude_m = *c.excitation.amplitude_m;
       out.warnings.insert(out.warnings.end(), op.warnings.begin(), op.warnings.end());
@@ -59,7 +60,7 @@ DamperDesignResult run_damper_design(const case_file::Case& c) {
       out.warnings.insert(out.warnings.end(), out.buffer->warnings.begin(), out.buffer->warnings.end());
     }
     out.curve = eta_curve(d.model == fm::DamperModel::kAuto ? fm::DamperModel::kAuto : out.family, layer.clearance_m, f,
-                          d.model_options, c.design.sweep_min_over_clearance * layer.clearance_m,
+                          model_options, c.design.sweep_min_over_clearance * layer.clearance_m,
                           c.design.sweep_max_over_clearance * layer.clearance_m, c.design.sweep_points);
   } catch (const std::invalid_argument& e) {
     throw strict_json::InputError(c.path, "", std::string("the closed forms refuse this case: ") + e.what());

@@ -174,7 +174,8 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
 
   // The closed form at the same point, for comparison (same model family as the case).
   const auto& damper = c.dampers.front();
-  out.closed_form = fm::reduced_loss_factor(damper.model, out.dem.clearance_m, x, f, damper.model_options);
+  out.closed_form = fm::reduced_loss_factor(damper.model, out.dem.clearance_m, x, f,
+                                            case_file::layer_model_options(damper, damper.layers.front()));
   out.warnings = out.dem.warnings;
   return out;
 }

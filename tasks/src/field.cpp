@@ -104,7 +104,8 @@ void fit_scattered(const case_file::Case& c, FieldResult& r) {
   if (r.field.provenance.source == surrogate::FieldSource::kFormulas) return;
   const auto& damper = c.dampers.front();
   try {
-    const auto samples = surrogate::scattered_samples(r.field, damper.model, damper.model_options);
+    const auto samples = surrogate::scattered_samples(r.field, damper.model,
+                                                      case_file::layer_model_options(damper, damper.layers.front()));
     r.scattered_fit = surrogate::fit_scattered_law(
         samples, "pdamp field --source " + std::string(surrogate::to_string(r.field.provenance.source)) + ", case " + c.name);
   } catch (const std::exception& e) {
@@ -124,7 +125,7 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, RunHooks&
     evaluator = surrogate::dem_evaluator(options);
   } else {
     evaluator = surrogate::formula_evaluator(single.damper.model, single.layer.clearance_m, single.layer.bed_mass_kg,
-                                             single.damper.model_options);
+                                             case_file::layer_model_options(single.damper, single.layer));
   }
   const auto& grid = plan.grid;
   surrogate::SweepOptions sweep = plan.sweep;

@@ -25,7 +25,7 @@ SensitivityStudy sensitivity_study(const case_file::Case& c) {
   if (!(x > 0.0)) {
     const auto family = single.damper.model == fm::DamperModel::kBouncing ? fm::DamperModel::kBouncing
                                                                            : fm::DamperModel::kRolling;
-    x = fm::optimum_stroke(family, single.layer.clearance_m, single.damper.model_options).x_opt_m;
+    x = fm::optimum_stroke(family, single.layer.clearance_m, case_file::layer_model_options(single.damper, single.layer)).x_opt_m;
   }
   study.amplitude_m = x;
   study.variants = case_file::sensitivity_variants(c, study.warnings);
@@ -47,7 +47,7 @@ surrogate::PointEvaluator variant_evaluator(const case_file::SensitivityVariant&
     return surrogate::dem_evaluator(options);
   }
   const detail::SingleDamper d = detail::single_damper(v.variant, "pdamp sensitivity");
-  return surrogate::formula_evaluator(d.damper.model, d.layer.clearance_m, d.layer.bed_mass_kg, d.damper.model_options);
+  return surrogate::formula_evaluator(d.damper.model, d.layer.clearance_m, d.layer.bed_mass_kg, case_file::layer_model_options(d.damper, d.layer));
 }
 
 surrogate::SweepOptions study_sweep(const case_file::Case& c, const std::string& source) {
@@ -73,7 +73,7 @@ SensitivityResult study_result(const case_file::Case& c, const SensitivityStudy&
     const auto& v = study.variants[k];
     const auto& p = result.points[k];
     const detail::SingleDamper d = detail::single_damper(v.variant, "pdamp sensitivity");
-    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, d.damper.model_options);
+    const auto closed = fm::reduced_loss_factor(d.damper.model, d.layer.clearance_m, x, f, case_file::layer_model_options(d.damper, d.layer));
     const bool ok = p.status == surrogate::PointStatus::kOk;
     SensitivityRow row;
     row.parameter = v.parameter;

@@ -2,6 +2,7 @@
 // readers): the shipped cases, resolved defaults, physics_hash, and one test per error
 // class, each naming file, JSON pointer and rule (CaseError).
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -85,6 +86,53 @@ TEST_CASE("the buffer's allowable strain defaults to 0.3 and is refused outside 
                     "must be a finite number > 0 and <= 1");
 }
 
+TEST_CASE("the bed models' keys reach each layer's model options; absent, they keep today's closed forms",
+          "[case_file]") {
+  const pdamp::test::TempDir dir("case_file_bed_models");
+  const Case plain = load_case(shipped("low_intensity_36_spheres.json"));
+  const auto& options = plain.dampers.front().model_options;
+  CHECK(options.bed_restitution == 0.0);
+  CHECK(options.below_onset == pdamp::formulas::BelowOnsetModel::kScatteredFit);
+  CHECK_FALSE(plain.resolved["damper"]["model_options"].contains("bed_restitution"));
+  // The DEM contact's constant restitution, for the one-sphere bound's warning.
+  CHECK(options.particle_restitution == plain.dem.simulation.world.default_pair.restitution.constant);
+  // One sphere high: not nested.
+  CHECK_FALSE(pdamp::case_file::layer_model_options(plain.dampers.front(), plain.dampers.front().layers.front()).nested_bed);
+  const Case c = load_case(edited(dir, [](json& j) {
+    j["damper"]["model_options"] = {{"bed_restitution", 0.2}, {"below_onset", "impact_map"}};
+  }));
+  const auto& d = c.dampers.front();
+  const auto layer = pdamp::case_file::layer_model_options(d, d.layers.front());
+  CHECK(layer.bed_restitution == 0.2);
+  CHECK(layer.below_onset == pdamp::formulas::BelowOnsetModel::kImpactMap);
+  CHECK(c.resolved["damper"]["model_options"]["bed_restitution"] == 0.2);
+  CHECK(c.resolved["damper"]["model_options"]["below_onset"] == "impact_map");
+  CHECK(pdamp::case_file::physics_hash(c, "formulas") != pdamp::case_file::physics_hash(plain, "formulas"));
+}
+
+TEST_CASE("a layer of one particle per lane or a few particles is warned about; a collected bed is not",
+          "[case_file]") {
+  const pdamp::test::TempDir dir("case_file_single_particle");
+  const auto has = [](const std::vector<std::string>& warnings, const std::string& text) {
+    return std::any_of(warnings.begin(), warnings.end(),
+                       [&](const std::string& w) { return w.find(text) != std::string::npos; });
+  };
+  CHECK_FALSE(has(pdamp::case_file::settled_bed_warnings(load_case(shipped("low_intensity_36_spheres.json"))),
+                  "single spheres rebound"));
+  const Case one_slab = load_case(edited(dir, [](json& j) {
+    j["damper"]["particles"]["count"] = 6;
+    j["damper"]["particles"]["lattice"] = {1, 6, 1};
+  }));
+  const auto warnings = pdamp::case_file::settled_bed_warnings(one_slab);
+  CHECK(has(warnings, "one particle per lane along the drive"));
+  CHECK(has(warnings, "bed_restitution = (eps - kappa)/(1 + kappa) = "));
+  const Case few = load_case(edited(dir, [](json& j) {
+    j["damper"]["particles"]["count"] = 3;
+    j["damper"]["particles"]["lattice"] = {3, 1, 1};
+  }));
+  CHECK(has(pdamp::case_file::settled_bed_warnings(few), "3 particles"));
+}
+
 TEST_CASE("omitted keys are resolved to their defaults", "[case_file]") {
   const Case c = load_case(shipped("low_intensity_36_spheres.json"));
   CHECK(c.resolved["dem"]["steps_per_contact"] == 50);
@@ -154,6 +202,13 @@ TEST_CASE("ranges owned by an option struct come from its validate()", "[case_fi
   require_refused(
       edited(dir, [](json& c) { c["damper"]["model_options"] = {{"scattered", {{"s_min", 0.5}, {"s_max", 0.4}}}}; }),
       "/damper/model_options/scattered/s_max", "must be in [s_min, 1]");
+  // The bed models' keys (docs/cases.md): bed_restitution in [0, 0.9], below_onset a name.
+  require_refused(edited(dir, [](json& c) { c["damper"]["model_options"] = {{"bed_restitution", 0.95}}; }),
+                  "/damper/model_options/bed_restitution", "= 0.95: must be in [0, 0.9]");
+  require_refused(edited(dir, [](json& c) { c["damper"]["model_options"] = {{"bed_restitution", -0.1}}; }),
+                  "/damper/model_options/bed_restitution", "= -0.1: must be in [0, 0.9]");
+  require_refused(edited(dir, [](json& c) { c["damper"]["model_options"] = {{"below_onset", "map"}}; }),
+                  "/damper/model_options/below_onset", "impact_map");
   // dem_reference's validate(): a pin of the case, named by its pointer under /dem.
   require_refused(edited(dir, [](json& c) { c["dem"]["restitution_typo"] = 1; }), "/dem/restitution_typo",
                      "unknown key");

@@ -356,3 +356,23 @@ TEST_CASE("the gap between lanes and the ball-lot tolerance are case keys", "[cl
                          })),
                          "/damper/particles/lot_diameter_variation_m: = 0.01: must be a finite number >= 0 and <= 0.001");
 }
+
+TEST_CASE("the closed-form commands take the bed models' flags and refuse bad values in one line", "[cli]") {
+  // e_b = 0.2, κ = 0.4: onset 0.273478 h, peak 0.297089 h, η*_pk 1.364 (docs/physics.md §3.1).
+  const auto r = run_pdamp("optimum --model rolling --clearance 0.01 --bed-restitution 0.2 --json");
+  REQUIRE(r.exit_code == 0);
+  const json j = json::parse(r.out);
+  CHECK(j["x_onset_m"].get<double>() == Approx(0.00273478).epsilon(1e-5));
+  CHECK(j["x_opt_ideal_m"].get<double>() == Approx(0.00297089).epsilon(1e-5));
+  require_one_line_error(run_pdamp("optimum --model rolling --clearance 0.01 --bed-restitution 1.2"),
+                         "--bed-restitution: '1.2': must be a finite number >= 0 and <= 0.9");
+  require_one_line_error(
+      run_pdamp("loss --model rolling --clearance 0.01 --amplitude 0.003 --frequency 3 --below-onset map"),
+      "--below-onset: 'map' is not allowed (one of: scattered_fit impact_map)");
+  const auto held = run_pdamp("loss --model coulomb_block --clearance 0.003 --amplitude 0.001 --frequency 3.6 "
+                              "--friction 0.2 --json");
+  REQUIRE(held.exit_code == 0);
+  const json h = json::parse(held.out);
+  CHECK(h["regime"] == "stuck");
+  CHECK(h["eta_star"] == 0.0);
+}

@@ -257,3 +257,60 @@ TEST_CASE("a field loss model gives the lookup's slope, its warning bits and the
   CHECK(model.discontinuities_stroke_m(2.5).empty());
   CHECK_FALSE(model.warning_messages(2.5, 0.2).empty());
 }
+
+TEST_CASE("the bed models' responses: rebounding orbit, impact map and Coulomb block, with their stroke derivatives",
+          "[surrogate]") {
+  // Same central differences as above (δ = 1e-6 X, tolerance 1e-5 η*/X), on the rebounding
+  // bed (e_b = 0.2: orbit below the peak, tail above), below the onset with the impact map
+  // (piecewise linear in ξ, nodes 0.0014 apart in ξ: none of these strokes lies within 2δ of
+  // one), and the nested bed's Coulomb block under auto (Γ = 0.02-0.4 at 10 Hz: held, then
+  // sliding past μ = 0.3). η* is the formulas' to the bit, m_app that of the orbit or block.
+  const double h = 0.02;
+  fm::ModelOptions rebounding;
+  rebounding.bed_restitution = 0.2;
+  fm::ModelOptions map;
+  map.below_onset = fm::BelowOnsetModel::kImpactMap;
+  fm::ModelOptions nested;
+  nested.nested_bed = true;
+  struct Case {
+    fm::DamperModel model;
+    double frequency_hz;
+    fm::ModelOptions options;
+  };
+  for (const Case& c : {Case{fm::DamperModel::kRolling, 2.0, rebounding}, Case{fm::DamperModel::kAuto, 60.0, rebounding},
+                       Case{fm::DamperModel::kRolling, 2.0, map}, Case{fm::DamperModel::kAuto, 10.0, nested}}) {
+    const ClosedFormLossModel loss(c.model, h, c.options);
+    const auto jumps = loss.discontinuities_stroke_m(c.frequency_hz);
+    for (const double x_over_h : {0.05, 0.2, 0.27, 0.28, 0.29, 0.33, 0.4, 0.6, 1.0}) {
+      const double x = x_over_h * h, step = 1e-6 * x;
+      bool straddles = false;
+      for (double j : jumps) straddles = straddles || std::abs(x - j) < 2 * step;
+      if (straddles) continue;
+      const DamperResponse r = loss.evaluate(c.frequency_hz, x);
+      const DamperResponse up = loss.evaluate(c.frequency_hz, x + step);
+      const DamperResponse down = loss.evaluate(c.frequency_hz, x - step);
+      if (up.regime != down.regime) continue;
+      const auto formula = fm::reduced_loss_factor(c.model, h, x, c.frequency_hz, c.options);
+      CAPTURE(static_cast<int>(c.model), c.frequency_hz, x_over_h, r.regime);
+      CHECK(r.eta_star == formula.eta_star);
+      const double scale = 1.0 / x;
+      CHECK(r.d_eta_star_d_stroke_1_m == Approx((up.eta_star - down.eta_star) / (2 * step)).margin(1e-5 * scale));
+      CHECK(r.d_apparent_mass_fraction_d_stroke_1_m ==
+            Approx((up.apparent_mass_fraction - down.apparent_mass_fraction) / (2 * step)).margin(1e-5 * scale));
+      if (c.options.bed_restitution > 0.0 && r.regime == "sub_peak") {
+        const auto orbit = fm::rebounding_orbit(formula.inertia_factor, 0.2, h, x);
+        CHECK(r.apparent_mass_fraction == Approx(orbit.apparent_mass_fraction).margin(1e-12));
+      }
+      if (c.options.nested_bed) {
+        const auto block = fm::coulomb_block(0.3, formula.intensity, h / x);
+        CHECK(r.apparent_mass_fraction == block.apparent_mass_fraction);
+      }
+    }
+  }
+  // Below the onset with the map: m_app = κ/(1+κ); the nested bed has no jump.
+  CHECK(ClosedFormLossModel(fm::DamperModel::kRolling, h, map).evaluate(2.0, 0.2 * h).apparent_mass_fraction ==
+        Approx(0.4 / 1.4).epsilon(1e-15));
+  CHECK(ClosedFormLossModel(fm::DamperModel::kAuto, h, nested).discontinuities_stroke_m(10.0).empty());
+  CHECK(ClosedFormLossModel(fm::DamperModel::kRolling, h, rebounding).discontinuities_stroke_m(2.0).at(0) ==
+        fm::onset_stroke_m(0.4, h, 0.2));
+}

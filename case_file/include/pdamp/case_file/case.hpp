@@ -314,10 +314,21 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
 /// /dem/inner_structures/pins/0, /dampers/0/layers/1/particles, ...).
 CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::string& problem);
 
+/// The closed forms' options of one layer: its damper's, with nested_bed set where the
+/// layer's settled bed keeps spheres above its bottom rows (LatticeBed::settled_upper_spheres
+/// > 0, docs/physics.md §3.3): those rest on two or more others and cannot rotate.
+formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer);
+
+/// A layer of this many particles or fewer is no collected bed (settled_bed_warnings).
+inline constexpr int kFewParticles = 3;
+
 /// One sentence per layer whose bed is stacked across gravity (formulas::LatticeBed): its
 /// clearance is the settled bed's (smaller than its lattice's), and where spheres stay
 /// above the settled bottom rows the closed forms, which model one rolling layer, are
-/// outside their validity (docs/collect_and_collide.md §8).
+/// outside their validity (docs/collect_and_collide.md §8). One sentence per layer of one
+/// particle per lane along the drive (one slab) or at most kFewParticles particles: the
+/// collected-bed closed forms do not depend on restitution, single spheres rebound
+/// (docs/physics.md §3.1).
 std::vector<std::string> settled_bed_warnings(const Case& c);
 
 /// The identity of the physics a field of `source` (formulas, dem, measured) depends

@@ -33,6 +33,11 @@ enum class LossMethod {
 };
 std::string_view to_string(LossMethod method);
 
+/// Largest modal mass ratio of the beds (μ_j = Σ_d b_dj² m_bed,d / m_j, any kept mode) below
+/// which structure_setup stays silent: above it the first-harmonic coupling is off by more
+/// than 6 % and its warning sends the user to the DEM in the loop (docs/physics.md §7.8).
+inline constexpr double kMaxModalMassRatio = 0.1;
+
 struct StructureSetup {
   structure::ModalModel modal;               ///< beam: its finite-element modes; modal data: as read
   /// Beam: the beam as analysed, the dampers' weights added as carried weights (their
@@ -40,7 +45,9 @@ struct StructureSetup {
   std::optional<structure::BeamModel> beam;
   int rigid_modes_dropped = 0;               ///< beam: rigid-body modes at 0 Hz not kept
   std::vector<structure::Damper> dampers;    ///< in case order, layers in case order
-  std::vector<std::string> warnings;         ///< one sentence each (a field reused at another clearance)
+  /// One sentence each: the settled beds', a field reused at another clearance, a modal mass
+  /// ratio above kMaxModalMassRatio.
+  std::vector<std::string> warnings;
   /// kField: "damper/layer" of each DEM field built from rest (the ascending branch; a
   /// decay or a down sweep follows the descending one, docs/dem.md "Approach").
   std::vector<std::string> fields_from_rest;

@@ -23,16 +23,21 @@ namespace pdamp::formulas {
 inline constexpr double kStandardGravity = 9.80665;
 inline constexpr double kPi = 3.14159265358979323846;
 
-enum class DamperModel { kRolling, kBouncing, kScattered, kAuto };
+/// kCoulombBlock: a nested bed (ModelOptions::nested_bed), whose spheres cannot rotate: a
+/// block on its base held by Coulomb friction (docs/physics.md §3.3). `auto` answers with it
+/// for a nested bed; it has no collect-and-collide onset or peak (optimum_stroke refuses it).
+enum class DamperModel { kRolling, kBouncing, kScattered, kAuto, kCoulombBlock };
 std::string_view to_string(DamperModel model);
-/// "rolling", "bouncing", "scattered", "auto"; std::nullopt for anything else.
+/// "rolling", "bouncing", "scattered", "auto", "coulomb_block"; std::nullopt for anything else.
 std::optional<DamperModel> damper_model_from_string(std::string_view name);
 
 /// Which orbit the ideal model is on at a given stroke.
 enum class MotionRegime {
   kCollectAndCollide,  ///< X >= X_opt_ideal: impact at φ* <= π, bed rides with the wall
   kSubPeak,            ///< X_onset <= X < X_opt_ideal: symmetric orbit, impact at π + ψ
-  kScattered,          ///< X < X_onset: no synchronous orbit, empirical fit (§4)
+  kScattered,          ///< X < X_onset: no synchronous orbit: the scattered fit or the impact map (§4)
+  kStuck,              ///< Coulomb block (nested bed) at Γ <= μ: carried by the base, η* = 0 (§3.3)
+  kSliding,            ///< Coulomb block at Γ > μ: slides on its base, stick-slip or wall to wall (§3.3)
 };
 std::string_view to_string(MotionRegime regime);
 
@@ -62,6 +67,19 @@ struct ScatteredFit {
   std::vector<std::string> validate() const;
 };
 
+/// What answers below the collect-and-collide onset (docs/physics.md §4).
+enum class BelowOnsetModel {
+  kScatteredFit,  ///< the empirical law of ScatteredFit (§4.1): the default
+  kImpactMap,     ///< the plastic block's deterministic impact map, tabulated in cX/h (§4.2)
+};
+std::string_view to_string(BelowOnsetModel model);
+/// "scattered_fit", "impact_map"; std::nullopt for anything else.
+std::optional<BelowOnsetModel> below_onset_model_from_string(std::string_view name);
+
+/// Largest collective bed restitution accepted: K = (1+e_b)/(1−e_b) = 19 there, an onset at
+/// 0.017 (1+κ)h; no bed of the DEM comes near it (one sphere: e_b <= (ε − κ)/(1+κ) < 0.72).
+inline constexpr double kMaxBedRestitution = 0.9;
+
 /// Model constants with their defaults; all dimensionless.
 struct ModelOptions {
   /// κ = I/(m r²) of the rolling spheres: 2/5 solid, 2/3 thin-walled hollow; (0, 1].
@@ -84,6 +102,23 @@ struct ModelOptions {
   /// (default 0.3, dry steel on steel; a case takes its DEM contact's). It sets where
   /// `auto` leaves rolling: spheres roll without slip while μ >= κΓ/(1+κ).
   double base_friction = 0.3;
+  /// Collective restitution e_b of the collected bed at a wall (docs/physics.md §3.1): the bed
+  /// leaves the wall it has hit with e_b times its impact speed relative to the container.
+  /// In [0, kMaxBedRestitution]. 0 (default): the plastic orbits of §2-3, bit for bit. A
+  /// property of the bed, not of one contact: fit it from the DEM's jump and peak
+  /// (fit_bed_restitution); one sphere bounds it by (ε − κ)/(1+κ) (bed_restitution_bound).
+  double bed_restitution = 0.0;
+  /// Normal restitution ε of one sphere on the walls, in (0, 1], or NaN (default: unknown).
+  /// Only checked against: bed_restitution above the one-sphere bound gets a warning. A case
+  /// takes its DEM contact's constant restitution.
+  double particle_restitution = std::numeric_limits<double>::quiet_NaN();
+  /// The settled bed keeps spheres resting on two or more others (formulas::LatticeBed::
+  /// settled_upper_spheres > 0): they cannot rotate, so with gravity across the drive `auto`
+  /// takes the Coulomb block (docs/physics.md §3.3) and `rolling` warns. false: a bed one
+  /// sphere high (after settling), which rolls.
+  bool nested_bed = false;
+  /// Below the onset: the scattered fit (default) or the plastic block's impact map.
+  BelowOnsetModel below_onset = BelowOnsetModel::kScatteredFit;
   /// One line per violated rule ("rolling_inertia_factor = 1.5: must be in (0, 1]"),
   /// the fit's lines prefixed "scattered."; empty if valid.
   std::vector<std::string> validate() const;
@@ -172,6 +207,129 @@ double slip_intensity(const ModelOptions& options);
 /// factor κ (docs/physics.md §2-3).
 double onset_stroke_m(double inertia_factor, double clearance_m);
 double onset_reduced_loss_factor(double inertia_factor);
+
+// ---- The rebounding bed: collective restitution e_b (docs/physics.md §3.1) ---------------
+// A collected bed that rebounds from a wall as a whole with restitution e_b, K = (1+e_b)/(1−e_b),
+// c = 1/(1+κ): its symmetric orbit (impacts at ψ and π + ψ) closes when
+//   h/(cX) = πK cos ψ + 2 sin ψ = R_b cos(ψ − α_b),  R_b = √(π²K² + 4),  α_b = atan(2/(πK)),
+// with η* = (4c/π) K cos²ψ and m_app/m_bed = κ/(1+κ) − (2c/π) K sin 2ψ. The branch joined to
+// the peak (ψ = 0) is ψ = α_b − acos(h/(cX R_b)); it starts at the onset X_on = h/(c R_b)
+// (saddle-node, ψ = α_b) and peaks at X_pk = h/(cπK) with η*_pk = 4cK/π. e_b = 0 gives §2-3.
+
+/// K = (1+e_b)/(1−e_b) for e_b in [0, 1); throws std::invalid_argument outside.
+double rebound_factor(double bed_restitution);
+/// Onset X_on = h/(c√(π²K²+4)), m (the e_b = 0 value is onset_stroke_m's, bit for bit).
+double onset_stroke_m(double inertia_factor, double clearance_m, double bed_restitution);
+/// η* at the onset, (4c/π)K cos²α_b = 4cπK³/(π²K²+4).
+double onset_reduced_loss_factor(double inertia_factor, double bed_restitution);
+/// Peak X_pk = h(1−e_b)/(cπ(1+e_b)), m, and η*_pk = 4cK/π (e_b = 0: (1+κ)h/π and 4/(π(1+κ))).
+double peak_stroke_m(double inertia_factor, double clearance_m, double bed_restitution);
+double peak_reduced_loss_factor(double inertia_factor, double bed_restitution);
+
+/// The rebounding block's symmetric orbit at stroke X (docs/physics.md §3.1). On the branch
+/// joined to the peak, ψ = α_b − acos(h/(cX R_b)): ψ in (0, α_b] below the peak, ψ < 0 above
+/// it, where the block leaves each wall before the container's velocity extreme with e_b
+/// times its impact speed. That continuation holds while the relative velocity keeps its
+/// sign through the flight, cos ψ >= 1/K (ψ >= −acos(1/K); only ψ = 0 for e_b = 0).
+/// An event-driven simulation of the block (tests/formulas) follows it on both sides of the
+/// peak; the DEM follows it only below the peak (reduced_loss_factor uses the DEM's tail above).
+struct ReboundingOrbit {
+  bool exists = false;             ///< X_on <= X and ψ >= −acos(1/K)
+  double psi_rad = 0.0;            ///< departure phase ψ after the container's velocity extreme, rad
+  double eta_star = 0.0;           ///< (4c/π) K cos²ψ
+  double apparent_mass_fraction = 0.0;  ///< κ/(1+κ) − (2c/π) K sin 2ψ
+};
+/// κ in [0, 1], e_b in [0, kMaxBedRestitution], h and X > 0 and finite (std::invalid_argument).
+ReboundingOrbit rebounding_orbit(double inertia_factor, double bed_restitution, double clearance_m,
+                                 double stroke_m);
+
+/// Upper bound of e_b from one sphere (docs/physics.md §3.1): a sphere rolling into a
+/// frictionless wall at u leaves it at −εu with its spin; base friction, conserving u − κσ
+/// (σ = ωr), brings it back to rolling at −u(ε − κ)/(1+κ). So e_b <= max(0, (ε − κ)/(1+κ)):
+/// a sphere with ε <= κ does not leave the wall. Bouncing (κ = 0): ε. Wall friction, the
+/// spheres behind the front one and the spin-down time only lower it. ε in (0, 1], κ in
+/// [0, 1] (std::invalid_argument otherwise).
+double bed_restitution_bound(double particle_restitution, double inertia_factor);
+
+/// e_b of a bed from two DEM points (docs/physics.md §3.1): the jump (the lowest stroke at
+/// which the bed is in collect-and-collide, X_on) and the peak (the largest η*, η*_pk). Each
+/// alone gives e_b in closed form: K_on = √((h/(cX_on))² − 4)/π and K_pk = πη*_pk/(4c);
+/// the fit takes the e_b in [0, kMaxBedRestitution] that minimises the sum of the squared
+/// relative misfits of ln X_on and ln η*_pk (golden section), and reports both single
+/// estimates (clamped to [0, kMaxBedRestitution]; a jump above the plastic onset gives 0)
+/// and the two misfits: a bed the rebounding block describes has both close.
+/// The peak's stroke is not used: above the peak the DEM follows η*_pk X_pk/X = 4h/(π²X)
+/// whatever e_b, so the largest sampled η* may lie on that tail.
+struct BedRestitutionFit {
+  double bed_restitution = 0.0;     ///< e_b, best of both points
+  double from_onset = 0.0;          ///< e_b from X_on alone
+  double from_peak = 0.0;           ///< e_b from η*_pk alone
+  double onset_misfit = 0.0;        ///< X_on(e_b)/X_on − 1 at the fitted e_b
+  double peak_misfit = 0.0;         ///< η*_pk(e_b)/η*_pk − 1 at the fitted e_b
+};
+/// κ in [0, 1], h, X_on, η*_pk > 0 and finite (std::invalid_argument otherwise).
+BedRestitutionFit fit_bed_restitution(double inertia_factor, double clearance_m, double onset_stroke_m,
+                                      double peak_eta_star);
+
+// ---- Below the onset: the plastic block's impact map (docs/physics.md §4.2) ---------------
+/// The plastic block of §2 (κ = 0) below its onset, simulated: collected on the wall it
+/// leaves at the container's velocity extreme, in free flight relative to the container
+/// (relative acceleration −a_c), plastic at the walls, riding with a wall while it pushes.
+/// A rolling bed is the same block with relative motion scaled by c = 1/(1+κ), so one table
+/// serves every κ: η*_bed(X) = c·η*_map(ξ) with ξ = cX/h. The table is computed once per
+/// process on first use (about 0.1 s): kImpactMapPoints strokes ξ_i = i·ξ_on/N, i = 1..N,
+/// ξ_on = 1/√(π²+4), each averaged over kImpactMapCycles cycles after kImpactMapWarmCycles,
+/// then smoothed by a moving average over kImpactMapSmoothingPoints neighbours (the chaotic
+/// strokes scatter from point to point; the periodic windows, such as the one ending in the
+/// near-zero dip at ξ = 0.157, are wider than the window and keep their shape).
+inline constexpr int kImpactMapPoints = 270;
+inline constexpr int kImpactMapWarmCycles = 100;
+inline constexpr int kImpactMapCycles = 1000;
+inline constexpr int kImpactMapSmoothingPoints = 5;
+/// One stroke of the map, simulated (what the table holds before smoothing).
+struct ImpactMapPoint {
+  double stroke_over_clearance = 0.0;  ///< ξ = X/h of the block
+  double eta_star = 0.0;               ///< impact losses per cycle / (π m V²)
+  double impacts_per_cycle = 0.0;
+  double apparent_mass_fraction = 0.0; ///< 1 + Re(û)/V, û the first harmonic of the relative velocity
+};
+/// The simulation of one stroke ξ in (0, 1/√(π²+4)] (std::invalid_argument otherwise).
+ImpactMapPoint simulate_impact_map(double stroke_over_clearance, int warm_cycles = kImpactMapWarmCycles,
+                                   int cycles = kImpactMapCycles);
+/// The smoothed table's η* of the block at ξ = cX/h (linear interpolation; below the first
+/// point linear to 0 at ξ = 0, the block's small-stroke limit; above ξ_on the last value).
+/// Thread-safe; about 20 ns after the first call.
+double impact_map_reduced_loss_factor(double stroke_over_effective_clearance);
+/// dη*/dξ of that interpolant (of the piece ξ lies on; 0 above ξ_on).
+double impact_map_reduced_loss_factor_slope(double stroke_over_effective_clearance);
+/// The table itself: ξ_i, the raw η*_i and the smoothed η*_i.
+struct ImpactMapTable {
+  std::vector<double> stroke_over_clearance;
+  std::vector<double> eta_star_raw;
+  std::vector<double> eta_star;
+};
+const ImpactMapTable& impact_map_table();
+
+// ---- Nested beds: the Coulomb block (docs/physics.md §3.3) --------------------------------
+/// A block on its base with Coulomb friction μ in a container x_c = X sin φ with walls h apart,
+/// r = μ/Γ. Stuck for r >= 1 (η* = 0, m_app = m_bed). Above: released at sin φ_d = r, it slides
+/// with u/V = cos φ_d − cos φ − r(φ − φ_d) until it sticks again (stick-slip, r > r_c =
+/// 1/√(1+π²/4) = 0.537: slide X·D(r) per half cycle, η* = (2/π) r D(r)) or, for r <= r_c,
+/// slides without sticking (Den Hartog: cos φ_1 = πr/2, η* = (4/π) r sin φ_1); where the
+/// slide from the wall reaches the far wall first it hits it (plastic) and is held there:
+/// η* = (2/π) r h/X + (u_h/V)²/π. m_app from the first harmonic of its velocity (§1).
+struct CoulombBlock {
+  MotionRegime regime = MotionRegime::kStuck;  ///< kStuck or kSliding
+  double eta_star = 0.0;
+  double apparent_mass_fraction = 1.0;
+  double slide_over_stroke = 0.0;  ///< relative travel per half cycle / X
+  bool wall_to_wall = false;       ///< the slide reaches the far wall
+  /// r <= r_c with a slide between h and the wall-to-wall one: the block's orbit is neither
+  /// of the three above; the stick-free one is returned (reduced_loss_factor warns).
+  bool outside_domain = false;
+};
+/// μ >= 0, Γ > 0, h/X > 0, all finite (std::invalid_argument otherwise).
+CoulombBlock coulomb_block(double friction, double intensity, double clearance_over_stroke);
 
 /// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0), all finite
 /// (std::invalid_argument naming the quantity otherwise, and for invalid options).

@@ -102,6 +102,8 @@ class ClosedFormLossModel final : public LossModel {
   double clearance_m() const { return clearance_m_; }
 
  private:
+  DamperResponse rebounding_response(const formulas::LossResult& loss, double stroke_m, double d_kappa) const;
+  DamperResponse coulomb_response(const formulas::LossResult& loss, double frequency_hz, double stroke_m) const;
   formulas::DamperModel model_;
   double clearance_m_;
   formulas::ModelOptions options_;
