@@ -22,7 +22,7 @@ namespace {
 namespace dr = pdamp::dem_reference;
 using Clock = std::chrono::steady_clock;
 
-/// The low-intensity case of docs/physics.md §8: 36 steel spheres (r = 5 mm) in one layer,
+/// The low-intensity case of docs/theory.md §8: 36 steel spheres (r = 5 mm) in one layer,
 /// collected against −x in a 160 × 61 × 40 mm box driven along x at 2 Hz, X = 40 mm.
 dr::DamperSimulationOptions low_intensity_case() {
   dr::DamperSimulationOptions o;

@@ -562,7 +562,7 @@ const std::vector<Command>& commands() {
       {{"buffer",
         "pdamp buffer --frequency HZ (--amplitude M | --intensity G) --radius M --layer-modulus PA [options] [--json]",
         "sizing of a buffered (polymer-coated) wall: the layer thickness whose tip strain under the\n"
-        "design impact is the allowable strain (docs/physics.md section 5)",
+        "design impact is the allowable strain (docs/theory.md section 5)",
         {{"--frequency", "HZ", "design frequency, Hz (> 0)"},
          {"--amplitude", "M", "design stroke X, m (> 0); or give --intensity"},
          {"--intensity", "G", "design intensity Gamma = X Omega^2/g (> 0)"},

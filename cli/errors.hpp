@@ -1,5 +1,5 @@
 // The command line's exit codes and the one table that maps pdamp's error classes to them
-// (docs/interface.md): the classes are the libraries' own (strict_json: InputError,
+// (docs/command_line.md): the classes are the libraries' own (strict_json: InputError,
 // NumericalError, Interrupted; tasks: JobsServedElsewhere).
 #pragma once
 

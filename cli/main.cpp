@@ -27,7 +27,7 @@ void print_overview() {
                "2 bad input, 3 numerical failure at run time.\n";
 }
 
-/// One error line on stderr (docs/interface.md); the message is made printable so that a
+/// One error line on stderr (docs/command_line.md); the message is made printable so that a
 /// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
 int print_error(const std::string& what, int exit_code) {
   pdamp::cli::distributed::note_failure(what);  // a worker rank tells rank 0 in its replies

@@ -228,7 +228,7 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
       const auto& bed = layer.bed;
       // A lone sphere per lane, or a few spheres: no collected bed that moves as a block. The
       // collected-bed closed forms do not depend on restitution; such spheres rebound from the
-      // walls (the one-sphere bound of bed_restitution, docs/physics.md §3.1).
+      // walls (the one-sphere bound of bed_restitution, docs/theory.md §3.1).
       if (bed.slabs == 1 || layer.particle_count <= kFewParticles) {
         std::ostringstream text;
         text.precision(3);
@@ -243,7 +243,7 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
                << formulas::bed_restitution_bound(d.model_options.particle_restitution,
                                                   d.model_options.rolling_inertia_factor)
                << " for rolling)";
-        text << ": set model_options.bed_restitution (docs/physics.md §3.1) or use the layer's DEM field";
+        text << ": set model_options.bed_restitution (docs/theory.md §3.1) or use the layer's DEM field";
         out.push_back(text.str());
       }
       if (bed.settled_clearance_m == bed.clearance_m) continue;
@@ -257,7 +257,7 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
              << " spheres stay above the bottom rows, resting on two or more others: a nested bed, which does not "
                 "roll; model auto takes it as a Coulomb block held by its base up to Gamma = mu = "
              << d.model_options.base_friction
-             << " (docs/physics.md §3.3); the DEM holds a nested bed so only at low friction (mu <= 0.2) and moves "
+             << " (docs/theory.md §3.3); the DEM holds a nested bed so only at low friction (mu <= 0.2) and moves "
                 "differently from the block above it: use the layer's DEM field (docs/collect_and_collide.md §8)";
       out.push_back(text.str());
     }

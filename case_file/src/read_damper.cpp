@@ -46,7 +46,7 @@ void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
     options.scattered.source =
         s.text("source", options.scattered.provisional ? defaults.scattered.source : std::string("case file"));
   });
-  // The rebounding bed and the law below the onset (docs/physics.md §3.1, §4.2): read only
+  // The rebounding bed and the law below the onset (docs/theory.md §3.1, §4.2): read only
   // when given, so that a case without them keeps its resolved form and physics hash.
   if (const auto e_b = r.optional_number("bed_restitution", Range{})) options.bed_restitution = *e_b;
   if (r.has("below_onset"))
@@ -75,7 +75,7 @@ void read_damper_drive(ObjectReader& r, DamperSpec& d) {
     read_model_options(defaults, d.model_options);
   }
   check_model_options(r, d.model_options);
-  // Gravity along the drive breaks the closed forms' assumption (docs/physics.md §2).
+  // Gravity along the drive breaks the closed forms' assumption (docs/theory.md §2).
   const double g_norm = std::hypot(d.gravity_m_s2[0], d.gravity_m_s2[1], d.gravity_m_s2[2]);
   d.model_options.gravity_along_drive = g_norm > 0.0 && std::abs(d.gravity_m_s2[d.drive_axis]) > 0.01 * g_norm;
   const double g_across = std::sqrt(std::max(0.0, g_norm * g_norm - d.gravity_m_s2[d.drive_axis] * d.gravity_m_s2[d.drive_axis]));

@@ -48,7 +48,7 @@ double base_friction(const dr::WorldOptions& world, const LayerSpec& layer) {
 }
 
 /// ε of the spheres on the walls of a layer when it is a constant (a table or a law: NaN),
-/// for the one-sphere bound of the closed forms' bed_restitution (docs/physics.md §3.1).
+/// for the one-sphere bound of the closed forms' bed_restitution (docs/theory.md §3.1).
 double particle_restitution(const dr::WorldOptions& world, const LayerSpec& layer) {
   const int particles = layer.compartment.particles.front().material;
   const int wall = layer.compartment.wall_material;

@@ -127,7 +127,7 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
     out.dampers.push_back(std::move(damper));
   }
   // The beds' modal mass ratio μ_j = Σ_d b_dj² Σ_l m_bed,l / m_j (as pdamp modes reports it):
-  // the first-harmonic coupling of the averaging solvers (docs/physics.md §7.2-7.6) treats the
+  // the first-harmonic coupling of the averaging solvers (docs/theory.md §7.2-7.6) treats the
   // bed as a small load on the mode; above μ = 0.1 it is off by more than 6 %, and the DEM in
   // the loop (§7.8) is the check. A coupling the solvers refuse is reported by them, not here.
   try {
@@ -151,7 +151,7 @@ StructureSetup structure_setup(const Case& c, LossMethod method) {
       text.precision(3);
       text << "the beds' modal mass ratio is " << largest << " in mode " << mode + 1 << " (above " << kMaxModalMassRatio
            << "): the first-harmonic coupling of the closed forms and fields is then off by more than 6 % "
-              "(docs/physics.md section 7); check the result with the DEM in the loop (section 7.8: pdamp decay "
+              "(docs/theory.md section 7); check the result with the DEM in the loop (section 7.8: pdamp decay "
               "--method dem, or the verification of a filling_ratios task)";
       out.warnings.push_back(text.str());
     }

@@ -88,7 +88,7 @@ class ContactLaw {
   /// > 0: the wall is the surface of a bonded layer of that thickness (WallLayerLaw).
   ContactParams particle_wall(double radius_i, double mass_i, int material_i, int wall_material,
                               double wall_radius_m, double layer_thickness_m = 0.0) const;
-  /// γ_n realising ε(v) of the contact's pair (docs/physics.md §6): Hertz's via
+  /// γ_n realising ε(v) of the contact's pair (docs/theory.md §6): Hertz's via
   /// formulas::DampingTable, a layer's via its formulas::LayeredDampingTable.
   double damping_coefficient(const ContactParams& params, double impact_speed_m_s) const;
   const WallLayerLaw& layer_law(int index) const { return layers_[static_cast<std::size_t>(index)]; }

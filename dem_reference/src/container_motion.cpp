@@ -1,4 +1,4 @@
-// Harmonic container motion x_c = X sin(Ωt) along an axis (docs/physics.md §1).
+// Harmonic container motion x_c = X sin(Ωt) along an axis (docs/theory.md §1).
 #include "pdamp/dem_reference/container_motion.hpp"
 
 #include <cmath>

@@ -44,7 +44,7 @@ double period_correlation(const std::vector<double>& signal, int samples, int pe
 }
 
 /// Thresholds of the motion-mode labels (docs/dem.md "Motion modes" derives them from
-/// the mode definitions of docs/physics.md §8.1 and the ideal orbits of §2-3).
+/// the mode definitions of docs/theory.md §8.1 and the ideal orbits of §2-3).
 struct ModeThresholds {
   /// solid_like: the bed uses under a tenth of its clearance and carries over 80% of the
   /// rigidly attached bed's inertial force (m_f = 1).
@@ -69,7 +69,7 @@ struct ModeThresholds {
   static constexpr double kMaxLag_deg = 150.0;
   static constexpr double kMaxMass = 1.5;
   /// rolling: the bed keeps at least half of its settled base contacts, on average over
-  /// the analysed periods (most of it rolls on its base, docs/physics.md §3); otherwise
+  /// the analysed periods (most of it rolls on its base, docs/theory.md §3); otherwise
   /// bouncing (airborne: spheres hopping after the wall impacts, or no gravity).
   static constexpr double kRollingBase = 0.5;
   /// A sphere is mobile when its rms speed relative to the bed's mean velocity exceeds

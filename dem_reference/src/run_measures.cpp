@@ -80,7 +80,7 @@ DriveBinMeasures DriveBinMeasure::result() const {
   if (eta_star_per_period_.empty()) {
     throw std::invalid_argument("DriveBinMeasure::result: no whole period accumulated yet");
   }
-  // Complex power over all completed periods (docs/physics.md §1): the sum of the periods' bins.
+  // Complex power over all completed periods (docs/theory.md §1): the sum of the periods' bins.
   const auto cp = all_bin_.result(frequency_hz_);
   DriveBinMeasures m;
   m.eta_star = cp.reduced_loss_factor(bed_mass_kg_);

@@ -1,5 +1,5 @@
 // The beds the closed forms of §2-3 leave out: the rebounding bed (collective restitution
-// e_b, docs/physics.md §3.1), the plastic block's impact map below the onset (§4.2) and the
+// e_b, docs/theory.md §3.1), the plastic block's impact map below the onset (§4.2) and the
 // nested bed as a Coulomb block (§3.3).
 #include <algorithm>
 #include <array>
@@ -448,7 +448,7 @@ CoulombBlock coulomb_block(double friction, double intensity, double clearance_o
     harmonic = slide_integral(c1, r, p1, p1 + kPi);
   }
   // Half-wave symmetry u(φ + π) = −u(φ): û = (2/π)·(the half cycle's integral);
-  // m_app/m_bed = 1 + Re(û)/V (the bed moves at v_c + u, docs/physics.md §1).
+  // m_app/m_bed = 1 + Re(û)/V (the bed moves at v_c + u, docs/theory.md §1).
   block.apparent_mass_fraction = 1.0 + 2.0 / kPi * harmonic.real();
   return block;
 }

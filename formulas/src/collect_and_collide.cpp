@@ -324,7 +324,7 @@ OptimumStroke optimum_stroke(DamperModel model, double clearance_m, const ModelO
   result.eta_star_onset = onset_eta_star(inertia_factor);
   const double e_b = options.bed_restitution;
   if (e_b > 0.0) {
-    // The rebounding bed (docs/physics.md §3.1): onset and peak move together toward small
+    // The rebounding bed (docs/theory.md §3.1): onset and peak move together toward small
     // strokes and closer to each other (X_on/X_pk = πK/√(π²K²+4)). The calibration keeps
     // its meaning, where between the plastic onset and peak the design stroke sits:
     // t = (c − π/R)/(1 − π/R), so x_opt = X_on + t(X_pk − X_on) (c·X_pk for e_b = 0).
@@ -375,7 +375,7 @@ void common_warnings(const LossResult& result, double clearance_m, double stroke
                      const Warn& warn) {
   if (options.gravity_along_drive) {
     warn([&] { return std::string(
-        "gravity along the drive is not in the ideal models (docs/physics.md section 2): it moves "
+        "gravity along the drive is not in the ideal models (docs/theory.md section 2): it moves "
         "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
         " is an optimistic estimate"); });
   }
@@ -394,11 +394,11 @@ void common_warnings(const LossResult& result, double clearance_m, double stroke
 }
 
 /// Largest X/h at which the rebounding bed's tail η*_pk X_pk/X has been compared with the DEM
-/// (docs/physics.md §3.1: the one-high layer of tests/dem_reference/test_bed_models.cpp at
+/// (docs/theory.md §3.1: the one-high layer of tests/dem_reference/test_bed_models.cpp at
 /// X/h = 0.55, 0.7 and 1.0, 10-13 % below the tail).
 constexpr double kMaxTailStrokeOverClearance = 1.0;
 
-/// The rebounding bed (e_b > 0) at or above its onset (docs/physics.md §3.1): the orbit
+/// The rebounding bed (e_b > 0) at or above its onset (docs/theory.md §3.1): the orbit
 /// below the peak, the DEM's tail η*_pk X_pk/X = 4h/(π²X) above it.
 template <class Warn>
 void rebounding_loss(LossResult& result, double inertia_factor, double clearance_m, double stroke_m, double e_b,
@@ -420,16 +420,16 @@ void rebounding_loss(LossResult& result, double inertia_factor, double clearance
     warn([&] { return std::string(
         "rebounding bed (bed_restitution = " + format(e_b) + ") at X/h = " + format(stroke_m / clearance_m) +
         ": above its peak eta* = eta*_pk X_pk/X = " + format(result.eta_star) + " is what the DEM of rebounding "
-        "layers shows up to X/h = " + format(kMaxTailStrokeOverClearance) + " (docs/physics.md section 3.1); "
+        "layers shows up to X/h = " + format(kMaxTailStrokeOverClearance) + " (docs/theory.md section 3.1); "
         "beyond it is extrapolated"); });
   }
 }
 
-/// Largest base friction at which the DEM held a nested bed up to Γ = μ (docs/physics.md §3.3,
+/// Largest base friction at which the DEM held a nested bed up to Γ = μ (docs/theory.md §3.3,
 /// tests/dem_reference/test_bed_models.cpp: μ = 0.1 and 0.2 held; 0.35 and 0.5 moved below μ).
 constexpr double kMaxHeldNestedFriction = 0.2;
 
-/// The nested bed: the Coulomb block on its base (docs/physics.md §3.3).
+/// The nested bed: the Coulomb block on its base (docs/theory.md §3.3).
 template <class Warn>
 void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const ModelOptions& options,
                   const Warn& warn) {
@@ -445,14 +445,14 @@ void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const
   if (block.regime == MotionRegime::kSliding) {
     warn([&] { return std::string(
         "nested bed at Gamma = " + format(result.intensity) + " > mu = " + format(mu) + ": the Coulomb block slides "
-        "(eta* = " + format(result.eta_star) + "), an estimate: the DEM of a nested bed (docs/physics.md section 3.3) "
+        "(eta* = " + format(result.eta_star) + "), an estimate: the DEM of a nested bed (docs/theory.md section 3.3) "
         "gives 0.24-0.26 at Gamma = 3 mu where the block gives 0.15-0.31, and is still held at Gamma = 1.5 mu for "
         "mu = 0.1 where the block gives 0.23: check with pdamp dem"); });
   } else if (mu > kMaxHeldNestedFriction) {
     warn([&] { return std::string(
         "nested bed held by its base (eta* = 0) up to Gamma = mu = " + format(mu) + ": the DEM holds a nested bed "
         "so only at low friction (mu <= " + format(kMaxHeldNestedFriction) + "); at mu = 0.35 and 0.5 it moved from "
-        "Gamma = 0.28 and 0.1 with eta* = 0.3-0.75 (docs/physics.md section 3.3), so eta* = 0 at Gamma = " +
+        "Gamma = 0.28 and 0.1 with eta* = 0.3-0.75 (docs/theory.md section 3.3), so eta* = 0 at Gamma = " +
         format(result.intensity) + " may be far too low: check with pdamp dem"); });
   }
   if (block.outside_domain) {
@@ -514,7 +514,7 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
     result.eta_star = orbit.eta_star;
     result.impact_phase_rad = orbit.impact_phase_rad;
   } else if (impact_map) {
-    // The plastic block's map in ξ = cX/h, c = 1/(1+κ) (docs/physics.md §4.2): η* = c·η*_map(ξ).
+    // The plastic block's map in ξ = cX/h, c = 1/(1+κ) (docs/theory.md §4.2): η* = c·η*_map(ξ).
     const double c = 1.0 / (1.0 + inertia_factor);
     result.regime = MotionRegime::kScattered;
     result.impact_phase_rad = kNaN;
@@ -602,7 +602,7 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
   if (explicit_family && options.nested_bed && options.gravity_across_drive) {
     warn([&] { return std::string(
         std::string(to_string(model)) + " model for a nested bed (spheres resting on two or more others cannot "
-        "rotate, docs/physics.md section 3.3): the bed does not roll but is held by its base up to Gamma = mu = " +
+        "rotate, docs/theory.md section 3.3): the bed does not roll but is held by its base up to Gamma = mu = " +
         format(options.base_friction) + " (Gamma = " + format(result.intensity) +
         " here) and then slides; the auto model takes that Coulomb block"); });
   }
@@ -612,7 +612,7 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
         "bed_restitution e_b = " + format(options.bed_restitution) + " exceeds what one sphere can give, (eps - kappa)/"
         "(1+kappa) = " + format(bed_restitution_bound(options.particle_restitution, inertia_factor)) + " for eps = " +
         format(options.particle_restitution) + " and kappa = " + format(inertia_factor) +
-        " (docs/physics.md section 3.1): a bed rebounds less than its front sphere, so the onset and peak are placed "
+        " (docs/theory.md section 3.1): a bed rebounds less than its front sphere, so the onset and peak are placed "
         "too low"); });
   }
   common_warnings(result, clearance_m, stroke_m, options, warn);

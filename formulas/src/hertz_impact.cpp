@@ -278,7 +278,7 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
     said.push_back(
         "Impact speed v = 2*X*Omega = " + number(v, 4) + " m/s from " + origin + " at f = " + number(f, 4) +
         " Hz: at the bouncing optimum the bed leaves one wall at the peak container velocity V = X*Omega "
-        "and meets the other wall moving at -V (docs/physics.md, section 2).");
+        "and meets the other wall moving at -V (docs/theory.md, section 2).");
   }
   if (input.particles_per_contact == 1.0) {
     said.push_back("One sphere (r = " + number(r, 4) + " m, m = " + number(particle_mass, 4) +
@@ -360,7 +360,7 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
   }
   if (input.impact_velocity_m_s == 0.0 && intensity < 1.0) {
     warn.push_back("design intensity Gamma = " + number(intensity, 3) +
-                   " < 1: the bed rolls rather than flies (docs/physics.md, section 3), so the bouncing impact "
+                   " < 1: the bed rolls rather than flies (docs/theory.md, section 3), so the bouncing impact "
                    "speed 2*X*Omega "
                    "overestimates the impact");
   }

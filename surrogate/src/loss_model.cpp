@@ -56,7 +56,7 @@ BlockSlopes block_slopes(formulas::MotionRegime regime, double impact_phase_rad)
 }
 
 /// The rebounding block's η*, m_app/m and their derivatives with respect to r = h_eff/X on
-/// its orbit (ψ from the departure phase), K = (1+e_b)/(1−e_b) (docs/physics.md §3.1):
+/// its orbit (ψ from the departure phase), K = (1+e_b)/(1−e_b) (docs/theory.md §3.1):
 /// r = πK cos ψ + 2 sin ψ ⇒ dψ/dr = 1/(2 cos ψ − πK sin ψ); η_b = (4/π)K cos²ψ,
 /// m_b = −(2/π)K sin 2ψ.
 BlockSlopes rebounding_slopes(double psi, double k) {
@@ -115,7 +115,7 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
       model_ == formulas::DamperModel::kRolling || model_ == formulas::DamperModel::kBouncing;
   if (scattered && options_.below_onset == formulas::BelowOnsetModel::kImpactMap &&
       model_ != formulas::DamperModel::kScattered) {
-    // η* = c·E(ξ), ξ = cX/h, c = 1/(1+κ) (docs/physics.md §4.2); dc/dX = −c² dκ/dX.
+    // η* = c·E(ξ), ξ = cX/h, c = 1/(1+κ) (docs/theory.md §4.2); dc/dX = −c² dκ/dX.
     const double c = 1.0 / scale;
     const double dc = -c * c * d_kappa;
     const double xi = c * stroke_m / clearance_m_;
@@ -162,7 +162,7 @@ DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_
 DamperResponse ClosedFormLossModel::rebounding_response(const formulas::LossResult& loss, double stroke_m,
                                                        double d_kappa) const {
   // η* = η_b/(1+κ) and m_app/m = (κ + m_b)/(1+κ) on the rebounding orbit below the peak; above
-  // it η* = 4h/(π²X) (the DEM's tail, docs/physics.md §3.1: independent of κ and e_b) with the
+  // it η* = 4h/(π²X) (the DEM's tail, docs/theory.md §3.1: independent of κ and e_b) with the
   // apparent mass of the orbit continued (ψ < 0), held at its last value ψ = −acos(1/K) where
   // that orbit ends, and flagged as assumed.
   DamperResponse response;
@@ -195,7 +195,7 @@ DamperResponse ClosedFormLossModel::rebounding_response(const formulas::LossResu
 
 DamperResponse ClosedFormLossModel::coulomb_response(const formulas::LossResult& loss, double frequency_hz,
                                                      double stroke_m) const {
-  // The nested bed as a Coulomb block (docs/physics.md §3.3): η* and m_app from
+  // The nested bed as a Coulomb block (docs/theory.md §3.3): η* and m_app from
   // formulas::coulomb_block; the stroke derivatives by central differences (the block's
   // η* and m_app are smooth in X inside each of its regimes; 1e-6 X keeps the truncation
   // error near 1e-12 and the rounding error near 1e-10 relative).
@@ -263,7 +263,7 @@ std::vector<std::string> ClosedFormLossModel::warning_messages(double frequency_
   if ((response.warnings & kLossApparentMassAssumed) && response.regime == "collect_and_collide")
     sentences.push_back("apparent mass above the rebounding bed's peak taken from the rebounding block's orbit, " +
                         std::to_string(response.apparent_mass_fraction) +
-                        " of the bed mass (the DEM of rebounding layers gives 1.0-1.25 there, docs/physics.md "
+                        " of the bed mass (the DEM of rebounding layers gives 1.0-1.25 there, docs/theory.md "
                         "section 3.1)");
   else if (response.warnings & kLossApparentMassAssumed)
     sentences.push_back("apparent mass below the onset assumed to be the no-impact limit kappa/(1+kappa) = " +

@@ -53,7 +53,7 @@ TEST_CASE("every shipped format-1 case reads as one damper of one layer", "[case
     CHECK_FALSE(c.structure.has_value());
     CHECK(c.task.kind == pdamp::case_file::TaskKind::kDamperDesign);
   }
-  // 160 mm inner length minus 6 slabs of 10 mm spheres (docs/physics.md §9, clearance of a real bed); exact in binary to 1e-12.
+  // 160 mm inner length minus 6 slabs of 10 mm spheres (docs/theory.md §9, clearance of a real bed); exact in binary to 1e-12.
   const Case low = load_case(shipped("low_intensity_36_spheres.json"));
   CHECK(low.dampers.front().layers.front().clearance_m == Approx(0.100).margin(1e-12));
   // The buffered case's /dem/wall_layer is the geometry of its one compartment.

@@ -217,7 +217,7 @@ TEST_CASE("a damper's container_rotary_inertia_kg_m2 defaults to 0, is read in k
 }
 
 // The beds' modal mass ratio μ_j = Σ b_dj² m_bed / m_j (pdamp modes): above 0.1 the structure
-// setup warns and names the mode (docs/physics.md §7.8). The shipped three-layer decay case
+// setup warns and names the mode (docs/theory.md §7.8). The shipped three-layer decay case
 // carries 0.16 in its first mode, the optimisation case's starting design 0.08.
 TEST_CASE("a modal mass ratio above 0.1 gets a warning sending the user to the DEM in the loop", "[case_file]") {
   const auto warning = [](const std::string& name) {

@@ -25,7 +25,7 @@ inline std::string edited_case(const std::string& name, const std::function<void
   return path.string();
 }
 
-/// docs/interface.md: exit 2, nothing on stdout, one line `pdamp: error: ...` on stderr.
+/// docs/command_line.md: exit 2, nothing on stdout, one line `pdamp: error: ...` on stderr.
 inline void require_one_line_error(const RunResult& r, const std::string& must_contain) {
   CHECK(r.exit_code == 2);
   CHECK(r.out.empty());

@@ -1,4 +1,4 @@
-// Command-line contract (docs/interface.md): exit codes, one-line errors naming file,
+// Command-line contract (docs/command_line.md): exit codes, one-line errors naming file,
 // key and range, --json keys, atomic -o output. Runs the built pdamp binary (through
 // an argument vector, support/run_pdamp.hpp).
 #include <catch2/catch.hpp>
@@ -24,7 +24,7 @@ TEST_CASE("shipped cases validate and report the collected bed's clearance", "[c
   const auto r = run_pdamp("validate " + case_path("low_intensity_36_spheres.json"));
   REQUIRE(r.exit_code == 0);
   const json resolved = json::parse(r.out);
-  // 160 mm inner length minus 6 slabs of 10 mm spheres (docs/physics.md §9, clearance of a real bed).
+  // 160 mm inner length minus 6 slabs of 10 mm spheres (docs/theory.md §9, clearance of a real bed).
   CHECK(resolved["damper"]["derived"]["clearance_m"].get<double>() == Approx(0.100).margin(1e-12));
   // 36 steel spheres of 5 mm radius: 36 * 4/3 pi r^3 * 7850 kg/m^3.
   CHECK(resolved["damper"]["derived"]["bed_mass_kg"].get<double>() ==
@@ -78,7 +78,7 @@ TEST_CASE("json output is exactly one object with the promised keys", "[cli]") {
   REQUIRE(optimum.exit_code == 0);
   const json o = json::parse(optimum.out);
   for (const char* key : {"model", "clearance_m", "x_opt_m", "x_opt_ideal_m", "x_onset_m"}) CHECK(o.contains(key));
-  // Calibrated design value 0.4 h_roll (docs/physics.md §3).
+  // Calibrated design value 0.4 h_roll (docs/theory.md §3).
   CHECK(o["x_opt_m"].get<double>() == Approx(0.04).epsilon(1e-4));
 
   const auto size = run_pdamp("size --model bouncing --stroke 0.01 --json");
@@ -91,7 +91,7 @@ TEST_CASE("json output is exactly one object with the promised keys", "[cli]") {
   REQUIRE(loss.exit_code == 0);
   const json l = json::parse(loss.out);
   for (const char* key : {"eta_star", "e_diss_j", "energy_per_cycle_j", "regime", "warnings"}) CHECK(l.contains(key));
-  // X = h/2: eta* = (1 - cos phi*)^2/pi = 1.0685 (docs/physics.md §2); E_diss = eta* m V^2/2.
+  // X = h/2: eta* = (1 - cos phi*)^2/pi = 1.0685 (docs/theory.md §2); E_diss = eta* m V^2/2.
   const double v = 0.005 * 2 * kPi * 50;
   CHECK(l["eta_star"].get<double>() == Approx(1.0685).epsilon(1e-3));
   CHECK(l["e_diss_j"].get<double>() == Approx(l["eta_star"].get<double>() * 0.5 * 2.0 * v * v).epsilon(1e-12));
@@ -213,7 +213,7 @@ TEST_CASE("loss takes a scattered-fit file and rejects a bad one", "[cli]") {
   REQUIRE(r.exit_code == 0);
   const json l = json::parse(r.out);
   // Independent value: 0.25 * eta*_onset(rolling) * s, eta*_onset = 4 pi/((pi^2+4)(7/5)),
-  // s = X/X_onset with X_onset = (7/5) h/sqrt(pi^2+4) (docs/physics.md §3, §4).
+  // s = X/X_onset with X_onset = (7/5) h/sqrt(pi^2+4) (docs/theory.md §3, §4).
   const double onset = 1.4 * 0.1 / std::sqrt(kPi * kPi + 4.0);
   const double eta_onset = 4.0 * kPi / ((kPi * kPi + 4.0) * 1.4);
   CHECK(l["eta_star"].get<double>() == Approx(0.25 * eta_onset * 0.03 / onset).epsilon(1e-9));
@@ -248,7 +248,7 @@ TEST_CASE("pdamp field imports a measured field and rejects a broken CSV", "[cli
 
 TEST_CASE("a DEM instability exits with code 3 and advice and a refused time step with code 2", "[cli]") {
   // An overlap limit of 1e-9 of the radius is exceeded by the first contact of the
-  // settled bed: the run stops as unstable (docs/interface.md exit code 3).
+  // settled bed: the run stops as unstable (docs/command_line.md exit code 3).
   const auto unstable = edited_case("pdamp_dem_unstable.json", [](json& c) {
     c["dem"] = {{"stiffness_softening", 1e-3}, {"max_overlap_fraction", 1e-9}, {"transient_periods", 0},
                 {"analysed_periods", 1}};
@@ -358,7 +358,7 @@ TEST_CASE("the gap between lanes and the ball-lot tolerance are case keys", "[cl
 }
 
 TEST_CASE("the closed-form commands take the bed models' flags and refuse bad values in one line", "[cli]") {
-  // e_b = 0.2, κ = 0.4: onset 0.273478 h, peak 0.297089 h, η*_pk 1.364 (docs/physics.md §3.1).
+  // e_b = 0.2, κ = 0.4: onset 0.273478 h, peak 0.297089 h, η*_pk 1.364 (docs/theory.md §3.1).
   const auto r = run_pdamp("optimum --model rolling --clearance 0.01 --bed-restitution 0.2 --json");
   REQUIRE(r.exit_code == 0);
   const json j = json::parse(r.out);

@@ -1,5 +1,5 @@
 // The one table of error classes and exit codes (cli/errors.cpp): each class of error
-// ends a command with its documented exit code (docs/interface.md).
+// ends a command with its documented exit code (docs/command_line.md).
 #include <catch2/catch.hpp>
 
 #include <csignal>

@@ -96,7 +96,7 @@ TEST_CASE("pdamp field --shard writes only its log, and merge equals the serial 
   CHECK(o["file"] == (tmp.path / "merged" / "field.json").string());
   CHECK(field_values(tmp.path / "merged") == field_values(tmp.path / "serial"));
   CHECK(fs::exists(tmp.path / "merged" / "field_table.csv"));
-  // The contract's form, `pdamp field merge DIR...` (docs/interface.md): the case from the first
+  // The contract's form, `pdamp field merge DIR...` (docs/command_line.md): the case from the first
   // folder's shard_case.json, the source from its log; the same field.
   const auto bare = run_pdamp({"field", "merge", shards[1], shards[2], shards[0], "-o", (tmp.path / "by_dirs").string(),
                                "--json"});

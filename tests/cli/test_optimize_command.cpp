@@ -77,7 +77,7 @@ TEST_CASE("the optimised three-layer design settles faster than the best single 
           "[cli][optimizer]") {
   // Independent reference: the baseline is the exhaustive best over layer and slab count
   // with all the budget in one layer; the chosen design must beat it outright (the design's
-  // claim, docs/physics.md §7.7: layers of different clearance take over one after another).
+  // claim, docs/theory.md §7.7: layers of different clearance take over one after another).
   const json r = run_json({"optimize", case_path(kCase), "--no-verify"});
   const double chosen = r["designs"]["chosen"]["settling_time_s"].get<double>();
   const double single = r["designs"]["baseline"]["settling_time_s"].get<double>();

@@ -110,7 +110,7 @@ TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other 
   require_inert(html);
   CHECK(html.find("&lt;script&gt;") != std::string::npos);
   // The design table: the 36-sphere bed's clearance h_roll = 0.1 m (docs/cases.md) and
-  // the rolling design stroke 0.4 h = 0.04 m (docs/physics.md §3).
+  // the rolling design stroke 0.4 h = 0.04 m (docs/theory.md §3).
   CHECK(html.find("clearance_m") != std::string::npos);
   CHECK(html.find("0.04") != std::string::npos);
   if (fs::is_regular_file(out / "eta_curve.png")) {

@@ -10,7 +10,7 @@ namespace dr = pdamp::dem_reference;
 
 inline constexpr double kPi = 3.14159265358979323846;
 
-/// The damper of cases/low_intensity_36_spheres.json (docs/physics.md §8): 36 steel spheres
+/// The damper of cases/low_intensity_36_spheres.json (docs/theory.md §8): 36 steel spheres
 /// r = 5 mm, 6 × 6 × 1 lattice collected against −x in a 160 × 61 × 40 mm box (h_roll =
 /// 0.1 m), 2 Hz along x, gravity −z, stroke X = x_over_h·h_roll; restitution, friction,
 /// rolling friction as given and Young's modulus 210 GPa / softening. Periods and samples

@@ -1,4 +1,4 @@
-// The bed models of docs/physics.md §3.1 (the rebounding bed) and §3.3 (the nested bed)
+// The bed models of docs/theory.md §3.1 (the rebounding bed) and §3.3 (the nested bed)
 // against short DEM runs of beds that no case ships: a one-sphere-high layer at two
 // restitutions and a nested two-high bed at two frictions. Softened contacts (the
 // landmarks of a rolling layer depend on ε and μ, not on the stiffness, once contacts are
@@ -108,7 +108,7 @@ Landmarks sweep(double restitution, const std::vector<double>& strokes_over_h, d
 
 }  // namespace
 
-// The rebounding bed (docs/physics.md §3.1) in a one-high layer of 12 spheres (not a shipped
+// The rebounding bed (docs/theory.md §3.1) in a one-high layer of 12 spheres (not a shipped
 // bed) at ε = 0.3 and 0.9, κ = 2/5: the one-sphere bound gives e_b <= 0 and 0.357. The DEM's
 // jump (the first collected stroke on a grid 0.04 h apart) and peak give e_b. The tolerances
 // are the DEM's own: the jump is known to half a grid step, the peak to twice its standard
@@ -147,7 +147,7 @@ TEST_CASE("a one-high layer's jump and peak give a bed restitution within the on
 }
 
 // Above its peak the rebounding layer (ε = 0.9) follows η*_pk·X_pk/X = 4h/(π²X) whatever e_b
-// (docs/physics.md §3.1), an observation: the DEM lies 10-13 % below it at X/h = 0.55-1.0
+// (docs/theory.md §3.1), an observation: the DEM lies 10-13 % below it at X/h = 0.55-1.0
 // (0.666, 0.518, 0.353 against 0.737, 0.579, 0.405; standard errors 1-3 %). Checked within
 // 15 %, the spread the peak itself has between neighbouring strokes and restitutions here.
 TEST_CASE("above its peak a rebounding layer follows eta*_pk X_pk / X", "[dem_reference][long]") {
@@ -165,7 +165,7 @@ TEST_CASE("above its peak a rebounding layer follows eta*_pk X_pk / X", "[dem_re
   }
 }
 
-// The nested bed (docs/physics.md §3.3): 16 spheres settling into 5 + 3 per lane, 6 of them
+// The nested bed (docs/theory.md §3.3): 16 spheres settling into 5 + 3 per lane, 6 of them
 // resting on two others (not a shipped bed), at μ = 0.1 and 0.2. The Coulomb block holds it
 // for Γ <= μ: the DEM is held there too (solid_like, η* < 1e-3 against 0.2-0.4 once it moves:
 // the threshold is the check, not a tolerance). At Γ = 3μ both move (DEM η* 0.26 and 0.24,

@@ -137,7 +137,7 @@ TEST_CASE("the load of two compartments is the sum of their loads alone", "[dem_
 }
 
 // Reference: geometry. The clearance of a collected bed is the container's inner length
-// along the collect axis less the settled bed's extent (docs/physics.md §9, "Clearance of a
+// along the collect axis less the settled bed's extent (docs/theory.md §9, "Clearance of a
 // real bed", formulas::LatticeBed::settled_clearance_m): A's 2 × 2 × 2 lattice is two high
 // across gravity, so each lane's 4 spheres settle onto the base, 0.06 − 4·0.01 = 0.02 m
 // (its lattice would leave 0.04 m); B is a cylinder, 0.08 − 3·0.008 = 0.056 m; whether

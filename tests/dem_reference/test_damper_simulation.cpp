@@ -21,7 +21,7 @@ namespace {
 namespace dr = pdamp::dem_reference;
 constexpr double kPi = 3.14159265358979323846;
 
-/// Low-intensity case of docs/physics.md §8 (cases/low_intensity_36_spheres.json): 36 steel
+/// Low-intensity case of docs/theory.md §8 (cases/low_intensity_36_spheres.json): 36 steel
 /// spheres r = 5 mm, 6 × 6 × 1 lattice collected against −x in a 160 × 61 × 40 mm box
 /// (h_roll = 0.1 m), 2 Hz along x, gravity −z. Young's modulus divided by `softening`.
 dr::DamperSimulationOptions low_intensity(double stroke_over_clearance, double softening) {
@@ -54,7 +54,7 @@ dr::DamperSimulationOptions high_intensity(double stroke_over_clearance, double 
   return o;
 }
 
-/// Ideal bouncing η* = (1 − cos φ*)²/π with φ* − sin φ* = h/X (docs/physics.md §2), X >= h/π.
+/// Ideal bouncing η* = (1 − cos φ*)²/π with φ* − sin φ* = h/X (docs/theory.md §2), X >= h/π.
 double ideal_bouncing(double stroke_over_clearance) {
   double lo = 0.0, hi = kPi;
   for (int k = 0; k < 200; ++k) {
@@ -141,7 +141,7 @@ TEST_CASE("result files are complete CSV and VTK written atomically", "[dem_refe
   std::filesystem::remove_all(dir);
 }
 
-// References: the rolling model of docs/physics.md §3 — onset of the
+// References: the rolling model of docs/theory.md §3 — onset of the
 // collect-and-collide orbit (7/5)h/√(π²+4) = 0.376 h_roll, ideal peak 0.446 h_roll,
 // design value ≈ 0.4 h_roll from the source study — and the no-slip rolling bed's
 // apparent mass 2/7 of m_bed at small strokes (rigid-body mechanics). The test asks for
@@ -181,14 +181,14 @@ TEST_CASE("low-intensity sweep shows the jump to rolling collect-and-collide nea
   CHECK(soft.eta_star == Approx(stiff.eta_star).epsilon(0.10));
 }
 
-// Reference: the ideal bouncing collect-and-collide model of docs/physics.md
+// Reference: the ideal bouncing collect-and-collide model of docs/theory.md
 // §2 — onset h/√(π²+4) = 0.2685 h where the orbit's η* is 4π/(π²+4) = 0.906, and
 // η* = (1 − cos φ*)²/π above X_opt = h/π. The jump is the smallest stroke from which η*
 // stays at or above 0.906 for every larger stroke of the sweep; it must lie within 10% of
 // the onset. η* must lie within 15% of the ideal for X in [1, 1.3] h/π; at and
 // just above the peak (X < 1.15 h/π) the lattice bed sits higher — its aligned chains of
 // spheres pass the impact on like a Newton's cradle, so the bed is not a plastic block
-// (docs/physics.md §2: 4/π is not an upper bound with partial rebound; measured +15-22%, independent
+// (docs/theory.md §2: 4/π is not an upper bound with partial rebound; measured +15-22%, independent
 // of μ and of ε in 0.2-0.8) — there only the lower bound applies. E/100: docs/dem.md
 // records η* at h/π for E, E/10, E/100 (equal within the per-period scatter).
 //

@@ -22,7 +22,7 @@ constexpr double kGravity = 9.80665;
 constexpr double kSteelE = 210e9, kSteelNu = 0.3, kSteelRho = 7850.0;
 constexpr double kAluE = 70e9, kAluNu = 0.33, kAluRho = 2700.0;
 
-/// 1/E* = (1−ν₁²)/E₁ + (1−ν₂²)/E₂ (docs/physics.md §5), written out here rather than taken
+/// 1/E* = (1−ν₁²)/E₁ + (1−ν₂²)/E₂ (docs/theory.md §5), written out here rather than taken
 /// from formulas/ so that the reference does not share code with the DEM.
 double effective_modulus(double e1, double nu1, double e2, double nu2) {
   return 1.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2);
@@ -174,7 +174,7 @@ BouncingRun elastic_bouncing(int steps_per_contact) {
 }  // namespace
 
 // Reference: Hertz statics. A sphere at rest on a flat surface carries its weight with
-// the overlap δ = (3mg/(4E*√R))^{2/3} (docs/physics.md §5 force law set equal to mg), so its
+// the overlap δ = (3mg/(4E*√R))^{2/3} (docs/theory.md §5 force law set equal to mg), so its
 // centre sits at plate top + r − δ. With E* of steel on aluminium, δ ≈ 38 nm. The
 // tolerance of 1% of δ (0.4 nm) leaves room for the decaying oscillation at the end of
 // the 0.25 s run only: leapfrog's equilibrium is the exact force balance.
@@ -298,7 +298,7 @@ TEST_CASE("an off-centre hit on a pin deflects the sphere by the reflection abou
 }
 
 // Reference: Hertz's elastic impact on a flat face, contact time
-// t_c = 2.868(m²/(R E*² v))^{1/5} with R* = r (docs/physics.md §5). The pin's end face is flat:
+// t_c = 2.868(m²/(R E*² v))^{1/5} with R* = r (docs/theory.md §5). The pin's end face is flat:
 // its stiffness must be the flat one, not the mantle's (whose equivalent radius
 // √(r·rρ/(r+ρ)) would lengthen the contact by (r/R_eq)^{1/5}, +8% here). 1%: the contact
 // is resolved by ~50 steps (one step = 2%, counted from touch to release so the error

@@ -1,6 +1,6 @@
-// The motion-mode labels of docs/physics.md §8.1 (docs/dem.md "Motion modes") on
+// The motion-mode labels of docs/theory.md §8.1 (docs/dem.md "Motion modes") on
 // runs that show each mode. The thresholds come from the mode definitions and the ideal
-// orbits of docs/physics.md §2-3 (dem_reference/src/damper_simulation.cpp, ModeThresholds),
+// orbits of docs/theory.md §2-3 (dem_reference/src/damper_simulation.cpp, ModeThresholds),
 // not from these runs. Softened runs (E/100) are repeated at full stiffness under [long].
 #include <catch2/catch.hpp>
 
@@ -16,7 +16,7 @@ namespace {
 
 namespace dr = pdamp::dem_reference;
 
-/// The shipped low-intensity layer (cases/low_intensity_36_spheres.json, docs/physics.md §8):
+/// The shipped low-intensity layer (cases/low_intensity_36_spheres.json, docs/theory.md §8):
 /// 36 steel spheres r = 5 mm, 6 × 6 × 1 collected against −x in 160 × 61 × 40 mm
 /// (h_roll = 0.1 m), 2 Hz along x, gravity −z; ε, μ, μ_r as given, E = 210 GPa / softening.
 dr::DamperSimulationOptions layer(double x_over_h, double restitution, double friction, double rolling,
@@ -102,7 +102,7 @@ dr::DamperSimulationOptions local_run(double softening) {
 
 }  // namespace
 
-// Reference: docs/physics.md §8.1 definition of solid-like motion, the bed moving with the
+// Reference: docs/theory.md §8.1 definition of solid-like motion, the bed moving with the
 // container: relative stroke ≪ h and m_app = m_bed. The bed does not move at all (see
 // solid_run), so m_f = 1 within the elastic jitter (5%).
 TEST_CASE("a layer held by rolling resistance at Gamma = 0.08 is solid_like", "[dem_reference]") {
@@ -124,7 +124,7 @@ TEST_CASE("a floating bed at X = 0.03 h without gravity is decoupled", "[dem_ref
   CHECK(std::abs(r.indicators.phase_lag_deg) > 160.0);
 }
 
-// Reference: the ideal bouncing orbit (docs/physics.md §2): one crossing per half period,
+// Reference: the ideal bouncing orbit (docs/theory.md §2): one crossing per half period,
 // η* = 1.08 at X = 0.4 h and 0.59 at X = h for a plastic block; with ε = 0.5 the bed
 // rebounds and loses less at X = h (measured 1.05 and 0.46: within 0.2 of the plastic
 // value at 0.4 h, above half of it at h). No gravity: no base contact.
@@ -140,7 +140,7 @@ TEST_CASE("a collected bed without gravity at X/h = 0.4 and 1.0 is bouncing coll
   }
 }
 
-// Reference: the rolling orbit of docs/physics.md §3 above X_opt ≈ 0.4 h_roll: the layer
+// Reference: the rolling orbit of docs/theory.md §3 above X_opt ≈ 0.4 h_roll: the layer
 // crosses in step once per half period while rolling on its base (at X = 0.6 h, Γ = 0.97:
 // the drive acceleration stays below gravity). η* near the ideal 0.88 (rolling curve at
 // 0.6 h): above 0.7.
@@ -171,7 +171,7 @@ TEST_CASE("rolling runs with period-to-period scatter are rolling collect-and-co
   }
 }
 
-// Reference: the scattered state below the onset (docs/physics.md §4): no synchronous orbit,
+// Reference: the scattered state below the onset (docs/theory.md §4): no synchronous orbit,
 // little dissipation. The layer at X = 0.2 h_roll (onset 0.376 h) and the floating bed at
 // X = 0.15 h (onset 0.27 h); neither crosses in step (crossings < 0.5).
 TEST_CASE("below the onset the layer and a floating bed are scattering", "[dem_reference]") {

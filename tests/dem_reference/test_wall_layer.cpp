@@ -1,4 +1,4 @@
-// Buffered walls (a polymer layer on the container walls, docs/physics.md §5) against Hertz's
+// Buffered walls (a polymer layer on the container walls, docs/theory.md §5) against Hertz's
 // elastic impact, the energy balance of the bottomed-out layer, and the layer sizing of
 // formulas::size_buffer_layer checked in the DEM.
 #include <catch2/catch.hpp>
@@ -34,7 +34,7 @@ double effective_modulus(double e1, double nu1, double e2, double nu2) {
 /// Hertz stiffness K = (4/3)E*√r of a sphere on a flat surface, N/m^{3/2}.
 double hertz_stiffness(double e_star) { return 4.0 / 3.0 * e_star * std::sqrt(kRadius); }
 
-/// Elastic maximum penetration from ½mv² = (2/5)Kδ^{5/2} (docs/physics.md §5), m.
+/// Elastic maximum penetration from ½mv² = (2/5)Kδ^{5/2} (docs/theory.md §5), m.
 double elastic_penetration(double mass, double stiffness, double v) {
   return std::pow(1.25 * mass * v * v / stiffness, 0.4);
 }
@@ -181,7 +181,7 @@ TEST_CASE("a fast sphere bottoms out the layer and the hard wall stops it", "[de
   CHECK(impact.rebound == Approx(1.0).epsilon(0.005));
 }
 
-// Reference: the sizing itself (docs/physics.md §5: the sizing "must be checked in the DEM").
+// Reference: the sizing itself (docs/theory.md §5: the sizing "must be checked in the DEM").
 // formulas::size_buffer_layer (layered model) chooses the thickness t whose tip strain
 // δ_max/t under the design impact (one front-row sphere carrying particles_per_contact
 // spheres at v = 2XΩ) is the allowable strain ε_a. The DEM gets the designed t and one
@@ -249,7 +249,7 @@ TEST_CASE("the buffered-wall sizing reaches its allowable strain under the desig
 }
 
 // Reference: geometry. The collected bed's clearance in a layered box is the inner
-// length less both layers and the bed's extent (docs/physics.md §9, "Clearance of a real bed").
+// length less both layers and the bed's extent (docs/theory.md §9, "Clearance of a real bed").
 TEST_CASE("a layered compartment's clearance excludes both layers", "[dem_reference]") {
   dr::WorldOptions o = layered_world(0.8, 0.8, 1.0);
   auto& c = o.compartments.front();

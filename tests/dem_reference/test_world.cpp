@@ -109,7 +109,7 @@ TEST_CASE("total energy of elastic frictionless spheres in a closed box does not
 }
 
 // Reference: rigid-body mechanics. A solid sphere (I = 2/5 m r²) rolling without slip on
-// a base accelerating at a_c has centre acceleration κ/(1+κ)·a_c = 2/7·a_c (docs/physics.md §3);
+// a base accelerating at a_c has centre acceleration κ/(1+κ)·a_c = 2/7·a_c (docs/theory.md §3);
 // it needs friction μ >= 2a_c/(7g) = 0.058 at a_c = 2 m/s². Below that it slides with
 // kinetic friction: a = μg. 2%: the fit over 50 ms averages out the small
 // oscillation of the Mindlin spring.

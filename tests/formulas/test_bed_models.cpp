@@ -1,4 +1,4 @@
-// The bed models of docs/physics.md §3.1 (the rebounding bed), §3.3 (the nested bed as a
+// The bed models of docs/theory.md §3.1 (the rebounding bed), §3.3 (the nested bed as a
 // Coulomb block) and §4.2 (the plastic block's impact map below the onset) against
 // event-driven simulations written here, independent of formulas/src/bed_models.cpp: they
 // integrate the block's flight piece by piece in closed form, find the impacts by
@@ -245,7 +245,7 @@ CoulombMeasure simulate_coulomb(double r, double h, int warm_cycles, int cycles)
 
 // ---- Rebounding bed ------------------------------------------------------------------------
 
-// The worked numbers of docs/physics.md §3.1: e_b = 0.2, κ = 0.4 (K = 1.5, c = 1/1.4):
+// The worked numbers of docs/theory.md §3.1: e_b = 0.2, κ = 0.4 (K = 1.5, c = 1/1.4):
 // X_on = 1.4h/√(2.25π² + 4) = 0.273478 h, X_pk = 1.4h/(1.5π) = 0.297089 h, η*_pk = 6/(1.4π) = 1.36418.
 TEST_CASE("rebounding bed landmarks: e_b = 0.2, kappa = 0.4 gives X_on 0.273 h, X_pk 0.297 h, eta*_pk 1.364",
           "[formulas]") {
@@ -317,7 +317,7 @@ TEST_CASE("the event-driven rebounding block follows the rebounding orbit on bot
 
 // e_b = 0 is the plastic closed form bit for bit (the default); a small e_b approaches it
 // continuously below the peak (the orbit's ψ moves by O(e_b)), while above the peak the
-// rebounding bed takes the DEM's tail η*_pk·X_pk/X = 4h/(π²X) (docs/physics.md §3.1).
+// rebounding bed takes the DEM's tail η*_pk·X_pk/X = 4h/(π²X) (docs/theory.md §3.1).
 TEST_CASE("bed_restitution 0 is the plastic closed form bit for bit; small e_b is continuous below the peak",
           "[formulas]") {
   const double h = 0.01, f = 3.0;

@@ -454,7 +454,7 @@ TEST_CASE("bouncing landmarks: 4/pi at h/pi, 1.069 at h/2, 0.585 at h, 0.906 at 
 
   const fm::IdealOrbit half = fm::ideal_orbit(0.0, h, h / 2.0);
   REQUIRE(half.eta_star == Approx(1.06876978910505817788).epsilon(1e-13));
-  REQUIRE(half.eta_star == Approx(1.069).margin(5e-4));  // docs/physics.md §2, stated digits
+  REQUIRE(half.eta_star == Approx(1.069).margin(5e-4));  // docs/theory.md §2, stated digits
   REQUIRE(half.impact_phase_rad == Approx(2.55419595283704303783).epsilon(1e-14));
 
   const fm::IdealOrbit full = fm::ideal_orbit(0.0, h, h);
@@ -636,7 +636,7 @@ TEST_CASE("below the onset every model gives the scattered-state fit", "[formula
     REQUIRE(r.model_used == fm::DamperModel::kRolling);
     REQUIRE(std::isnan(r.impact_phase_rad));
     REQUIRE(r.stroke_over_onset == Approx(s).epsilon(1e-14));
-    // docs/physics.md §4 form with η*_onset = 4π/((π²+4)(1+κ)).
+    // docs/theory.md §4 form with η*_onset = 4π/((π²+4)(1+κ)).
     const double expected = 0.6 * 4.0 * kPi / ((kPi * kPi + 4.0) * 1.4) * std::pow(s, 3.0);
     REQUIRE(r.eta_star == Approx(expected).epsilon(1e-14));
     REQUIRE(has_warning(r, "does not exist") == (model == fm::DamperModel::kRolling));
@@ -830,7 +830,7 @@ TEST_CASE("model and regime names round-trip and unknown names give nullopt", "[
 
 TEST_CASE("energy measures reproduce a viscous damper's energy per cycle", "[formulas]") {
   // A viscous damper c at amplitude X, frequency Ω dissipates πcΩX² per cycle, and its
-  // η* is c/(m Ω) (docs/physics.md §1): independent textbook result.
+  // η* is c/(m Ω) (docs/theory.md §1): independent textbook result.
   const double c = 3.0;
   const double m = 0.7;
   const double omega = 2.0 * kPi * 5.0;

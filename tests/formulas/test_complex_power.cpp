@@ -152,7 +152,7 @@ TEST_CASE("a spring gives an apparent mass of -k/Omega^2 and no dissipation", "[
 
 TEST_CASE("the apparent mass and eta* do not depend on the time origin", "[formulas]") {
   // Starting the record at t0 multiplies F* and V* by the same factor e^{iΩt0}, so
-  // F*·conj(V*) is unchanged (docs/physics.md §1); F* itself must rotate by exactly that factor.
+  // F*·conj(V*) is unchanged (docs/theory.md §1); F* itself must rotate by exactly that factor.
   const LinearElement element{1.3, 0.45, 800.0};
   const auto force = [&](double t) { return element.force(t); };
   const ComplexPower origin = analyse(sample(force, velocity, 6));

@@ -256,7 +256,7 @@ TEST_CASE("the yield speed of a sphere on a flat carries Thornton's constant 1.5
 }
 
 TEST_CASE("at the yield speed the Hertz peak pressure equals p_y", "[formulas][cor]") {
-  // Reference: docs/physics.md §5, δ_max = (15m*v²/(16E*√R*))^{2/5}, with a = √(R*δ) and
+  // Reference: docs/theory.md §5, δ_max = (15m*v²/(16E*√R*))^{2/5}, with a = √(R*δ) and
   // p₀ = 2E*a/(πR*) (Hertz; Johnson 1985, ch. 4). Same algebra, so rounding only: 1e-12.
   const double pressure = 1.2e9, modulus = 115e9, radius = 0.003, mass = 2e-3;
   const double v = pf::yield_speed(pressure, modulus, radius, mass);
@@ -624,7 +624,7 @@ TEST_CASE("realised restitution tends to 5/(4 gamma^2) at heavy damping", "[form
 
 TEST_CASE("the textbook damping law realises about 0.40 for a target 0.3 without tension",
           "[formulas][cor]") {
-  // docs/physics.md §6: γ_n = −√5·β reaches ε only if the contact ends at zero overlap
+  // docs/theory.md §6: γ_n = −√5·β reaches ε only if the contact ends at zero overlap
   // (tension allowed); ending at zero force gives about 0.40 for a target 0.3.
   for (double target : {0.1, 0.3, 0.5, 0.7, 0.9}) {
     CAPTURE(target);
@@ -698,7 +698,7 @@ TEST_CASE(
     std::vector<double> rebound_accurate;
     for (double speed : {0.1, 2.0}) {
       CAPTURE(speed);
-      // Time scale of the contact: docs/physics.md §5, t_c ≈ 2.87(m*²/(R*E*²v))^{1/5}.
+      // Time scale of the contact: docs/theory.md §5, t_c ≈ 2.87(m*²/(R*E*²v))^{1/5}.
       const double time_scale =
           2.87 *
           std::pow(kSphereMass * kSphereMass / (kSphereRadius * modulus * modulus * speed), 0.2);

@@ -116,7 +116,7 @@ TEST_CASE("the contact-time constant is 2(15/16)^(2/5) times twice the Hertz int
   const double integral = sum / (3.0 * kIntervals);
   CHECK(integral == Approx(1.4716).epsilon(1e-4));
   CHECK(fm::contact_time_coefficient() == Approx(2.0 * std::pow(15.0 / 16.0, 0.4) * integral).epsilon(1e-10));
-  // 2.87 is the rounded value often quoted (docs/physics.md §5): 2.8683 is within 0.06%.
+  // 2.87 is the rounded value often quoted (docs/theory.md §5): 2.8683 is within 0.06%.
   CHECK(fm::contact_time_coefficient() == Approx(2.87).epsilon(1e-3));
 
   const fm::Material steel;
@@ -180,7 +180,7 @@ TEST_CASE("materials and contacts with invalid values are rejected with the numb
 
 namespace {
 
-// 60 Hz design at Γ = 10 (docs/physics.md §8 hybrids): steel spheres r = 5 mm on a polymer
+// 60 Hz design at Γ = 10 (docs/theory.md §8 hybrids): steel spheres r = 5 mm on a polymer
 // layer, the front-row sphere carrying 6 spheres.
 fm::BufferDesignInput design_input() {
   fm::BufferDesignInput in;

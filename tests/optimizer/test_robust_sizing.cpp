@@ -37,7 +37,7 @@ double dense_worst_eta_star(const opt::RobustSizingOptions& options, double clea
 
 }  // namespace
 
-// Reference: at one stroke the ideal η*(h) peaks at X = (1+κ)h/π (docs/physics.md §2), which
+// Reference: at one stroke the ideal η*(h) peaks at X = (1+κ)h/π (docs/theory.md §2), which
 // is clearance_for_stroke when the calibration is 1 (bouncing's default; rolling set to
 // 1 here: with the default 0.8976 the design stroke is deliberately off the ideal peak).
 // The peak is 18.5 % above the onset, so the 10 % margin does not bind. Tolerances:

@@ -1,5 +1,5 @@
 // Tests of the single-mode backbones against the small-mass-ratio formula ζ_add = ½η*μ
-// (docs/physics.md §7.3) and the apparent-mass frequency shift.
+// (docs/theory.md §7.3) and the apparent-mass frequency shift.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <memory>
@@ -79,7 +79,7 @@ TEST_CASE("the added damping ratio is half the loss factor times the modal mass 
 
 TEST_CASE("a bouncing damper at its peak adds 0.64 of the mass ratio as damping", "[structure]") {
   // At X_opt = h/π the ideal orbit gives η* = 4/π and m_app = 0 (docs/structure_coupling.md §2;
-  // collect_and_collide.md §2): ζ_add = ½(4/π)μ = 0.637μ with no frequency shift (docs/physics.md §7.3). A container adds
+  // collect_and_collide.md §2): ζ_add = ½(4/π)μ = 0.637μ with no frequency shift (docs/theory.md §7.3). A container adds
   // its mass to the mode: m_eff = 1 + m_c|φ|².
   pdamp::formulas::ModelOptions mo;
   mo.gravity_across_drive = false;

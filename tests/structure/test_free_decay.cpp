@@ -127,7 +127,7 @@ TEST_CASE("the envelope's settling time matches a direct time integration within
 
 TEST_CASE("two layers of different clearance take over one after the other", "[structure]") {
   // Closed-form bouncing layers with h = 40 mm and 8 mm: the wide one works at large
-  // amplitude, the narrow one late in the decay (docs/physics.md §7.7). The wide layer's power
+  // amplitude, the narrow one late in the decay (docs/theory.md §7.7). The wide layer's power
   // dominates at the start (η* 0.9 against 0.12 at X = 0.03 m), the narrow one's later.
   pdamp::formulas::ModelOptions mo;
   mo.gravity_across_drive = false;

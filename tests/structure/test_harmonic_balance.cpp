@@ -488,7 +488,7 @@ TEST_CASE("harmonic balance rejects bad inputs naming the field", "[structure]")
 
 // Reference: the closed-form rolling damper on a 1-DOF held at its onset over a band of
 // frequencies (the damper amplitude pinned at the onset stroke, X = (1+κ)h/√(π²+4) with
-// κ = 2/5: docs/physics.md §3): the response is flat there, and the flat top is one peak (at
+// κ = 2/5: docs/theory.md §3): the response is flat there, and the flat top is one peak (at
 // its middle), not one peak per sample that round-off makes a local maximum.
 TEST_CASE("a response held at the onset over a band of frequencies is one peak", "[structure]") {
   const double h = 0.03;

@@ -71,7 +71,7 @@ TEST_CASE("drive points of an intensity grid reproduce the node's intensity and 
                                       {0.1, 1.0, 3, AxisSpacing::kLinear});
   for (std::size_t k = 0; k < grid.size(); ++k) {
     const DrivePoint d = drive_point(grid, k, clearance);
-    // Reference: the definitions Γ = X(2πf)²/g and s = X/h (docs/physics.md §1), to rounding.
+    // Reference: the definitions Γ = X(2πf)²/g and s = X/h (docs/theory.md §1), to rounding.
     const double omega = 2.0 * kPi * d.frequency_hz;
     CHECK(d.amplitude_m * omega * omega / kG == Approx(grid.coordinate0(k)).epsilon(1e-14));
     CHECK(d.amplitude_m / clearance == Approx(grid.coordinate1(k)).epsilon(1e-15));

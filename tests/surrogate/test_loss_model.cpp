@@ -44,7 +44,7 @@ TEST_CASE("a formula field holds the closed-form values at its grid points", "[s
       for (std::size_t k = 0; k < grid.size(); ++k) {
         const DrivePoint drive = drive_point(grid, k, kClearance);
         // Reference: the LossModel of the closed forms at the same drive, and the
-        // definition E_diss = η*·½ m_bed (XΩ)² (docs/physics.md §1).
+        // definition E_diss = η*·½ m_bed (XΩ)² (docs/theory.md §1).
         const DamperResponse expected = closed_form.evaluate(drive.frequency_hz, drive.amplitude_m);
         const FieldPoint& p = result.field.points[k];
         CHECK(p.eta_star == expected.eta_star);

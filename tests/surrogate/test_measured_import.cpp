@@ -49,7 +49,7 @@ TEST_CASE("a measured CSV in any row order becomes a full grid with derived colu
   CHECK(p.eta_star == 0.5);
   CHECK(std::isnan(p.eta_star_stderr));  // empty cell: not given
   CHECK(p.motion_mode == "collect_and_collide");
-  // Reference: E_diss = η*·½ m_bed (2πfX)² and m_app/m_bed (docs/physics.md §1).
+  // Reference: E_diss = η*·½ m_bed (2πfX)² and m_app/m_bed (docs/theory.md §1).
   const double v = 2 * kPi * 3.0 * 0.02;
   CHECK(p.e_diss_j == Approx(0.5 * 0.5 * 0.74 * v * v).epsilon(1e-14));
   CHECK(p.apparent_mass_fraction == Approx(0.20 / 0.74).epsilon(1e-15));

@@ -21,7 +21,7 @@ namespace fm = pdamp::formulas;
 namespace fs = std::filesystem;
 
 constexpr double kPi = 3.14159265358979323846;
-/// η*_onset of the bouncing block, 4π/(π²+4) (docs/physics.md §2).
+/// η*_onset of the bouncing block, 4π/(π²+4) (docs/theory.md §2).
 const double kBouncingOnset = 4 * kPi / (kPi * kPi + 4);
 
 using pdamp::test::TempDir;
@@ -131,7 +131,7 @@ TEST_CASE("samples are the ok field points below the onset of the family in use"
   for (std::size_t k = 0; k < field.grid.size(); ++k) {
     field.points.push_back({0.1, 0.01, 1.0, FieldPoint::kUnknown, FieldPoint::kUnknown, "", PointStatus::kOk});
   }
-  // Reference onsets (docs/physics.md §2-3): X_onset = (1+κ)h/√(π²+4), κ = 0.4 rolling, 0 bouncing.
+  // Reference onsets (docs/theory.md §2-3): X_onset = (1+κ)h/√(π²+4), κ = 0.4 rolling, 0 bouncing.
   const double rolling_onset = 1.4 * h / std::sqrt(kPi * kPi + 4), bouncing_onset = h / std::sqrt(kPi * kPi + 4);
   const auto automatic = scattered_samples(field);
   // Γ = 0.5 (rolling): X/h = 0.1, 0.2, 0.3 below 0.376; Γ = 2 > Γ_slip = 1.05 (spheres

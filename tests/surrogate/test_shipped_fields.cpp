@@ -102,7 +102,7 @@ TEST_CASE("the fitted auto curve follows the DEM field of the 36-sphere case", "
 
 TEST_CASE("at the smallest strokes the DEM bed's apparent mass is about 2/7 of its mass", "[surrogate]") {
   // A bed of spheres rolling without slip transmits 2/7 of the container's inertial
-  // force (docs/physics.md §3). Tolerance 0.04: measured 0.26-0.29 at X = 0.15 h, the
+  // force (docs/theory.md §3). Tolerance 0.04: measured 0.26-0.29 at X = 0.15 h, the
   // remainder is sliding and the occasional wall contact.
   const auto field = sg::read_effective_field(kDir + "low_intensity_36_spheres_dem/field.json");
   for (std::size_t i0 = 0; i0 < field.grid.axis0.size(); ++i0)

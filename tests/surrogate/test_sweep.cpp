@@ -130,7 +130,7 @@ TEST_CASE("a sweep evaluates every node once and fills the derived columns", "[s
   CHECK(result.field.points == reference_field().points);
   CHECK(result.field.clearance_m == 0.04);
   CHECK(result.field.bed_mass_kg == 0.74);
-  // Derived columns (docs/physics.md §1): E_diss = η*·½ m_bed (XΩ)², m_app/m_bed.
+  // Derived columns (docs/theory.md §1): E_diss = η*·½ m_bed (XΩ)², m_app/m_bed.
   const Grid grid = sweep_grid();
   for (std::size_t k = 0; k < grid.size(); ++k) {
     const FieldPoint& p = result.field.points[k];

@@ -33,7 +33,7 @@ const case_file::Case& low_intensity() {
 
 }  // namespace
 
-// Reference: the definitions of docs/physics.md §1, E_diss = η*·½ m_bed (XΩ)², the energy
+// Reference: the definitions of docs/theory.md §1, E_diss = η*·½ m_bed (XΩ)², the energy
 // per cycle 2π E_diss and c_eq = η* m_bed Ω, evaluated here from η* (rounding only: 1e-12).
 TEST_CASE("a loss point's energies follow from eta* by the complex-power definitions", "[tasks]") {
   tasks::LossOptions o;
@@ -66,7 +66,7 @@ TEST_CASE("the clearance for a stroke has that stroke as its design stroke", "[t
   }
 }
 
-// Reference: the rolling design stroke is 0.4 h_roll (docs/physics.md §3, the design value
+// Reference: the rolling design stroke is 0.4 h_roll (docs/theory.md §3, the design value
 // of the source study's experiments); the curve spans the case's design sweep.
 TEST_CASE("the damper design of the shipped low-intensity case is the rolling design stroke", "[tasks]") {
   const auto& c = low_intensity();
@@ -169,7 +169,7 @@ TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted r
 }
 
 // Reference: the collect-and-collide orbit of a collected bed exists down to its saddle-node
-// onset, for a free plastic block X_on = h/√(π² + 4) = 0.269 h (docs/physics.md), below the
+// onset, for a free plastic block X_on = h/√(π² + 4) = 0.269 h (docs/theory.md), below the
 // stroke at which a bed started from rest jumps onto it (0.27-0.30 h for this layer, from the
 // DEM field of cases/fields/link_narrow_dem). Between the two the state depends on history:
 // the narrow link layer (2 × 4 spheres of r = 5 mm, h = 8 mm, 3.6 Hz) at X = 2.1 mm = 0.26 h

@@ -316,7 +316,7 @@ CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::str
 
 /// The closed forms' options of one layer: its damper's, with nested_bed set where the
 /// layer's settled bed keeps spheres above its bottom rows (LatticeBed::settled_upper_spheres
-/// > 0, docs/physics.md §3.3): those rest on two or more others and cannot rotate.
+/// > 0, docs/theory.md §3.3): those rest on two or more others and cannot rotate.
 formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer);
 
 /// A layer of this many particles or fewer is no collected bed (settled_bed_warnings).
@@ -328,7 +328,7 @@ inline constexpr int kFewParticles = 3;
 /// outside their validity (docs/collect_and_collide.md §8). One sentence per layer of one
 /// particle per lane along the drive (one slab) or at most kFewParticles particles: the
 /// collected-bed closed forms do not depend on restitution, single spheres rebound
-/// (docs/physics.md §3.1).
+/// (docs/theory.md §3.1).
 std::vector<std::string> settled_bed_warnings(const Case& c);
 
 /// The identity of the physics a field of `source` (formulas, dem, measured) depends

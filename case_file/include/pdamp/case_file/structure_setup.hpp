@@ -35,7 +35,7 @@ std::string_view to_string(LossMethod method);
 
 /// Largest modal mass ratio of the beds (μ_j = Σ_d b_dj² m_bed,d / m_j, any kept mode) below
 /// which structure_setup stays silent: above it the first-harmonic coupling is off by more
-/// than 6 % and its warning sends the user to the DEM in the loop (docs/physics.md §7.8).
+/// than 6 % and its warning sends the user to the DEM in the loop (docs/theory.md §7.8).
 inline constexpr double kMaxModalMassRatio = 0.1;
 
 struct StructureSetup {

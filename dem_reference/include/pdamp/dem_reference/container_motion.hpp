@@ -37,7 +37,7 @@ class ContainerMotion {
 };
 
 /// Harmonic translation x_c(t) = X sin(Ωt)·a along a unit axis a, Ω = 2πf
-/// (docs/physics.md §1): velocity XΩ cos(Ωt)·a, no rotation.
+/// (docs/theory.md §1): velocity XΩ cos(Ωt)·a, no rotation.
 class HarmonicMotion final : public ContainerMotion {
  public:
   /// axis: any non-zero vector (normalised here); amplitude X >= 0 m; frequency f > 0 Hz.

@@ -42,7 +42,7 @@ inline constexpr long long kMaxRecordedSamples = 10'000'000;
 inline constexpr int kMaxSnapshots = 10'000;
 }  // namespace limits
 
-/// A harmonic DEM run (docs/physics.md §1): x_c = X sin(Ωt) along drive_axis.
+/// A harmonic DEM run (docs/theory.md §1): x_c = X sin(Ωt) along drive_axis.
 struct DamperSimulationOptions {
   WorldOptions world;
   Vec3 drive_axis{1.0, 0.0, 0.0};  ///< direction of the drive (normalised), world = body frame at rest
@@ -85,7 +85,7 @@ struct DamperSimulationOptions {
 
 struct DamperResult {
   Summary summary;
-  double eta_star = 0.0;               ///< reduced loss factor from complex power (docs/physics.md §1)
+  double eta_star = 0.0;               ///< reduced loss factor from complex power (docs/theory.md §1)
   double eta_star_stderr = 0.0;        ///< standard error of the mean of the per-period values (sample sd/√n)
   /// η* from the energy balance instead: (D + ΔE)/(n·π·m_bed·V²) (independent check).
   double eta_star_energy_balance = 0.0;
@@ -108,7 +108,7 @@ struct DamperResult {
   EnergyBalance energy;
   TimeSeries series;
   std::vector<ParticleSnapshot> snapshots;
-  std::vector<std::string> warnings;   ///< validity-range remarks (docs/interface.md)
+  std::vector<std::string> warnings;   ///< validity-range remarks (docs/command_line.md)
   /// The checkpoint hook asked the run to stop (HarmonicCheckpoints::stop) after it wrote
   /// its state: the measures are unset, the run continues from that state.
   bool stopped = false;

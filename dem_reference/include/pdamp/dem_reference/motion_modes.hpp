@@ -12,7 +12,7 @@
 
 namespace pdamp::dem_reference {
 
-/// Motion modes of docs/physics.md §8.1 (criteria in docs/dem.md "Motion modes").
+/// Motion modes of docs/theory.md §8.1 (criteria in docs/dem.md "Motion modes").
 enum class MotionMode {
   kSolidLike,
   kRollingCollectAndCollide,
@@ -113,7 +113,7 @@ class MotionModeAccumulator {
   std::vector<double> fluctuation_sum_;  ///< per sphere, Σ over blocks of |v_i − v_bed|², m²/s²
 };
 
-/// The label of docs/physics.md §8.1 from the indicators (docs/dem.md "Motion modes"): the first
+/// The label of docs/theory.md §8.1 from the indicators (docs/dem.md "Motion modes"): the first
 /// that applies.
 MotionMode classify_motion(const MotionIndicators& indicators, double eta_star, double intensity);
 

@@ -44,7 +44,7 @@ class EnergyLedger {
   EnergyAccount opening_;
 };
 
-/// Complex-power measures at the drive frequency (docs/physics.md §1) over the analysed
+/// Complex-power measures at the drive frequency (docs/theory.md §1) over the analysed
 /// periods, from the drive bin accumulated every step.
 struct DriveBinMeasures {
   double eta_star = 0.0;            ///< reduced loss factor over all periods

@@ -118,7 +118,7 @@ class World {
   int compartment(int i) const;
   double bed_mass_kg() const;          ///< all particles
   /// Clearance h of the compartment's collected bed along its collect axis (the free
-  /// travel of the settled bed, docs/physics.md §9, "Clearance of a real bed",
+  /// travel of the settled bed, docs/theory.md §9, "Clearance of a real bed",
   /// formulas::LatticeBed::settled_clearance_m), m; NaN if a lattice cannot be built.
   double clearance_m(int compartment) const;
   /// Σ m v: total momentum of the particles at the current time, kg·m/s.

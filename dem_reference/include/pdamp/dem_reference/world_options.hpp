@@ -70,7 +70,7 @@ struct MaterialOptions {
   formulas::Material material;  ///< density kg/m³, Young's modulus Pa, Poisson ratio
 };
 
-/// Normal coefficient of restitution of one material pair (docs/physics.md §6).
+/// Normal coefficient of restitution of one material pair (docs/theory.md §6).
 /// Precedence: `model` if set, else the table if it is non-empty, else `constant`.
 struct RestitutionOptions {
   double constant = 0.8;                 ///< ε, dimensionless, in [0.01, 1] (limits::kMinRestitution)
@@ -117,7 +117,7 @@ struct ParticleGroupOptions {
 };
 
 enum class InitialPlacement {
-  kCollectedLattice,  ///< simple-cubic lattice against a wall (default, docs/physics.md §3)
+  kCollectedLattice,  ///< simple-cubic lattice against a wall (default, docs/theory.md §3)
   kCentredLattice,    ///< the same lattice shifted to the middle of the drive axis
   kRandom,            ///< random non-overlapping positions (seeded)
 };
@@ -142,7 +142,7 @@ struct PinOptions {
   int material = -1;             ///< index into materials; −1 = the compartment's wall material
 };
 
-/// Buffered walls: a polymer layer on container walls (docs/physics.md §5). The sphere
+/// Buffered walls: a polymer layer on container walls (docs/theory.md §5). The sphere
 /// presses into the layer (Hertz with the layer's modulus); once it has penetrated
 /// the whole thickness the hard wall acts in addition.
 struct WallLayerOptions {

@@ -1,5 +1,5 @@
 // Containers and the collected lattice bed: the clearance h of a real bed
-// (docs/physics.md §9, "Clearance of a real bed") and the DEM's initial placement.
+// (docs/theory.md §9, "Clearance of a real bed") and the DEM's initial placement.
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// Closed-form collect-and-collide models of a particle damper (docs/physics.md §2-4).
+// Closed-form collect-and-collide models of a particle damper (docs/theory.md §2-4).
 //
 // One ideal model serves both regimes: the bed moves as one block that leaves a wall
 // at maximum container velocity, travels relative to the container, and hits the
@@ -24,7 +24,7 @@ inline constexpr double kStandardGravity = 9.80665;
 inline constexpr double kPi = 3.14159265358979323846;
 
 /// kCoulombBlock: a nested bed (ModelOptions::nested_bed), whose spheres cannot rotate: a
-/// block on its base held by Coulomb friction (docs/physics.md §3.3). `auto` answers with it
+/// block on its base held by Coulomb friction (docs/theory.md §3.3). `auto` answers with it
 /// for a nested bed; it has no collect-and-collide onset or peak (optimum_stroke refuses it).
 enum class DamperModel { kRolling, kBouncing, kScattered, kAuto, kCoulombBlock };
 std::string_view to_string(DamperModel model);
@@ -41,7 +41,7 @@ enum class MotionRegime {
 };
 std::string_view to_string(MotionRegime regime);
 
-/// Empirical scattered-state law (docs/physics.md §4) in s = X/X_onset < 1:
+/// Empirical scattered-state law (docs/theory.md §4) in s = X/X_onset < 1:
 ///   η*(s) = jump_fraction · η*_onset · s^exponent
 /// where η*_onset is the ideal orbit's value at the onset of the model in use, so
 /// jump_fraction < 1 is the height of the jump into the collect-and-collide state.
@@ -67,7 +67,7 @@ struct ScatteredFit {
   std::vector<std::string> validate() const;
 };
 
-/// What answers below the collect-and-collide onset (docs/physics.md §4).
+/// What answers below the collect-and-collide onset (docs/theory.md §4).
 enum class BelowOnsetModel {
   kScatteredFit,  ///< the empirical law of ScatteredFit (§4.1): the default
   kImpactMap,     ///< the plastic block's deterministic impact map, tabulated in cX/h (§4.2)
@@ -102,7 +102,7 @@ struct ModelOptions {
   /// (default 0.3, dry steel on steel; a case takes its DEM contact's). It sets where
   /// `auto` leaves rolling: spheres roll without slip while μ >= κΓ/(1+κ).
   double base_friction = 0.3;
-  /// Collective restitution e_b of the collected bed at a wall (docs/physics.md §3.1): the bed
+  /// Collective restitution e_b of the collected bed at a wall (docs/theory.md §3.1): the bed
   /// leaves the wall it has hit with e_b times its impact speed relative to the container.
   /// In [0, kMaxBedRestitution]. 0 (default): the plastic orbits of §2-3, bit for bit. A
   /// property of the bed, not of one contact: fit it from the DEM's jump and peak
@@ -114,7 +114,7 @@ struct ModelOptions {
   double particle_restitution = std::numeric_limits<double>::quiet_NaN();
   /// The settled bed keeps spheres resting on two or more others (formulas::LatticeBed::
   /// settled_upper_spheres > 0): they cannot rotate, so with gravity across the drive `auto`
-  /// takes the Coulomb block (docs/physics.md §3.3) and `rolling` warns. false: a bed one
+  /// takes the Coulomb block (docs/theory.md §3.3) and `rolling` warns. false: a bed one
   /// sphere high (after settling), which rolls.
   bool nested_bed = false;
   /// Below the onset: the scattered fit (default) or the plastic block's impact map.
@@ -134,7 +134,7 @@ struct IdealOrbit {
   /// ψ in [0, atan(2/π)] on kSubPeak; NaN when scattered.
   double impact_phase_rad = 0.0;
 };
-/// φ* in [0, π] solving φ − sin φ = r for r = h_eff/X in [0, π] (docs/physics.md §2), to a
+/// φ* in [0, π] solving φ − sin φ = r for r = h_eff/X in [0, π] (docs/theory.md §2), to a
 /// few ulp: start from the inverse series at 0, φ ≈ (6r)^{1/3}(1 + (6r)^{2/3}/60 + ...),
 /// or at π, then 1-3 safeguarded Newton steps on the convex φ − sin φ (summed as a
 /// series below φ = 1, where the difference cancels); about 0.1 µs. Never fails on
@@ -188,7 +188,7 @@ struct LossResult {
   double velocity_amplitude_m_s = 0.0;  ///< |V*| = XΩ
   double impact_phase_rad = 0.0;  ///< NaN in the scattered state
   double stroke_over_onset = 0.0; ///< s = X/X_onset of the family used
-  std::vector<std::string> warnings;  ///< validity-range violations (docs/interface.md)
+  std::vector<std::string> warnings;  ///< validity-range violations (docs/command_line.md)
   /// How many warnings apply (warnings.size(), also when reduced_loss_factor_counted
   /// leaves `warnings` empty).
   std::size_t warning_count = 0;
@@ -204,11 +204,11 @@ double auto_inertia_factor(double intensity, const ModelOptions& options);
 /// Γ_slip = μ(1+κ)/κ: the intensity up to which the base friction keeps spheres rolling.
 double slip_intensity(const ModelOptions& options);
 /// Onset stroke (1+κ)h/√(π²+4) and η* there, 4π/((π²+4)(1+κ)), of the block of inertia
-/// factor κ (docs/physics.md §2-3).
+/// factor κ (docs/theory.md §2-3).
 double onset_stroke_m(double inertia_factor, double clearance_m);
 double onset_reduced_loss_factor(double inertia_factor);
 
-// ---- The rebounding bed: collective restitution e_b (docs/physics.md §3.1) ---------------
+// ---- The rebounding bed: collective restitution e_b (docs/theory.md §3.1) ---------------
 // A collected bed that rebounds from a wall as a whole with restitution e_b, K = (1+e_b)/(1−e_b),
 // c = 1/(1+κ): its symmetric orbit (impacts at ψ and π + ψ) closes when
 //   h/(cX) = πK cos ψ + 2 sin ψ = R_b cos(ψ − α_b),  R_b = √(π²K² + 4),  α_b = atan(2/(πK)),
@@ -226,7 +226,7 @@ double onset_reduced_loss_factor(double inertia_factor, double bed_restitution);
 double peak_stroke_m(double inertia_factor, double clearance_m, double bed_restitution);
 double peak_reduced_loss_factor(double inertia_factor, double bed_restitution);
 
-/// The rebounding block's symmetric orbit at stroke X (docs/physics.md §3.1). On the branch
+/// The rebounding block's symmetric orbit at stroke X (docs/theory.md §3.1). On the branch
 /// joined to the peak, ψ = α_b − acos(h/(cX R_b)): ψ in (0, α_b] below the peak, ψ < 0 above
 /// it, where the block leaves each wall before the container's velocity extreme with e_b
 /// times its impact speed. That continuation holds while the relative velocity keeps its
@@ -243,7 +243,7 @@ struct ReboundingOrbit {
 ReboundingOrbit rebounding_orbit(double inertia_factor, double bed_restitution, double clearance_m,
                                  double stroke_m);
 
-/// Upper bound of e_b from one sphere (docs/physics.md §3.1): a sphere rolling into a
+/// Upper bound of e_b from one sphere (docs/theory.md §3.1): a sphere rolling into a
 /// frictionless wall at u leaves it at −εu with its spin; base friction, conserving u − κσ
 /// (σ = ωr), brings it back to rolling at −u(ε − κ)/(1+κ). So e_b <= max(0, (ε − κ)/(1+κ)):
 /// a sphere with ε <= κ does not leave the wall. Bouncing (κ = 0): ε. Wall friction, the
@@ -251,7 +251,7 @@ ReboundingOrbit rebounding_orbit(double inertia_factor, double bed_restitution, 
 /// [0, 1] (std::invalid_argument otherwise).
 double bed_restitution_bound(double particle_restitution, double inertia_factor);
 
-/// e_b of a bed from two DEM points (docs/physics.md §3.1): the jump (the lowest stroke at
+/// e_b of a bed from two DEM points (docs/theory.md §3.1): the jump (the lowest stroke at
 /// which the bed is in collect-and-collide, X_on) and the peak (the largest η*, η*_pk). Each
 /// alone gives e_b in closed form: K_on = √((h/(cX_on))² − 4)/π and K_pk = πη*_pk/(4c);
 /// the fit takes the e_b in [0, kMaxBedRestitution] that minimises the sum of the squared
@@ -271,7 +271,7 @@ struct BedRestitutionFit {
 BedRestitutionFit fit_bed_restitution(double inertia_factor, double clearance_m, double onset_stroke_m,
                                       double peak_eta_star);
 
-// ---- Below the onset: the plastic block's impact map (docs/physics.md §4.2) ---------------
+// ---- Below the onset: the plastic block's impact map (docs/theory.md §4.2) ---------------
 /// The plastic block of §2 (κ = 0) below its onset, simulated: collected on the wall it
 /// leaves at the container's velocity extreme, in free flight relative to the container
 /// (relative acceleration −a_c), plastic at the walls, riding with a wall while it pushes.
@@ -310,7 +310,7 @@ struct ImpactMapTable {
 };
 const ImpactMapTable& impact_map_table();
 
-// ---- Nested beds: the Coulomb block (docs/physics.md §3.3) --------------------------------
+// ---- Nested beds: the Coulomb block (docs/theory.md §3.3) --------------------------------
 /// A block on its base with Coulomb friction μ in a container x_c = X sin φ with walls h apart,
 /// r = μ/Γ. Stuck for r >= 1 (η* = 0, m_app = m_bed). Above: released at sin φ_d = r, it slides
 /// with u/V = cos φ_d − cos φ − r(φ − φ_d) until it sticks again (stick-slip, r > r_c =
@@ -350,7 +350,7 @@ LossResult reduced_loss_factor(DamperModel model, double clearance_m, double str
 LossResult reduced_loss_factor_counted(DamperModel model, double clearance_m, double stroke_m,
                                        double frequency_hz, const ModelOptions& validated_options);
 
-/// Energy measures from η* (docs/physics.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
+/// Energy measures from η* (docs/theory.md §1): E_diss = η*·½ m_bed |V*|² = Re(P)/Ω, J.
 /// η* >= 0, m_bed > 0, |V*| >= 0, all finite (std::invalid_argument otherwise).
 double dissipated_energy_measure(double eta_star, double bed_mass_kg, double velocity_amplitude_m_s);
 /// Energy dissipated per cycle, 2π·E_diss, J; e_diss_j >= 0 and finite.

@@ -1,4 +1,4 @@
-// Complex-power measure of damper dissipation (Yang's method, docs/physics.md §1).
+// Complex-power measure of damper dissipation (Yang's method, docs/theory.md §1).
 //
 // Derivation and conventions: docs/complex_power.md.
 #pragma once
@@ -25,7 +25,7 @@ struct ComplexPower {
   double apparent_mass_kg = 0.0;
   int periods = 0;             ///< whole periods analysed, k >= 1
   int samples_per_period = 0;  ///< T/dt, >= 3
-  /// η* = E_diss/(½ m_bed |V*|²), dimensionless (docs/physics.md §1); a viscous damper c
+  /// η* = E_diss/(½ m_bed |V*|²), dimensionless (docs/theory.md §1); a viscous damper c
   /// gives c/(m_bed Ω). Throws std::invalid_argument unless bed_mass_kg > 0 and finite.
   double reduced_loss_factor(double bed_mass_kg) const;
 };

@@ -1,4 +1,4 @@
-// Coefficient-of-restitution models: the contact level of pdamp (docs/physics.md §6).
+// Coefficient-of-restitution models: the contact level of pdamp (docs/theory.md §6).
 #pragma once
 
 #include <memory>
@@ -23,7 +23,7 @@ class RestitutionModel {
 std::unique_ptr<RestitutionModel> make_constant_restitution(double restitution);
 
 /// ε = ε₀ − k·v (v in m/s), clamped to [kMinLinearRestitution, 1]: the steel-polymer
-/// trend of docs/physics.md §6 (nearly flat, slight linear decrease). ε₀ in (0, 1], k finite
+/// trend of docs/theory.md §6 (nearly flat, slight linear decrease). ε₀ in (0, 1], k finite
 /// (s/m; k > 0 is a decrease).
 std::unique_ptr<RestitutionModel> make_linear_restitution(double intercept, double slope_s_per_m);
 /// Floor of the linear law, so that a steep line never gives ε <= 0.
@@ -45,7 +45,7 @@ std::unique_ptr<RestitutionModel> make_tabulated_restitution(std::span<const dou
 /// continuous at v_y, decreasing, ε ~ 1.19·r^{1/4} (∝ v^{−1/4}) for v ≫ v_y.
 /// p_y is the limiting contact PRESSURE, not the yield stress Y (p_y ≈ 1.6 Y at first
 /// yield: use make_thornton_restitution_from_yield_stress for Y). E* (Pa), R* (m),
-/// m* (kg) are the contact's effective quantities (docs/physics.md §5); all > 0.
+/// m* (kg) are the contact's effective quantities (docs/theory.md §5); all > 0.
 std::unique_ptr<RestitutionModel> make_thornton_restitution(double limiting_pressure_pa,
                                                             double effective_modulus_pa,
                                                             double effective_radius_m,
@@ -103,7 +103,7 @@ RestitutionFit fit_restitution(const ImpactData& data, RestitutionLaw law,
 /// Damped Hertz contact F = K δ^{3/2} + γ_n·√(m* K)·δ^{1/4}·δ̇ (K = (4/3)E*√R*): in
 /// units δ₀ = (m*v²/K)^{2/5} and t₀ = δ₀/v it is x'' = −x^{3/2} − γ_n x^{1/4} x',
 /// x(0) = 0, x'(0) = 1, so ε depends on the dimensionless γ_n alone, for any speed,
-/// mass and stiffness. The textbook law (docs/physics.md §6, S_n = 2E*√(R*δ) = (3/2)Kδ^{1/2})
+/// mass and stiffness. The textbook law (docs/theory.md §6, S_n = 2E*√(R*δ) = (3/2)Kδ^{1/2})
 /// is γ_n = −√5·β with β = ln ε/√(ln²ε + π²); it reaches ε (to ~1e-6) only if the
 /// contact is taken to end at zero overlap with a tensile force allowed.
 /// pdamp's contact ends when the total force returns to zero (no tension), which

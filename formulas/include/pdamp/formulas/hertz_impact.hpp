@@ -1,4 +1,4 @@
-// Hertz impact of elastic spheres and buffered-wall sizing (docs/physics.md §5).
+// Hertz impact of elastic spheres and buffered-wall sizing (docs/theory.md §5).
 //
 // Derivations, constants and the buffer's assumptions: docs/hertz_and_buffer.md.
 #pragma once
@@ -39,7 +39,7 @@ HertzContact sphere_wall_contact(double radius_m, double mass_kg, const Material
                                  const Material& wall);
 HertzContact sphere_rigid_wall_contact(double radius_m, double mass_kg, const Material& sphere);
 
-/// Elastic impact at normal approach speed v > 0 (docs/physics.md §5). Energy balance
+/// Elastic impact at normal approach speed v > 0 (docs/theory.md §5). Energy balance
 /// ½m*v² = ∫₀^δ F dδ' = (8/15) E* √R* δ^{5/2} at the turning point gives
 ///   δ_max = (15 m* v² / (16 E* √R*))^{2/5}, m.
 /// Both throw std::invalid_argument unless v > 0 and finite and the contact's E*, R*,
@@ -63,7 +63,7 @@ enum class BufferModel {
   kHalfSpace,
 };
 
-/// Design of a polymer layer on a container wall (docs/physics.md §5): the thickness t
+/// Design of a polymer layer on a container wall (docs/theory.md §5): the thickness t
 /// whose tip strain under the design impact, δ_max/t (the compression of the layer under
 /// the sphere's tip over its thickness), equals the allowable strain ε_a of the polymer:
 /// δ_max(t) = ε_a·t. ε_a = 1 is the layer the design impact just compresses fully
@@ -127,7 +127,7 @@ struct BufferDesign {
   double half_space_thickness_m = 0.0;
   double layered_compression_of_half_space_design = 0.0;
   std::vector<std::string> assumptions;   ///< readable sentences with the numbers used
-  std::vector<std::string> warnings;      ///< validity-range violations (docs/interface.md)
+  std::vector<std::string> warnings;      ///< validity-range violations (docs/command_line.md)
 };
 /// Sizes the layer: X from Γ if needed, v = 2XΩ unless given, m* from the bed's sharing,
 /// E* from particle and layer; kLayered: t from ½m*v² = U(ε_a t; t) with the layered law

@@ -1,4 +1,4 @@
-// Contact of a sphere with an elastic layer bonded to a rigid wall (docs/physics.md §5).
+// Contact of a sphere with an elastic layer bonded to a rigid wall (docs/theory.md §5).
 //
 // Derivations, limits and the numerical reference: docs/hertz_and_buffer.md, section
 // "A thin layer is not a half-space".

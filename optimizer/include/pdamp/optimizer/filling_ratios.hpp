@@ -1,4 +1,4 @@
-// Filling ratios of a multi-layer particle damper for a transient (docs/physics.md
+// Filling ratios of a multi-layer particle damper for a transient (docs/theory.md
 // §7.7): how many whole slabs of spheres each stacked layer holds so that the
 // structure's free decay settles fastest under a particle-mass budget.
 #pragma once

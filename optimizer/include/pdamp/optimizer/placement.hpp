@@ -9,7 +9,7 @@
 // it (down the onset cliff into the scattered state), and the added damping ratio of the
 // single-mode averaged model (structure::backbone_point),
 // is what placement maximises. ζ_add,j is the backbone's Σ_dampers Σ_layers b_j² η* m_bed / (2 m_eff),
-// ≈ ½ η* μ_j for a small modal mass ratio μ_j = b_j² m_bed/m_j (docs/physics.md §7.3).
+// ≈ ½ η* μ_j for a small modal mass ratio μ_j = b_j² m_bed/m_j (docs/theory.md §7.3).
 #pragma once
 
 #include <cstdint>

@@ -38,7 +38,7 @@ struct RobustSizingOptions {
   std::optional<double> clearance_min_m;
   std::optional<double> clearance_max_m;
   /// Every operating stroke stays at X >= (1 + onset_margin)·X_onset(h), X_onset the
-  /// onset of the family the closed form uses there (docs/physics.md §2-3); in [0, 1].
+  /// onset of the family the closed form uses there (docs/theory.md §2-3); in [0, 1].
   double onset_margin = 0.1;
   RobustCriterion criterion = RobustCriterion::kWorstCase;
   /// One line per violated rule ("stroke_min_m = 0: must be > 0 and finite"), the

@@ -1,5 +1,5 @@
 // Starting external programs (gnuplot) without a shell, and the interruption state
-// that a signal leaves (docs/interface.md: "No shell: external programs start with an
+// that a signal leaves (docs/command_line.md: "No shell: external programs start with an
 // argument vector; nothing in a case file or a path can run a command").
 #pragma once
 

@@ -14,7 +14,7 @@ namespace pdamp::report {
 
 /// Collects a command's result files in a staging folder inside DIR and moves each
 /// into place with rename() only when all are complete, so an interrupted or failed
-/// command leaves no partial file (docs/interface.md: -o DIR writes atomically). A run
+/// command leaves no partial file (docs/command_line.md: -o DIR writes atomically). A run
 /// replaces the whole set of files the previous run wrote into DIR (listed in
 /// DIR/.pdamp-outputs.json), so the outputs of two runs never mix; files pdamp did not
 /// write are never touched.

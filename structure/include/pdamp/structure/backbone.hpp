@@ -1,6 +1,6 @@
 // Backbones of a modal model with particle dampers: per mode, the single-mode averaged
 // natural frequency and added damping ratio as functions of the damper amplitude
-// (docs/physics.md §7.5, docs/structure_coupling.md §6; NLvib's nonlinear modal analysis in its
+// (docs/theory.md §7.5, docs/structure_coupling.md §6; NLvib's nonlinear modal analysis in its
 // single-mode, single-harmonic form).
 #pragma once
 

@@ -1,5 +1,5 @@
 // Particle dampers attached to a modal model: the first-harmonic equivalent dynamic
-// stiffness of each bed layer and the point mass of each container (docs/physics.md §7.2,
+// stiffness of each bed layer and the point mass of each container (docs/theory.md §7.2,
 // docs/structure_coupling.md §1-2).
 #pragma once
 
@@ -78,7 +78,7 @@ struct CouplingOptions {
 /// Force the container applies to the bed, F̂ = Z(Ω, X)·X̂, with
 ///   Z = −Ω² m_bed (m_app/m_bed) + iΩ c_eq,   c_eq = η*(f, X)·m_bed·Ω,
 /// so the bed pushes the structure with −F̂. Check: the energy per cycle π c_eq Ω X² equals
-/// 2π·η*·½ m_bed (XΩ)², the definition of η* (docs/physics.md §1), and Im(F̂ conj V̂)/(Ω|V̂|²)
+/// 2π·η*·½ m_bed (XΩ)², the definition of η* (docs/theory.md §1), and Im(F̂ conj V̂)/(Ω|V̂|²)
 /// = m_app (V̂ = iΩX̂).
 struct LayerImpedance {
   std::complex<double> dynamic_stiffness_n_m;    ///< Z, N/m

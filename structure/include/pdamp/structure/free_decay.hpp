@@ -1,5 +1,5 @@
 // Free decay of a modal model with particle dampers by slowly varying amplitude: per mode an
-// envelope a_j(t) with dE_j/dt = −E_cycle(X)/T (docs/physics.md §7.6, docs/structure_coupling.md §7).
+// envelope a_j(t) with dE_j/dt = −E_cycle(X)/T (docs/theory.md §7.6, docs/structure_coupling.md §7).
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 // Forced response of a modal model with particle dampers by first-order harmonic balance:
 // every root of the amplitude equations per frequency, their slow-flow stability, the
-// branches, folds and jumps, and the peaks (docs/physics.md §7.4, docs/structure_coupling.md §3-5).
+// branches, folds and jumps, and the peaks (docs/theory.md §7.4, docs/structure_coupling.md §3-5).
 #pragma once
 
 #include <complex>

@@ -1,4 +1,4 @@
-// Modal reduced models of structures (docs/physics.md §7): the data every coupling shares.
+// Modal reduced models of structures (docs/theory.md §7): the data every coupling shares.
 // A ModalModel comes from the beam finite elements (beam.hpp) or from imported modal
 // data (a user's own FE package; a 1-DOF oscillator is one mode).
 //

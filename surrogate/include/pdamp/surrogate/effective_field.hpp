@@ -29,7 +29,7 @@ enum class FieldSource { kFormulas, kDem, kMeasured };
 std::string_view to_string(FieldSource source);
 std::optional<FieldSource> field_source_from_string(std::string_view name);
 
-/// The damper's response at one grid point (docs/physics.md §1). NaN marks "not given".
+/// The damper's response at one grid point (docs/theory.md §1). NaN marks "not given".
 struct FieldPoint {
   static constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
   double eta_star = kUnknown;                ///< reduced loss factor η* = E_diss/E_kin, dimensionless

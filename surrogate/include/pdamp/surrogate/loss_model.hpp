@@ -25,7 +25,7 @@ enum LossWarning : std::uint32_t {
   kLossApparentMassAssumed = 1u << 5,    ///< apparent mass from a stated assumption, not derived or measured
 };
 
-/// The damper's response at one operating point (docs/physics.md §1).
+/// The damper's response at one operating point (docs/theory.md §1).
 struct DamperResponse {
   double eta_star = 0.0;                ///< reduced loss factor η*, dimensionless
   double apparent_mass_fraction = 1.0;  ///< m_app/m_bed, dimensionless; NaN where the source does not give it
@@ -79,7 +79,7 @@ std::vector<std::string> describe_loss_warnings(std::uint32_t warnings);
 /// sub-peak orbit (impact at π + ψ): m_app/m_bed = −(2/π) sin 2ψ (−8/(π²+4) = −0.577 at the onset).
 /// Rolling spheres (κ > 0) move as v_c + u_block/(1+κ):  m_app/m_bed = (κ + m_block)/(1+κ).
 /// Below the onset (no orbit, scattered fit for η*) the assumption is the no-impact
-/// limit κ/(1+κ) (2/7 for rolling solid spheres, docs/physics.md §3; 0 for a free block),
+/// limit κ/(1+κ) (2/7 for rolling solid spheres, docs/theory.md §3; 0 for a free block),
 /// flagged kLossApparentMassAssumed. Derivatives in X are analytic (chain rule through the
 /// impact phase and, for auto's friction-limited sliding, through κ_eff(Γ)). They diverge
 /// like 1/√(X − X_onset) just above the onset (a saddle-node, docs §3): the onset is a jump

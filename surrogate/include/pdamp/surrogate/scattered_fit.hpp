@@ -1,4 +1,4 @@
-// Weighted least-squares fit of the empirical scattered-state law (docs/physics.md §4) to
+// Weighted least-squares fit of the empirical scattered-state law (docs/theory.md §4) to
 // field points below the collect-and-collide onset, and its coefficient file.
 #pragma once
 

@@ -100,7 +100,7 @@ struct SweepResult {
 /// directory, FIFO or device throws std::invalid_argument at once. A second sweep on the
 /// same file at the same time is refused (std::runtime_error; the file is locked with flock).
 ///
-/// Ok points with NaN e_diss_j get η*·½ m_bed (XΩ)² (docs/physics.md §1), and NaN
+/// Ok points with NaN e_diss_j get η*·½ m_bed (XΩ)² (docs/theory.md §1), and NaN
 /// apparent_mass_fraction gets apparent_mass_kg/m_bed.
 ///
 /// If the evaluator or the progress callback throws, no new point is started, points in

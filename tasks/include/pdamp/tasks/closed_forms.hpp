@@ -37,7 +37,7 @@ std::vector<CurvePoint> eta_curve(formulas::DamperModel model, double clearance_
                                   const formulas::ModelOptions& options, double x_min_m, double x_max_m, int points);
 
 /// The loss factor at one operating point, with the energies of a bed of `bed_mass_kg`
-/// (docs/physics.md §2: E_diss = η* · ½ m_bed |V*|², the energy per cycle 2π E_diss, the
+/// (docs/theory.md §2: E_diss = η* · ½ m_bed |V*|², the energy per cycle 2π E_diss, the
 /// equivalent viscous damping η* m_bed Ω).
 struct LossPoint {
   formulas::LossResult loss;

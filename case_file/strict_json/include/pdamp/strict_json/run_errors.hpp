@@ -1,7 +1,7 @@
 // The errors of a run that are not bad input (input_error.hpp): a numerical failure found
 // while computing, and a stop asked for by a signal. With InputError they are pdamp's whole
 // error model; the command line maps each class to its exit code in one table
-// (docs/interface.md: 2 bad input, 3 numerical failure, the signal's own end).
+// (docs/command_line.md: 2 bad input, 3 numerical failure, the signal's own end).
 #pragma once
 
 #include <stdexcept>
