@@ -230,7 +230,8 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
                                                            p.end_time_s, false, p.steps_per_s, NAN});
                                          });
         });
-        detail::check_outcome(branch.outcome, branch.message, label(branch.points.size()));
+        // The point that stopped the branch is the first without a result; a completed branch has none.
+        detail::check_outcome(branch.outcome, branch.message, label(std::min(branch.points.size(), n - 1)));
         for (std::size_t i = 0; i < branch.points.size(); ++i)
           for (double m : branch.points[i].magnitude)
             if (!std::isfinite(m)) throw NumericalError(label(i) + ": the steady-state amplitude is not finite");
