@@ -238,11 +238,13 @@ std::vector<std::string> settled_bed_warnings(const Case& c) {
              << ": the closed forms model a collected bed moving as one block, whose orbits do not depend on "
                 "restitution; single spheres rebound from the walls";
         if (std::isfinite(d.model_options.particle_restitution))
-          text << " (with eps = " << d.model_options.particle_restitution
-               << " up to bed_restitution = (eps - kappa)/(1 + kappa) = "
+          text << " (with eps = " << d.model_options.particle_restitution << ", rolling: bed_restitution between "
+               << formulas::frictionless_wall_restitution(d.model_options.particle_restitution,
+                                                          d.model_options.rolling_inertia_factor)
+               << " at frictionless walls and "
                << formulas::bed_restitution_bound(d.model_options.particle_restitution,
                                                   d.model_options.rolling_inertia_factor)
-               << " for rolling)";
+               << " when the walls stop the spin)";
         text << ": set model_options.bed_restitution (docs/theory.md §3.1) or use the layer's DEM field";
         out.push_back(text.str());
       }

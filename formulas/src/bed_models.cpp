@@ -297,11 +297,18 @@ ReboundingOrbit rebounding_orbit(double inertia_factor, double bed_restitution, 
   return orbit;
 }
 
-double bed_restitution_bound(double particle_restitution, double inertia_factor) {
+double frictionless_wall_restitution(double particle_restitution, double inertia_factor) {
   require(particle_restitution > 0.0 && particle_restitution <= 1.0, "particle_restitution", particle_restitution,
           "in (0, 1]");
   require_inertia_factor(inertia_factor);
   return std::max(0.0, (particle_restitution - inertia_factor) / (1.0 + inertia_factor));
+}
+
+double bed_restitution_bound(double particle_restitution, double inertia_factor) {
+  require(particle_restitution > 0.0 && particle_restitution <= 1.0, "particle_restitution", particle_restitution,
+          "in (0, 1]");
+  require_inertia_factor(inertia_factor);
+  return particle_restitution / (1.0 + inertia_factor);
 }
 
 BedRestitutionFit fit_bed_restitution(double inertia_factor, double clearance_m, double onset_stroke,

@@ -609,7 +609,7 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
   if (options.bed_restitution > 0.0 && std::isfinite(options.particle_restitution) &&
       options.bed_restitution > bed_restitution_bound(options.particle_restitution, inertia_factor)) {
     warn([&] { return std::string(
-        "bed_restitution e_b = " + format(options.bed_restitution) + " exceeds what one sphere can give, (eps - kappa)/"
+        "bed_restitution e_b = " + format(options.bed_restitution) + " exceeds what one sphere can give, eps/"
         "(1+kappa) = " + format(bed_restitution_bound(options.particle_restitution, inertia_factor)) + " for eps = " +
         format(options.particle_restitution) + " and kappa = " + format(inertia_factor) +
         " (docs/theory.md section 3.1): a bed rebounds less than its front sphere, so the onset and peak are placed "

@@ -375,27 +375,34 @@ TEST_CASE("bed_restitution 0 is the plastic closed form bit for bit; small e_b i
   }
 }
 
-TEST_CASE("e_b is bounded by what one sphere gives, (eps - kappa)/(1 + kappa), and above it the closed forms warn",
+TEST_CASE("one sphere gives e_b between (eps - kappa)/(1 + kappa) at a frictionless wall and eps/(1 + kappa) "
+          "without spin, and above that the closed forms warn",
           "[formulas]") {
-  CHECK(fm::bed_restitution_bound(0.8, 0.4) == Approx(0.4 / 1.4).epsilon(1e-15));
-  CHECK(fm::bed_restitution_bound(0.3, 0.4) == 0.0);
-  CHECK(fm::bed_restitution_bound(0.4, 0.4) == 0.0);
+  CHECK(fm::frictionless_wall_restitution(0.8, 0.4) == Approx(0.4 / 1.4).epsilon(1e-15));
+  CHECK(fm::frictionless_wall_restitution(0.3, 0.4) == 0.0);
+  CHECK(fm::frictionless_wall_restitution(0.4, 0.4) == 0.0);
+  CHECK(fm::frictionless_wall_restitution(0.7, 0.0) == Approx(0.7).epsilon(1e-15));
+  CHECK(fm::bed_restitution_bound(0.8, 0.4) == Approx(0.8 / 1.4).epsilon(1e-15));
   CHECK(fm::bed_restitution_bound(0.7, 0.0) == Approx(0.7).epsilon(1e-15));
-  // Independent derivation by integration: a sphere rolling at u into a frictionless wall
-  // leaves it at −εu with its spin σ = u; base friction (constant μg against the slip
-  // u − σ... here in the convention where rolling is u = σ) slows the slip until it rolls:
-  // du/dt = −a·sign(u − σ), dσ/dt = +a·sign(u − σ)/κ, explicit steps of 1e-6 of the slip time.
+  // Independent derivation by integration: a sphere rolling at u = 1 into the wall leaves it
+  // at −ε with spin σ0 (σ = ωr; 1 at a frictionless wall, which keeps the spin; 0 when the
+  // wall stops it); base friction (constant deceleration a against the slip) acts until it
+  // rolls: du/dt = a·sign(σ − u), dσ/dt = −a·sign(σ − u)/κ, explicit steps of 1e-6 of the
+  // slip time, rolling again at u = σ.
+  const auto rolls_back_at = [](double eps, double kappa, double sigma0) {
+    double u = -eps, sigma = sigma0;
+    const double a = 1.0, dt = 1e-6;
+    for (int k = 0; k < 10'000'000 && u < sigma; ++k) {
+      u += a * dt;
+      sigma -= a * dt / kappa;
+    }
+    return std::max(0.0, -u);
+  };
   for (const double eps : {0.5, 0.8, 0.95}) {
     for (const double kappa : {0.4, 2.0 / 3.0}) {
-      double u = -eps, sigma = 1.0;
-      const double a = 1.0, dt = 1e-6;
-      for (int k = 0; k < 10'000'000 && u < sigma; ++k) {
-        u += a * dt;
-        sigma -= a * dt / kappa;
-      }
-      // Rolling again at u = σ (opposite to the impact speed 1 if ε > κ).
-      CAPTURE(eps, kappa, u);
-      CHECK(std::max(0.0, -u) == Approx(fm::bed_restitution_bound(eps, kappa)).margin(3e-6));
+      CAPTURE(eps, kappa);
+      CHECK(rolls_back_at(eps, kappa, 1.0) == Approx(fm::frictionless_wall_restitution(eps, kappa)).margin(3e-6));
+      CHECK(rolls_back_at(eps, kappa, 0.0) == Approx(fm::bed_restitution_bound(eps, kappa)).margin(3e-6));
     }
   }
   CHECK_THROWS_AS(fm::bed_restitution_bound(0.0, 0.4), std::invalid_argument);
@@ -404,10 +411,10 @@ TEST_CASE("e_b is bounded by what one sphere gives, (eps - kappa)/(1 + kappa), a
 
   fm::ModelOptions o;
   o.particle_restitution = 0.8;
-  o.bed_restitution = 0.25;  // below (0.8 − 0.4)/1.4 = 0.286
+  o.bed_restitution = 0.55;  // below 0.8/1.4 = 0.571
   CHECK_FALSE(has_warning(fm::reduced_loss_factor(fm::DamperModel::kRolling, 0.01, 0.003, 3.0, o),
                           "exceeds what one sphere can give"));
-  o.bed_restitution = 0.35;
+  o.bed_restitution = 0.6;
   CHECK(has_warning(fm::reduced_loss_factor(fm::DamperModel::kRolling, 0.01, 0.003, 3.0, o),
                     "exceeds what one sphere can give"));
   o.bed_restitution = 0.95;

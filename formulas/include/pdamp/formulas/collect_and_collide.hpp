@@ -106,7 +106,7 @@ struct ModelOptions {
   /// leaves the wall it has hit with e_b times its impact speed relative to the container.
   /// In [0, kMaxBedRestitution]. 0 (default): the plastic orbits of §2-3, bit for bit. A
   /// property of the bed, not of one contact: fit it from the DEM's jump and peak
-  /// (fit_bed_restitution); one sphere bounds it by (ε − κ)/(1+κ) (bed_restitution_bound).
+  /// (fit_bed_restitution); one sphere bounds it by ε/(1+κ) (bed_restitution_bound).
   double bed_restitution = 0.0;
   /// Normal restitution ε of one sphere on the walls, in (0, 1], or NaN (default: unknown).
   /// Only checked against: bed_restitution above the one-sphere bound gets a warning. A case
@@ -243,12 +243,19 @@ struct ReboundingOrbit {
 ReboundingOrbit rebounding_orbit(double inertia_factor, double bed_restitution, double clearance_m,
                                  double stroke_m);
 
-/// Upper bound of e_b from one sphere (docs/theory.md §3.1): a sphere rolling into a
-/// frictionless wall at u leaves it at −εu with its spin; base friction, conserving u − κσ
-/// (σ = ωr), brings it back to rolling at −u(ε − κ)/(1+κ). So e_b <= max(0, (ε − κ)/(1+κ)):
-/// a sphere with ε <= κ does not leave the wall. Bouncing (κ = 0): ε. Wall friction, the
-/// spheres behind the front one and the spin-down time only lower it. ε in (0, 1], κ in
-/// [0, 1] (std::invalid_argument otherwise).
+/// e_b of one sphere at a frictionless wall (docs/theory.md §3.1): rolling into it at u, it
+/// leaves at −εu with its spin σ = u (σ = ωr); base friction, conserving u − κσ, brings it
+/// back to rolling at −u(ε − κ)/(1+κ), so max(0, (ε − κ)/(1+κ)) (a sphere with ε <= κ does not
+/// leave the wall). Bouncing (κ = 0): ε. ε in (0, 1], κ in [0, 1] (std::invalid_argument
+/// otherwise).
+double frictionless_wall_restitution(double particle_restitution, double inertia_factor);
+
+/// Upper bound of e_b from one sphere (docs/theory.md §3.1): ε/(1+κ), the sphere that leaves
+/// the wall at −εu without spin. Wall friction opposes the spin's slip at the wall and can
+/// stop it, not reverse it, so a lone sphere lies between frictionless_wall_restitution
+/// and this (the DEM, μ = 0.3: e_b 0.17-0.21 at ε = 0.3, 0.29-0.34 at ε = 0.5, above the
+/// frictionless 0 and 0.071); a bed's spheres behind the front one only lower it. ε in
+/// (0, 1], κ in [0, 1] (std::invalid_argument otherwise).
 double bed_restitution_bound(double particle_restitution, double inertia_factor);
 
 /// e_b of a bed from two DEM points (docs/theory.md §3.1): the jump (the lowest stroke at
