@@ -13,6 +13,7 @@
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/strict_json/input_error.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
 #include "pdamp/tasks/damper_design.hpp"
 #include "pdamp/tasks/dem_run.hpp"
@@ -112,6 +113,26 @@ TEST_CASE("a formulas field is the closed form at every node, here or spread ove
   CHECK(elsewhere.jobs_elsewhere == static_cast<int>(plan.grid.size()));
   CHECK(spread.field.points == here.field.points);
   CHECK_FALSE(here.scattered_fit.has_value());  // a formulas field has no scattered state to fit
+}
+
+// The descending branch's sweep: its approach stroke X_a may be a node of the grid (that
+// node and those above start from rest, as the evaluator runs them), and the sweep carries
+// X_a into the field's provenance. Planning only (no DEM run).
+TEST_CASE("a DEM field approached from above accepts X_a on its grid and records it", "[tasks]") {
+  const test::TempDir dir("field_approach");
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(case_path("fields/link_narrow_dem/case.json")));
+  const double top = j["field"]["axis1"]["max"].get<double>();
+  j["dem"]["approach"] = {{"amplitude_m", top}};
+  const auto path = dir.path / "narrow_from_above.json";
+  std::ofstream(path) << j.dump();
+  const auto c = case_file::load_case(path.string());
+  tasks::FieldOptions options;
+  options.source = "dem";
+  const auto plan = tasks::plan_field(c, options, tasks::local_executor());
+  CHECK(plan.sweep.approach_amplitude_m == top);
+  const auto at_top = surrogate::dem_point_options(c.dem.simulation, 3.6, top);
+  CHECK(at_top.approach_amplitude_m == 0.0);  // from rest at X_a itself
+  CHECK(surrogate::dem_point_options(c.dem.simulation, 3.6, 0.5 * top).approach_amplitude_m == top);
 }
 
 // Reference: the baseline variant is the case itself, so its eta* is the case's closed form
