@@ -25,6 +25,21 @@ inline dem::WorldOptions bed(double radius_m, const dem::Vec3& box_m, std::vecto
   return w;
 }
 
+/// One mode (f Hz, ζ, modal mass m) on a moving base with base participation Γ (kg) along y,
+/// shape φ = 1 along y at the point "tip".
+inline structure::ModalModel one_mode_on_base(double f_hz, double zeta, double mass_kg, double participation_kg) {
+  structure::ModalModel m;
+  m.natural_frequencies_hz = Eigen::VectorXd::Constant(1, f_hz);
+  m.damping_ratios = Eigen::VectorXd::Constant(1, zeta);
+  m.modal_masses_kg = Eigen::VectorXd::Constant(1, mass_kg);
+  Eigen::MatrixXd shape(2, 1);
+  shape << 0.0, 1.0;
+  m.points = {{"tip", shape, Eigen::RowVectorXd::Zero(1)}};
+  m.base_participation = Eigen::MatrixXd(1, 2);
+  m.base_participation << 0.0, participation_kg;
+  return m;
+}
+
 /// A damper at the point "tip", driven along y, with the bed `world`.
 inline structure::CosimulationDamper tip_damper(const dem::WorldOptions& world, double container_mass_kg) {
   structure::CosimulationDamper d;

@@ -25,16 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 /// container mass m_c, the site is the mass M = m + m_c on a spring k = m(2πf)² and a
 /// dashpot c = 2ζ(2πf)m to the base, in absolute coordinates M ÿ = −c(ẏ − u̇) − k(y − u).
 ModalModel base_oscillator(double f_hz, double zeta, double mass_kg) {
-  ModalModel m;
-  m.natural_frequencies_hz = Eigen::VectorXd::Constant(1, f_hz);
-  m.damping_ratios = Eigen::VectorXd::Constant(1, zeta);
-  m.modal_masses_kg = Eigen::VectorXd::Constant(1, mass_kg);
-  Eigen::MatrixXd shape(2, 1);
-  shape << 0.0, 1.0;
-  m.points = {{"tip", shape, Eigen::RowVectorXd::Zero(1)}};
-  m.base_participation = Eigen::MatrixXd(1, 2);
-  m.base_participation << 0.0, mass_kg;
-  return m;
+  return pdamp::test::one_mode_on_base(f_hz, zeta, mass_kg, mass_kg);
 }
 
 /// A single sphere floating in a long box without gravity: it keeps the container's start

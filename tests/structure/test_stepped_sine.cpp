@@ -23,18 +23,7 @@ constexpr double kPi = 3.14159265358979323846;
 /// it: 10/√1.25 = 8.944 Hz).
 constexpr double kF = 10.0, kZeta = 0.01, kM = 1.0, kGamma = 0.8, kMc = 0.25, kU = 1e-4;
 
-ModalModel lightly_damped_mode() {
-  ModalModel m;
-  m.natural_frequencies_hz = Eigen::VectorXd::Constant(1, kF);
-  m.damping_ratios = Eigen::VectorXd::Constant(1, kZeta);
-  m.modal_masses_kg = Eigen::VectorXd::Constant(1, kM);
-  Eigen::MatrixXd shape(2, 1);
-  shape << 0.0, 1.0;
-  m.points = {{"tip", shape, Eigen::RowVectorXd::Constant(1, 0.0)}};
-  m.base_participation = Eigen::MatrixXd(1, 2);
-  m.base_participation << 0.0, kGamma;
-  return m;
-}
+ModalModel lightly_damped_mode() { return pdamp::test::one_mode_on_base(kF, kZeta, kM, kGamma); }
 
 /// The exact steady transmissibility |U + q̂|/U of that mode with the container at f_hz.
 double exact_transmissibility(double f_hz) {
