@@ -195,6 +195,10 @@ int run_run(const ParsedArgs& args, CommandContext& context) {
   if (!context.primary && c.task.kind != case_file::TaskKind::kFrf && c.task.kind != case_file::TaskKind::kFillingRatios)
     return kExitOk;
   context.report = true;  // with -o DIR, the task also writes DIR/report.html
+  for (const char* flag : {"--no-verify", "--calibration-cache"})
+    if (args.has(flag) && c.task.kind != case_file::TaskKind::kFillingRatios)
+      throw InputError(flag, "", "applies to task kind filling_ratios; this case's task is " +
+                                     std::string(case_file::to_string(c.task.kind)));
   switch (c.task.kind) {
     case case_file::TaskKind::kDamperDesign:
       if (args.has("--method"))
@@ -528,11 +532,13 @@ const FlagSpec kModelOverrides[] = {
 const std::vector<Command>& commands() {
   static const std::vector<Command> all = [] {
     std::vector<Command> list = {
-      {{"run", "pdamp run CASE.json [--method formulas|field|dem] [--dem-points N] [--dem-sweep D] [--resume] [-o DIR] [--json]",
+      {{"run", "pdamp run CASE.json [--method formulas|field|dem|calibrated] [--dem-points N] [--dem-sweep D] [--no-verify] [--calibration-cache DIR] [--resume] [-o DIR] [--json]",
         "the main job: what the case's `task` asks (damper_design: optimum stroke, clearance\n"
         "for a target stroke, eta* curve over stroke, buffered-wall sizing; modes, frf, decay:\n"
         "as pdamp modes, frf and decay; filling_ratios and placement: as pdamp optimize)",
-        concat_flags(concat_flags({kMethodFlag, kNoVerifyFlag, kOutFlag, kJsonFlag}, kDemSweepFlags), kCheckpointFlags), 1},
+        concat_flags(concat_flags({kMethodFlag, kNoVerifyFlag, kCalibrationCacheFlag, kOutFlag, kJsonFlag}, kDemSweepFlags),
+                     kCheckpointFlags),
+        1},
        run_run, true},
       {{"optimum", "pdamp optimum --model rolling|bouncing --clearance M [--json]",
         "optimal container stroke for a clearance: design value, ideal peak and onset",

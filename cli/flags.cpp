@@ -47,6 +47,10 @@ const std::vector<FlagSpec> kCheckpointFlags{
 const FlagSpec kNoVerifyFlag{"--no-verify", "",
                              "skip the DEM verification the task's verify block asks for (the optimisation only)"};
 
+const FlagSpec kCalibrationCacheFlag{"--calibration-cache", "DIR",
+                                     "filling_ratios on calibrated beds: the folder of the beds' cache files\n"
+                                     "                          (default ~/.cache/pdamp/bed_calibration)"};
+
 case_file::LossMethod loss_method(const ParsedArgs& args, const std::string& command) {
   const std::string name = args.optional_text("--method").value_or("formulas");
   if (name == "formulas") return case_file::LossMethod::kFormulas;

@@ -20,6 +20,8 @@ extern const std::vector<FlagSpec> kDemSweepFlags;
 /// `--resume` and `--checkpoint-interval` (pdamp dem, decay --method dem, optimize --verify, run).
 extern const std::vector<FlagSpec> kCheckpointFlags;
 extern const FlagSpec kNoVerifyFlag;
+/// --calibration-cache DIR (pdamp optimize and pdamp run on a filling_ratios task).
+extern const FlagSpec kCalibrationCacheFlag;
 
 /// The loss models `--method` asks for (formulas, the default, or field); InputError for
 /// dem (a co-simulation, not a loss model) and anything else. `command` names who refuses dem.

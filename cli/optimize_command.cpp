@@ -30,7 +30,7 @@ const FlagSpec kBackendFlag{"--backend", "NAME",
 const FlagSpec kVerifyFlag{"--verify", "",
                            "run the DEM verification (the task's verify settings, or their defaults when the\n"
                            "                          task has none): DEM-in-the-loop free decay of the chosen and the\n"
-                           "                          baseline design against the closed forms (docs/optimizer.md)"};
+                           "                          baseline design against the prediction (docs/optimizer.md)"};
 
 std::optional<opt::Backend> backend_flag(const ParsedArgs& args) {
   const auto name = args.optional_text("--backend");
@@ -90,17 +90,25 @@ Rows verification_rows(const tasks::Verification& v) {
 }
 
 int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
-  if (args.has("--method"))
-    throw InputError("--method", "", "task kind filling_ratios uses the closed forms of each layer (formulas) only");
   if (args.has("--verify") && args.has("--no-verify")) throw InputError("--verify", "", "and --no-verify exclude each other");
   tasks::FillingRatiosOptions options;
+  if (const auto method = args.optional_text("--method")) {
+    if (*method != "formulas" && *method != "calibrated")
+      throw InputError("--method", "", "'" + *method + "': task kind filling_ratios takes formulas or calibrated");
+    options.calibrated = *method == "calibrated";
+  }
+  const bool calibrated = options.calibrated.value_or(c.task.filling_ratios->calibration.has_value());
+  if (const auto cache = args.optional_text("--calibration-cache")) {
+    if (!calibrated) throw InputError("--calibration-cache", "", "applies to calibrated beds (--method calibrated)");
+    options.calibration_cache = *cache;
+  }
   options.backend = backend_flag(args);
   options.force_verify = args.has("--verify");
   options.skip_verify = args.has("--no-verify");
   const bool verify = !options.skip_verify && (options.force_verify || c.task.filling_ratios->verify);
   if (!verify) refuse_checkpoint_flags(args, "applies to the DEM verification (--verify)");
-  // Under mpirun only the verification's DEM runs are spread over the ranks.
-  if (!context.primary && !verify) return kExitOk;
+  // Under mpirun only the calibration's and the verification's DEM runs are spread over the ranks.
+  if (!context.primary && !verify && !calibrated) return kExitOk;
   auto files = output_dir(args, context);
   if (verify) {
     const tasks::CheckpointFile folder = checkpoint_file(args, "verify");
@@ -212,7 +220,7 @@ int run_optimize_case(const ParsedArgs& args, CommandContext& context, const Cas
 }
 
 Command optimize_command() {
-  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field] [--verify|--no-verify] [--resume] [-o DIR] [--json]",
+  return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field|calibrated] [--calibration-cache DIR] [--verify|--no-verify] [--resume] [-o DIR] [--json]",
            "optimise the case's task (kind filling_ratios: whole slabs per layer of the first damper\n"
            "for the fastest free decay under a particle-mass budget; relaxed solve, rounded\n"
            "neighbours, single-layer baseline; with the task's verify block or --verify, the\n"
@@ -220,8 +228,10 @@ Command optimize_command() {
            "along a beam, or among named points, where the damper adds the most damping to the\n"
            "target modes; docs/optimizer.md)",
            concat_flags({kBackendFlag,
-            {"--method", "M", "placement only: each layer's eta*(f, X) from formulas (the closed forms;\n"
-                              "                          default) or field (its field_file); filling_ratios uses formulas"},
+            {"--method", "M", "each layer's eta*(f, X): placement formulas (the closed forms; default) or\n"
+                              "                          field (its field_file); filling_ratios formulas or calibrated (each\n"
+                              "                          candidate bed's DEM decay; default: calibrated with a calibration block)"},
+            kCalibrationCacheFlag,
             kVerifyFlag, kNoVerifyFlag,
             {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg,\n"
                           "                          case_resolved.json and with the verification verify_decay.csv,\n"

@@ -1,4 +1,5 @@
 // Designs of a filling_ratios case as cases of their own (case.hpp, with_design).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -8,7 +9,7 @@ namespace pdamp::case_file {
 
 using nlohmann::json;
 
-Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening) {
+Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening, bool other_seed) {
   if (!c.task.filling_ratios || c.format_version != 2)
     throw CaseError(c.path, "/task", "a design needs a format-2 case of task kind filling_ratios");
   const auto& damper = c.dampers.front();
@@ -33,6 +34,11 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
   if (stiffness_softening != 1.0) {
     if (!document["dem"].is_object()) document["dem"] = json::object();
     document["dem"]["stiffness_softening"] = c.dem.stiffness_softening * stiffness_softening;
+  }
+  if (other_seed) {
+    if (!document["dem"].is_object()) document["dem"] = json::object();
+    const auto seed = static_cast<long long>(c.dem.simulation.world.seed);
+    document["dem"]["seed"] = seed < std::numeric_limits<int>::max() ? seed + 1 : seed - 1;
   }
   return load_case_document(document, c.path);
 }

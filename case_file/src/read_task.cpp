@@ -152,6 +152,14 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
                                  number_text(lightest_slab_kg) + " kg");
   t.decay = read_decay(r, c);
   r.object("verify", false, [&](ObjectReader& v) { t.verify = read_verify(v, t.decay); });
+  r.object("calibration", false, [&](ObjectReader& b) {
+    CalibrationSpec spec;
+    spec.duration_s = b.number("duration_s", t.verify ? t.verify->duration_s : t.decay.duration_s, limits::kDuration, " s");
+    spec.stiffness_softening =
+        b.number("stiffness_softening", t.verify ? t.verify->stiffness_softening : 1.0, {1e-6, 1.0});
+    spec.strokes_per_decade = b.integer("strokes_per_decade", CalibrationSpec{}.strokes_per_decade, 1, 100);
+    t.calibration = spec;
+  });
   return t;
 }
 

@@ -114,6 +114,24 @@ std::vector<std::string> FillingRatioOptions::validate() const {
     problems.push_back("mass_budget_kg = 0 and max_total_slabs = 0: give at least one constraint");
   if (integral_samples < 10 || integral_samples > 100000)
     problems.push_back("integral_samples = " + std::to_string(integral_samples) + ": must be in [10, 100000]");
+  if (!bed_models.empty()) {
+    long designs = 1;
+    if (bed_models.size() != layers.size())
+      problems.push_back("bed_models: " + std::to_string(bed_models.size()) + " layers for " +
+                         std::to_string(layers.size()) + " candidates");
+    for (std::size_t k = 0; k < std::min(bed_models.size(), layers.size()); ++k) {
+      const int max_slabs = std::max(layers[k].max_slabs(), 0);
+      designs = std::min(designs * (max_slabs + 1L), kMaxEnumeratedDesigns + 1L);
+      bool complete = bed_models[k].size() == static_cast<std::size_t>(max_slabs) + 1;
+      for (std::size_t n = 1; complete && n < bed_models[k].size(); ++n) complete = bed_models[k][n] != nullptr;
+      if (!complete)
+        problems.push_back("bed_models[" + std::to_string(k) + "]: must hold a model for every slab count 1.." +
+                           std::to_string(max_slabs));
+    }
+    if (designs > kMaxEnumeratedDesigns)
+      problems.push_back("bed_models: more than " + std::to_string(kMaxEnumeratedDesigns) +
+                         " whole-slab designs to enumerate");
+  }
   if (!(decay.duration_s > 0.0 && std::isfinite(decay.duration_s)))
     problems.push_back("decay.duration_s = " + number(decay.duration_s) + ": must be > 0 and finite");
   return problems;
@@ -135,8 +153,15 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
     structure::DamperLayer layer;
     layer.name = l.name;
     layer.bed_mass_kg = n * l.slab_mass_kg();
-    layer.loss_model = std::make_shared<surrogate::ClosedFormLossModel>(
-        options.model, l.clearance_m(n), options.model_options);
+    if (options.bed_models.empty()) {
+      layer.loss_model =
+          std::make_shared<surrogate::ClosedFormLossModel>(options.model, l.clearance_m(n), options.model_options);
+    } else {
+      if (std::abs(n - std::round(n)) > kWholeTolerance)
+        throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + number(n) +
+                                    ": calibrated beds exist for whole slabs only");
+      layer.loss_model = options.bed_models[k][static_cast<std::size_t>(std::lround(n))];
+    }
     damper.layers.push_back(std::move(layer));
   }
   return damper;
@@ -285,65 +310,90 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
     out.warnings.push_back("the starting design (the case's particle counts) exceeds the budget: the search starts "
                            "inside the bounds instead");
 
-  // 1. The continuous relaxation: n_k real, mass and clearance linear in n_k.
-  Problem problem;
-  for (std::size_t k = 0; k < n_layers; ++k) {
-    const auto& l = options.layers[k];
-    const double upper = l.max_slabs();
-    problem.variables.push_back({"slabs_" + l.name, "", 0.0, upper, std::clamp<double>(l.initial_slabs, 0.0, upper)});
-  }
-  problem.objective = {std::string(to_string(options.objective)),
-                       [&](std::span<const double> x) { return evaluate(x).objective; }, nullptr};
-  if (options.mass_budget_kg > 0.0) {
-    // Scaled to kg/budget so that the constraint tolerance is relative.
-    problem.constraints.push_back(
-        {"mass_budget_kg",
-         [&](std::span<const double> x) { return total_mass(options, x) / options.mass_budget_kg - 1.0; },
-         [&](std::span<const double>, std::span<double> g) {
-           for (std::size_t k = 0; k < n_layers; ++k) g[k] = options.layers[k].slab_mass_kg() / options.mass_budget_kg;
-         }});
-  }
-  if (options.max_total_slabs > 0) {
-    problem.constraints.push_back(
-        {"max_total_slabs", [&](std::span<const double> x) { return total_slabs(x) / options.max_total_slabs - 1.0; },
-         [&](std::span<const double>, std::span<double> g) {
-           for (std::size_t k = 0; k < n_layers; ++k) g[k] = 1.0 / options.max_total_slabs;
-         }});
-  }
-  out.summary = solve(problem, solver);
-  out.relaxed = evaluate(out.summary.x);
+  if (!options.bed_models.empty()) {
+    // Calibrated beds exist at whole slabs only: every feasible whole-slab design (an
+    // odometer over the layers' counts), the best chosen.
+    std::vector<double> n(n_layers, 0.0);
+    double best = std::numeric_limits<double>::infinity();
+    for (;;) {
+      if (feasible(options, n)) {
+        out.neighbours.push_back(evaluate(n));
+        if (out.neighbours.back().objective < best) best = out.neighbours.back().objective, out.chosen = out.neighbours.back();
+      }
+      std::size_t k = 0;
+      while (k < n_layers && n[k] >= options.layers[k].max_slabs()) n[k++] = 0.0;
+      if (k == n_layers) break;
+      n[k] += 1.0;
+    }
+    out.neighbours_total = out.neighbours_feasible = static_cast<int>(out.neighbours.size());
+    out.relaxed = out.chosen;
+    out.summary.outcome = Outcome::kConverged;
+    out.summary.evaluations = out.decay_evaluations;
+    for (const auto& l : out.chosen.layers) out.summary.x.push_back(l.slabs);
+    out.summary.message = "every feasible whole-slab design with the calibrated beds (" +
+                          std::to_string(out.neighbours.size()) + " designs)";
+  } else {
+    // 1. The continuous relaxation: n_k real, mass and clearance linear in n_k.
+    Problem problem;
+    for (std::size_t k = 0; k < n_layers; ++k) {
+      const auto& l = options.layers[k];
+      const double upper = l.max_slabs();
+      problem.variables.push_back({"slabs_" + l.name, "", 0.0, upper, std::clamp<double>(l.initial_slabs, 0.0, upper)});
+    }
+    problem.objective = {std::string(to_string(options.objective)),
+                         [&](std::span<const double> x) { return evaluate(x).objective; }, nullptr};
+    if (options.mass_budget_kg > 0.0) {
+      // Scaled to kg/budget so that the constraint tolerance is relative.
+      problem.constraints.push_back(
+          {"mass_budget_kg",
+           [&](std::span<const double> x) { return total_mass(options, x) / options.mass_budget_kg - 1.0; },
+           [&](std::span<const double>, std::span<double> g) {
+             for (std::size_t k = 0; k < n_layers; ++k) g[k] = options.layers[k].slab_mass_kg() / options.mass_budget_kg;
+           }});
+    }
+    if (options.max_total_slabs > 0) {
+      problem.constraints.push_back(
+          {"max_total_slabs", [&](std::span<const double> x) { return total_slabs(x) / options.max_total_slabs - 1.0; },
+           [&](std::span<const double>, std::span<double> g) {
+             for (std::size_t k = 0; k < n_layers; ++k) g[k] = 1.0 / options.max_total_slabs;
+           }});
+    }
+    out.summary = solve(problem, solver);
+    out.relaxed = evaluate(out.summary.x);
 
-  // 2. Every rounded neighbour of the relaxed optimum (floor/ceil per fractional n_k).
-  std::vector<double> base(n_layers);
-  std::vector<std::size_t> fractional;
-  for (std::size_t k = 0; k < n_layers; ++k) {
-    const double x = out.summary.x[k];
-    const double whole = std::round(x);
-    if (std::abs(x - whole) <= kWholeTolerance) {
-      base[k] = whole;
-    } else {
-      base[k] = std::floor(x);
-      fractional.push_back(k);
+    // 2. Every rounded neighbour of the relaxed optimum (floor/ceil per fractional n_k).
+    std::vector<double> base(n_layers);
+    std::vector<std::size_t> fractional;
+    for (std::size_t k = 0; k < n_layers; ++k) {
+      const double x = out.summary.x[k];
+      const double whole = std::round(x);
+      if (std::abs(x - whole) <= kWholeTolerance) {
+        base[k] = whole;
+      } else {
+        base[k] = std::floor(x);
+        fractional.push_back(k);
+      }
     }
-  }
-  out.neighbours_total = 1 << fractional.size();
-  double best = std::numeric_limits<double>::infinity();
-  for (int mask = 0; mask < out.neighbours_total; ++mask) {
-    std::vector<double> n = base;
-    for (std::size_t b = 0; b < fractional.size(); ++b)
-      if (mask & (1 << b)) n[fractional[b]] += 1.0;
-    if (!feasible(options, n)) continue;
-    ++out.neighbours_feasible;
-    out.neighbours.push_back(evaluate(n));
-    if (out.neighbours.back().objective < best) {
-      best = out.neighbours.back().objective;
-      out.chosen = out.neighbours.back();
+    out.neighbours_total = 1 << fractional.size();
+    double best = std::numeric_limits<double>::infinity();
+    for (int mask = 0; mask < out.neighbours_total; ++mask) {
+      std::vector<double> n = base;
+      for (std::size_t b = 0; b < fractional.size(); ++b)
+        if (mask & (1 << b)) n[fractional[b]] += 1.0;
+      if (!feasible(options, n)) continue;
+      ++out.neighbours_feasible;
+      out.neighbours.push_back(evaluate(n));
+      if (out.neighbours.back().objective < best) {
+        best = out.neighbours.back().objective;
+        out.chosen = out.neighbours.back();
+      }
     }
-  }
-  if (out.neighbours.empty()) {
-    // Cannot happen for a feasible relaxed point (flooring only lowers mass and slabs).
-    throw strict_json::NumericalError("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
-                             out.summary.brief_report() + ")");
+    if (out.neighbours.empty()) {
+      // Cannot happen for a feasible relaxed point (flooring only lowers mass and slabs).
+      throw strict_json::NumericalError("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
+                               out.summary.brief_report() + ")");
+    }
+
   }
 
   // 3. The single-layer baseline: all mass in one layer, exhaustive over layer and slabs.

@@ -201,7 +201,7 @@ std::string caption(const std::string& file_name) {
       {"decay", "free decay with the dampers and without the beds"},
       {"decay_dem", "free decay, DEM in the loop"},
       {"decay_compare", "free-decay envelopes: chosen design, best single layer, case start"},
-      {"verify_decay", "DEM verification: envelopes by the DEM (solid) and by the closed forms (dashed)"},
+      {"verify_decay", "DEM verification: envelopes by the DEM (solid) and as predicted (dashed: the closed forms or the calibrated beds)"},
       {"force_velocity", "DEM: container force and velocity"},
       {"field_map", "effective field"},
       {"field_cuts", "effective field: cuts with the closed form"}};

@@ -285,7 +285,9 @@ Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
 
 /// verify_decay.csv (one block per design: the DEM's site displacement and envelope and the
 /// predicted envelope at the same instants) and its plot.
-Warnings verification_files(OutputDir& out, const std::string& case_name, const tasks::Verification& v) {
+/// `predicted_by`: what predicted ("closed forms", "calibrated beds").
+Warnings verification_files(OutputDir& out, const std::string& case_name, const tasks::Verification& v,
+                            const std::string& predicted_by) {
   std::ostringstream csv;
   csv.precision(10);
   csv << "# design, time_s, site_displacement_m (DEM), dem_envelope_m, predicted_envelope_m, threshold_m; "
@@ -301,18 +303,22 @@ Warnings verification_files(OutputDir& out, const std::string& case_name, const 
   }
   out.add("verify_decay.csv", csv.str());
   std::ostringstream gp;
-  gp << "# DEM verification of pdamp optimize: envelopes, DEM against the closed forms; run: gnuplot verify_decay.gp\n"
+  gp << "# DEM verification of pdamp optimize: envelopes, DEM against the " << predicted_by
+     << "; run: gnuplot verify_decay.gp\n"
      << "set datafile separator ','\n"
-     << "set title " << gnuplot_string(case_name + ": DEM verification (DEM in the loop vs closed forms)") << " noenhanced\n"
+     << "set title " << gnuplot_string(case_name + ": DEM verification (DEM in the loop vs " + predicted_by + ")")
+     << " noenhanced\n"
      << "set xlabel 'time t / s'\nset ylabel 'envelope at the damper site / mm'\nset grid\nset key top right\n"
      << "set logscale y\n"
      << "do for [t in 'pngcairo svg'] {\n"
      << "  set terminal t size 900,600 enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'verify_decay.svg' : 'verify_decay.png'\n"
      << "  plot 'verify_decay.csv' index 0 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'blue' title 'chosen, DEM', \\\n"
-     << "       '' index 0 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'blue' title 'chosen, closed forms', \\\n"
+     << "       '' index 0 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'blue' title "
+     << gnuplot_string("chosen, " + predicted_by) << ", \\\n"
      << "       '' index 1 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer, DEM', \\\n"
-     << "       '' index 1 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'red' title 'best single layer, closed forms', \\\n"
+     << "       '' index 1 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'red' title "
+     << gnuplot_string("best single layer, " + predicted_by) << ", \\\n"
      << "       '' index 0 using 2:($6*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
      << "}\n";
   return out.add_plot("verify_decay.gp", gp.str(), {"verify_decay.png", "verify_decay.svg"});
@@ -322,7 +328,9 @@ Warnings verification_files(OutputDir& out, const std::string& case_name, const 
 
 Warnings write_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
   Warnings warnings = design_files(out, res);
-  if (res.verification) append(warnings, verification_files(out, res.case_name, *res.verification));
+  if (res.verification)
+    append(warnings, verification_files(out, res.case_name, *res.verification,
+                                        res.calibration ? "calibrated beds" : "closed forms"));
   return warnings;
 }
 

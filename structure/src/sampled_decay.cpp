@@ -4,6 +4,7 @@
 #include "pdamp/structure/free_decay.hpp"
 
 #include <algorithm>
+#include <complex>
 #include <numbers>
 #include <optional>
 
@@ -83,6 +84,87 @@ double half_integral_square(const std::vector<double>& t, const std::vector<doub
   for (std::size_t i = 1; i < t.size() && i < e.size(); ++i)
     sum += 0.25 * (t[i] - t[i - 1]) * (e[i] * e[i] + e[i - 1] * e[i - 1]);
   return sum;
+}
+
+}  // namespace pdamp::structure
+
+namespace pdamp::structure {
+
+namespace {
+
+/// ∫_{t0}^{t1} g(t) e^{(λ − iΩ)(t − t0)} dt for g sampled at t (linear between samples, the
+/// ends t0 and t1 inside the samples `first − 1 .. last`), by the trapezoid.
+std::complex<double> weighted_integral(const std::vector<double>& t, const Eigen::VectorXd& g, double offset,
+                                       std::size_t first, std::size_t last, double t0, double t1, double omega,
+                                       double lambda) {
+  const auto at = [&](std::size_t s) { return g(static_cast<Eigen::Index>(s)) - offset; };
+  const auto kernel = [&](double time) { return std::exp(std::complex<double>(lambda, -omega) * (time - t0)); };
+  const auto between = [&](std::size_t s, double time) {  // g at `time` in [t[s − 1], t[s]]
+    return at(s - 1) + (at(s) - at(s - 1)) * (time - t[s - 1]) / (t[s] - t[s - 1]);
+  };
+  // Pieces: [t0, t_first], the samples up to t_{last−1}, [t_{last−1}, t1].
+  std::vector<std::pair<double, double>> points = {{t0, between(first, t0)}};
+  for (std::size_t s = first; s < last; ++s) points.emplace_back(t[s], at(s));
+  points.emplace_back(t1, between(last, t1));
+  std::complex<double> sum;
+  for (std::size_t k = 1; k < points.size(); ++k) {
+    const auto& [ta, ga] = points[k - 1];
+    const auto& [tb, gb] = points[k];
+    sum += 0.5 * (tb - ta) * (ga * kernel(ta) + gb * kernel(tb));
+  }
+  return sum;
+}
+
+}  // namespace
+
+std::vector<surrogate::DecayPeriodResponse> bed_response_per_period(const std::vector<double>& t,
+                                                                   const Eigen::VectorXd& y, double offset,
+                                                                   const Eigen::VectorXd& force_on_bed_n,
+                                                                   double bed_mass_kg) {
+  // Upward zero crossings of y − offset: the sample just after each, and the interpolated instant.
+  std::vector<std::pair<std::size_t, double>> up;
+  for (std::size_t s = 1; s < t.size(); ++s) {
+    const double r0 = y(static_cast<Eigen::Index>(s - 1)) - offset, r1 = y(static_cast<Eigen::Index>(s)) - offset;
+    if (r0 < 0.0 && r1 >= 0.0 && t[s] > t[s - 1]) up.emplace_back(s, t[s - 1] + (t[s] - t[s - 1]) * r0 / (r0 - r1));
+  }
+  if (up.size() < 2) return {};
+  const std::size_t periods = up.size() - 1;
+  // The motion decays within a period, y ≈ Im(X e^{st}), s = −λ + iΩ. Taken as a pure sine,
+  // an inertial bed F = m_a ÿ + c ẏ would seem to give energy back (its kinetic energy falls
+  // with the envelope): η* low by 2(λ/Ω)·m_a/m_bed, as large as the tail's η* itself at the
+  // structure's own damping. So the envelope is taken out: each period's harmonics are taken
+  // of the signals times e^{λ(t − t0)}, λ from the neighbouring periods' strokes (first pass
+  // λ = 0), and the bed's impedance F̂/(sX̂) = m_a s + c gives m_a = Im/Ω and c = Re + m_a λ:
+  // exact for a linear bed, η* = c/(m_bed Ω), m_app/m_bed = m_a/m_bed (docs/theory.md §1).
+  std::vector<double> lambda(periods, 0.0), stroke(periods), middle(periods);
+  std::vector<surrogate::DecayPeriodResponse> out(periods);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t k = 0; k < periods; ++k) {
+      const auto [first, t0] = up[k];
+      const auto [last, t1] = up[k + 1];
+      const double period = t1 - t0, omega = 2.0 * std::numbers::pi / period;
+      const std::complex<double> x_hat =
+          2.0 / period * weighted_integral(t, y, offset, first, last, t0, t1, omega, lambda[k]);
+      const std::complex<double> f_hat =
+          2.0 / period * weighted_integral(t, force_on_bed_n, 0.0, first, last, t0, t1, omega, lambda[k]);
+      const std::complex<double> s(-lambda[k], omega);
+      const std::complex<double> impedance = f_hat / (s * x_hat);  // m_a s + c
+      const double mass = impedance.imag() / omega, damping = impedance.real() + mass * lambda[k];
+      middle[k] = 0.5 * (t0 + t1);
+      stroke[k] = std::abs(x_hat) * std::exp(-0.5 * lambda[k] * period);  // at the period's middle
+      out[k] = {middle[k], 1.0 / period, stroke[k], damping / (bed_mass_kg * omega), mass / bed_mass_kg};
+    }
+    for (std::size_t k = 0; k < periods && periods > 1; ++k) {
+      const std::size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, periods - 1);
+      const double rate = std::log(stroke[a] / stroke[b]) / (middle[b] - middle[a]);
+      lambda[k] = std::isfinite(rate) ? rate : 0.0;
+    }
+  }
+  std::erase_if(out, [](const surrogate::DecayPeriodResponse& r) {
+    return !(std::isfinite(r.stroke_m) && r.stroke_m > 0.0 && std::isfinite(r.eta_star) &&
+             std::isfinite(r.apparent_mass_fraction));
+  });
+  return out;
 }
 
 }  // namespace pdamp::structure

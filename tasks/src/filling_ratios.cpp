@@ -120,28 +120,10 @@ DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const 
   return checkpoint;
 }
 
-/// A design's modal model and release state (from rest at q(0)).
-struct DesignModes {
-  st::ModalModel modal;
-  Eigen::VectorXd initial_modal_displacements;
-};
-
-/// The modes of `design`: under axial gravity its own beds' weights load the beam's geometric
-/// stiffness (the beam analysed anew with them, and the static release computed on it);
-/// otherwise the modes do not depend on the beds and are the problem's, exactly.
-DesignModes design_modes(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingDesign& design) {
-  if (!c.structure || c.structure->kind != case_file::StructureSpec::Kind::kBeam ||
-      !c.structure->beam.geometric_stiffness || c.structure->beam.axial_gravity_m_s2 == 0.0)
-    return {p.modal, p.initial_modal_displacements};
-  const Case dc = case_file::with_design(c, whole_slabs(design));
-  const case_file::StructureSetup setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
-  return {setup.modal, case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay)};
-}
-
 /// The DEM-in-the-loop decay of `design` over the verification's duration (the task's
 /// decay from its initial state, on the design's modes) at verify softening `softening`.
 VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                                 const std::string& label, const opt::FillingDesign& design, const DesignModes& modes,
+                                 const std::string& label, const opt::FillingDesign& design, const detail::DesignModes& modes,
                                  double softening, const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
   const Case dc = case_file::with_design(c, whole_slabs(design), softening);
   std::vector<st::Damper> containers = {p.options.damper};
@@ -183,7 +165,7 @@ double end_envelope(const VerifiedDecay& dem) {
 
 /// The design against its DEM decay `dem` (and, if run, the same decay ten times stiffer).
 DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
-                         const std::string& name, const opt::FillingDesign& design, const DesignModes& modes,
+                         const std::string& name, const opt::FillingDesign& design, const detail::DesignModes& modes,
                          VerifiedDecay dem, std::optional<SofteningCheck> stiffer) {
   DesignCheck out;
   out.name = name;
@@ -248,7 +230,8 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
   const std::size_t jobs = 2 * softenings;
   std::vector<DemDecayCheckpoint> files(jobs);
-  const DesignModes modes[] = {design_modes(c, p, r.chosen), design_modes(c, p, r.baseline)};
+  const detail::DesignModes modes[] = {detail::design_modes(c, p, whole_slabs(r.chosen)),
+                                       detail::design_modes(c, p, whole_slabs(r.baseline))};
   const auto softening_of = [&](std::size_t k) { return k < 2 ? verify.stiffness_softening : stiffer_softening; };
   const auto suffix_of = [](std::size_t k) { return std::string(k < 2 ? "" : "_stiffer"); };
   for (std::size_t k = 0; k < jobs; ++k) {
@@ -352,7 +335,8 @@ json verification_json(const Verification& v) {
   const auto& verify = v.spec;
   json out = {{"method", "dem"},
               {"what", "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
-                       "optimiser's modal model, from the task's initial state, against the closed forms over the same time"},
+                       "optimiser's modal model, from the task's initial state, against the prediction (the optimiser's bed models) over "
+                       "the same time"},
               {"objective", v.settling_objective ? "settling_time" : "integral_square"},
               {"duration_s", verify.duration_s},
               {"tolerance_relative", verify.tolerance_relative},
@@ -401,6 +385,19 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   out.case_name = c.name;
   out.mass_budget_kg = task.mass_budget_kg;
   out.problem = case_file::filling_ratio_problem(c);
+  if (o.calibrated.value_or(task.calibration.has_value())) {
+    case_file::CalibrationSpec spec;
+    if (task.calibration) {
+      spec = *task.calibration;
+    } else {
+      spec.duration_s = task.verify ? task.verify->duration_s : task.decay.duration_s;
+      spec.stiffness_softening = task.verify ? task.verify->stiffness_softening : 1.0;
+    }
+    out.calibration = calibrate_beds(c, out.problem, spec,
+                                     o.calibration_cache.empty() ? default_calibration_cache() : o.calibration_cache,
+                                     hooks, executor);
+    out.problem.options.bed_models = out.calibration->models();
+  }
   const auto& p = out.problem;
 
   opt::Options solver;
@@ -415,6 +412,9 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   const auto& r = out.optimum;
   out.warnings = p.warnings;
   out.warnings.insert(out.warnings.end(), r.warnings.begin(), r.warnings.end());
+  if (out.calibration)
+    out.warnings.push_back("same_mass is by the closed forms: one compartment holding the chosen mass is no candidate "
+                           "bed and has no calibration");
   for (const auto* d : {&r.chosen, &r.relaxed, &r.baseline})
     if (!std::isfinite(d->objective)) throw strict_json::NumericalError("pdamp optimize: a design's objective is not finite");
 
@@ -462,7 +462,7 @@ json to_json(const FillingRatiosResult& res) {
   json result = {
       {"task", "filling_ratios"},
       {"case", res.case_name},
-      {"method", "formulas"},
+      {"method", res.calibration ? "calibrated" : "formulas"},
       {"damper", p.options.damper.name},
       {"mass_budget_kg", res.mass_budget_kg},
       {"objective", {{"kind", std::string(opt::to_string(p.options.objective))}, {"unit", unit},
@@ -496,6 +496,7 @@ json to_json(const FillingRatiosResult& res) {
                   {"report", s.brief_report()}}},
       {"decay_evaluations", r.decay_evaluations},
       {"solve_time_s", r.solve_time_s}};
+  result["calibration"] = res.calibration ? to_json(*res.calibration) : json(nullptr);
   result["verification"] = res.verification ? verification_json(*res.verification) : json(nullptr);
   return result;
 }

@@ -52,4 +52,14 @@ void check_outcome(dem_reference::Outcome outcome, const std::string& message, c
   if (outcome != dem_reference::Outcome::kCompleted) throw strict_json::NumericalError(label + ": DEM failed: " + message);
 }
 
+DesignModes design_modes(const case_file::Case& c, const case_file::FillingRatioProblem& p,
+                         const std::vector<long>& slabs) {
+  if (!c.structure || c.structure->kind != case_file::StructureSpec::Kind::kBeam ||
+      !c.structure->beam.geometric_stiffness || c.structure->beam.axial_gravity_m_s2 == 0.0)
+    return {p.modal, p.initial_modal_displacements};
+  const case_file::Case dc = case_file::with_design(c, slabs);
+  const case_file::StructureSetup setup = case_file::structure_setup(dc, case_file::LossMethod::kFormulas);
+  return {setup.modal, case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay)};
+}
+
 }  // namespace pdamp::tasks::detail

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/strict_json/input_error.hpp"
@@ -60,5 +61,17 @@ auto call_dem(const case_file::Case& c, F&& f) {
 
 /// A co-simulation that stopped: strict_json::NumericalError with the advice on the case keys to change.
 void check_outcome(dem_reference::Outcome outcome, const std::string& message, const std::string& label);
+
+/// A filling-ratio design's modal model and release state (from rest at q(0)).
+struct DesignModes {
+  structure::ModalModel modal;
+  Eigen::VectorXd initial_modal_displacements;
+};
+
+/// The modes of the design of whole `slabs`: under axial gravity its own beds' weights load
+/// the beam's geometric stiffness (the beam analysed anew with them, and the static release
+/// computed on it); otherwise the modes do not depend on the beds and are the problem's, exactly.
+DesignModes design_modes(const case_file::Case& c, const case_file::FillingRatioProblem& p,
+                         const std::vector<long>& slabs);
 
 }  // namespace pdamp::tasks::detail

@@ -157,20 +157,20 @@ std::string edited_optimize_case(const pdamp::test::TempDir& dir, const std::fun
 
 TEST_CASE("a filling_ratios task reads its verify block, with defaults for the keys left out", "[case_file]") {
   const pdamp::test::TempDir dir("verify_block");
-  // Empty block: the documented defaults; the duration is the task's own (40 s in the case).
+  // Empty block: the documented defaults; the duration is the task's own (20 s in the case).
   const Case defaults = load_case(edited_optimize_case(dir, [](json& t) { t["verify"] = json::object(); }));
   REQUIRE(defaults.task.filling_ratios.has_value());
   REQUIRE(defaults.task.filling_ratios->verify.has_value());
   const auto& v = *defaults.task.filling_ratios->verify;
   CHECK(v.tolerance_relative == 0.3);
   CHECK(v.duration_s == defaults.task.filling_ratios->decay.duration_s);
-  CHECK(v.duration_s == 40.0);
+  CHECK(v.duration_s == 20.0);
   CHECK(v.stiffness_softening == 1.0);
   CHECK(v.require_ranking);
   CHECK(v.softening_check);
   CHECK(defaults.resolved["task"]["verify"]["softening_check"] == true);
   CHECK(defaults.resolved["task"]["verify"]["tolerance_relative"] == 0.3);
-  CHECK(defaults.resolved["task"]["verify"]["duration_s"] == 40.0);
+  CHECK(defaults.resolved["task"]["verify"]["duration_s"] == 20.0);
   CHECK(defaults.resolved["task"]["verify"]["require_ranking"] == true);
 
   const Case given = load_case(edited_optimize_case(dir, [](json& t) {
@@ -187,6 +187,42 @@ TEST_CASE("a filling_ratios task reads its verify block, with defaults for the k
   // Absent: no verification asked.
   const Case none = load_case(edited_optimize_case(dir, [](json& t) { t.erase("verify"); }));
   CHECK_FALSE(none.task.filling_ratios->verify.has_value());
+}
+
+TEST_CASE("a filling_ratios task reads its calibration block, its defaults the verification's", "[case_file]") {
+  const pdamp::test::TempDir dir("calibration_block");
+  // Empty: the verify block's duration and softening (the shipped case's: 20 s, 1e-3).
+  const Case shipped = load_case(edited_optimize_case(dir, [](json& t) { t["calibration"] = json::object(); }));
+  REQUIRE(shipped.task.filling_ratios->calibration.has_value());
+  const auto& c = *shipped.task.filling_ratios->calibration;
+  CHECK(c.duration_s == 20.0);
+  CHECK(c.stiffness_softening == 0.001);
+  CHECK(c.strokes_per_decade == 8);
+  CHECK(shipped.resolved["task"]["calibration"]["strokes_per_decade"] == 8);
+  // Without a verify block: the task's duration and full stiffness.
+  const Case bare = load_case(edited_optimize_case(dir, [](json& t) {
+    t.erase("verify");
+    t["calibration"] = json::object();
+  }));
+  CHECK(bare.task.filling_ratios->calibration->duration_s == 20.0);
+  CHECK(bare.task.filling_ratios->calibration->stiffness_softening == 1.0);
+  const Case given = load_case(edited_optimize_case(dir, [](json& t) {
+    t["calibration"] = {{"duration_s", 7.5}, {"stiffness_softening", 0.01}, {"strokes_per_decade", 4}};
+  }));
+  CHECK(given.task.filling_ratios->calibration->duration_s == 7.5);
+  CHECK(given.task.filling_ratios->calibration->stiffness_softening == 0.01);
+  CHECK(given.task.filling_ratios->calibration->strokes_per_decade == 4);
+  // Absent: the closed forms.
+  const Case none = load_case(edited_optimize_case(dir, [](json& t) { t.erase("calibration"); }));
+  CHECK_FALSE(none.task.filling_ratios->calibration.has_value());
+  const auto refused = [&](const json& calibration, const std::string& pointer, const std::string& rule) {
+    const std::string path = edited_optimize_case(dir, [&](json& t) { t["calibration"] = calibration; });
+    require_case_error(path, path, pointer, rule);
+  };
+  refused({{"strokes_per_decade", 0}}, "/task/calibration/strokes_per_decade", "[1, 100]");
+  refused({{"stiffness_softening", 2.0}}, "/task/calibration/stiffness_softening", "1");
+  refused({{"duration_s", 0.0}}, "/task/calibration/duration_s", "> 0");
+  refused({{"seconds", 1.0}}, "/task/calibration/seconds", "unknown");
 }
 
 TEST_CASE("a bad verify block is refused naming its key and the allowed range", "[case_file]") {

@@ -139,6 +139,7 @@ TEST_CASE("a killed DEM verification resumes both designs and equals the uninter
   c["task"]["global_evaluations"] = 30;
   c["task"]["max_evaluations"] = 120;
   c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}};
+  c["task"].erase("calibration");
   const fs::path path = dir.path / "case.json";
   std::ofstream(path) << c.dump(2);
   const fs::path whole = dir.path / "whole", parts = dir.path / "parts";

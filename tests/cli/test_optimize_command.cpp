@@ -44,7 +44,9 @@ std::string edited(const TempDir& dir, const std::function<void(json&)>& edit) {
 TEST_CASE("pdamp optimize chooses whole slabs per layer and reports the relaxed, chosen and baseline designs",
           "[cli][optimizer]") {
   const TempDir dir("optimize");
-  const json r = run_json({"optimize", case_path(kCase), "--no-verify", "-o", dir.path.string()});
+  const json r = run_json({"optimize", case_path(kCase), "--method", "formulas", "--no-verify", "-o", dir.path.string()});
+  CHECK(r["method"] == "formulas");
+  CHECK(r["calibration"].is_null());
   for (const char* key : {"task", "case", "design", "designs", "objective", "solver", "rounding", "baseline_layer",
                           "mass_budget_kg", "warnings", "outputs", "file"})
     CHECK(r.contains(key));
@@ -78,7 +80,14 @@ TEST_CASE("the optimised three-layer design settles faster than the best single 
   // Independent reference: the baseline is the exhaustive best over layer and slab count
   // with all the budget in one layer; the chosen design must beat it outright (the design's
   // claim, docs/theory.md §7.7: layers of different clearance take over one after another).
-  const json r = run_json({"optimize", case_path(kCase), "--no-verify"});
+  // By the closed forms with room for every layer (98.7 g: the shipped budget of six slabs
+  // puts the closed forms' best in one layer, docs/optimizer.md).
+  const TempDir dir("optimize_layers");
+  const json r = run_json({"optimize", edited(dir, [](json& c) {
+                             c["task"]["mass_budget_kg"] = 0.0987;
+                             c["task"].erase("calibration");
+                           }),
+                           "--no-verify"});
   const double chosen = r["designs"]["chosen"]["settling_time_s"].get<double>();
   const double single = r["designs"]["baseline"]["settling_time_s"].get<double>();
   INFO("chosen " << chosen << " s, best single layer (" << r["baseline_layer"] << ") " << single << " s");
@@ -90,8 +99,8 @@ TEST_CASE("the optimised three-layer design settles faster than the best single 
 
 TEST_CASE("pdamp run on task kind filling_ratios is pdamp optimize, and --backend ipopt chooses the same design",
           "[cli][optimizer]") {
-  const json a = run_json({"run", case_path(kCase), "--no-verify"});
-  const json b = run_json({"optimize", case_path(kCase), "--backend", "ipopt", "--no-verify"});
+  const json a = run_json({"run", case_path(kCase), "--method", "formulas", "--no-verify"});
+  const json b = run_json({"optimize", case_path(kCase), "--method", "formulas", "--backend", "ipopt", "--no-verify"});
   CHECK(a["task"] == "filling_ratios");
   CHECK(a["solver"]["backend"] == "nlopt");
   CHECK(b["solver"]["backend"] == "ipopt");
@@ -121,7 +130,7 @@ TEST_CASE("pdamp optimize exits 2 naming the key for a bad budget, layer or back
 // that both DEM runs (chosen and baseline) take about a second each. Independent
 // references: the static tip deflection of the cantilever F L³/(3EI) (the initial
 // envelope), passivity (the envelope never exceeds its initial value), an upper bound on the
-// damping the beds can add in 2.5 periods (so neither decay can settle to 2 %), and
+// damping the beds can add in 2.5 periods (so neither decay can settle to 10 %), and
 // conservation of energy (the co-simulation's ledger).
 TEST_CASE("pdamp optimize --verify runs the DEM on the chosen and baseline designs and reports them side by side",
           "[cli][optimizer][dem]") {
@@ -130,6 +139,7 @@ TEST_CASE("pdamp optimize --verify runs the DEM on the chosen and baseline desig
     c["task"]["global_evaluations"] = 30;
     c["task"]["max_evaluations"] = 120;
     c["task"]["verify"] = {{"duration_s", 0.7}, {"stiffness_softening", 1e-4}, {"tolerance_relative", 0.3}};
+    c["task"].erase("calibration");
   });
   // One run: the readable table on stdout, the result JSON in optimize.json.
   const auto run = run_pdamp({"optimize", path, "-o", (dir.path / "out").string()});
@@ -154,9 +164,9 @@ TEST_CASE("pdamp optimize --verify runs the DEM on the chosen and baseline desig
     const json& d = v["designs"][name];
     const json& dem = d["dem"];
     CHECK(dem["initial_envelope_m"].get<double>() == Approx(static_tip).epsilon(0.02));
-    // Bed mass ≤ 98.7 g on a tip carrying 0.75 kg (plus the beam's share): μ ≲ 0.1, so
-    // ζ_add ≤ ½·η*_max·μ ≈ 0.064 and 2.5 periods leave at least e^(−2π·0.064·2.5) = 0.37
-    // of the envelope: far above the 2 % threshold.
+    // Bed mass ≤ 49.4 g on a tip carrying 0.75 kg (plus the beam's share): μ ≲ 0.07, so
+    // ζ_add ≤ ½·η*_max·μ ≈ 0.045 and 2.5 periods leave at least e^(−2π·0.045·2.5) = 0.49
+    // of the envelope: far above the 10 % threshold.
     CHECK(dem["settled"] == false);
     CHECK(dem["outcome"] == "not_settled");
     CHECK(dem["settling_time_s"].is_null());
@@ -189,6 +199,7 @@ TEST_CASE("the task's verification is skipped with --no-verify, and --verify wit
     c["task"]["global_evaluations"] = 30;
     c["task"]["max_evaluations"] = 120;
     c["task"]["verify"] = {{"duration_s", 0.7}, {"stiffness_softening", 1e-4}};
+    c["task"].erase("calibration");
   });
   const json r = run_json({"optimize", path, "--no-verify"});
   CHECK(r["verification"].is_null());
@@ -196,29 +207,35 @@ TEST_CASE("the task's verification is skipped with --no-verify, and --verify wit
   require_one_line_error(run_pdamp({"optimize", path, "--verify", "--no-verify"}), "--verify");
 }
 
-// Reference: the DEM in the loop: the shipped optimisation's chosen design must
-// settle faster than the best single layer by the closed forms and by the DEM verification
-// the case asks for (35 s, contacts softened 1e-3: docs/optimizer.md measures 1e-2 alike).
-// The DEM settles the chosen design in 31.0 s and leaves the baseline at 0.66 mm > 0.45 mm.
-// The softening check is off here: it runs each design again 2.5 times as long, and its
-// logic is tested in tests/tasks (docs/optimizer.md records the shipped case's check).
-TEST_CASE("the shipped optimisation's chosen design settles first by the closed forms and by the DEM", "[cli][optimizer][long]") {
+// Reference: the DEM in the loop. The shipped optimisation on calibrated beds (each
+// candidate bed's own DEM decay, seeded apart from the verification's runs) must predict the
+// DEM-in-the-loop decays of the chosen design and of the baseline within the case's 15 % and
+// rank them as the DEM does: the reduced closing of the design loop CI runs (docs/optimizer.md,
+// "Calibrated beds", measured -7 % and +8 %, the check at 1e-2 within 3 %). The softening check
+// is off here: it runs each design again 2.5 times as long, and its logic is tested in
+// tests/tasks (docs/optimizer.md records the shipped case's check).
+TEST_CASE("the shipped optimisation on calibrated beds predicts the DEM within its tolerance", "[cli][optimizer][long]") {
   const TempDir dir("optimize_shipped_verify");
   const std::string path = edited(dir, [](json& c) { c["task"]["verify"]["softening_check"] = false; });
-  const json r = run_json({"optimize", path, "-o", (dir.path / "out").string()});
+  const json r = run_json({"optimize", path, "--calibration-cache", (dir.path / "cache").string(), "-o",
+                           (dir.path / "out").string()});
+  CHECK(r["method"] == "calibrated");
+  CHECK(r["calibration"]["runs"] == 11);
   const json& v = r["verification"];
   REQUIRE(v.is_object());
   CHECK(v["ranking"]["predicted_chosen_ahead"] == true);
   CHECK(v["ranking"]["dem_chosen_ahead"] == true);
   for (const char* name : {"chosen", "baseline"}) {
     INFO(name);
-    CHECK(v["designs"][name]["dem"]["energy_error"].get<double>() < 0.01);
+    const json& d = v["designs"][name];
+    CHECK(d["dem"]["energy_error"].get<double>() < 0.01);
+    CHECK(d["dem"]["settled"] == true);
+    CHECK(d["compared"] == "objective");
+    CHECK(std::abs(d["relative_difference"].get<double>()) <= 0.15);
+    CHECK(d["passed"] == true);
   }
-  CHECK(v["designs"]["chosen"]["dem"]["settled"] == true);
-  // The DEM's decay is the closed forms' within a factor of 1.5 in settling time (the
-  // scattered-state tail, docs/optimizer.md): a jamming bed (the previous design) was 6 off.
-  const double predicted = v["designs"]["chosen"]["predicted"]["settling_time_s"].get<double>();
-  const double dem = v["designs"]["chosen"]["dem"]["settling_time_s"].get<double>();
-  CHECK(dem / predicted < 1.5);
-  CHECK(dem / predicted > 1.0 / 1.5);
+  CHECK(v["passed"] == true);
+  // The budget binds: six slabs of 8.2 g in each design.
+  for (const char* name : {"chosen", "baseline"})
+    CHECK(r["designs"][name]["total_mass_kg"].get<double>() > r["mass_budget_kg"].get<double>() - 0.0083);
 }

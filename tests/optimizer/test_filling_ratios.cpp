@@ -185,3 +185,38 @@ TEST_CASE("invalid filling-ratio options name the field", "[optimizer]") {
   o.layers[0].initial_slabs = 9;
   CHECK_THROWS_WITH(opt::optimize_filling_ratios(model, o), Catch::Contains("layers[0].initial_slabs = 9"));
 }
+
+// Reference: the enumeration of the test above with the calibrated beds, and each bed's model
+// evaluated directly. Beds whose models are the closed forms of another friction (so that
+// the calibrated designs differ from the closed forms' own): the optimiser must choose by
+// the given models, over every whole-slab design under the budget.
+TEST_CASE("with calibrated beds every whole-slab design is evaluated on its own bed's model", "[optimizer]") {
+  const auto model = one_mode();
+  auto o = layered({0.07, 0.04, 0.028}, 5.0);
+  auto options = o.model_options;
+  options.scattered.jump_fraction = 0.0;  // no dissipation below the onset: another bed
+  options.scattered.exponent = 2.0;
+  options.scattered.provisional = false;
+  o.bed_models.resize(o.layers.size());
+  for (std::size_t k = 0; k < o.layers.size(); ++k)
+    for (int n = 0; n <= o.layers[k].max_slabs(); ++n)
+      o.bed_models[k].push_back(n == 0 ? nullptr
+                                       : std::make_shared<pdamp::surrogate::ClosedFormLossModel>(
+                                             o.model, o.layers[k].clearance_m(n), options));
+  const auto result = opt::optimize_filling_ratios(model, o);
+  const auto reference = enumerate(model, o);
+  CHECK(slabs_of(result.chosen) == reference.slabs);
+  CHECK(result.chosen.objective == reference.objective);
+  CHECK(result.neighbours_feasible == reference.points);
+  CHECK(slabs_of(result.relaxed) == reference.slabs);
+  // The damper of a design carries the calibrated bed itself.
+  const auto damper = opt::filling_damper(o, std::vector<double>{2.0, 0.0, 1.0});
+  REQUIRE(damper.layers.size() == 2);
+  CHECK(damper.layers[0].loss_model == o.bed_models[0][2]);
+  CHECK(damper.layers[1].loss_model == o.bed_models[2][1]);
+  // Calibrated beds exist at whole slabs only.
+  CHECK_THROWS_WITH(opt::filling_damper(o, std::vector<double>{1.5, 0.0, 0.0}), Catch::Contains("whole slabs only"));
+  // A missing bed is refused by name.
+  o.bed_models[1].pop_back();
+  CHECK_THROWS_WITH(opt::optimize_filling_ratios(model, o), Catch::Contains("bed_models[1]"));
+}

@@ -10,6 +10,7 @@
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/placement.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace pdamp;
 using test::case_path;
@@ -22,6 +23,7 @@ TEST_CASE("filling ratios: the chosen design is within the budget and its decay 
   const auto c = case_file::load_case(case_path("manipulator_link_optimize.json"));
   tasks::FillingRatiosOptions options;
   options.skip_verify = true;
+  options.calibrated = false;  // the closed forms
   const auto r = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
   CHECK_FALSE(r.verification.has_value());
   const auto& chosen = r.optimum.chosen;
@@ -80,6 +82,7 @@ case_file::Case short_verification(bool softening_check, double axial_gravity_m_
   c["task"]["global_evaluations"] = 30;
   c["task"]["max_evaluations"] = 120;
   c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}, {"softening_check", softening_check}};
+  c["task"].erase("calibration");
   if (axial_gravity_m_s2 != 0.0) {
     c["structure"]["axial_gravity_m_s2"] = axial_gravity_m_s2;
     c["structure"]["geometric_stiffness"] = true;
@@ -163,4 +166,79 @@ TEST_CASE("under axial gravity the verification scores each design on its own mo
     const auto expected = optimizer::evaluate_filling_design(setup.modal, own, tasks::slabs_of(d.design));
     CHECK(d.predicted.objective == expected.objective);
   }
+}
+
+namespace {
+
+/// Records the notes a task gives.
+struct NoteHooks : tasks::RunHooks {
+  std::vector<std::string> notes;
+  void note(const std::string& text) override { notes.push_back(text); }
+};
+
+/// The shipped optimisation on calibrated beds, each bed's decay cut to 1.5 s (5 periods) of
+/// contacts softened 1e-3 (softer, a single slab's fast impacts in its 50 mm of travel
+/// overlap more than the DEM allows).
+case_file::Case short_calibration() {
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  nlohmann::json c = nlohmann::json::parse(in);
+  c["task"].erase("verify");
+  c["task"]["calibration"] = {{"duration_s", 1.5}, {"stiffness_softening", 1e-3}};
+  return case_file::load_case_document(c, "short_calibration.json");
+}
+
+}  // namespace
+
+// Reference: the cache's contract (a bed's file holds its decay's field and periods; a
+// repeated calibration runs nothing and reads the same numbers; a damaged file runs that bed
+// again), the problem's candidates (6 + 3 + 2 beds), and the optimiser's own scoring of the
+// chosen design on the calibrated beds.
+TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed bed by bed", "[tasks]") {
+  const test::TempDir cache("bed_calibration");
+  const auto c = short_calibration();
+  tasks::FillingRatiosOptions options;
+  options.calibration_cache = cache.path;
+  const auto first = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  REQUIRE(first.calibration);
+  const auto& calibration = *first.calibration;
+  CHECK(calibration.beds.size() == 11);
+  CHECK(calibration.runs == 11);
+  for (const auto& bed : calibration.beds) {
+    INFO(bed.layer << " " << bed.slabs);
+    CHECK_FALSE(bed.cached);
+    CHECK(std::filesystem::exists(bed.file));
+    CHECK(bed.periods.size() >= 4);  // 1.5 s at about 3.5 Hz: 4 whole periods after the first crossing
+    CHECK(bed.field.bed_mass_kg == Approx(bed.slabs * 16 * first.problem.options.layers[0].sphere_mass_kg));
+  }
+  CHECK(tasks::to_json(first)["method"] == "calibrated");
+  const auto again = optimizer::evaluate_filling_design(first.problem.modal, first.problem.options,
+                                                        tasks::slabs_of(first.optimum.chosen));
+  CHECK(again.objective == first.optimum.chosen.objective);
+
+  // Again: every bed from the cache, the same fields, the same choice.
+  const auto second = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  CHECK(second.calibration->runs == 0);
+  for (std::size_t b = 0; b < calibration.beds.size(); ++b) {
+    CHECK(second.calibration->beds[b].cached);
+    CHECK(second.calibration->beds[b].field == calibration.beds[b].field);
+  }
+  CHECK(tasks::slabs_of(second.optimum.chosen) == tasks::slabs_of(first.optimum.chosen));
+
+  // A damaged file: that bed runs again (the same numbers: the same DEM), with a note.
+  { std::ofstream(calibration.beds[4].file) << "{ not json"; }
+  NoteHooks hooks;
+  const auto third = tasks::run_filling_ratios(c, options, hooks, tasks::local_executor());
+  CHECK(third.calibration->runs == 1);
+  CHECK_FALSE(third.calibration->beds[4].cached);
+  // The same DEM run again: the same field (its provenance's time aside).
+  CHECK(third.calibration->beds[4].field.points == calibration.beds[4].field.points);
+  CHECK(third.calibration->beds[4].field.grid == calibration.beds[4].field.grid);
+  REQUIRE(hooks.notes.size() == 1);
+  CHECK(hooks.notes[0].find(calibration.beds[4].file.string()) != std::string::npos);
+
+  // --method formulas: the closed forms, no calibration.
+  options.calibrated = false;
+  const auto closed_forms = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  CHECK_FALSE(closed_forms.calibration);
+  CHECK(tasks::to_json(closed_forms)["method"] == "formulas");
 }

@@ -179,6 +179,19 @@ struct VerifySpec {
   bool softening_check = true;
 };
 
+/// `calibration` of task kind filling_ratios: every candidate bed (each layer holding each
+/// whole slab count alone) calibrated from a DEM-in-the-loop decay of the structure, its
+/// per-period response gathered into a field the optimiser uses in place of the closed
+/// forms (docs/optimizer.md, "Calibrated beds").
+struct CalibrationSpec {
+  /// Simulated time of each bed's decay, s, (0, 1e5]; default verify's duration_s, else the task's.
+  double duration_s = 0.0;
+  /// Factor on every Young's modulus of the calibration runs, on top of /dem's, (0, 1];
+  /// default verify's stiffness_softening, else 1.
+  double stiffness_softening = 1.0;
+  int strokes_per_decade = 8;  ///< stroke bins of each bed's field per decade, [1, 100]
+};
+
 /// `task` kind filling_ratios: the whole slabs each layer of the first
 /// damper holds, for the fastest free decay under a particle-mass budget (docs/optimizer.md).
 /// The layers' containers and lattices give the candidates; their counts, the start.
@@ -194,6 +207,9 @@ struct FillingRatiosTask {
   /// `verify`: present when the task asks for the DEM verification (pdamp run and pdamp
   /// optimize run it; `pdamp optimize --verify` runs it with these defaults when absent).
   std::optional<VerifySpec> verify;
+  /// `calibration`: present when the optimiser runs on calibrated beds (pdamp optimize
+  /// --method overrides).
+  std::optional<CalibrationSpec> calibration;
   // Derived on load, one per layer of the first damper:
   std::vector<int> spheres_per_slab;  ///< spheres in one full slab of the layer's lattice
   std::vector<int> spheres_per_lane;  ///< of a slab, stacked across gravity in one lane (LatticeBed)
@@ -275,8 +291,11 @@ Case load_case_document(const nlohmann::json& document, const std::string& path)
 /// read again by the case reader from the case's document: the layers' beds, clearances and
 /// masses, the resolved JSON and the physics hash are the design's own, and a design the
 /// reader refuses is a CaseError naming the layer's key. Cases are not changed after loading:
-/// a design is a new case.
-Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening = 1.0);
+/// a design is a new case. `other_seed`: the DEM's seed one further (the one below when the
+/// seed is the largest allowed), another realisation of the ball lot (the calibration's runs,
+/// so that no verification repeats one of them).
+Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening = 1.0,
+                 bool other_seed = false);
 
 /// One case of a sensitivity study: the parameter varied, its value, and the case with it.
 struct SensitivityVariant {

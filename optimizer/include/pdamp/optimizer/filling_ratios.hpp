@@ -3,6 +3,7 @@
 // structure's free decay settles fastest under a particle-mass budget.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -73,6 +74,13 @@ struct FillingRatioOptions {
   double mass_budget_kg = 0.0;  ///< Σ m_k <= budget, kg; 0 = no mass constraint (then max_total_slabs > 0)
   int max_total_slabs = 0;      ///< Σ n_k <= this; 0 = no slab constraint
   int integral_samples = 400;   ///< kIntegralSquare: instants, [10, 100000]
+  /// Calibrated beds (tasks::calibrate_beds): bed_models[k][n] answers for layer k holding n
+  /// whole slabs (n in [1, max_slabs()]; entry 0 unused) in place of the closed forms. Empty:
+  /// the closed forms. Given, it holds every layer and slab count, designs are whole slabs
+  /// only (a calibrated bed exists only there), and optimize_filling_ratios enumerates them all.
+  std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> bed_models;
+  /// Largest number of whole-slab designs enumerated with bed_models (Π(max_slabs + 1)).
+  static constexpr long kMaxEnumeratedDesigns = 100000;
   /// One line per violated rule, naming the field ("layers[1].slab_length_m = 0: must be > 0"),
   /// including a budget below the lightest slab ("mass_budget_kg = ...").
   std::vector<std::string> validate() const;
@@ -127,8 +135,9 @@ struct FillingRatioResult {
 };
 
 /// The damper of a design (n_k per layer, real allowed): closed-form layers of clearance
-/// h_k and bed mass m_k, named by the candidates; layers with n_k <= 1e-9 left out.
-/// std::invalid_argument if slabs.size() != options.layers.size() or n_k out of bounds.
+/// h_k and bed mass m_k (the calibrated bed of bed_models when given), named by the
+/// candidates; layers with n_k <= 1e-9 left out. std::invalid_argument if slabs.size() !=
+/// options.layers.size(), n_k out of bounds, or not whole with bed_models.
 structure::Damper filling_damper(const FillingRatioOptions& options, std::span<const double> slabs);
 
 /// Runs the free decay of one design and scores it (options must be valid).
@@ -146,7 +155,9 @@ FillingDesign evaluate_single_compartment(const structure::ModalModel& model, co
 
 /// Relaxed solve (n_k real: mass and clearance linear in n_k; optimizer::solve with
 /// `solver`), then every feasible rounded neighbour, then the single-layer baseline, the bare
-/// structure and the same mass in one compartment.
+/// structure and the same mass in one compartment (by the closed forms). With bed_models:
+/// every feasible whole-slab design instead of the relaxed solve and its neighbours (all in
+/// `neighbours`, `relaxed` the chosen one, the summary converged with the count in its message).
 /// Throws std::invalid_argument for invalid options (every violation, one a line) and
 /// what the free decay throws for an invalid model or initial state.
 FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, const FillingRatioOptions& options,

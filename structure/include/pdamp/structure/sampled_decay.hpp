@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "pdamp/structure/modal_model.hpp"
+#include "pdamp/surrogate/decay_field.hpp"
 
 namespace pdamp::structure {
 
@@ -37,6 +38,20 @@ SampledSettling sampled_settling(const std::vector<double>& t, const Eigen::Vect
 /// drive_gravity_m_s2[d] the gravity along damper d's drive (m/s²).
 double static_site_offset(const ModalModel& modal, const Eigen::MatrixXd& drive_shapes,
                           const std::vector<double>& bed_masses_kg, const std::vector<double>& drive_gravity_m_s2);
+
+/// The first-harmonic response of one bed over each whole period of a sampled decay
+/// (surrogate::DecayPeriodResponse): the periods lie between successive upward zero crossings
+/// of y − offset (interpolated); X̂ and F̂ are the coefficients at Ω = 2π/T over the period
+/// (trapezoid on the samples, linear between them) of the signals with the envelope's decay
+/// e^{−λt} taken out (λ from the neighbouring periods), and the bed's impedance F̂/(sX̂),
+/// s = −λ + iΩ, gives η* and m_app/m_bed exactly for a linear bed on a decaying motion. y is
+/// the site displacement along the drive, F the force the container applies to the bed (the
+/// negative of what the bed exerts on it). `t` ascending; y and force of its size;
+/// bed_mass_kg > 0. Periods whose measures are not finite are left out.
+std::vector<surrogate::DecayPeriodResponse> bed_response_per_period(const std::vector<double>& t,
+                                                                   const Eigen::VectorXd& y, double offset,
+                                                                   const Eigen::VectorXd& force_on_bed_n,
+                                                                   double bed_mass_kg);
 
 /// ½∫e² dt of sampled values e(t) (trapezoid on e²), m²·s for an envelope in m.
 double half_integral_square(const std::vector<double>& t, const std::vector<double>& e);

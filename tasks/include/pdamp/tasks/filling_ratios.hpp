@@ -17,6 +17,7 @@
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/sampled_decay.hpp"
+#include "pdamp/tasks/bed_calibration.hpp"
 #include "pdamp/tasks/executor.hpp"
 #include "pdamp/tasks/output_folder.hpp"
 #include "pdamp/tasks/run_hooks.hpp"
@@ -32,6 +33,11 @@ struct FillingRatiosOptions {
   /// The verification's checkpoints, verify_<design>.checkpoint in this folder (empty: none).
   std::filesystem::path checkpoint_dir;
   bool resume = false;  ///< continue the verification's decays from their checkpoints
+  /// The beds' models: true calibrated (the task's calibration block, or its defaults),
+  /// false the closed forms; default: calibrated when the task has a calibration block.
+  std::optional<bool> calibrated;
+  /// Where calibrated beds are cached (empty: default_calibration_cache()).
+  std::filesystem::path calibration_cache;
 };
 
 /// What the verification keeps of a design's DEM decay: what it compares, reports and plots.
@@ -109,6 +115,7 @@ struct FillingRatiosResult {
   std::string case_name;
   case_file::FillingRatioProblem problem;
   double mass_budget_kg = 0.0;
+  std::optional<BedCalibration> calibration;  ///< the calibrated beds the optimiser used, if any
   optimizer::FillingRatioResult optimum;
   DesignComparison comparison;
   std::optional<Verification> verification;

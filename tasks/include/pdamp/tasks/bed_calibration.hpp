@@ -1,0 +1,68 @@
+// Calibrated beds for the filling-ratio optimiser: each candidate bed (one layer holding n
+// whole slabs, the others empty) runs a DEM-in-the-loop free decay of the structure from the
+// task's initial state; its response period by period (structure::bed_response_per_period)
+// becomes the bed's field along a decay (surrogate::decay_field), which the optimiser uses in
+// place of the closed forms. The calibration's DEM runs take the case's seed one further (another
+// realisation of the ball lot): a verification never repeats one of them. Each bed is cached in a file of its own under a key of the
+// physics it depends on, so a repeated or interrupted calibration runs only what is missing.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/filling_ratio_problem.hpp"
+#include "pdamp/surrogate/decay_field.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
+#include "pdamp/tasks/executor.hpp"
+#include "pdamp/tasks/run_hooks.hpp"
+
+namespace pdamp::tasks {
+
+/// One calibrated bed.
+struct CalibratedBed {
+  std::string layer;
+  int layer_index = 0;
+  int slabs = 0;
+  std::string key;                 ///< 16 hex digits of the physics the calibration depends on
+  std::filesystem::path file;      ///< its cache file
+  bool cached = false;             ///< read from the cache (not run now)
+  surrogate::EffectiveField field;
+  std::vector<surrogate::DecayPeriodResponse> periods;
+  std::int64_t steps = 0;          ///< of its DEM decay
+  double energy_error = 0.0;       ///< the DEM decay's energy-ledger error
+  double wall_time_s = 0.0;        ///< of its DEM decay (when it ran)
+};
+
+struct BedCalibration {
+  case_file::CalibrationSpec spec;
+  std::filesystem::path cache_dir;
+  std::vector<CalibratedBed> beds;  ///< layer by layer, slabs 1..max
+  int runs = 0;                     ///< beds run now (the others came from the cache)
+  double wall_time_s = 0.0;
+  /// The beds as optimizer::FillingRatioOptions::bed_models ([layer][slabs], entry 0 empty).
+  std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> models() const;
+};
+
+/// The default cache folder: $XDG_CACHE_HOME/pdamp/bed_calibration, else
+/// $HOME/.cache/pdamp/bed_calibration, else ./.pdamp-cache/bed_calibration.
+std::filesystem::path default_calibration_cache();
+
+/// Calibrates every candidate bed of the case's filling-ratio problem: cached beds are read,
+/// the others run as jobs of `executor` (each writes its cache file atomically when done, so
+/// an interrupted calibration keeps what finished). A cache file that cannot be read or holds
+/// another key is run again, with a note. InputError for refused DEM options, NumericalError
+/// for a decay the DEM cannot run or a bed whose decay gives no field.
+BedCalibration calibrate_beds(const case_file::Case& c, const case_file::FillingRatioProblem& p,
+                              const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
+                              RunHooks& hooks, Executor& executor);
+
+/// The calibration's result keys (spec, cache folder, per bed: layer, slabs, key, cached, file,
+/// periods, stroke range, steps, wall time).
+nlohmann::json to_json(const BedCalibration& calibration);
+
+}  // namespace pdamp::tasks

@@ -1,0 +1,233 @@
+// Calibrated beds (bed_calibration.hpp).
+#include "pdamp/tasks/bed_calibration.hpp"
+
+#include <chrono>
+#include <cstdlib>
+
+#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/structure/sampled_decay.hpp"
+#include "pdamp/surrogate/dem_evaluator.hpp"
+#include "pdamp/tasks/decay.hpp"
+#include "structure_support.hpp"
+
+namespace pdamp::tasks {
+
+namespace st = structure;
+using case_file::Case;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kCacheFormat = "pdamp.bed_calibration";
+/// Raised whenever what a cache file holds or how it is computed from the DEM changes
+/// (structure::bed_response_per_period, surrogate::decay_field): it is part of every key.
+constexpr int kCacheFormatVersion = 1;
+
+/// The physics a bed's calibration depends on: the design case's structure, dampers,
+/// materials and DEM settings (the softening included), the release, the duration, the
+/// binning and the DEM's model version; not names, descriptions or the budget.
+std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec) {
+  const json& r = design.resolved;
+  json identity = {{"structure", r.value("structure", json())},   {"dampers", r.value("dampers", json())},
+                   {"materials", r.value("materials", json())},   {"dem", r.value("dem", json())},
+                   {"initial_state", r.at("task").value("initial_state", json())},
+                   {"duration_s", spec.duration_s},              {"strokes_per_decade", spec.strokes_per_decade},
+                   {"dem_model_version", surrogate::dem_model_version()},
+                   {"calibration_version", kCacheFormatVersion}};
+  return surrogate::case_hash(identity);
+}
+
+json period_rows(const std::vector<surrogate::DecayPeriodResponse>& periods) {
+  json rows = json::array();
+  for (const auto& p : periods)
+    rows.push_back({p.time_s, p.frequency_hz, p.stroke_m, p.eta_star, p.apparent_mass_fraction});
+  return rows;
+}
+
+json cache_document(const CalibratedBed& bed) {
+  return {{"format", kCacheFormat},          {"format_version", kCacheFormatVersion},
+          {"key", bed.key},                  {"layer", bed.layer},
+          {"slabs", bed.slabs},              {"steps", bed.steps},
+          {"energy_error", bed.energy_error}, {"wall_time_s", bed.wall_time_s},
+          {"periods", period_rows(bed.periods)}, {"field", surrogate::to_json(bed.field)}};
+}
+
+/// The bed from a cache document, or false (with the reason in `why`) when it is not one of
+/// this bed's key.
+bool bed_from_document(const json& d, CalibratedBed& bed, std::string& why) {
+  try {
+    if (d.at("format") != kCacheFormat || d.at("format_version") != kCacheFormatVersion || d.at("key") != bed.key) {
+      why = "it holds another calibration";
+      return false;
+    }
+    bed.field = surrogate::effective_field_from_json(d.at("field"), bed.file.string());
+    bed.periods.clear();
+    for (const auto& row : d.at("periods"))
+      bed.periods.push_back({row.at(0).get<double>(), row.at(1).get<double>(), row.at(2).get<double>(),
+                             row.at(3).get<double>(), row.at(4).get<double>()});
+    bed.steps = d.at("steps").get<std::int64_t>();
+    bed.energy_error = d.at("energy_error").get<double>();
+    bed.wall_time_s = d.at("wall_time_s").get<double>();
+    return true;
+  } catch (const std::exception& e) {
+    why = e.what();
+    return false;
+  }
+}
+
+/// The cached bed, or false (with the reason in `why`) when the file is absent, unreadable
+/// or of another key.
+bool read_cached(CalibratedBed& bed, std::string& why) {
+  if (!std::filesystem::exists(bed.file)) return false;
+  try {
+    const json d = strict_json::parse_json_document(strict_json::read_input_file(bed.file.string()), bed.file.string());
+    return bed.cached = bed_from_document(d, bed, why);
+  } catch (const std::exception& e) {
+    why = e.what();
+    return false;
+  }
+}
+
+/// Runs bed's DEM decay, builds its field and writes its cache file.
+json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
+                   CalibratedBed bed, RunHooks& hooks) {
+  std::vector<long> slabs(p.options.layers.size(), 0);
+  slabs[static_cast<std::size_t>(bed.layer_index)] = bed.slabs;
+  const Case design = case_file::with_design(c, slabs, spec.stiffness_softening, true);
+  const detail::DesignModes modes = detail::design_modes(c, p, slabs);
+  std::vector<st::Damper> containers = {p.options.damper};
+  containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
+  case_file::DecayTask decay = c.task.filling_ratios->decay;
+  decay.duration_s = spec.duration_s;
+  const DemDecay d = dem_decay(design, modes.modal, containers, detail::dem_dampers(design),
+                               modes.initial_modal_displacements, decay,
+                               "pdamp optimize: calibration (" + bed.layer + ", " + std::to_string(bed.slabs) + " slabs)",
+                               "/task/calibration/duration_s", DemDecayCheckpoint{}, hooks);
+  const auto& r = d.cosimulation;
+  const auto& layer = p.options.layers[static_cast<std::size_t>(bed.layer_index)];
+  const double bed_mass_kg = bed.slabs * layer.slab_mass_kg();
+  bed.periods = st::bed_response_per_period(r.history.time_s, r.history.site_displacement_m.col(0), d.static_offset_m,
+                                            -r.history.container_load_n.col(0), bed_mass_kg);
+  try {
+    bed.field = surrogate::decay_field(bed.periods, layer.clearance_m(bed.slabs), bed_mass_kg,
+                                       surrogate::make_provenance(surrogate::FieldSource::kDem,
+                                                                  case_file::physics_hash(design, "dem"),
+                                                                  surrogate::dem_model_version()),
+                                       spec.strokes_per_decade);
+  } catch (const std::invalid_argument& e) {
+    throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+                                      std::to_string(bed.slabs) + " slabs gives no field: " + e.what() +
+                                      " (/task/calibration/duration_s)");
+  }
+  bed.steps = r.steps;
+  bed.energy_error = r.energy.relative_error;
+  bed.wall_time_s = r.wall_time_s;
+  const json document = cache_document(bed);
+  strict_json::write_file_atomically(bed.file, document.dump(1));
+  return document;
+}
+
+}  // namespace
+
+std::filesystem::path default_calibration_cache() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
+    return std::filesystem::path(xdg) / "pdamp" / "bed_calibration";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
+    return std::filesystem::path(home) / ".cache" / "pdamp" / "bed_calibration";
+  return std::filesystem::path(".pdamp-cache") / "bed_calibration";
+}
+
+std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> BedCalibration::models() const {
+  std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> out;
+  for (const auto& bed : beds) {
+    const auto k = static_cast<std::size_t>(bed.layer_index);
+    if (out.size() <= k) out.resize(k + 1);
+    if (out[k].size() <= static_cast<std::size_t>(bed.slabs)) out[k].resize(static_cast<std::size_t>(bed.slabs) + 1);
+    out[k][static_cast<std::size_t>(bed.slabs)] = std::make_shared<surrogate::EffectiveFieldLossModel>(bed.field);
+  }
+  return out;
+}
+
+BedCalibration calibrate_beds(const Case& c, const case_file::FillingRatioProblem& p,
+                              const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
+                              RunHooks& hooks, Executor& executor) {
+  const auto start = std::chrono::steady_clock::now();
+  BedCalibration out;
+  out.spec = spec;
+  out.cache_dir = cache_dir;
+  std::error_code error;
+  std::filesystem::create_directories(cache_dir, error);
+  if (error)
+    throw std::runtime_error("pdamp optimize: cannot create the calibration cache " + cache_dir.string() + ": " +
+                             error.message());
+  std::vector<std::size_t> to_run;
+  for (std::size_t k = 0; k < p.options.layers.size(); ++k) {
+    const auto& layer = p.options.layers[k];
+    for (int n = 1; n <= layer.max_slabs(); ++n) {
+      CalibratedBed bed;
+      bed.layer = layer.name;
+      bed.layer_index = static_cast<int>(k);
+      bed.slabs = n;
+      std::vector<long> slabs(p.options.layers.size(), 0);
+      slabs[k] = n;
+      bed.key = calibration_key(case_file::with_design(c, slabs, spec.stiffness_softening, true), spec);
+      bed.file = cache_dir / (layer.name + "_" + std::to_string(n) + "_" + bed.key + ".json");
+      std::string why;
+      if (!read_cached(bed, why)) {
+        if (!why.empty()) hooks.note("pdamp: warning: " + bed.file.string() + " is not used (" + why + "): it runs again");
+        to_run.push_back(out.beds.size());
+      }
+      out.beds.push_back(std::move(bed));
+    }
+  }
+  const auto documents = run_jobs<json>(
+      executor, to_run.size(), parallel_jobs(executor, to_run.size()),
+      [&](std::size_t j) { return calibrate_bed(c, p, spec, out.beds[to_run[j]], hooks); }, nullptr,
+      [&](std::size_t j) { return static_cast<double>(to_run[j]); },
+      static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
+  for (std::size_t j = 0; j < to_run.size(); ++j) {
+    CalibratedBed& bed = out.beds[to_run[j]];
+    std::string why;
+    // What the job returned is what it wrote to the cache (on this process or another).
+    if (!bed_from_document(documents[j], bed, why))
+      throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+                                        std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
+  }
+  out.runs = static_cast<int>(to_run.size());
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+json to_json(const BedCalibration& calibration) {
+  json beds = json::array();
+  for (const auto& b : calibration.beds) {
+    double lowest = INFINITY, highest = 0.0;
+    for (const auto& p : b.periods) lowest = std::min(lowest, p.stroke_m), highest = std::max(highest, p.stroke_m);
+    beds.push_back({{"layer", b.layer},
+                    {"slabs", b.slabs},
+                    {"key", b.key},
+                    {"cached", b.cached},
+                    {"file", b.file.string()},
+                    {"periods", b.periods.size()},
+                    {"stroke_min_m", lowest},
+                    {"stroke_max_m", highest},
+                    {"steps", b.steps},
+                    {"energy_error", b.energy_error},
+                    {"wall_time_s", b.wall_time_s}});
+  }
+  return {{"method", "dem_decay"},
+          {"what", "each candidate bed alone in a DEM-in-the-loop free decay of the structure from the task's initial "
+                   "state; its response period by period binned into a field over the strokes the decay passed"},
+          {"duration_s", calibration.spec.duration_s},
+          {"stiffness_softening", calibration.spec.stiffness_softening},
+          {"strokes_per_decade", calibration.spec.strokes_per_decade},
+          {"cache_dir", calibration.cache_dir.string()},
+          {"runs", calibration.runs},
+          {"beds", beds},
+          {"wall_time_s", calibration.wall_time_s}};
+}
+
+}  // namespace pdamp::tasks
