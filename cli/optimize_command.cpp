@@ -149,8 +149,25 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
     rows.push_back({"chosen " + l.name, std::to_string(std::lround(l.slabs)) + " slabs, phi = " +
                                             format_number(l.filling_ratio, 4) + ", h = " + format_number(l.clearance_m * 1e3, 4) +
                                             " mm, m = " + format_number(l.bed_mass_kg * 1e3, 4) + " g"});
+  if (const auto& cal = result.calibration)
+    rows.push_back({"calibration", std::to_string(cal->beds.size()) + " beds, " + std::to_string(cal->runs) +
+                                       " DEM decays run (the others cached in " + cal->cache_dir.string() + "), " +
+                                       format_number(cal->wall_time_s, 4) + " s wall"});
   if (result.verification)
     for (auto& row : verification_rows(*result.verification)) rows.push_back(std::move(row));
+  for (const auto& round : result.rounds) {
+    if (result.rounds.size() < 2) break;
+    std::string line = round.passed ? "pass" : "fail";
+    for (const auto& d : round.designs) {
+      line += "; " + d.name + " (";
+      for (std::size_t k = 0; k < d.slabs.size(); ++k) line += (k ? ", " : "") + format_number(d.slabs[k], 3);
+      line += ") " + (d.compared == "settled_only_one" ? std::string("only one settled")
+                                                        : format_number(100.0 * d.relative_difference, 3) + " %");
+    }
+    if (!round.recalibrated.empty()) line += "; recalibrated " + std::to_string(round.recalibrated.size()) + " bed(s)";
+    rows.push_back({"design loop round " + std::to_string(round.round), line});
+  }
+  if (result.rounds.size() > 1) rows.push_back({"design loop", result.loop_outcome});
   const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report});
   std::error_code ignored;
   for (const auto& checkpoint : result.checkpoints) std::filesystem::remove(checkpoint, ignored);  // the results are kept

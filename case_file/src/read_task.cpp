@@ -106,6 +106,7 @@ VerifySpec read_verify(ObjectReader& r, const DecayTask& decay) {
   v.stiffness_softening = r.number("stiffness_softening", VerifySpec{}.stiffness_softening, {1e-6, 1.0});
   v.require_ranking = r.boolean("require_ranking", VerifySpec{}.require_ranking);
   v.softening_check = r.boolean("softening_check", VerifySpec{}.softening_check);
+  v.rounds = r.integer("rounds", VerifySpec{}.rounds, 1, 10);
   return v;
 }
 

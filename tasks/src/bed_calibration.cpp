@@ -1,8 +1,11 @@
 // Calibrated beds (bed_calibration.hpp).
 #include "pdamp/tasks/bed_calibration.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/strict_json/number_text.hpp"
@@ -29,14 +32,15 @@ constexpr int kCacheFormatVersion = 1;
 /// The physics a bed's calibration depends on: the design case's structure, dampers,
 /// materials and DEM settings (the softening included), the release, the duration, the
 /// binning and the DEM's model version; not names, descriptions or the budget.
-std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec) {
+std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec, double extra_damping_ratio) {
   const json& r = design.resolved;
   json identity = {{"structure", r.value("structure", json())},   {"dampers", r.value("dampers", json())},
                    {"materials", r.value("materials", json())},   {"dem", r.value("dem", json())},
                    {"initial_state", r.at("task").value("initial_state", json())},
                    {"duration_s", spec.duration_s},              {"strokes_per_decade", spec.strokes_per_decade},
                    {"dem_model_version", surrogate::dem_model_version()},
-                   {"calibration_version", kCacheFormatVersion}};
+                   {"calibration_version", kCacheFormatVersion},
+                   {"extra_damping_ratio", extra_damping_ratio}};
   return surrogate::case_hash(identity);
 }
 
@@ -50,7 +54,8 @@ json period_rows(const std::vector<surrogate::DecayPeriodResponse>& periods) {
 json cache_document(const CalibratedBed& bed) {
   return {{"format", kCacheFormat},          {"format_version", kCacheFormatVersion},
           {"key", bed.key},                  {"layer", bed.layer},
-          {"slabs", bed.slabs},              {"steps", bed.steps},
+          {"slabs", bed.slabs},              {"extra_damping_ratio", bed.extra_damping_ratio},
+          {"steps", bed.steps},
           {"energy_error", bed.energy_error}, {"wall_time_s", bed.wall_time_s},
           {"periods", period_rows(bed.periods)}, {"field", surrogate::to_json(bed.field)}};
 }
@@ -97,7 +102,8 @@ json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const
   std::vector<long> slabs(p.options.layers.size(), 0);
   slabs[static_cast<std::size_t>(bed.layer_index)] = bed.slabs;
   const Case design = case_file::with_design(c, slabs, spec.stiffness_softening, true);
-  const detail::DesignModes modes = detail::design_modes(c, p, slabs);
+  detail::DesignModes modes = detail::design_modes(c, p, slabs);
+  modes.modal.damping_ratios.array() += bed.extra_damping_ratio;
   std::vector<st::Damper> containers = {p.options.damper};
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
   case_file::DecayTask decay = c.task.filling_ratios->decay;
@@ -151,6 +157,50 @@ std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> BedCalibra
   return out;
 }
 
+namespace {
+
+/// Reads or runs `beds` (their key and file set here): cached ones from the cache, the others
+/// as jobs of `executor`. Returns how many ran.
+int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
+                const std::filesystem::path& cache_dir, std::vector<CalibratedBed>& beds, RunHooks& hooks,
+                Executor& executor) {
+  std::error_code error;
+  std::filesystem::create_directories(cache_dir, error);
+  if (error)
+    throw std::runtime_error("pdamp optimize: cannot create the calibration cache " + cache_dir.string() + ": " +
+                             error.message());
+  std::vector<std::size_t> to_run;
+  for (std::size_t b = 0; b < beds.size(); ++b) {
+    CalibratedBed& bed = beds[b];
+    std::vector<long> slabs(p.options.layers.size(), 0);
+    slabs[static_cast<std::size_t>(bed.layer_index)] = bed.slabs;
+    bed.key = calibration_key(case_file::with_design(c, slabs, spec.stiffness_softening, true), spec,
+                              bed.extra_damping_ratio);
+    bed.file = cache_dir / (bed.layer + "_" + std::to_string(bed.slabs) + "_" + bed.key + ".json");
+    std::string why;
+    if (!read_cached(bed, why)) {
+      if (!why.empty()) hooks.note("pdamp: warning: " + bed.file.string() + " is not used (" + why + "): it runs again");
+      to_run.push_back(b);
+    }
+  }
+  const auto documents = run_jobs<json>(
+      executor, to_run.size(), parallel_jobs(executor, to_run.size()),
+      [&](std::size_t j) { return calibrate_bed(c, p, spec, beds[to_run[j]], hooks); }, nullptr,
+      [&](std::size_t j) { return static_cast<double>(to_run[j]); },
+      static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
+  for (std::size_t j = 0; j < to_run.size(); ++j) {
+    CalibratedBed& bed = beds[to_run[j]];
+    std::string why;
+    // What the job returned is what it wrote to the cache (on this process or another).
+    if (!bed_from_document(documents[j], bed, why))
+      throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+                                        std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
+  }
+  return static_cast<int>(to_run.size());
+}
+
+}  // namespace
+
 BedCalibration calibrate_beds(const Case& c, const case_file::FillingRatioProblem& p,
                               const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
                               RunHooks& hooks, Executor& executor) {
@@ -158,47 +208,64 @@ BedCalibration calibrate_beds(const Case& c, const case_file::FillingRatioProble
   BedCalibration out;
   out.spec = spec;
   out.cache_dir = cache_dir;
-  std::error_code error;
-  std::filesystem::create_directories(cache_dir, error);
-  if (error)
-    throw std::runtime_error("pdamp optimize: cannot create the calibration cache " + cache_dir.string() + ": " +
-                             error.message());
-  std::vector<std::size_t> to_run;
   for (std::size_t k = 0; k < p.options.layers.size(); ++k) {
-    const auto& layer = p.options.layers[k];
-    for (int n = 1; n <= layer.max_slabs(); ++n) {
+    for (int n = 1; n <= p.options.layers[k].max_slabs(); ++n) {
       CalibratedBed bed;
-      bed.layer = layer.name;
+      bed.layer = p.options.layers[k].name;
       bed.layer_index = static_cast<int>(k);
       bed.slabs = n;
-      std::vector<long> slabs(p.options.layers.size(), 0);
-      slabs[k] = n;
-      bed.key = calibration_key(case_file::with_design(c, slabs, spec.stiffness_softening, true), spec);
-      bed.file = cache_dir / (layer.name + "_" + std::to_string(n) + "_" + bed.key + ".json");
-      std::string why;
-      if (!read_cached(bed, why)) {
-        if (!why.empty()) hooks.note("pdamp: warning: " + bed.file.string() + " is not used (" + why + "): it runs again");
-        to_run.push_back(out.beds.size());
-      }
       out.beds.push_back(std::move(bed));
     }
   }
-  const auto documents = run_jobs<json>(
-      executor, to_run.size(), parallel_jobs(executor, to_run.size()),
-      [&](std::size_t j) { return calibrate_bed(c, p, spec, out.beds[to_run[j]], hooks); }, nullptr,
-      [&](std::size_t j) { return static_cast<double>(to_run[j]); },
-      static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
-  for (std::size_t j = 0; j < to_run.size(); ++j) {
-    CalibratedBed& bed = out.beds[to_run[j]];
-    std::string why;
-    // What the job returned is what it wrote to the cache (on this process or another).
-    if (!bed_from_document(documents[j], bed, why))
-      throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
-                                        std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
-  }
-  out.runs = static_cast<int>(to_run.size());
+  out.runs = read_or_run(c, p, spec, cache_dir, out.beds, hooks, executor);
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
+}
+
+double decay_damping_ratio(std::span<const double> time_s, std::span<const double> envelope_m, double frequency_hz) {
+  if (time_s.size() < 2 || envelope_m.size() != time_s.size() || !(frequency_hz > 0.0)) return NAN;
+  const double duration = time_s.back() - time_s.front();
+  const double ratio = envelope_m.front() / envelope_m.back();
+  if (!(duration > 0.0) || !(ratio > 0.0) || !std::isfinite(ratio)) return NAN;
+  return std::log(ratio) / (2.0 * std::numbers::pi * frequency_hz * duration);
+}
+
+std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::FillingRatioProblem& p,
+                                               BedCalibration& calibration, const std::vector<long>& slabs,
+                                               double design_damping_ratio, RunHooks& hooks, Executor& executor) {
+  const auto start = std::chrono::steady_clock::now();
+  // A design of one bed is that bed alone: its calibration already came down at its rate.
+  if (std::count_if(slabs.begin(), slabs.end(), [](long n) { return n > 0; }) < 2) return {};
+  std::vector<CalibratedBed> beds;
+  std::vector<std::size_t> index;  // into calibration.beds
+  for (std::size_t b = 0; b < calibration.beds.size(); ++b) {
+    const CalibratedBed& alone = calibration.beds[b];
+    if (slabs.at(static_cast<std::size_t>(alone.layer_index)) != alone.slabs) continue;
+    std::vector<double> time, stroke;
+    for (const auto& period : alone.periods) time.push_back(period.time_s), stroke.push_back(period.stroke_m);
+    const double frequency = alone.periods.empty() ? NAN : alone.periods.front().frequency_hz;
+    // What the design's other beds add: the design's average rate of decay less the bed's own
+    // (each includes the structure's damping). A bed recalibrated before holds a decay with
+    // its extra damping in it: its own alone is that less the extra (damping ratios add).
+    const double own = decay_damping_ratio(time, stroke, frequency) - alone.extra_damping_ratio;
+    CalibratedBed bed;
+    bed.layer = alone.layer;
+    bed.layer_index = alone.layer_index;
+    bed.slabs = alone.slabs;
+    bed.extra_damping_ratio = std::isfinite(own) ? std::max(design_damping_ratio - own, 0.0) : 0.0;
+    if (bed.extra_damping_ratio == alone.extra_damping_ratio) continue;
+    beds.push_back(std::move(bed));
+    index.push_back(b);
+  }
+  calibration.runs += read_or_run(c, p, calibration.spec, calibration.cache_dir, beds, hooks, executor);
+  std::vector<std::string> changed;
+  for (std::size_t b = 0; b < beds.size(); ++b) {
+    changed.push_back(beds[b].layer + " " + std::to_string(beds[b].slabs) + " slabs: extra damping ratio " +
+                      strict_json::format_number(beds[b].extra_damping_ratio, 3));
+    calibration.beds[index[b]] = std::move(beds[b]);
+  }
+  calibration.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return changed;
 }
 
 json to_json(const BedCalibration& calibration) {
@@ -208,6 +275,7 @@ json to_json(const BedCalibration& calibration) {
     for (const auto& p : b.periods) lowest = std::min(lowest, p.stroke_m), highest = std::max(highest, p.stroke_m);
     beds.push_back({{"layer", b.layer},
                     {"slabs", b.slabs},
+                    {"extra_damping_ratio", b.extra_damping_ratio},
                     {"key", b.key},
                     {"cached", b.cached},
                     {"file", b.file.string()},

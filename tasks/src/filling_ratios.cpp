@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <sstream>
 
 #include "pdamp/strict_json/input_error.hpp"
@@ -212,9 +213,13 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
 /// each design at the verification's softening, then (softening check) each ten times
 /// stiffer. Every process optimised the same way (NLopt's seed is fixed); a job carries the
 /// design it verifies, so a process that chose another design refuses it.
+/// The DEM decays run so far, by design and softening: a later round of the design loop
+/// reuses them (the same inputs give the same run) instead of running them again.
+using DecayRuns = std::map<std::string, VerifiedDecay>;
+
 Verification verify_designs(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r,
                             const case_file::VerifySpec& verify, const FillingRatiosOptions& o, RunHooks& hooks,
-                            Executor& executor, std::vector<std::filesystem::path>& checkpoints) {
+                            Executor& executor, std::vector<std::filesystem::path>& checkpoints, DecayRuns& runs) {
   const auto start = std::chrono::steady_clock::now();
   Verification v;
   v.spec = verify;
@@ -238,15 +243,28 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
     files[k] = verification_checkpoint(o, designs[k % 2].first, suffix_of(k), *designs[k % 2].second, softening_of(k), hooks);
     if (!files[k].file.path.empty()) checkpoints.push_back(files[k].file.path);
   }
-  const auto decays = run_jobs<VerifiedDecay>(
-      executor, jobs, true,
-      [&](std::size_t k) {
+  const auto run_key = [&](std::size_t k) {
+    std::ostringstream key;
+    for (const double n : slabs_of(*designs[k % 2].second)) key << n << ' ';
+    key << "softening " << softening_of(k);
+    return key.str();
+  };
+  std::vector<std::size_t> to_run;
+  for (std::size_t k = 0; k < jobs; ++k)
+    if (!runs.contains(run_key(k))) to_run.push_back(k);
+  const auto ran = run_jobs<VerifiedDecay>(
+      executor, to_run.size(), true,
+      [&](std::size_t j) {
+        const std::size_t k = to_run[j];
         const std::string label = designs[k % 2].first + (k < 2 ? "" : ", softening " + format_number(softening_of(k), 3));
         return verification_decay(c, p, verify, label, *designs[k % 2].second, modes[k % 2], softening_of(k), files[k],
                                   hooks);
       },
-      &v.mpi, [&](std::size_t k) { return design_fingerprint(*designs[k % 2].second); },
+      &v.mpi, [&](std::size_t j) { return design_fingerprint(*designs[to_run[j] % 2].second); },
       static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
+  for (std::size_t j = 0; j < to_run.size(); ++j) runs[run_key(to_run[j])] = ran[j];
+  std::vector<VerifiedDecay> decays;
+  for (std::size_t k = 0; k < jobs; ++k) decays.push_back(runs.at(run_key(k)));
   v.softening_converged = true;
   for (std::size_t k = 0; k < 2; ++k) {
     std::optional<SofteningCheck> stiffer;
@@ -373,6 +391,44 @@ DesignComparison compare_designs(const case_file::FillingRatioProblem& p, const 
 
 }  // namespace
 
+namespace {
+
+VerificationRound round_summary(int round, const Verification& v) {
+  VerificationRound out;
+  out.round = round;
+  for (const auto& d : v.designs)
+    out.designs.push_back({d.name, slabs_of(d.design), d.predicted_objective, d.dem_objective,
+                           d.predicted_end_envelope_m, d.dem_end_envelope_m, d.agreement.compared,
+                           d.agreement.relative_difference, d.passed});
+  out.ranking_passed = v.ranking_passed;
+  out.passed = v.passed;
+  return out;
+}
+
+json rounds_json(const std::vector<VerificationRound>& rounds) {
+  json out = json::array();
+  for (const auto& r : rounds) {
+    json designs = json::object();
+    for (const auto& d : r.designs)
+      designs[d.name] = {{"slabs", d.slabs},
+                         {"predicted_objective", number_or_null(d.predicted_objective)},
+                         {"dem_objective", number_or_null(d.dem_objective)},
+                         {"predicted_end_envelope_m", number_or_null(d.predicted_end_envelope_m)},
+                         {"dem_end_envelope_m", number_or_null(d.dem_end_envelope_m)},
+                         {"compared", d.compared},
+                         {"relative_difference", number_or_null(d.relative_difference)},
+                         {"passed", d.passed}};
+    out.push_back({{"round", r.round},
+                   {"designs", designs},
+                   {"ranking_passed", r.ranking_passed},
+                   {"passed", r.passed},
+                   {"recalibrated", r.recalibrated}});
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<double> slabs_of(const opt::FillingDesign& d) {
   std::vector<double> n;
   for (const auto& l : d.layers) n.push_back(l.slabs);
@@ -398,25 +454,22 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
                                      hooks, executor);
     out.problem.options.bed_models = out.calibration->models();
   }
-  const auto& p = out.problem;
 
   opt::Options solver;
   solver.backend = o.backend.value_or(*opt::backend_from_string(task.backend));
   solver.global_evaluations = task.global_evaluations;
   solver.max_evaluations = task.max_evaluations;
-  try {
-    out.optimum = opt::optimize_filling_ratios(p.modal, p.options, solver);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(c.path, "/task", e.what());
-  }
-  const auto& r = out.optimum;
-  out.warnings = p.warnings;
-  out.warnings.insert(out.warnings.end(), r.warnings.begin(), r.warnings.end());
-  if (out.calibration)
-    out.warnings.push_back("same_mass is by the closed forms: one compartment holding the chosen mass is no candidate "
-                           "bed and has no calibration");
-  for (const auto* d : {&r.chosen, &r.relaxed, &r.baseline})
-    if (!std::isfinite(d->objective)) throw strict_json::NumericalError("pdamp optimize: a design's objective is not finite");
+  const auto optimise = [&] {
+    try {
+      out.optimum = opt::optimize_filling_ratios(out.problem.modal, out.problem.options, solver);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.path, "/task", e.what());
+    }
+    for (const auto* d : {&out.optimum.chosen, &out.optimum.relaxed, &out.optimum.baseline})
+      if (!std::isfinite(d->objective))
+        throw strict_json::NumericalError("pdamp optimize: a design's objective is not finite");
+  };
+  optimise();
 
   // The DEM verification: the task's verify block, or --verify with its defaults.
   std::optional<case_file::VerifySpec> verify = task.verify;
@@ -426,7 +479,45 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   }
   if (o.skip_verify) verify.reset();
   if (verify) {
-    out.verification = verify_designs(c, p, r, *verify, o, hooks, executor, out.checkpoints);
+    // The design loop: on calibrated beds a failed round recalibrates the chosen design's
+    // beds where it operates, optimises and verifies again (docs/optimizer.md).
+    const int rounds = out.calibration ? verify->rounds : 1;
+    DecayRuns runs;
+    for (int round = 1;; ++round) {
+      out.verification = verify_designs(c, out.problem, out.optimum, *verify, o, hooks, executor, out.checkpoints, runs);
+      out.rounds.push_back(round_summary(round, *out.verification));
+      if (out.verification->passed) {
+        out.loop_outcome = "agreed";
+        break;
+      }
+      if (round >= rounds) {
+        out.loop_outcome = "rounds_exhausted";
+        break;
+      }
+      const DesignCheck& chosen = out.verification->designs.front();
+      const double design_damping =
+          decay_damping_ratio(chosen.dem.settling.envelope_time_s, chosen.dem.settling.envelope_m,
+                              chosen.dem.settling.frequency_hz);
+      out.rounds.back().recalibrated = recalibrate_in_design(c, out.problem, *out.calibration,
+                                                             whole_slabs(chosen.design), design_damping, hooks, executor);
+      if (out.rounds.back().recalibrated.empty()) {
+        out.loop_outcome = "nothing_to_recalibrate";
+        break;
+      }
+      hooks.note("pdamp optimize: round " + std::to_string(round) + " of the design loop failed; recalibrated " +
+                 std::to_string(out.rounds.back().recalibrated.size()) + " bed(s) where the chosen design operates");
+      out.problem.options.bed_models = out.calibration->models();
+      optimise();
+    }
+  }
+  const auto& p = out.problem;
+  const auto& r = out.optimum;
+  out.warnings = p.warnings;
+  out.warnings.insert(out.warnings.end(), r.warnings.begin(), r.warnings.end());
+  if (out.calibration)
+    out.warnings.push_back("same_mass is by the closed forms: one compartment holding the chosen mass is no candidate "
+                           "bed and has no calibration");
+  if (out.verification) {
     for (const auto& d : out.verification->designs) {
       for (const auto& w : d.dem.warnings) out.warnings.push_back("verify (" + d.name + "): " + w);
       if (d.softening_check && !d.softening_check->agreement.within)
@@ -440,6 +531,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     if (!out.verification->passed)
       out.warnings.push_back("the DEM verification failed (tolerance " + format_number(verify->tolerance_relative, 3) +
                              (out.verification->ranking_passed ? "" : "; the DEM does not rank the chosen design ahead of the baseline") +
+                             (out.rounds.size() > 1 ? " after " + std::to_string(out.rounds.size()) + " rounds of the design loop" : "") +
                              "): see verification in the result");
   }
   try {
@@ -498,6 +590,8 @@ json to_json(const FillingRatiosResult& res) {
       {"solve_time_s", r.solve_time_s}};
   result["calibration"] = res.calibration ? to_json(*res.calibration) : json(nullptr);
   result["verification"] = res.verification ? verification_json(*res.verification) : json(nullptr);
+  result["design_loop"] = res.rounds.empty() ? json(nullptr)
+                                             : json{{"rounds", rounds_json(res.rounds)}, {"outcome", res.loop_outcome}};
   return result;
 }
 

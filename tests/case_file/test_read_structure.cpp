@@ -168,6 +168,7 @@ TEST_CASE("a filling_ratios task reads its verify block, with defaults for the k
   CHECK(v.stiffness_softening == 1.0);
   CHECK(v.require_ranking);
   CHECK(v.softening_check);
+  CHECK(v.rounds == 3);
   CHECK(defaults.resolved["task"]["verify"]["softening_check"] == true);
   CHECK(defaults.resolved["task"]["verify"]["tolerance_relative"] == 0.3);
   CHECK(defaults.resolved["task"]["verify"]["duration_s"] == 20.0);
@@ -175,7 +176,7 @@ TEST_CASE("a filling_ratios task reads its verify block, with defaults for the k
 
   const Case given = load_case(edited_optimize_case(dir, [](json& t) {
     t["verify"] = {{"tolerance_relative", 0.5}, {"duration_s", 12.5}, {"stiffness_softening", 0.01},
-                   {"require_ranking", false}, {"softening_check", false}};
+                   {"require_ranking", false}, {"softening_check", false}, {"rounds", 1}};
   }));
   const auto& g = *given.task.filling_ratios->verify;
   CHECK(g.tolerance_relative == 0.5);
@@ -183,6 +184,7 @@ TEST_CASE("a filling_ratios task reads its verify block, with defaults for the k
   CHECK(g.stiffness_softening == 0.01);
   CHECK_FALSE(g.require_ranking);
   CHECK_FALSE(g.softening_check);
+  CHECK(g.rounds == 1);
 
   // Absent: no verification asked.
   const Case none = load_case(edited_optimize_case(dir, [](json& t) { t.erase("verify"); }));
@@ -234,6 +236,7 @@ TEST_CASE("a bad verify block is refused naming its key and the allowed range", 
   refused({{"tolerance_relative", 0.0}}, "/task/verify/tolerance_relative", "> 0 and <= 10");
   refused({{"tolerance_relative", 11.0}}, "/task/verify/tolerance_relative", "<= 10");
   refused({{"duration_s", -1.0}}, "/task/verify/duration_s", "> 0");
+  refused({{"rounds", 0}}, "/task/verify/rounds", "[1, 10]");
   refused({{"stiffness_softening", 0.0}}, "/task/verify/stiffness_softening", ">= 1e-06 and <= 1");
   refused({{"stiffness_softening", 2.0}}, "/task/verify/stiffness_softening", "<= 1");
   refused({{"require_ranking", "yes"}}, "/task/verify/require_ranking", "must be true or false");

@@ -242,3 +242,55 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
   CHECK_FALSE(closed_forms.calibration);
   CHECK(tasks::to_json(closed_forms)["method"] == "formulas");
 }
+
+// Reference: the loop's definition (docs/optimizer.md, "Calibrated beds"): a round that fails
+// recalibrates the chosen design's beds with the damping the design's other beds add, then
+// optimises and verifies again, up to verify.rounds; a design verified before is not run
+// again (the same inputs, the same DEM decay). A tolerance no decay meets makes every
+// round fail.
+TEST_CASE("the design loop recalibrates the chosen design's beds and stops after its rounds", "[tasks]") {
+  const test::TempDir cache("design_loop");
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  nlohmann::json document = nlohmann::json::parse(in);
+  document["task"]["calibration"] = {{"duration_s", 1.5}, {"stiffness_softening", 1e-3}};
+  document["task"]["verify"] = {{"duration_s", 1.5}, {"stiffness_softening", 1e-3}, {"softening_check", false},
+                                {"tolerance_relative", 1e-6}, {"rounds", 2}};
+  const auto c = case_file::load_case_document(document, "design_loop.json");
+  tasks::FillingRatiosOptions options;
+  options.calibration_cache = cache.path;
+  NoteHooks hooks;
+  const auto r = tasks::run_filling_ratios(c, options, hooks, tasks::local_executor());
+  REQUIRE(r.verification);
+  CHECK_FALSE(r.verification->passed);
+  REQUIRE_FALSE(r.rounds.empty());
+  const auto& first = r.rounds.front();
+  CHECK_FALSE(first.passed);
+  int layers = 0;
+  for (const double n : first.designs.front().slabs) layers += n > 0.0 ? 1 : 0;
+  if (layers < 2) {
+    // A single bed is its own calibration: nothing to recalibrate, the loop ends.
+    CHECK(r.rounds.size() == 1);
+    CHECK(r.loop_outcome == "nothing_to_recalibrate");
+    return;
+  }
+  REQUIRE(r.rounds.size() == 2);
+  CHECK(r.loop_outcome == "rounds_exhausted");
+  CHECK(first.recalibrated.size() == static_cast<std::size_t>(layers));
+  CHECK(r.rounds.back().recalibrated.empty());
+  // The chosen design's beds now carry the damping its other beds add; the others none.
+  int raised = 0;
+  for (const auto& bed : r.calibration->beds) {
+    const bool in_design = first.designs.front().slabs.at(static_cast<std::size_t>(bed.layer_index)) == bed.slabs;
+    CHECK((bed.extra_damping_ratio > 0.0) == in_design);
+    raised += bed.extra_damping_ratio > 0.0 ? 1 : 0;
+  }
+  CHECK(raised == layers);
+  CHECK(r.calibration->runs == 11 + layers);
+  // A design verified in both rounds: the same DEM decay, not a new one.
+  for (const auto& d : r.rounds.back().designs)
+    for (const auto& before : first.designs)
+      if (before.slabs == d.slabs) CHECK(before.dem_end_envelope_m == d.dem_end_envelope_m);
+  const auto j = tasks::to_json(r);
+  CHECK(j["design_loop"]["rounds"].size() == 2);
+  CHECK(j["design_loop"]["outcome"] == "rounds_exhausted");
+}

@@ -177,6 +177,10 @@ struct VerifySpec {
   /// unless the two objectives agree within tolerance_relative: the softening has converged
   /// on the quantity judged. Skipped when the runs are at full stiffness already.
   bool softening_check = true;
+  /// With calibrated beds: rounds of the design loop, [1, 10]. A round that fails
+  /// recalibrates the chosen design's beds where that design operates (docs/optimizer.md,
+  /// "Calibrated beds"), optimises and verifies again; 1: no loop.
+  int rounds = 3;
 };
 
 /// `calibration` of task kind filling_ratios: every candidate bed (each layer holding each

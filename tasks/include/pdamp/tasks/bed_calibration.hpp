@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct CalibratedBed {
   std::string layer;
   int layer_index = 0;
   int slabs = 0;
+  /// Damping ratio added to every mode of the structure in the bed's decay: 0 for the bed
+  /// alone; in a recalibration (recalibrate_in_design) what a design's other beds add, so that
+  /// the bed comes down at the design's rate.
+  double extra_damping_ratio = 0.0;
   std::string key;                 ///< 16 hex digits of the physics the calibration depends on
   std::filesystem::path file;      ///< its cache file
   bool cached = false;             ///< read from the cache (not run now)
@@ -60,6 +65,21 @@ std::filesystem::path default_calibration_cache();
 BedCalibration calibrate_beds(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                               const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
                               RunHooks& hooks, Executor& executor);
+
+/// The average damping ratio of a decay from its envelope: ln(e_first/e_last)/(2πf·Δt); NaN
+/// with fewer than two points or an envelope that is not positive.
+double decay_damping_ratio(std::span<const double> time_s, std::span<const double> envelope_m, double frequency_hz);
+
+/// The closing of the design loop (docs/optimizer.md, "Calibrated beds"): the beds of the
+/// design of `slabs` calibrated again where that design operates: each bed's decay with every
+/// mode's damping ratio raised by what the design's other beds add, the design's average
+/// damping ratio `design_damping_ratio` (from its DEM verification) less the bed's own alone
+/// (never below 0), so that the bed comes down at about the design's rate. Replaces those beds
+/// in `calibration` (cached like the others) and returns one line per bed replaced; none for
+/// a design of one bed (its calibration is that design already).
+std::vector<std::string> recalibrate_in_design(const case_file::Case& c, const case_file::FillingRatioProblem& p,
+                                               BedCalibration& calibration, const std::vector<long>& slabs,
+                                               double design_damping_ratio, RunHooks& hooks, Executor& executor);
 
 /// The calibration's result keys (spec, cache folder, per bed: layer, slabs, key, cached, file,
 /// periods, stroke range, steps, wall time).

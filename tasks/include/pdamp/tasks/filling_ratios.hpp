@@ -111,6 +111,25 @@ struct DesignComparison {
   std::vector<structure::FreeDecay> decays;  ///< chosen, baseline, initial
 };
 
+/// One round of the design loop: the designs verified and how they agreed.
+struct VerificationRound {
+  int round = 1;
+  struct Design {
+    std::string name;  ///< "chosen", "baseline"
+    std::vector<double> slabs;
+    double predicted_objective = NAN, dem_objective = NAN;  ///< NaN: not settled
+    double predicted_end_envelope_m = NAN, dem_end_envelope_m = NAN;
+    std::string compared;
+    double relative_difference = NAN;
+    bool passed = false;
+  };
+  std::vector<Design> designs;
+  bool ranking_passed = false;
+  bool passed = false;
+  /// The beds recalibrated after this round (empty: the loop ended here).
+  std::vector<std::string> recalibrated;
+};
+
 struct FillingRatiosResult {
   std::string case_name;
   case_file::FillingRatioProblem problem;
@@ -118,7 +137,9 @@ struct FillingRatiosResult {
   std::optional<BedCalibration> calibration;  ///< the calibrated beds the optimiser used, if any
   optimizer::FillingRatioResult optimum;
   DesignComparison comparison;
-  std::optional<Verification> verification;
+  std::optional<Verification> verification;  ///< of the last round
+  std::vector<VerificationRound> rounds;     ///< every round of the design loop (one without calibration)
+  std::string loop_outcome;                  ///< "agreed", "rounds_exhausted", "nothing_to_recalibrate"
   std::vector<std::filesystem::path> checkpoints;  ///< the verification's files, to remove once its results are kept
   std::vector<std::string> warnings;
 };
