@@ -28,7 +28,7 @@ constexpr std::size_t kMaxArrayRows = 40;
 bool skipped_key(const std::string& key) {
   static const char* const kSkipped[] = {"file", "plot", "outputs", "warnings", "report", "message", "envelope",
                                          "envelope_points", "energy", "what", "rule", "designs", "verification",
-                                         "solver", "rounding"};
+                                         "solver", "rounding", "calibration", "design_loop"};
   return std::any_of(std::begin(kSkipped), std::end(kSkipped), [&](const char* s) { return key == s; });
 }
 
@@ -190,6 +190,46 @@ std::string verification_section(const json& result) {
   return out.str();
 }
 
+/// filling_ratios on calibrated beds: the beds, and the rounds of the design loop.
+std::string calibration_section(const json& result) {
+  std::ostringstream out;
+  if (result.contains("calibration") && result["calibration"].is_object()) {
+    const json& c = result["calibration"];
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& b : c["beds"])
+      rows.push_back({html_escape(scalar_text(b["layer"])), scalar_text(b["slabs"]), scalar_text(b["extra_damping_ratio"]),
+                      scalar_text(b["periods"]), mm(b["stroke_min_m"]) + " – " + mm(b["stroke_max_m"]),
+                      b["cached"].get<bool>() ? "cache" : "run now (" + seconds(b["wall_time_s"]) + " s)"});
+    out << "<h2>Calibrated beds</h2>\n<p>" << html_escape(scalar_text(c["what"])) << ": "
+        << html_escape(scalar_text(c["duration_s"])) << " s each, stiffness softening "
+        << html_escape(scalar_text(c["stiffness_softening"])) << "; " << html_escape(scalar_text(c["runs"]))
+        << " DEM decays run now, the others from " << html_escape(scalar_text(c["cache_dir"])) << ".</p>\n"
+        << table({"layer", "slabs", "extra damping ratio", "periods", "strokes / mm", "source"}, rows);
+  }
+  if (result.contains("design_loop") && result["design_loop"].is_object()) {
+    const json& loop = result["design_loop"];
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& r : loop["rounds"]) {
+      for (const char* name : {"chosen", "baseline"}) {
+        if (!r["designs"].contains(name)) continue;
+        const json& d = r["designs"][name];
+        std::string slabs;
+        for (const auto& n : d["slabs"]) slabs += (slabs.empty() ? "" : ", ") + scalar_text(n);
+        rows.push_back({scalar_text(r["round"]), name, slabs, seconds(d["predicted_objective"]), seconds(d["dem_objective"]),
+                        d["relative_difference"].is_number()
+                            ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
+                            : "only one settled",
+                        d["passed"].get<bool>() ? "pass" : "FAIL",
+                        std::string(name) == "chosen" ? std::to_string(r["recalibrated"].size()) : ""});
+      }
+    }
+    out << "<h2>Design loop</h2>\n<p>Outcome: " << html_escape(scalar_text(loop["outcome"])) << ".</p>\n"
+        << table({"round", "design", "slabs", "predicted", "DEM", "DEM − predicted", "result", "beds recalibrated after"},
+                 rows);
+  }
+  return out.str();
+}
+
 /// What a picture shows, by its file name.
 std::string caption(const std::string& file_name) {
   static const std::map<std::string, std::string> kCaptions = {
@@ -294,7 +334,8 @@ std::string report_html(const ReportInput& in) {
   std::vector<std::vector<std::string>> cells;
   for (const auto& [k, v] : rows) cells.push_back({k, v});
   out << "<h2>Key numbers</h2>\n" << table({"quantity", "value"}, cells);
-  if (r.is_object()) out << designs_section(r) << solver_section(r) << verification_section(r) << array_tables(r);
+  if (r.is_object())
+    out << designs_section(r) << solver_section(r) << calibration_section(r) << verification_section(r) << array_tables(r);
 
   out << "<h2>Plots</h2>\n";
   if (!in.gnuplot_found)

@@ -616,6 +616,9 @@ void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out
   for (const auto* m : {&h.modal_displacements, &h.site_displacement_m, &h.site_rotation_rad, &h.container_load_n,
                         &h.container_moment_nm})
     write_matrix(out, *m);
+  out.f64s(h.pending_load_sum_n);
+  out.f64s(h.pending_moment_sum_nm);
+  out.i64(h.pending_steps);
   out.i64(static_cast<std::int64_t>(r.warnings.size()));
   for (const auto& w : r.warnings) out.text(w);
   out.tag("end of cosimulation result");
@@ -647,6 +650,10 @@ CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Inde
   h.site_rotation_rad = read_matrix(in, "history.site_rotation_rad", samples, dampers);
   h.container_load_n = read_matrix(in, "history.container_load_n", samples, dampers);
   h.container_moment_nm = read_matrix(in, "history.container_moment_nm", samples, dampers);
+  h.pending_load_sum_n = in.finite_f64s_up_to("history.pending_load_sum_n", dampers);
+  h.pending_moment_sum_nm = in.finite_f64s_up_to("history.pending_moment_sum_nm", dampers);
+  h.pending_steps = in.i64("history.pending_steps");
+  if (h.pending_steps < 0) in.fail("history.pending_steps", "must not be negative");
   const std::size_t warnings = in.count("warnings", 10000, 8);
   for (std::size_t k = 0; k < warnings; ++k) r.warnings.push_back(in.text("warnings", kMaxWarningBytes));
   in.expect_tag("end of cosimulation result");
@@ -667,6 +674,9 @@ void append_continuation(CosimulationResult& total, const CosimulationResult& ne
     to->conservativeResize(have + add, from->cols());
     if (add > 0) to->bottomRows(add) = from->bottomRows(add);
   }
+  h.pending_load_sum_n = g.pending_load_sum_n;
+  h.pending_moment_sum_nm = g.pending_moment_sum_nm;
+  h.pending_steps = g.pending_steps;
   total.energy = state.energy_since_start;
   total.steps += next.steps;
   total.simulated_time_s += next.simulated_time_s;

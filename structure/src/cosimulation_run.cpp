@@ -88,7 +88,12 @@ class SampledHistory final : public RunMeasure {
       history_.site_rotation_rad.topRows(samples_) = earlier->site_rotation_rad;
       history_.container_load_n.topRows(samples_) = earlier->container_load_n;
       history_.container_moment_nm.topRows(samples_) = earlier->container_moment_nm;
+      history_.pending_load_sum_n = earlier->pending_load_sum_n;
+      history_.pending_moment_sum_nm = earlier->pending_moment_sum_nm;
+      history_.pending_steps = earlier->pending_steps;
     }
+    history_.pending_load_sum_n.resize(dampers, 0.0);
+    history_.pending_moment_sum_nm.resize(dampers, 0.0);
   }
 
   /// One sample: t, q, y_d, θ_d, and the bed's force and moment on the container (−F_d, −M_d).
@@ -109,8 +114,23 @@ class SampledHistory final : public RunMeasure {
     ++samples_;
   }
 
+  /// The bed's force and moment are averaged over the steps since the last sample (an
+  /// impact lasts a few steps, far shorter than a sample interval: a value read at the
+  /// sample alone would alias it); the motion is read at the sample.
   void after_step(const StepView& s, std::int64_t&) override {
-    if (s.step % sample_every_ == 0) record(s.time_s, s.q, s.site_y, s.site_theta, s.force, s.moment);
+    auto& h = history_;
+    for (std::size_t d = 0; d < s.force.size(); ++d)
+      h.pending_load_sum_n[d] += s.force[d], h.pending_moment_sum_nm[d] += s.moment[d];
+    ++h.pending_steps;
+    if (s.step % sample_every_ != 0) return;
+    for (std::size_t d = 0; d < s.force.size(); ++d) {
+      h.pending_load_sum_n[d] /= static_cast<double>(h.pending_steps);
+      h.pending_moment_sum_nm[d] /= static_cast<double>(h.pending_steps);
+    }
+    record(s.time_s, s.q, s.site_y, s.site_theta, h.pending_load_sum_n, h.pending_moment_sum_nm);
+    std::fill(h.pending_load_sum_n.begin(), h.pending_load_sum_n.end(), 0.0);
+    std::fill(h.pending_moment_sum_nm.begin(), h.pending_moment_sum_nm.end(), 0.0);
+    h.pending_steps = 0;
   }
 
   void write(CosimulationResult& result, std::int64_t) const override {
@@ -121,6 +141,9 @@ class SampledHistory final : public RunMeasure {
     h.site_rotation_rad = history_.site_rotation_rad.topRows(samples_);
     h.container_load_n = history_.container_load_n.topRows(samples_);
     h.container_moment_nm = history_.container_moment_nm.topRows(samples_);
+    h.pending_load_sum_n = history_.pending_load_sum_n;
+    h.pending_moment_sum_nm = history_.pending_moment_sum_nm;
+    h.pending_steps = history_.pending_steps;
   }
 
   void release(CosimulationResult& result, std::int64_t) override {

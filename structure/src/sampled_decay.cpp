@@ -129,6 +129,14 @@ std::vector<surrogate::DecayPeriodResponse> bed_response_per_period(const std::v
   }
   if (up.size() < 2) return {};
   const std::size_t periods = up.size() - 1;
+  // Each force sample is the mean over the interval that ends at it (CosimulationHistory):
+  // it belongs half an interval earlier, a phase lag ΩΔt/2 that would turn the inertial force
+  // into damping, η* too high by (m_app/m_bed)·sin(ΩΔt/2) (0.015 at 60 samples a period:
+  // the whole η* of a rolling bed's tail). The mean of the two intervals either side of a
+  // sample is centred on it (a triangle of width 2Δt: its gain at Ω is 1 − (ΩΔt)²/12).
+  Eigen::VectorXd force_at_samples = force_on_bed_n;
+  for (Eigen::Index k = 0; k + 1 < force_on_bed_n.size(); ++k)
+    force_at_samples(k) = 0.5 * (force_on_bed_n(k) + force_on_bed_n(k + 1));
   // The motion decays within a period, y ≈ Im(X e^{st}), s = −λ + iΩ. Taken as a pure sine,
   // an inertial bed F = m_a ÿ + c ẏ would seem to give energy back (its kinetic energy falls
   // with the envelope): η* low by 2(λ/Ω)·m_a/m_bed, as large as the tail's η* itself at the
@@ -146,7 +154,7 @@ std::vector<surrogate::DecayPeriodResponse> bed_response_per_period(const std::v
       const std::complex<double> x_hat =
           2.0 / period * weighted_integral(t, y, offset, first, last, t0, t1, omega, lambda[k]);
       const std::complex<double> f_hat =
-          2.0 / period * weighted_integral(t, force_on_bed_n, 0.0, first, last, t0, t1, omega, lambda[k]);
+          2.0 / period * weighted_integral(t, force_at_samples, 0.0, first, last, t0, t1, omega, lambda[k]);
       const std::complex<double> s(-lambda[k], omega);
       const std::complex<double> impedance = f_hat / (s * x_hat);  // m_a s + c
       const double mass = impedance.imag() / omega, damping = impedance.real() + mass * lambda[k];

@@ -27,7 +27,7 @@ namespace {
 constexpr const char* kCacheFormat = "pdamp.bed_calibration";
 /// Raised whenever what a cache file holds or how it is computed from the DEM changes
 /// (structure::bed_response_per_period, surrogate::decay_field): it is part of every key.
-constexpr int kCacheFormatVersion = 1;
+constexpr int kCacheFormatVersion = 3;  // 3: the bed's force the mean over each sample interval, centred
 
 /// The physics a bed's calibration depends on: the design case's structure, dampers,
 /// materials and DEM settings (the softening included), the release, the duration, the
@@ -232,7 +232,8 @@ double decay_damping_ratio(std::span<const double> time_s, std::span<const doubl
 
 std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::FillingRatioProblem& p,
                                                BedCalibration& calibration, const std::vector<long>& slabs,
-                                               double design_damping_ratio, RunHooks& hooks, Executor& executor) {
+                                               double design_damping_ratio, double design_threshold_m, RunHooks& hooks,
+                                               Executor& executor) {
   const auto start = std::chrono::steady_clock::now();
   // A design of one bed is that bed alone: its calibration already came down at its rate.
   if (std::count_if(slabs.begin(), slabs.end(), [](long n) { return n > 0; }) < 2) return {};
@@ -241,8 +242,12 @@ std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::F
   for (std::size_t b = 0; b < calibration.beds.size(); ++b) {
     const CalibratedBed& alone = calibration.beds[b];
     if (slabs.at(static_cast<std::size_t>(alone.layer_index)) != alone.slabs) continue;
+    // The bed's own decay over the same span as the design's: down to the design's threshold.
     std::vector<double> time, stroke;
-    for (const auto& period : alone.periods) time.push_back(period.time_s), stroke.push_back(period.stroke_m);
+    for (const auto& period : alone.periods) {
+      time.push_back(period.time_s), stroke.push_back(period.stroke_m);
+      if (period.stroke_m < design_threshold_m) break;
+    }
     const double frequency = alone.periods.empty() ? NAN : alone.periods.front().frequency_hz;
     // What the design's other beds add: the design's average rate of decay less the bed's own
     // (each includes the structure's damping). A bed recalibrated before holds a decay with

@@ -494,12 +494,17 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
         out.loop_outcome = "rounds_exhausted";
         break;
       }
+      // The chosen design's rate of decay down to its threshold: its ζ_eq when it settled,
+      // else over the whole record.
       const DesignCheck& chosen = out.verification->designs.front();
-      const double design_damping =
-          decay_damping_ratio(chosen.dem.settling.envelope_time_s, chosen.dem.settling.envelope_m,
-                              chosen.dem.settling.frequency_hz);
-      out.rounds.back().recalibrated = recalibrate_in_design(c, out.problem, *out.calibration,
-                                                             whole_slabs(chosen.design), design_damping, hooks, executor);
+      const auto& settling = chosen.dem.settling;
+      const double design_damping = std::isfinite(settling.damping_ratio)
+                                        ? settling.damping_ratio
+                                        : decay_damping_ratio(settling.envelope_time_s, settling.envelope_m,
+                                                              settling.frequency_hz);
+      out.rounds.back().recalibrated =
+          recalibrate_in_design(c, out.problem, *out.calibration, whole_slabs(chosen.design), design_damping,
+                                chosen.dem.threshold_m, hooks, executor);
       if (out.rounds.back().recalibrated.empty()) {
         out.loop_outcome = "nothing_to_recalibrate";
         break;

@@ -246,7 +246,7 @@ void require_confirmed(const json& r) {
 // candidate bed's own DEM decay, seeded apart from the verification's runs) must predict the
 // DEM-in-the-loop decays of the chosen design and of the baseline within the cases' 15 % and
 // rank them as the DEM does: the reduced closing of the design loop CI runs (docs/optimizer.md,
-// "Calibrated beds": the link −7 % and +8 %, the cantilever −7 % and −1 %, the checks at 1e-2
+// "Calibrated beds": the link −3 % and +4 %, the cantilever −4 % and −1 %, the checks at 1e-2
 // within 6 %). The softening check is off here: it runs each design again 2.5 times as long,
 // and its logic is tested in tests/tasks (docs/optimizer.md records the cases' checks).
 TEST_CASE("the shipped optimisations on calibrated beds predict the DEM within their tolerance",

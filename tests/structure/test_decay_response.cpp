@@ -20,7 +20,9 @@ struct LinearBedDecay {
 };
 
 /// y = y_s + X e^{−λt} sin(Ωt) sampled `per_period` times a period over `periods`; the force
-/// the container applies to a linear bed F = m_a ÿ + c ẏ, exactly.
+/// the container applies to a linear bed F = m_a ÿ + c ẏ as the co-simulation's history holds
+/// it, the exact mean over the interval ending at each sample: (m_a Δẏ + c Δy)/Δt (the first
+/// sample its own value).
 LinearBedDecay linear_bed_decay(double omega, double lambda, double m_a, double c, double offset, int per_period,
                                 int periods) {
   const double amplitude = 0.01, dt = 2.0 * std::numbers::pi / omega / per_period;
@@ -28,13 +30,14 @@ LinearBedDecay linear_bed_decay(double omega, double lambda, double m_a, double 
   LinearBedDecay d;
   d.y.resize(n);
   d.force.resize(n);
+  std::vector<double> v(n);
   for (int k = 0; k < n; ++k) {
     const double t = k * dt, e = amplitude * std::exp(-lambda * t), s = std::sin(omega * t), co = std::cos(omega * t);
-    const double v = e * (omega * co - lambda * s);
-    const double a = e * ((lambda * lambda - omega * omega) * s - 2.0 * lambda * omega * co);
+    v[k] = e * (omega * co - lambda * s);
     d.t.push_back(t);
     d.y(k) = offset + e * s;
-    d.force(k) = m_a * a + c * v;
+    const double a = e * ((lambda * lambda - omega * omega) * s - 2.0 * lambda * omega * co);
+    d.force(k) = k == 0 ? m_a * a + c * v[0] : (m_a * (v[k] - v[k - 1]) + c * (d.y(k) - d.y(k - 1))) / dt;
   }
   return d;
 }
@@ -46,8 +49,8 @@ TEST_CASE("bed_response_per_period: a linear bed's eta* and apparent mass, perio
   const double omega = 2.0 * std::numbers::pi * 3.5, m_bed = 0.05, m_a = 0.02, c = 0.3, offset = -1e-3;
   const double eta = c / (m_bed * omega), mass_fraction = m_a / m_bed;
   SECTION("steady amplitude: exact to the trapezoid's error") {
-    // 200 samples a period: the trapezoid's and the linear interpolation's errors are
-    // O((Ωdt)²/12) = 8e-5.
+    // 200 samples a period: the trapezoid's, the linear interpolation's and the centring's
+    // errors are O((Ωdt)²/12) = 8e-5.
     const auto d = linear_bed_decay(omega, 0.0, m_a, c, offset, 200, 12);
     const auto periods = st::bed_response_per_period(d.t, d.y, offset, d.force, m_bed);
     REQUIRE(periods.size() >= 10);

@@ -133,10 +133,18 @@ struct CosimulationHistory {
   Eigen::MatrixXd modal_displacements;  ///< samples x modes, q (relative for base motion)
   Eigen::MatrixXd site_displacement_m;  ///< samples x dampers: absolute site motion along n, m
   Eigen::MatrixXd site_rotation_rad;    ///< samples x dampers: site rotation about z, rad
-  /// samples x dampers: force the bed exerts on the container along n, N (−load·a)
+  /// samples x dampers: force the bed exerts on the container along n, N (−load·a), the mean
+  /// over the steps since the previous sample (the first sample: its own step): an impact
+  /// lasts a few steps, and a value read at the sample alone would alias it
   Eigen::MatrixXd container_load_n;
-  /// samples x dampers: moment the bed exerts on the container about the rotation axis, N m
+  /// samples x dampers: moment the bed exerts on the container about the rotation axis, N m,
+  /// the mean over the same steps
   Eigen::MatrixXd container_moment_nm;
+  /// Per damper, the bed's force and moment summed over the steps since the last sample, and
+  /// their count: what the next sample averages (a run continued from a checkpoint between two
+  /// samples goes on with them).
+  std::vector<double> pending_load_sum_n, pending_moment_sum_nm;
+  std::int64_t pending_steps = 0;
 };
 
 /// First harmonics at Ω over whole periods (harmonic kinds), as complex amplitudes against

@@ -45,8 +45,10 @@ double static_site_offset(const ModalModel& modal, const Eigen::MatrixXd& drive_
 /// (trapezoid on the samples, linear between them) of the signals with the envelope's decay
 /// e^{−λt} taken out (λ from the neighbouring periods), and the bed's impedance F̂/(sX̂),
 /// s = −λ + iΩ, gives η* and m_app/m_bed exactly for a linear bed on a decaying motion. y is
-/// the site displacement along the drive, F the force the container applies to the bed (the
-/// negative of what the bed exerts on it). `t` ascending; y and force of its size;
+/// the site displacement along the drive at the samples, F the force the container applies to
+/// the bed (the negative of what the bed exerts on it) as CosimulationHistory::container_load_n
+/// holds it: each sample the mean over the interval ending there (centred on the samples
+/// here, as the mean of the two intervals either side). `t` ascending; y and force of its size;
 /// bed_mass_kg > 0. Periods whose measures are not finite are left out.
 std::vector<surrogate::DecayPeriodResponse> bed_response_per_period(const std::vector<double>& t,
                                                                    const Eigen::VectorXd& y, double offset,

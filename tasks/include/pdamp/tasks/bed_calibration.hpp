@@ -72,14 +72,16 @@ double decay_damping_ratio(std::span<const double> time_s, std::span<const doubl
 
 /// The closing of the design loop (docs/optimizer.md, "Calibrated beds"): the beds of the
 /// design of `slabs` calibrated again where that design operates: each bed's decay with every
-/// mode's damping ratio raised by what the design's other beds add, the design's average
-/// damping ratio `design_damping_ratio` (from its DEM verification) less the bed's own alone
-/// (never below 0), so that the bed comes down at about the design's rate. Replaces those beds
-/// in `calibration` (cached like the others) and returns one line per bed replaced; none for
-/// a design of one bed (its calibration is that design already).
+/// mode's damping ratio raised by what the design's other beds add, so that the bed comes
+/// down at about the design's rate: the design's equivalent damping ratio down to its
+/// settling threshold `design_damping_ratio` (from its DEM verification) less the bed's own
+/// alone over the same span, down to the stroke `design_threshold_m` (never below 0).
+/// Replaces those beds in `calibration` (cached like the others) and returns one line per bed
+/// replaced; none for a design of one bed (its calibration is that design already).
 std::vector<std::string> recalibrate_in_design(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                                                BedCalibration& calibration, const std::vector<long>& slabs,
-                                               double design_damping_ratio, RunHooks& hooks, Executor& executor);
+                                               double design_damping_ratio, double design_threshold_m, RunHooks& hooks,
+                                               Executor& executor);
 
 /// The calibration's result keys (spec, cache folder, per bed: layer, slabs, key, cached, file,
 /// periods, stroke range, steps, wall time).
