@@ -654,6 +654,10 @@ const std::vector<Command>& commands() {
     // Level III after the damper commands, before validate.
     auto structure = structure_commands();
     list.insert(list.end() - 1, structure.begin(), structure.end());
+    // Every command that writes a folder takes --overwrite (report::OutputDir's owner check).
+    for (auto& command : list)
+      if (std::any_of(command.spec.flags.begin(), command.spec.flags.end(), [](const FlagSpec& f) { return f.name == "-o"; }))
+        command.spec.flags.push_back(kOverwriteFlag);
     return list;
   }();
   return all;

@@ -18,6 +18,7 @@ struct CommandContext {
   /// compute the jobs they are sent).
   bool primary = true;
   bool report = false;        ///< pdamp run: also DIR/report.html
+  std::string command;        ///< the command's name ("run", "field merge"), for the output folder's owner
 };
 
 struct Command {

@@ -7,6 +7,8 @@ namespace pdamp::cli {
 
 const FlagSpec kJsonFlag{"--json", "", "print exactly one JSON object on stdout"};
 const FlagSpec kOutFlag{"-o", "DIR", "write result files (JSON, CSV, plots) into DIR, atomically"};
+const FlagSpec kOverwriteFlag{"--overwrite", "",
+                              "let -o DIR replace the outputs another command or case left there (refused otherwise)"};
 
 const FlagSpec kMethodFlag{"--method", "M",
                            "source of each layer's eta*(f, X) and apparent mass: formulas (the closed\n"

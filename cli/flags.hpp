@@ -12,6 +12,8 @@ namespace pdamp::cli {
 
 extern const FlagSpec kJsonFlag;
 extern const FlagSpec kOutFlag;
+/// --overwrite: -o DIR may replace the outputs of another command or case.
+extern const FlagSpec kOverwriteFlag;
 /// `--method formulas|field|dem` (default formulas): pdamp modes, frf, decay and run.
 extern const FlagSpec kMethodFlag;
 /// The stepped sine's and the linear sweep's flags of pdamp frf --method dem; pdamp run

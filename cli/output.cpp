@@ -24,8 +24,18 @@ void print_warnings(const std::vector<std::string>& warnings) {
 
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context) {
   if (!context.primary) return nullptr;
-  if (const auto dir = args.optional_text("-o")) return std::make_unique<report::OutputDir>(*dir);
-  return nullptr;
+  const auto dir = args.optional_text("-o");
+  if (!dir) return nullptr;
+  // The owner of the folder's outputs: the command and the file it ran on (its first
+  // argument, made absolute, so that another spelling of the same path is the same case).
+  report::OutputOwner owner;
+  owner.command = context.command;
+  if (!args.positional().empty()) {
+    std::error_code error;
+    const auto absolute = std::filesystem::weakly_canonical(args.positional().front(), error);
+    owner.input = error ? args.positional().front() : absolute.string();
+  }
+  return std::make_unique<report::OutputDir>(*dir, "-o", owner, args.has("--overwrite"));
 }
 
 tasks::OutputFolder output_folder(const report::OutputDir* files) {

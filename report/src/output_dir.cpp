@@ -40,21 +40,31 @@ void remove_stale_staging(const fs::path& dir) {
   }
 }
 
-/// The files the previous run recorded; only plain names of this folder count, so a
-/// tampered manifest cannot delete anything outside it.
-std::vector<std::string> previous_outputs(const fs::path& dir) {
-  std::vector<std::string> names;
+/// What the previous run recorded: its files (only plain names of this folder count, so a
+/// tampered manifest cannot delete anything outside it) and its owner.
+struct PreviousOutputs {
+  std::vector<std::string> files;
+  OutputOwner owner;
+};
+PreviousOutputs previous_outputs(const fs::path& dir) {
+  PreviousOutputs out;
   try {
     const auto doc = strict_json::parse_json_document(strict_json::read_input_file((dir / kManifest).string()), kManifest);
     for (const auto& item : doc.at("files")) {
       const std::string name = item.get<std::string>();
       if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name[0] == '.') continue;
-      names.push_back(name);
+      out.files.push_back(name);
     }
+    if (doc.contains("command") && doc["command"].is_string()) out.owner.command = doc["command"].get<std::string>();
+    if (doc.contains("input") && doc["input"].is_string()) out.owner.input = doc["input"].get<std::string>();
   } catch (const std::exception&) {
     // no manifest (first run) or an unreadable one: nothing is removed
   }
-  return names;
+  return out;
+}
+
+std::string owner_text(const OutputOwner& owner) {
+  return "pdamp " + owner.command + (owner.input.empty() ? "" : " on " + strict_json::printable(owner.input));
 }
 
 /// Blocks SIGINT, SIGTERM and SIGHUP for its lifetime: the renames of a commit are
@@ -75,7 +85,8 @@ class SignalBlock {
 
 }  // namespace
 
-OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
+OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool overwrite)
+    : dir_(std::move(dir)), owner_(std::move(owner)) {
   const std::string shown = strict_json::printable(dir_.string());
   if (dir_.empty()) throw strict_json::InputError(flag, "", "'': an empty path is not an output directory");
   std::error_code error;
@@ -86,6 +97,18 @@ OutputDir::OutputDir(fs::path dir, std::string flag) : dir_(std::move(dir)) {
   if (error || !fs::is_directory(dir_))
     throw strict_json::InputError(flag, "", "'" + shown + "': cannot create the output directory (" +
                                    (error ? error.message() : std::string("not a directory")) + ")");
+  // A commit removes the previous set: refused when that set is another owner's (a user who
+  // reuses a folder name would lose another study's results, hours of DEM).
+  if (const PreviousOutputs previous = previous_outputs(dir_);
+      !overwrite && !previous.owner.command.empty() && !owner_.command.empty() && !(previous.owner == owner_)) {
+    std::string files;
+    for (std::size_t k = 0; k < previous.files.size() && k < 4; ++k)
+      files += (k ? ", " : "") + strict_json::printable(previous.files[k]);
+    if (previous.files.size() > 4) files += ", ... (" + std::to_string(previous.files.size()) + " files)";
+    throw strict_json::InputError(flag, "", "'" + shown + "' holds the outputs of " + owner_text(previous.owner) + " (" +
+                                                files + "), which this run would replace: pass --overwrite, or choose "
+                                                "another folder");
+  }
   remove_stale_staging(dir_);
   staging_ = dir_ / (kStagingPrefix + std::to_string(::getpid()));
   fs::remove_all(staging_, error);
@@ -182,10 +205,12 @@ std::vector<std::string> OutputDir::commit() {
   std::set<std::string> current(names_.begin(), names_.end());
   current.insert(in_place_.begin(), in_place_.end());
   for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
-  for (const auto& old : previous_outputs(dir_))
+  for (const auto& old : previous_outputs(dir_).files)
     if (!current.count(old) && fs::is_regular_file(fs::symlink_status(dir_ / old, error))) fs::remove(dir_ / old, error);
-  strict_json::write_file_atomically(dir_ / kManifest,
-                        nlohmann::json{{"format", "pdamp.outputs"}, {"files", current}}.dump(2) + "\n");
+  strict_json::write_file_atomically(
+      dir_ / kManifest, nlohmann::json{{"format", "pdamp.outputs"}, {"files", current}, {"command", owner_.command},
+                                       {"input", owner_.input}}
+                            .dump(2) + "\n");
   for (const auto& name : current) paths.push_back((dir_ / name).string());
   committed_ = true;
   return paths;

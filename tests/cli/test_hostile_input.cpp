@@ -406,6 +406,21 @@ TEST_CASE("duplicate keys and binary bytes in a case file are refused on one lin
   CHECK(r.err.find('\x1b') == std::string::npos);  // no terminal escape reaches the screen
 }
 
+// Reference: the strict reader's nesting limit (64 levels), met before the rest is read: a
+// 20 MB file of "[" is refused at once (parsed whole it took 68 s and 2.2 GB).
+TEST_CASE("JSON nested deeper than the limit is refused where it is met", "[cli]") {
+  TempDir tmp("deep");
+  const fs::path deep = tmp.path / "deep.json";
+  std::ofstream(deep) << std::string(20'000'000, '[');
+  require_one_line_error(run_pdamp({"validate", deep.string()}), "deep.json: /0/0/0");
+  const auto r = run_pdamp({"validate", deep.string()});
+  CHECK_THAT(r.err, Catch::Contains("nested deeper than 64 levels"));
+  const fs::path fine = tmp.path / "fine.json";
+  std::ofstream(fine) << std::string(60, '[') << std::string(60, ']');
+  const auto shallow = run_pdamp({"validate", fine.string()});
+  CHECK(shallow.err.find("nested deeper") == std::string::npos);  // refused for what it is, not its depth
+}
+
 TEST_CASE("round two of the hostile inputs: bytes after the JSON, huge lattices, grids validate must see", "[cli]") {
   TempDir tmp("round_two");
   // Text after a NUL byte was ignored by the parser: "{valid case}\0garbage" passed.
@@ -492,4 +507,34 @@ TEST_CASE("round two: the manifest name, a full stdout, many cuts", "[cli]") {
   REQUIRE(r.exit_code == 0);
   CHECK(json::parse(r.out)["points"] == 4000);
   require_plot(tmp.path / "cuts", "field_cuts.png");
+}
+
+// Reference: the output folder's contract (report::OutputDir): a commit replaces the
+// previous set, so a folder holding another command's or another case's outputs is refused
+// (exit 2, naming them) unless --overwrite; the same command on the same case replaces its
+// own set as before.
+TEST_CASE("-o refuses a folder holding another command's or case's outputs unless --overwrite", "[cli]") {
+  TempDir tmp("owner");
+  const std::string dir = (tmp.path / "out").string();
+  const std::string low = case_path("low_intensity_36_spheres.json"), high = case_path("high_intensity_cylinder.json");
+  REQUIRE(run_pdamp({"run", low, "-o", dir}).exit_code == 0);
+  REQUIRE(fs::exists(fs::path(dir) / "design.json"));
+  // The same command on the same case (another spelling of its path): replaced as before.
+  const std::string other_spelling = (fs::path(low).parent_path() / "." / fs::path(low).filename()).string();
+  CHECK(run_pdamp({"run", other_spelling, "-o", dir}).exit_code == 0);
+  // Another command: refused before any work, the earlier set intact.
+  const auto loss = run_pdamp({"loss", "--model", "rolling", "--clearance", "0.1", "--amplitude", "0.04",
+                               "--frequency", "3", "-o", dir});
+  require_one_line_error(loss, "holds the outputs of pdamp run on");
+  CHECK_THAT(loss.err, Catch::Contains("design.json"));
+  CHECK_THAT(loss.err, Catch::Contains("--overwrite"));
+  CHECK(fs::exists(fs::path(dir) / "design.json"));
+  // Another case: refused the same way.
+  require_one_line_error(run_pdamp({"run", high, "-o", dir}), "holds the outputs of pdamp run on " + low);
+  // --overwrite: replaced, and the folder is the new owner's.
+  CHECK(run_pdamp({"loss", "--model", "rolling", "--clearance", "0.1", "--amplitude", "0.04", "--frequency", "3",
+                   "-o", dir, "--overwrite"})
+            .exit_code == 0);
+  CHECK_FALSE(fs::exists(fs::path(dir) / "design.json"));
+  require_one_line_error(run_pdamp({"run", low, "-o", dir}), "holds the outputs of pdamp loss");
 }

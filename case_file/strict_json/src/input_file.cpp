@@ -145,6 +145,9 @@ std::string pointer_of(const std::vector<Frame>& frames) {
 struct DuplicateKey {
   std::string pointer;
 };
+struct TooDeep {
+  std::string pointer;
+};
 
 }  // namespace
 
@@ -156,8 +159,12 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
   };
   const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
     switch (event) {
-      case json::parse_event_t::object_start: frames.push_back({true, {}, {}, 0}); break;
-      case json::parse_event_t::array_start: frames.push_back({false, {}, {}, 0}); break;
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        // Refused as it is met: a file of 20 MB of "[" parsed whole took a minute and 2 GB.
+        if (frames.size() >= kMaxNestingDepth) throw TooDeep{pointer_of(frames)};
+        frames.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
+        break;
       case json::parse_event_t::key: {
         Frame& top = frames.back();
         top.key = parsed.get<std::string>();
@@ -182,6 +189,10 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
     return json::parse(text, track);
   } catch (const DuplicateKey& duplicate) {
     throw InputError(path, duplicate.pointer, "duplicate key (each key may appear once in an object)");
+  } catch (const TooDeep& deep) {
+    throw InputError(path, deep.pointer,
+                     "malformed JSON: arrays and objects nested deeper than " + std::to_string(kMaxNestingDepth) +
+                         " levels (no pdamp file needs more than 10)");
   } catch (const json::exception& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line 1, column 9: ..."
     // or "[json.exception.out_of_range.406] number overflow parsing '1e400'".

@@ -18,12 +18,23 @@ namespace pdamp::report {
 /// replaces the whole set of files the previous run wrote into DIR (listed in
 /// DIR/.pdamp-outputs.json), so the outputs of two runs never mix; files pdamp did not
 /// write are never touched.
+/// Who wrote a folder's outputs: the command and the file it ran on (recorded with them).
+struct OutputOwner {
+  std::string command;  ///< "run", "optimize", "field merge", ...; empty: not recorded
+  std::string input;    ///< the command's input file, absolute; empty: none
+  bool operator==(const OutputOwner&) const = default;
+};
+
 class OutputDir {
  public:
   /// Checks DIR before any work: InputError (exit 2) naming `flag` when the path is
-  /// empty, exists and is not a directory, or cannot be created or written. Removes
-  /// staging folders that processes no longer alive left behind.
-  explicit OutputDir(std::filesystem::path dir, std::string flag = "-o");
+  /// empty, exists and is not a directory, or cannot be created or written, and when DIR
+  /// holds the outputs of another owner (another command, or the same command on another
+  /// input: a commit would remove them) unless `overwrite`; a folder whose record names no
+  /// owner (an older pdamp's) is taken as this owner's. Removes staging folders that
+  /// processes no longer alive left behind.
+  explicit OutputDir(std::filesystem::path dir, std::string flag = "-o", OutputOwner owner = {},
+                     bool overwrite = false);
   ~OutputDir();  ///< removes the staging folder if commit() was not reached
   OutputDir(const OutputDir&) = delete;
   OutputDir& operator=(const OutputDir&) = delete;
@@ -52,6 +63,7 @@ class OutputDir {
   void start_writing();
 
   std::filesystem::path dir_;
+  OutputOwner owner_;
   std::filesystem::path staging_;
   std::vector<std::string> names_;     // staged, moved by commit()
   std::vector<std::string> in_place_;  // already in DIR

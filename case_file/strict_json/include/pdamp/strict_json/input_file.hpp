@@ -22,9 +22,14 @@ inline constexpr std::size_t kMaxInputFileBytes = std::size_t{256} << 20;
 /// a FIFO swapped in after the check cannot hang the caller either.
 std::string read_input_file(const std::string& path, std::size_t max_bytes = kMaxInputFileBytes);
 
+/// Deepest nesting of arrays and objects a pdamp file may have (the deepest, a case file,
+/// needs about 8).
+inline constexpr std::size_t kMaxNestingDepth = 64;
+
 /// Parses `text` (read from `path`) as one JSON document, refusing what
 /// nlohmann::json would accept silently: a key repeated in one object (the parser keeps
-/// the last one, so an edit that seems to change a value may not). InputError
+/// the last one, so an edit that seems to change a value may not), and nesting deeper than
+/// kMaxNestingDepth (refused where it is met, before the rest is parsed). InputError
 /// "<path>: malformed JSON: <where and what>" or "<path>: <pointer>: duplicate key".
 nlohmann::json parse_json_document(const std::string& text, const std::string& path);
 
