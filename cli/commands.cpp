@@ -195,10 +195,12 @@ int run_run(const ParsedArgs& args, CommandContext& context) {
   if (!context.primary && c.task.kind != case_file::TaskKind::kFrf && c.task.kind != case_file::TaskKind::kFillingRatios)
     return kExitOk;
   context.report = true;  // with -o DIR, the task also writes DIR/report.html
+  const std::string kind(case_file::to_string(c.task.kind));
   for (const char* flag : {"--no-verify", "--calibration-cache"})
     if (args.has(flag) && c.task.kind != case_file::TaskKind::kFillingRatios)
-      throw InputError(flag, "", "applies to task kind filling_ratios; this case's task is " +
-                                     std::string(case_file::to_string(c.task.kind)));
+      throw InputError(flag, "", "applies to task kind filling_ratios; this case's task is " + kind);
+  if (c.task.kind != case_file::TaskKind::kFrf)
+    refuse_flags(args, kDemSweepFlags, "applies to task kind frf (the DEM stepped sine); this case's task is " + kind);
   switch (c.task.kind) {
     case case_file::TaskKind::kDamperDesign:
       if (args.has("--method"))

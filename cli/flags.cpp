@@ -82,9 +82,11 @@ double checkpoint_interval(const ParsedArgs& args) {
   return args.optional_number("--checkpoint-interval", Range{0.0, 1e9}).value_or(60.0);
 }
 
-void refuse_checkpoint_flags(const ParsedArgs& args, const std::string& why) {
-  for (const auto& flag : kCheckpointFlags)
+void refuse_flags(const ParsedArgs& args, const std::vector<FlagSpec>& flags, const std::string& why) {
+  for (const auto& flag : flags)
     if (args.has(flag.name)) throw InputError(flag.name, "", why);
 }
+
+void refuse_checkpoint_flags(const ParsedArgs& args, const std::string& why) { refuse_flags(args, kCheckpointFlags, why); }
 
 }  // namespace pdamp::cli

@@ -36,6 +36,8 @@ tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string&
 /// --checkpoint-interval, s (default 60; 0: at every chance).
 double checkpoint_interval(const ParsedArgs& args);
 /// InputError when a checkpoint flag is given to a run that makes no checkpoints.
+/// A flag that would do nothing is refused (exit 2) with `why`: the first of `flags` given.
+void refuse_flags(const ParsedArgs& args, const std::vector<FlagSpec>& flags, const std::string& why);
 void refuse_checkpoint_flags(const ParsedArgs& args, const std::string& why);
 
 }  // namespace pdamp::cli

@@ -200,6 +200,8 @@ int run_frf_case(const ParsedArgs& args, CommandContext& context, const Case& c)
   }
   if (options.method == tasks::FrfMethod::kDem || options.method == tasks::FrfMethod::kCompare)
     options.dem = dem_frf_options(args, c);
+  else
+    refuse_flags(args, kDemSweepFlags, "applies to --method dem or --compare (the DEM in the loop)");
   // Under mpirun only the stepped sine's directions are spread over the ranks.
   const bool spread = options.method == tasks::FrfMethod::kCompare ||
                       (options.method == tasks::FrfMethod::kDem && !options.dem.linear_sweep);

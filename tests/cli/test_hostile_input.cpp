@@ -538,3 +538,13 @@ TEST_CASE("-o refuses a folder holding another command's or case's outputs unles
   CHECK_FALSE(fs::exists(fs::path(dir) / "design.json"));
   require_one_line_error(run_pdamp({"run", low, "-o", dir}), "holds the outputs of pdamp loss");
 }
+
+// Reference: a flag that would do nothing is refused, as a class: the DEM stepped sine's
+// flags without the DEM (frf), or on a task that has no stepped sine (run on a decay case).
+TEST_CASE("the DEM stepped sine's flags are refused where they would do nothing", "[cli]") {
+  const std::string beam = case_path("beam_base_excited.json"), link = case_path("manipulator_link_decay.json");
+  require_one_line_error(run_pdamp({"frf", beam, "--dem-points", "5"}), "--dem-points: applies to --method dem");
+  require_one_line_error(run_pdamp({"frf", beam, "--method", "field", "--dem-tolerance", "0.01"}), "--dem-tolerance");
+  require_one_line_error(run_pdamp({"run", link, "--dem-points", "5"}), "--dem-points: applies to task kind frf");
+  require_one_line_error(run_pdamp({"run", link, "--calibration-cache", "x"}), "--calibration-cache: applies to task kind filling_ratios");
+}
