@@ -283,10 +283,23 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
     strict_json::fail_at(file, cell_at(kFirstValue + kEtaStar), "must be null for status \"" + status + "\"");
   }
   if (p.eta_star_stderr < 0.0) strict_json::fail_at(file, cell_at(kFirstValue + kEtaStarStderr), "must be >= 0 or null");
+  if (const std::string problem = field_value_problem(p.eta_star, p.apparent_mass_fraction); !problem.empty())
+    strict_json::fail_at(file, cell_at(kFirstValue + (problem.starts_with("eta_star") ? kEtaStar : kApparentMassFraction)),
+                         problem);
   return p;
 }
 
 }  // namespace
+
+std::string field_value_problem(double eta_star, double apparent_mass_fraction) {
+  if (!std::isnan(eta_star) && !(eta_star >= kMinEtaStar && eta_star <= kMaxEtaStar))
+    return "eta_star = " + number(eta_star) + ": must be in [" + number(kMinEtaStar) + ", " + number(kMaxEtaStar) +
+           "] (docs/effective_fields.md, file format)";
+  if (!std::isnan(apparent_mass_fraction) && !(std::abs(apparent_mass_fraction) <= kMaxApparentMassFraction))
+    return "apparent_mass_fraction = " + number(apparent_mass_fraction) + ": must be in [" +
+           number(-kMaxApparentMassFraction) + ", " + number(kMaxApparentMassFraction) + "]";
+  return "";
+}
 
 bool FieldPoint::operator==(const FieldPoint& other) const {
   return same_number(eta_star, other.eta_star) && same_number(eta_star_stderr, other.eta_star_stderr) &&
@@ -391,6 +404,8 @@ std::vector<std::string> EffectiveField::validate() const {
       problems.push_back(at + ".eta_star = " + number(p.eta_star) + ": must be NaN (no value) for status " +
                          std::string(to_string(p.status)));
     }
+    if (const std::string problem = field_value_problem(p.eta_star, p.apparent_mass_fraction); !problem.empty())
+      problems.push_back(at + "." + problem);
     if (!std::isnan(p.eta_star_stderr) && !(p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr))) {
       problems.push_back(at + ".eta_star_stderr = " + number(p.eta_star_stderr) + ": must be >= 0 and finite, or NaN");
     }

@@ -29,9 +29,6 @@ enum Column : int { kFrequency, kAmplitude, kEta, kStderr, kApparentMass, kMotio
 constexpr std::array<std::string_view, kColumns> kNames = {"frequency_hz",    "amplitude_m",      "eta_star",
                                                            "eta_star_stderr", "apparent_mass_kg", "motion_mode"};
 constexpr int kRequiredColumns = 3;  // frequency_hz, amplitude_m, eta_star
-/// Largest η* a measured field may hold: 100 × the ideal peak 4/π would need a bed
-/// dissipating a hundred times its relative kinetic energy per radian.
-constexpr double kMaxEtaStar = 100.0;
 /// Smallest stroke, m (0.1 µm, as the case files): below, no rig resolves X.
 constexpr double kMinAmplitude_m = 1e-7;
 

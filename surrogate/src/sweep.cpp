@@ -279,6 +279,9 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       p.e_diss_j = nullable_number("e_diss_j");
       p.apparent_mass_kg = nullable_number("apparent_mass_kg");
       p.apparent_mass_fraction = nullable_number("apparent_mass_fraction");
+      if (const std::string problem = field_value_problem(p.eta_star, p.apparent_mass_fraction); !problem.empty())
+        object.fail(problem.starts_with("eta_star") ? "eta_star" : "apparent_mass_fraction",
+                    problem.substr(problem.find('=') + 2));
       p.motion_mode = object.string("motion_mode");
       if (detail::has_control_byte(p.motion_mode))
         object.fail("motion_mode", "\"" + p.motion_mode + "\" holds control characters (must be printable text)");

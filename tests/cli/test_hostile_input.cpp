@@ -548,3 +548,28 @@ TEST_CASE("the DEM stepped sine's flags are refused where they would do nothing"
   require_one_line_error(run_pdamp({"run", link, "--dem-points", "5"}), "--dem-points: applies to task kind frf");
   require_one_line_error(run_pdamp({"run", link, "--calibration-cache", "x"}), "--calibration-cache: applies to task kind filling_ratios");
 }
+
+// Reference: the field file's value ranges (surrogate::field_value_problem: η* in [−1, 100],
+// m_app/m_bed in [−10, 10]), applied by the reader: a field with η* = 1e300 or −5 is bad
+// input (exit 2 naming the file and the cell), not a numerical failure later.
+TEST_CASE("a field whose values are out of their physical range is refused naming the cell", "[cli]") {
+  TempDir tmp("field_ranges");
+  std::ifstream in(case_path("fields/link_narrow_dem/field.json"));
+  const json field = json::parse(in);
+  std::ifstream case_in(case_path("manipulator_link_decay.json"));
+  const json link = json::parse(case_in);
+  const std::size_t eta = 2;  // the table's columns: frequency_hz, amplitude_m, eta_star, ...
+  for (const double bad : {1e300, -5.0}) {
+    json edited = field;
+    edited["table"][3][eta] = bad;
+    const fs::path file = tmp.path / "field.json";
+    std::ofstream(file) << edited.dump();
+    json c = link;
+    for (auto& layer : c["dampers"][0]["layers"]) layer["field_file"] = file.string();
+    const fs::path case_file = tmp.path / "case.json";
+    std::ofstream(case_file) << c.dump();
+    const auto r = run_pdamp({"decay", case_file.string(), "--method", "field"});
+    require_one_line_error(r, "field.json: /table/3/2: eta_star");
+    CHECK_THAT(r.err, Catch::Contains("must be in [-1, 100]"));
+  }
+}

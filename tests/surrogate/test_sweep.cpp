@@ -226,6 +226,16 @@ TEST_CASE("a damaged line inside the results file is an error, not silently skip
   CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
                     Catch::Contains("line 20: /index: 99 must be in [0, 17]") && Catch::Contains("damaged"));
   CHECK(never.calls() == 0);
+
+  // A point whose η* is outside the field's physical range (field_value_problem): refused as
+  // the field file's reader refuses it, so no merge or resume takes it in.
+  std::string out_of_range = original;
+  const auto eta = out_of_range.find("\"eta_star\":", third_line);
+  const auto end = out_of_range.find(',', eta);
+  out_of_range.replace(eta, end - eta, "\"eta_star\":1e300");
+  std::ofstream(results) << out_of_range;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(never), sweep_options(results)),
+                    Catch::Contains("line 3: /eta_star") && Catch::Contains("must be in [-1, 100]"));
 }
 
 TEST_CASE("a second sweep on the same results file at the same time is refused", "[surrogate]") {

@@ -67,6 +67,18 @@ std::string_view pdamp_version();
 /// goes in: drop names and descriptions that do not change the physics.
 std::string case_hash(const nlohmann::json& case_json);
 
+/// Physical ranges of a field point's values, checked by every reader (field files, sweep
+/// logs and shards, merges) and by EffectiveField::validate. η*: a passive bed averages
+/// η* >= 0, a measured point scatters about 0 by its standard error (the shipped DEM fields
+/// reach −0.006), so −1; above, no collect-and-collide orbit or DEM bed comes near 100 (the
+/// ideal peaks are about 1-1.4). m_app/m_bed: the ideal orbits give −0.58 to 1, the DEM
+/// 0.19-1.6, so ±10.
+inline constexpr double kMinEtaStar = -1.0, kMaxEtaStar = 100.0;
+inline constexpr double kMaxApparentMassFraction = 10.0;
+/// "" when η* (NaN: not given) and m_app/m_bed (NaN: not given) are in their ranges, else the rule
+/// broken ("eta_star = 1e+300: must be in [-1, 100]").
+std::string field_value_problem(double eta_star, double apparent_mass_fraction);
+
 /// η*, E_diss, apparent mass and motion mode over a grid, with provenance.
 struct EffectiveField {
   Grid grid;
