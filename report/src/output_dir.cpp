@@ -227,7 +227,12 @@ std::string gnuplot_string(const std::string& text) {
     out += (out.empty() ? "'" : ".'") + piece + "'";
     piece.clear();
   };
-  for (char c : text) {
+  // gnuplot's SVG writes titles as text content, where "]]>" is not allowed (XML 1.0 §2.4):
+  // a name holding it made the picture ill-formed. A space keeps it readable and inert.
+  std::string inert = text;
+  for (std::size_t at = inert.find("]]>"); at != std::string::npos; at = inert.find("]]>", at + 3))
+    inert.insert(at + 2, " ");
+  for (char c : inert) {
     if (c == '\'') {
       flush();
       out += out.empty() ? "\"'\"" : ".\"'\"";

@@ -573,3 +573,17 @@ TEST_CASE("a field whose values are out of their physical range is refused namin
     CHECK_THAT(r.err, Catch::Contains("must be in [-1, 100]"));
   }
 }
+
+// Reference: XML 1.0 §2.4 ("]]>" may not appear in text content): gnuplot's SVG writes the
+// case name into titles as text, so a name holding it made an ill-formed picture.
+TEST_CASE("a case name holding ]]> leaves the SVG pictures well-formed", "[cli]") {
+  TempDir tmp("cdata_name");
+  const auto path = edited_case("pdamp_cdata_name.json", [](json& c) { c["name"] = "a ]]> <b> & c"; });
+  const fs::path out = tmp.path / "out";
+  REQUIRE(run_pdamp({"run", path, "-o", out.string()}).exit_code == 0);
+  if (!fs::exists(out / "eta_curve.svg")) return;  // no gnuplot here: no picture to check
+  std::ifstream in(out / "eta_curve.svg");
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(svg.find("]]>") == std::string::npos);
+  CHECK(svg.find("]] >") != std::string::npos);  // the name is still there, readable
+}

@@ -77,8 +77,9 @@ bool gnuplot_available();
 /// A gnuplot string expression of `text` that gnuplot takes verbatim: single-quoted
 /// pieces (no backquote command substitution, no @macro expansion, no escapes inside
 /// them) joined with "'" where the text has a quote, control characters (a newline
-/// would end the command) replaced by spaces. Use with `noenhanced` so that ^ _ { } @
-/// & show as typed.
+/// would end the command) replaced by spaces, and "]]>" broken by a space (the SVG
+/// terminal writes titles as XML text, where it is not allowed). Use with `noenhanced` so
+/// that ^ _ { } @ & show as typed.
 std::string gnuplot_string(const std::string& text);
 
 /// `name` as a safe single file-name component: letters, digits, '.', '-', '_' and
