@@ -2,6 +2,7 @@
 #include "flags.hpp"
 
 #include "errors.hpp"
+#include "pdamp/strict_json/input_file.hpp"
 
 namespace pdamp::cli {
 
@@ -75,6 +76,18 @@ tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string&
     return out;
   }
   out.path = std::filesystem::path(*dir) / (name + ".checkpoint");
+  // Whatever is in the way (a link that loops or leads nowhere, a folder) is the user's to
+  // move: named now, before any work, not as a raw filesystem error at the first write.
+  std::error_code error, link_error;
+  const auto status = std::filesystem::status(out.path, error);
+  const bool missing = error == std::errc::no_such_file_or_directory ||
+                       (!error && status.type() == std::filesystem::file_type::not_found);
+  const bool dangling = std::filesystem::is_symlink(std::filesystem::symlink_status(out.path, link_error)) && missing;
+  if (dangling || (!missing && (error || !std::filesystem::is_regular_file(status))))
+    throw InputError("-o", "", "'" + strict_json::printable(out.path.string()) + "' is in the way of the checkpoint (" +
+                                   (dangling ? std::string("a link to nothing")
+                                             : error ? error.message() : std::string("not a regular file")) +
+                                   "): move it away");
   return out;
 }
 

@@ -587,3 +587,26 @@ TEST_CASE("a case name holding ]]> leaves the SVG pictures well-formed", "[cli]"
   CHECK(svg.find("]]>") == std::string::npos);
   CHECK(svg.find("]] >") != std::string::npos);  // the name is still there, readable
 }
+
+// Reference: what stands where a checkpoint goes is named before any work (exit 2), not met
+// as a raw filesystem error: a link to itself, a link to nothing, a folder.
+TEST_CASE("a checkpoint path taken by a looping link, a dangling link or a folder is refused naming it", "[cli]") {
+  TempDir tmp("checkpoint_in_the_way");
+  const fs::path out = tmp.path / "out";
+  fs::create_directories(out);
+  const fs::path checkpoint = out / "decay_dem.checkpoint";
+  const std::string link = case_path("manipulator_link_decay.json");
+  const auto refused = [&](const std::string& why) {
+    const auto r = run_pdamp({"decay", link, "--method", "dem", "-o", out.string(), "--resume"});
+    require_one_line_error(r, "decay_dem.checkpoint' is in the way of the checkpoint");
+    CHECK_THAT(r.err, Catch::Contains(why));
+  };
+  fs::create_symlink(checkpoint, checkpoint);
+  refused("symbolic links");
+  fs::remove(checkpoint);
+  fs::create_symlink(tmp.path / "nowhere", checkpoint);
+  refused("a link to nothing");
+  fs::remove(checkpoint);
+  fs::create_directory(checkpoint);
+  refused("not a regular file");
+}
