@@ -1,11 +1,14 @@
 // The output folder of a run (output_dir.hpp): staged result files committed as one set, plots.
 #include "pdamp/report/output_dir.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -97,6 +100,21 @@ OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool ove
   if (error || !fs::is_directory(dir_))
     throw strict_json::InputError(flag, "", "'" + shown + "': cannot create the output directory (" +
                                    (error ? error.message() : std::string("not a directory")) + ")");
+  // One run writes a folder at a time: two runs into one folder would overwrite each
+  // other's checkpoint and set (each saying it wrote them). The lock goes with the process.
+  // The folder itself is locked (flock on its descriptor): no lock file is left behind.
+  lock_fd_ = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_fd_ < 0) {
+    std::ostringstream what;  // a stream: GCC 12 flags this chain of + with a false -Wrestrict
+    what << "'" << shown << "': cannot open the folder to lock it (" << std::strerror(errno) << ")";
+    throw strict_json::InputError(flag, "", what.str());
+  }
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw strict_json::InputError(flag, "", "'" + shown + "': another pdamp run is writing into this folder; wait for "
+                                                "it, or use another folder");
+  }
   // A commit removes the previous set: refused when that set is another owner's (a user who
   // reuses a folder name would lose another study's results, hours of DEM).
   if (const PreviousOutputs previous = previous_outputs(dir_);
@@ -121,6 +139,7 @@ OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool ove
 OutputDir::~OutputDir() {
   std::error_code error;
   fs::remove_all(staging_, error);
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the folder's lock
   // After a commit signals stay deferred until pdamp exits: one that arrives now finds
   // the results complete, and main says so (finished()).
   if (writing_ && !committed_) end_output_phase();
@@ -229,9 +248,11 @@ std::string gnuplot_string(const std::string& text) {
   };
   // gnuplot's SVG writes titles as text content, where "]]>" is not allowed (XML 1.0 §2.4):
   // a name holding it made the picture ill-formed. A space keeps it readable and inert.
-  std::string inert = text;
-  for (std::size_t at = inert.find("]]>"); at != std::string::npos; at = inert.find("]]>", at + 3))
-    inert.insert(at + 2, " ");
+  std::string inert;
+  for (char c : text) {
+    if (c == '>' && inert.size() >= 2 && inert[inert.size() - 1] == ']' && inert[inert.size() - 2] == ']') inert += ' ';
+    inert += c;
+  }
   for (char c : inert) {
     if (c == '\'') {
       flush();

@@ -3,6 +3,7 @@
 // file or flag and the key, and an interrupted run leaves no partial result.
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -513,7 +514,7 @@ TEST_CASE("round two: the manifest name, a full stdout, many cuts", "[cli]") {
 // previous set, so a folder holding another command's or another case's outputs is refused
 // (exit 2, naming them) unless --overwrite; the same command on the same case replaces its
 // own set as before.
-TEST_CASE("-o refuses a folder holding another command's or case's outputs unless --overwrite", "[cli]") {
+TEST_CASE("an output folder holding another command's or case's outputs is refused unless --overwrite", "[cli]") {
   TempDir tmp("owner");
   const std::string dir = (tmp.path / "out").string();
   const std::string low = case_path("low_intensity_36_spheres.json"), high = case_path("high_intensity_cylinder.json");
@@ -609,4 +610,22 @@ TEST_CASE("a checkpoint path taken by a looping link, a dangling link or a folde
   fs::remove(checkpoint);
   fs::create_directory(checkpoint);
   refused("not a regular file");
+}
+
+// Reference: one run writes a folder at a time (report::OutputDir flocks the folder for its
+// life): a second run into a folder another holds is refused before any work, naming it,
+// and runs once the first has ended. The lock is held here as a running pdamp holds it.
+TEST_CASE("a folder another run is writing into is refused until that run ends", "[cli]") {
+  TempDir tmp("folder_lock");
+  const fs::path out = tmp.path / "out";
+  fs::create_directories(out);
+  const std::string low = case_path("low_intensity_36_spheres.json");
+  const int fd = ::open(out.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  REQUIRE(fd >= 0);
+  REQUIRE(::flock(fd, LOCK_EX | LOCK_NB) == 0);
+  require_one_line_error(run_pdamp({"run", low, "-o", out.string()}), "another pdamp run is writing into this folder");
+  CHECK_FALSE(fs::exists(out / "design.json"));
+  ::close(fd);
+  CHECK(run_pdamp({"run", low, "-o", out.string()}).exit_code == 0);
+  CHECK(fs::exists(out / "design.json"));
 }

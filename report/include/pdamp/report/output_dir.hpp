@@ -31,8 +31,9 @@ class OutputDir {
   /// empty, exists and is not a directory, or cannot be created or written, and when DIR
   /// holds the outputs of another owner (another command, or the same command on another
   /// input: a commit would remove them) unless `overwrite`; a folder whose record names no
-  /// owner (an older pdamp's) is taken as this owner's. Removes staging folders that
-  /// processes no longer alive left behind.
+  /// owner (an older pdamp's) is taken as this owner's, and while another run holds DIR
+  /// (flock on the folder itself, held for the life of the object). Removes staging
+  /// folders that processes no longer alive left behind.
   explicit OutputDir(std::filesystem::path dir, std::string flag = "-o", OutputOwner owner = {},
                      bool overwrite = false);
   ~OutputDir();  ///< removes the staging folder if commit() was not reached
@@ -64,6 +65,7 @@ class OutputDir {
 
   std::filesystem::path dir_;
   OutputOwner owner_;
+  int lock_fd_ = -1;  ///< flock'ed for the run's life: one run writes a folder at a time
   std::filesystem::path staging_;
   std::vector<std::string> names_;     // staged, moved by commit()
   std::vector<std::string> in_place_;  // already in DIR
