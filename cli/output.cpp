@@ -26,6 +26,10 @@ std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const Comm
   if (!context.primary) return nullptr;
   const auto dir = args.optional_text("-o");
   if (!dir) return nullptr;
+  // Results name their files in JSON, which holds UTF-8 only: refused now, not after the work.
+  if (!strict_json::valid_utf8(*dir))
+    throw strict_json::InputError("-o", "", "'" + strict_json::printable(*dir) +
+                                   "' is not valid UTF-8: the results record their paths in JSON; rename the folder");
   // The owner of the folder's outputs: the command and the file it ran on (its first
   // argument, made absolute, so that another spelling of the same path is the same case).
   report::OutputOwner owner;

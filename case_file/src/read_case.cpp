@@ -170,6 +170,9 @@ Case load_case_document(const json& document, const std::string& path) {
 }
 
 Case load_case(const std::string& path) {
+  // Results and resolved cases record the case's path in JSON, which holds UTF-8 only.
+  if (!strict_json::valid_utf8(path))
+    throw CaseError(path, "", "the file's path is not valid UTF-8 (results record it in JSON): rename the file");
   json document;
   try {
     document = strict_json::parse_json_document(strict_json::read_input_file(path), path);

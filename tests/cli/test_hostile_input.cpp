@@ -629,3 +629,19 @@ TEST_CASE("a folder another run is writing into is refused until that run ends",
   CHECK(run_pdamp({"run", low, "-o", out.string()}).exit_code == 0);
   CHECK(fs::exists(out / "design.json"));
 }
+
+// Reference: JSON holds UTF-8 only (RFC 8259 §8.1), and results record their paths in it: a
+// folder or case path that is not UTF-8 is refused before any work (exit 2, the bytes
+// escaped), not met as the JSON library's error after the computation.
+TEST_CASE("an output folder or case path that is not UTF-8 is refused before any work", "[cli]") {
+  TempDir tmp("not_utf8");
+  const std::string bad_dir = (tmp.path / "out\xff").string();
+  require_one_line_error(run_pdamp({"loss", "--model", "rolling", "--clearance", "0.1", "--amplitude", "0.04",
+                                    "--frequency", "3", "-o", bad_dir}),
+                         "-o: '" + (tmp.path / "out\\xff").string() + "' is not valid UTF-8");
+  CHECK_FALSE(fs::exists(bad_dir));
+  const fs::path bad_case = tmp.path / "case\xfe.json";
+  fs::copy_file(case_path("low_intensity_36_spheres.json"), bad_case);
+  require_one_line_error(run_pdamp({"run", bad_case.string(), "-o", (tmp.path / "out").string()}),
+                         "the file's path is not valid UTF-8");
+}

@@ -55,6 +55,19 @@ std::string pointer_token(std::string_view key) {
   return token;
 }
 
+bool valid_utf8(const std::string& text) {
+  for (std::size_t i = 0; i < text.size();) {
+    if (static_cast<unsigned char>(text[i]) < 0x80) {
+      ++i;
+      continue;
+    }
+    const std::size_t n = utf8_length(text, i);
+    if (n == 0) return false;
+    i += n;
+  }
+  return true;
+}
+
 std::string printable(const std::string& text) {
   std::string out;
   out.reserve(text.size());

@@ -33,6 +33,10 @@ inline constexpr std::size_t kMaxNestingDepth = 64;
 /// "<path>: malformed JSON: <where and what>" or "<path>: <pointer>: duplicate key".
 nlohmann::json parse_json_document(const std::string& text, const std::string& path);
 
+/// Whether `text` is valid UTF-8 (what a JSON document may hold: paths written into results
+/// must be).
+bool valid_utf8(const std::string& text);
+
 /// `text` made printable on one line: control bytes (newline, NUL, ESC, ...) and bytes
 /// of invalid UTF-8 become \n, \0, \x1b ... escapes, so a message quoting a user's
 /// input stays one line and is not cut at a NUL byte.
