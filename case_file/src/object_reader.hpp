@@ -8,6 +8,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -57,11 +58,15 @@ class ObjectReader {
   bool has(const std::string& key) const { return object_.contains(key); }
   bool is_string(const std::string& key) const { return has(key) && object_.at(key).is_string(); }
   bool is_number(const std::string& key) const { return has(key) && object_.at(key).is_number(); }
-  std::vector<double> number_array(const std::string& key, Range range, const std::string& unit, std::size_t min_size) {
+  /// An array of min_size..max_size numbers in `range`.
+  std::vector<double> number_array(const std::string& key, Range range, const std::string& unit, std::size_t min_size,
+                                   std::size_t max_size = std::numeric_limits<std::size_t>::max()) {
     strict_.optional(key);
     if (!has(key) || !object_.at(key).is_array()) fail(key, "required (an array of numbers" + unit + ")");
     if (object_.at(key).size() < min_size)
       fail(key, "has " + std::to_string(object_.at(key).size()) + " entries: needs at least " + std::to_string(min_size));
+    if (object_.at(key).size() > max_size)
+      fail(key, "has " + std::to_string(object_.at(key).size()) + " entries: at most " + std::to_string(max_size));
     std::vector<double> values;
     for (std::size_t i = 0; i < object_.at(key).size(); ++i) {
       const json& item = object_.at(key)[i];

@@ -92,7 +92,9 @@ void read_sensitivity(ObjectReader& r, Case& c) {
                              "youngs_modulus_factor", "tilt_x_deg", "tilt_y_deg", "tilt_z_deg"});
     for (const auto& other : s.parameters)
       if (other.name == parameter.name) p.fail("name", "'" + parameter.name + "' is given twice");
-    parameter.values = p.number_array("values", Range{-1e6, 1e6}, "", 1);
+    // At most kMaxSensitivityValues: each value is a case of its own, held at once (10,000
+    // took 3 GB and 45 s before the first run); a finer scan is a field or a sweep.
+    parameter.values = p.number_array("values", Range{-1e6, 1e6}, "", 1, kMaxSensitivityValues);
     s.parameters.push_back(std::move(parameter));
   });
   s.threads = r.integer("threads", c.field.threads, 1, 256);

@@ -247,6 +247,10 @@ struct TaskSpec {
   std::optional<PlacementTask> placement;
 };
 
+/// Most values of one sensitivity parameter: every value is a case of its own (a DEM run);
+/// a sensitivity study is a few values about the operating point, a finer scan a field.
+inline constexpr std::size_t kMaxSensitivityValues = 50;
+
 /// `sensitivity`: the parameters `pdamp sensitivity` varies one at a time
 /// around the damper's operating point, each over the values given (docs/sensitivity.md).
 struct SensitivityParameter {
