@@ -441,6 +441,11 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   out.case_name = c.name;
   out.mass_budget_kg = task.mass_budget_kg;
   out.problem = case_file::filling_ratio_problem(c);
+  // A task opens its jobs through the executor once per process (executor.hpp): over MPI
+  // ranks that is the first round's verification; the calibration (every rank needs the
+  // same beds to choose the same design) and the design loop's later rounds run on each
+  // process's own threads.
+  Executor& own_threads = executor.processes() > 1 ? static_cast<Executor&>(local_executor()) : executor;
   if (o.calibrated.value_or(task.calibration.has_value())) {
     case_file::CalibrationSpec spec;
     if (task.calibration) {
@@ -451,7 +456,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     }
     out.calibration = calibrate_beds(c, out.problem, spec,
                                      o.calibration_cache.empty() ? default_calibration_cache() : o.calibration_cache,
-                                     hooks, executor);
+                                     hooks, own_threads);
     out.problem.options.bed_models = out.calibration->models();
   }
 
@@ -484,7 +489,8 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     const int rounds = out.calibration ? verify->rounds : 1;
     DecayRuns runs;
     for (int round = 1;; ++round) {
-      out.verification = verify_designs(c, out.problem, out.optimum, *verify, o, hooks, executor, out.checkpoints, runs);
+      out.verification = verify_designs(c, out.problem, out.optimum, *verify, o, hooks, round == 1 ? executor : own_threads,
+                                        out.checkpoints, runs);
       out.rounds.push_back(round_summary(round, *out.verification));
       if (out.verification->passed) {
         out.loop_outcome = "agreed";
@@ -504,7 +510,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
                                                               settling.frequency_hz);
       out.rounds.back().recalibrated =
           recalibrate_in_design(c, out.problem, *out.calibration, whole_slabs(chosen.design), design_damping,
-                                chosen.dem.threshold_m, hooks, executor);
+                                chosen.dem.threshold_m, hooks, own_threads);
       if (out.rounds.back().recalibrated.empty()) {
         out.loop_outcome = "nothing_to_recalibrate";
         break;
