@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -68,6 +69,21 @@ PreviousOutputs previous_outputs(const fs::path& dir) {
 
 std::string owner_text(const OutputOwner& owner) {
   return "pdamp " + owner.command + (owner.input.empty() ? "" : " on " + strict_json::printable(owner.input));
+}
+
+/// Whether a picture gnuplot wrote is whole: a PNG ends with its IEND chunk, an SVG with its
+/// closing tag (other files are taken as they are).
+bool complete_picture(const fs::path& path) {
+  const std::string name = path.filename().string();
+  const auto ends_with = [&](std::string_view suffix) {
+    return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (!ends_with(".png") && !ends_with(".svg")) return true;
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (ends_with(".png")) return text.size() >= 12 && text.compare(text.size() - 8, 4, "IEND") == 0;
+  const auto end = text.rfind("</svg>");
+  return end != std::string::npos && text.find_first_not_of(" \t\r\n", end + 6) == std::string::npos;
 }
 
 /// Blocks SIGINT, SIGTERM and SIGHUP for its lifetime: the renames of a commit are
@@ -200,8 +216,16 @@ std::vector<std::string> OutputDir::add_plot(const std::string& script_name, con
     return warnings;
   }
   for (const auto& name : outputs) {
-    if (fs::exists(staging_ / name)) names_.push_back(name);
-    else warnings.push_back("gnuplot did not produce " + name);
+    if (!fs::exists(staging_ / name)) {
+      warnings.push_back("gnuplot did not produce " + name);
+      continue;
+    }
+    // gnuplot exits 0 with a picture cut short when the disk fills: such a set must not
+    // replace a good one (an exception here ends the run before any rename).
+    if (!complete_picture(staging_ / name))
+      throw std::runtime_error(strict_json::printable((dir_ / name).string()) +
+                               ": gnuplot wrote it incomplete (a full disk?); the folder's earlier results are kept");
+    names_.push_back(name);
   }
   return warnings;
 }

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "cli/cli_support.hpp"
+#include "pdamp/report/external_program.hpp"
 #include "pdamp/report/html_report.hpp"
+#include "pdamp/report/output_dir.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -138,4 +140,27 @@ TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other 
   const fs::path plain = dir.path / "plain";
   REQUIRE(run_pdamp({"decay", decay_case, "-o", plain.string()}).exit_code == 0);
   CHECK_FALSE(fs::exists(plain / "report.html"));
+}
+
+// Reference: gnuplot exits 0 with a picture cut short when the disk fills (an SVG without its
+// closing tag, a PNG without its IEND chunk): such a staged set must not replace a good one.
+// A script that writes a cut SVG stands for it.
+TEST_CASE("a picture gnuplot leaves incomplete ends the run before the earlier results are replaced", "[cli][report]") {
+  if (!pdamp::report::find_executable("gnuplot")) return;  // nothing to run
+  const TempDir dir("incomplete_picture");
+  std::ofstream(dir.path / "kept.csv") << "1,2\n";
+  {
+    pdamp::report::OutputDir out(dir.path);
+    out.add("kept.csv", "1,2\n");
+    out.commit();
+  }
+  pdamp::report::OutputDir out(dir.path);
+  out.add("kept.csv", "3,4\n");
+  CHECK_THROWS_WITH(out.add_plot("cut.gp", "set print 'cut.svg'\nprint '<svg><g>'\nunset print\n", {"cut.svg"}),
+                    Catch::Contains("cut.svg: gnuplot wrote it incomplete"));
+  std::ifstream kept(dir.path / "kept.csv");
+  std::string line;
+  std::getline(kept, line);
+  CHECK(line == "1,2");  // the earlier set is untouched
+  CHECK_FALSE(fs::exists(dir.path / "cut.svg"));
 }
