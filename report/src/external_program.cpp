@@ -113,6 +113,11 @@ void install_interrupt_handlers() {
   // EINTR (that would report a write error instead of the interruption).
   action.sa_flags = SA_RESTART;
   for (int s : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(s, &action, nullptr);
+  // A file-size limit (ulimit -f) then fails a write with EFBIG, which the writer reports
+  // naming the file and cleans up after, instead of SIGXFSZ killing pdamp mid-write and
+  // leaving a temporary behind. gnuplot inherits the ignored signal: its cut-short
+  // pictures are caught by OutputDir.
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 void begin_output_phase() { ++g_output_phase; }

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pdamp/strict_json/output_file.hpp"
+
 namespace pdamp::report {
 
 namespace {
@@ -371,9 +373,7 @@ void stage_report(OutputDir& files, const case_file::Case& c, const json& result
   in.warnings = warnings;
   in.pictures = staged_pictures(page.parent_path());
   in.gnuplot_found = gnuplot_available();
-  std::ofstream out(page, std::ios::binary | std::ios::trunc);
-  out << report_html(in);
-  if (!out) throw std::runtime_error("cannot write " + page.string());
+  strict_json::write_file_synced(page, report_html(in), files.dir() / "report.html");
 }
 
 }  // namespace pdamp::report

@@ -37,10 +37,8 @@ void remove_stale_staging(const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir, error)) {
     const std::string name = entry.path().filename().string();
     if (name.rfind(kStagingPrefix, 0) != 0) continue;
-    const std::string digits = name.substr(std::string(kStagingPrefix).size());
-    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
-    const auto pid = static_cast<pid_t>(std::stol(digits));
-    if (::kill(pid, 0) != 0 && errno == ESRCH) fs::remove_all(entry.path(), error);
+    if (strict_json::names_a_dead_process(std::string_view(name).substr(std::string(kStagingPrefix).size())))
+      fs::remove_all(entry.path(), error);
   }
 }
 
@@ -171,9 +169,9 @@ void OutputDir::start_writing() {
 
 fs::path OutputDir::add(const std::string& name, const std::string& content) {
   start_writing();
-  std::ofstream out(staging_ / name, std::ios::binary | std::ios::trunc);
-  out << content;
-  if (!out) throw std::runtime_error("cannot write " + (staging_ / name).string());
+  // Written in full and fsynced now (an ofstream reports a full disk for the last buffer
+  // only at close, unchecked): a failure ends the run before any rename.
+  strict_json::write_file_synced(staging_ / name, content, dir_ / name);
   names_.push_back(name);
   return dir_ / name;
 }
@@ -244,16 +242,28 @@ std::vector<std::string> OutputDir::commit() {
       throw strict_json::InputError("-o", "", "'" + strict_json::printable((dir_ / name).string()) +
                                      "' exists and is not a file: move it away (pdamp writes " + name + " there)");
   }
-  const SignalBlock whole;
+  // Every staged file whole on disk before the first rename (a delayed write error of a
+  // full disk shows in fsync), the record of the new set staged with them: a failure here
+  // leaves the earlier set as it was.
+  for (const auto& name : names_) strict_json::sync_file(staging_ / name, dir_ / name);
   std::set<std::string> current(names_.begin(), names_.end());
   current.insert(in_place_.begin(), in_place_.end());
-  for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
-  for (const auto& old : previous_outputs(dir_).files)
+  const PreviousOutputs previous = previous_outputs(dir_);
+  strict_json::write_file_synced(staging_ / kManifest,
+                                 nlohmann::json{{"format", "pdamp.outputs"}, {"files", current},
+                                                {"command", owner_.command}, {"input", owner_.input}}
+                                         .dump(2) + "\n",
+                                 dir_ / kManifest);
+  {
+    const SignalBlock whole;
+    for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
+    fs::rename(staging_ / kManifest, dir_ / kManifest);
+    strict_json::sync_parent_folder(dir_ / kManifest);
+  }
+  // The earlier set's files this run did not write again go last: a crash before here
+  // leaves them as strays beside a complete new set, never a set with holes.
+  for (const auto& old : previous.files)
     if (!current.count(old) && fs::is_regular_file(fs::symlink_status(dir_ / old, error))) fs::remove(dir_ / old, error);
-  strict_json::write_file_atomically(
-      dir_ / kManifest, nlohmann::json{{"format", "pdamp.outputs"}, {"files", current}, {"command", owner_.command},
-                                       {"input", owner_.input}}
-                            .dump(2) + "\n");
   for (const auto& name : current) paths.push_back((dir_ / name).string());
   committed_ = true;
   return paths;

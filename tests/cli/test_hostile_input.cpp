@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iterator>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -655,4 +656,89 @@ TEST_CASE("a sensitivity parameter with more values than a study can use is refu
     c["sensitivity"] = {{"parameters", json::array({{{"name", "friction"}, {"values", values}}})}};
   });
   require_one_line_error(run_pdamp({"validate", path}), "/sensitivity/parameters/0/values: has 10000 entries: at most 50");
+}
+
+namespace {
+
+/// Every file of `dir` (hidden ones too) with its contents.
+std::map<std::string, std::string> folder_contents(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir)) files[entry.path().filename().string()] = slurp(entry.path());
+  return files;
+}
+
+/// A failed write must leave the folder's earlier set byte for byte, no staging folder and
+/// no temporary, and say so: exit 1, one error line naming a file of the set.
+void require_earlier_set_kept(const RunResult& r, const fs::path& dir, const std::map<std::string, std::string>& before) {
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.find("pdamp: error: ") != std::string::npos);
+  CHECK((r.err.find("write failed") != std::string::npos || r.err.find("incomplete") != std::string::npos));
+  const auto after = folder_contents(dir);
+  for (const auto& [name, text] : after) {
+    INFO(name);
+    CHECK(name.find(".tmp.") == std::string::npos);
+    CHECK(name.rfind(".pdamp-staging-", 0) != 0);
+  }
+  CHECK(after == before);
+}
+
+/// A size-limited tmpfs mounted for the test's life (root only; a container may still
+/// refuse: then `mounted` is false and the caller skips).
+struct SmallFileSystem {
+  fs::path point;
+  bool mounted = false;
+  SmallFileSystem(fs::path where, std::uintmax_t bytes) : point(std::move(where)) {
+    fs::create_directories(point);
+    if (::geteuid() != 0) return;
+    const auto r = run_program({"/bin/mount", "-t", "tmpfs", "-o", "size=" + std::to_string(bytes), "tmpfs", point.string()});
+    mounted = r.exit_code == 0;
+  }
+  ~SmallFileSystem() {
+    if (mounted) run_program({"/bin/umount", point.string()});
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a write that fails (a file-size limit, a full disk) keeps the folder's earlier set and leaves no temporary", "[cli]") {
+  TempDir tmp("write_failure");
+  const fs::path out = tmp.path / "field";
+  const std::vector<std::string> field_args = {"field", case_path("low_intensity_36_spheres.json"), "--source", "formulas",
+                                               "-o", out.string()};
+  REQUIRE(run_pdamp(field_args).exit_code == 0);
+  const auto before = folder_contents(out);
+  std::uintmax_t set_bytes = 0;
+  for (const auto& [name, text] : before) set_bytes += text.size();
+  // Limits that cut the first staged file (field.json, 4 KB), a data file written by the
+  // folder itself (the 15 KB curve CSV; an ofstream used to lose this failure at close),
+  // and gnuplot's pictures (50 KB PNG, 4 MB SVG). Before: SIGXFSZ killed pdamp mid-run
+  // (exit 153) with its staging folder left, or gnuplot's cut pictures replaced good ones.
+  for (const unsigned long limit : {3000UL, 10000UL, 20000UL, 1000000UL}) {
+    INFO("file-size limit " << limit);
+    RunOptions limited;
+    limited.file_size_limit_bytes = limit;
+    require_earlier_set_kept(run_pdamp(field_args, limited), out, before);
+  }
+  // A checkpoint that cannot be written: exit 1 naming it, no temporary beside it.
+  RunOptions limited;
+  limited.file_size_limit_bytes = 1000;
+  const fs::path dem = tmp.path / "dem";
+  const auto r = run_pdamp({"dem", case_path("low_intensity_36_spheres.json"), "-o", dem.string(), "--checkpoint-interval", "0"},
+                           limited);
+  CHECK(r.exit_code == 1);
+  CHECK_THAT(r.err, Catch::Contains("dem.checkpoint: write failed"));
+  for (const auto& entry : fs::directory_iterator(dem)) CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
+
+  // A real full disk: a file system that holds the earlier set and 64 KB more.
+  SmallFileSystem small(tmp.path / "small", set_bytes + (64u << 10));
+  if (!small.mounted) {
+    WARN("no size-limited tmpfs here (needs root and mount rights): the full-disk part is skipped");
+    return;
+  }
+  fs::copy(out, small.point, fs::copy_options::recursive);
+  REQUIRE(folder_contents(small.point) == before);
+  std::vector<std::string> args = field_args;
+  args.back() = small.point.string();
+  require_earlier_set_kept(run_pdamp(args), small.point, before);
 }

@@ -6,6 +6,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,6 +37,9 @@ struct RunOptions {
   std::function<void(pid_t)> while_running;
   /// Added to the child's environment, "NAME=value" each.
   std::vector<std::string> environment;
+  /// A file-size limit for the child (ulimit -f; 0: none): a write beyond it fails, an
+  /// injected write failure without a full disk.
+  unsigned long file_size_limit_bytes = 0;
 };
 
 inline std::string slurp(const std::filesystem::path& path) {
@@ -64,6 +68,10 @@ inline RunResult run_program(std::vector<std::string> argv_text, const RunOption
     if (in < 0 || out < 0 || err < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(err, 2) < 0) ::_exit(126);
     if (!dir.empty() && ::chdir(dir.c_str()) != 0) ::_exit(126);
     for (auto& variable : environment) ::putenv(variable.data());
+    if (options.file_size_limit_bytes > 0) {
+      const rlimit limit{options.file_size_limit_bytes, options.file_size_limit_bytes};
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(126);
+    }
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }

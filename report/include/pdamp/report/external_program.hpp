@@ -26,7 +26,8 @@ int run_program(const std::filesystem::path& program, const std::vector<std::str
 /// half-written then: results are only staged later; a staging folder left behind is
 /// removed by the next run into that directory). Inside one (OutputDir staging and
 /// committing files) the signal is recorded and the writer stops at its next step,
-/// removes what it staged and ends by the signal's default action.
+/// removes what it staged and ends by the signal's default action. SIGXFSZ is ignored,
+/// so a file-size limit is a write error naming the file.
 void install_interrupt_handlers();
 
 /// Marks the output phase (nesting counts). While it lasts signals are deferred.
