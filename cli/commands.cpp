@@ -232,12 +232,11 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
   // --checkpoint-interval seconds and when a signal arrives (then pdamp ends by it).
   const tasks::CheckpointFile checkpoint = checkpoint_file(args, "dem");
   CliHooks hooks(checkpoint_interval(args));
-  tasks::DemRunResult result;
-  {
-    const std::optional<report::DeferredSignals> deferred =
-        checkpoint.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
-    result = tasks::run_dem(c, plan, checkpoint, hooks);
-  }
+  // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
+  const std::optional<report::DeferredSignals> deferred =
+      checkpoint.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
+  tasks::DemRunResult result = tasks::run_dem(c, plan, checkpoint, hooks);
+  if (deferred) dem_results_ready(files.get());
   std::vector<std::string> warnings = result.warnings;
   if (files)
     for (auto& w : report::write_files(*files, result)) warnings.push_back(w);
@@ -258,8 +257,7 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
        {"particle_steps_per_s", format_number(r.particle_steps_per_s, 3)},
        {"run", r.summary.brief_report()}},
       {"summary.json", nullptr, false, "files", false, false});
-  std::error_code ignored;
-  if (!checkpoint.path.empty()) std::filesystem::remove(checkpoint.path, ignored);  // the results are kept
+  remove_checkpoints({checkpoint.path});
   return code;
 }
 

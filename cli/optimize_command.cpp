@@ -116,12 +116,11 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
     options.resume = folder.resume;
   }
   CliHooks hooks(checkpoint_interval(args));
-  tasks::FillingRatiosResult result;
-  {
-    const std::optional<report::DeferredSignals> deferred =
-        options.checkpoint_dir.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
-    result = tasks::run_filling_ratios(c, options, hooks, context.executor);
-  }
+  // Signals wait for a checkpoint during the runs, then for the commit (dem_results_ready).
+  const std::optional<report::DeferredSignals> deferred =
+      options.checkpoint_dir.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
+  tasks::FillingRatiosResult result = tasks::run_filling_ratios(c, options, hooks, context.executor);
+  if (deferred) dem_results_ready(files.get());
   std::vector<std::string> warnings = result.warnings;
   if (files)
     for (auto& w : report::write_files(*files, result)) warnings.push_back(w);
@@ -169,8 +168,7 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   }
   if (result.rounds.size() > 1) rows.push_back({"design loop", result.loop_outcome});
   const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report});
-  std::error_code ignored;
-  for (const auto& checkpoint : result.checkpoints) std::filesystem::remove(checkpoint, ignored);  // the results are kept
+  remove_checkpoints(result.checkpoints);
   return code;
 }
 

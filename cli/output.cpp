@@ -1,6 +1,8 @@
 // The end every command shares, and readable tables (output.hpp).
 #include "output.hpp"
 
+#include "pdamp/report/external_program.hpp"
+
 #include <iostream>
 #include <sstream>
 
@@ -44,6 +46,17 @@ std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const Comm
 
 tasks::OutputFolder output_folder(const report::OutputDir* files) {
   return files ? tasks::OutputFolder{files->dir()} : tasks::OutputFolder{};
+}
+
+void dem_results_ready(report::OutputDir* files) {
+  if (files) files->finish_despite_signals();
+  report::test_pause_point("run-ended");
+}
+
+void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints) {
+  std::error_code ignored;
+  for (const auto& checkpoint : checkpoints)
+    if (!checkpoint.empty()) std::filesystem::remove(checkpoint, ignored);
 }
 
 int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& result,

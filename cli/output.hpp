@@ -2,6 +2,7 @@
 // (result JSON, resolved case, report, commit, warnings, the result on stdout), tables.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <utility>
@@ -30,6 +31,15 @@ void print_warnings(const std::vector<std::string>& warnings);
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context);
 /// Where a task's result JSON says its files are.
 tasks::OutputFolder output_folder(const report::OutputDir* files);
+
+/// The end of a checkpointed DEM run (dem, decay --method dem, the verification of
+/// optimize and run), whose signals are deferred from its start to its commit (the
+/// command holds a report::DeferredSignals that long): the run is complete, so a signal
+/// from now on waits until its results are committed instead of abandoning them
+/// (report::OutputDir::finish_despite_signals); a test may pause here ("run-ended").
+void dem_results_ready(report::OutputDir* files);
+/// After the commit: the run's checkpoints go, its results being kept.
+void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints);
 
 /// How a command ends.
 struct ResultFiles {

@@ -239,13 +239,11 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
   auto files = output_dir(args, context);
   if (options.method == tasks::DecayMethod::kDem) options.checkpoint.file = checkpoint_file(args, "decay_dem");
   CliHooks hooks(checkpoint_interval(args));
-  tasks::DecayResult result;
-  {
-    // A checkpointed run defers signals to its next checkpoint.
-    const std::optional<report::DeferredSignals> deferred =
-        options.checkpoint.file.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
-    result = tasks::run_decay(c, options, hooks);
-  }
+  // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
+  const std::optional<report::DeferredSignals> deferred =
+      options.checkpoint.file.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
+  tasks::DecayResult result = tasks::run_decay(c, options, hooks);
+  if (deferred) dem_results_ready(files.get());
   std::vector<std::string> warnings = result.warnings;
   if (files)
     for (auto& w : report::write_files(*files, result)) warnings.push_back(w);
@@ -272,8 +270,7 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
                           format_number(100.0 * l["share"].get<double>(), 3) + "%)"});
   }
   const int code = finish(args, files.get(), out, warnings, rows, {"decay.json", &c, context.report});
-  std::error_code ignored;
-  if (!options.checkpoint.file.path.empty()) std::filesystem::remove(options.checkpoint.file.path, ignored);  // kept
+  remove_checkpoints({options.checkpoint.file.path});
   return code;
 }
 

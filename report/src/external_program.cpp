@@ -128,4 +128,17 @@ void stop_if_interrupted() {
   if (const int s = g_pending_signal; s != 0) throw strict_json::Interrupted(s);
 }
 
+void test_pause_point(const char* point) {
+  const char* wanted = std::getenv("PDAMP_TEST_PAUSE_AT");
+  if (wanted == nullptr) return;
+  const std::string setting = wanted;
+  const auto colon = setting.find(':');
+  if (colon == std::string::npos || setting.compare(0, colon, point) != 0) return;
+  const std::string marker = setting.substr(colon + 1);
+  const int fd = ::open(marker.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd >= 0) ::close(fd);
+  // A deferred signal is recorded; any other ends the process during the wait.
+  for (int k = 0; k < 60000 && g_pending_signal == 0; ++k) ::usleep(10000);
+}
+
 }  // namespace pdamp::report

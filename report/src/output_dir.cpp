@@ -164,7 +164,7 @@ void OutputDir::start_writing() {
     writing_ = true;
     begin_output_phase();
   }
-  stop_if_interrupted();
+  if (!finish_despite_signals_) stop_if_interrupted();
 }
 
 fs::path OutputDir::add(const std::string& name, const std::string& content) {
@@ -205,7 +205,7 @@ std::vector<std::string> OutputDir::add_plot(const std::string& script_name, con
             "' in the output directory for the plots"};
   const std::string log = script_name + ".log";
   const int status = run_program(*gnuplot, {script_name}, staging_, staging_ / log);
-  stop_if_interrupted();  // gnuplot ended by Ctrl-C: its pictures may be cut short
+  if (!finish_despite_signals_) stop_if_interrupted();  // gnuplot ended by Ctrl-C: its pictures may be cut short
   std::vector<std::string> warnings;
   if (status != 0) {
     // A failed run may leave truncated pictures: keep only the log, for the reason.
@@ -254,6 +254,7 @@ std::vector<std::string> OutputDir::commit() {
                                                 {"command", owner_.command}, {"input", owner_.input}}
                                          .dump(2) + "\n",
                                  dir_ / kManifest);
+  test_pause_point("commit");
   {
     const SignalBlock whole;
     for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
@@ -266,6 +267,7 @@ std::vector<std::string> OutputDir::commit() {
     if (!current.count(old) && fs::is_regular_file(fs::symlink_status(dir_ / old, error))) fs::remove(dir_ / old, error);
   for (const auto& name : current) paths.push_back((dir_ / name).string());
   committed_ = true;
+  test_pause_point("committed");
   return paths;
 }
 

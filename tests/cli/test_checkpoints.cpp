@@ -206,3 +206,50 @@ TEST_CASE("pdamp dem killed at a checkpoint and resumed equals the uninterrupted
   require_one_line_error(run_pdamp({"dem", c, "--amplitude", "0.05", "-o", parts.string(), "--resume"}),
                          "dem.checkpoint: /settings");
 }
+
+// The ending of a checkpointed DEM run: SIGTERM once the run is complete (before any file is
+// staged), once the set is staged (before the first rename), and once it is committed (before
+// the checkpoint goes). Each time the results are committed whole, the checkpoint is gone
+// (nothing is left to resume), and pdamp says the results are complete and ends by the
+// signal. Before, a signal before the commit abandoned the staged results, and a run shorter
+// than the checkpoint interval had no checkpoint either: the run was lost.
+TEST_CASE("a signal at every point of a DEM run's ending loses nothing", "[cli][cosimulation]") {
+  const TempDir dir("ending_signals");
+  const std::string decay_case = short_decay(dir, 4.0);
+  const fs::path reference = dir.path / "reference";
+  REQUIRE(run_pdamp({"decay", decay_case, "--method", "dem", "-o", reference.string()}).exit_code == 0);
+  struct Command {
+    std::vector<std::string> args;
+    std::string result, checkpoint;
+  };
+  const std::vector<Command> commands = {
+      {{"decay", decay_case, "--method", "dem"}, "decay.json", "decay_dem.checkpoint"},
+      {{"dem", case_path("low_intensity_36_spheres.json"), "--periods", "2"}, "summary.json", "dem.checkpoint"}};
+  for (const auto& command : commands) {
+    for (const std::string point : {"run-ended", "commit", "committed"}) {
+      INFO(command.args.front() << " at " << point);
+      const fs::path out = dir.path / (command.args.front() + "_" + point);
+      const fs::path marker = dir.path / (command.args.front() + "_" + point + ".marker");
+      RunOptions options;
+      options.environment = {"PDAMP_TEST_PAUSE_AT=" + point + ":" + marker.string()};
+      options.while_running = [&](pid_t pid) {
+        // A hang guard only: the run takes a few seconds.
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(600);
+        while (!fs::exists(marker) && std::chrono::steady_clock::now() < until)
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        ::kill(pid, SIGTERM);
+      };
+      std::vector<std::string> args = command.args;
+      args.insert(args.end(), {"-o", out.string()});
+      const auto r = run_pdamp(args, options);
+      INFO(r.err);
+      CHECK(r.exit_code == 128 + SIGTERM);
+      CHECK_THAT(r.err, Catch::Contains("interrupted after the results were written (they are complete)"));
+      REQUIRE(fs::exists(out / command.result));
+      CHECK_FALSE(fs::exists(out / command.checkpoint));
+      const json record = json::parse(slurp(out / ".pdamp-outputs.json"));
+      for (const auto& name : record["files"]) CHECK(fs::exists(out / name.get<std::string>()));
+      if (command.args.front() == "decay") CHECK(slurp(out / "decay_dem.csv") == slurp(reference / "decay_dem.csv"));
+    }
+  }
+}

@@ -50,4 +50,10 @@ int pending_interrupt();
 /// Throws strict_json::Interrupted when a signal arrived during the output phase.
 void stop_if_interrupted();
 
+/// A test hook at a named point of a run's ending ("run-ended", "commit", "committed"):
+/// when the environment variable PDAMP_TEST_PAUSE_AT is "<point>:<marker file>", pdamp
+/// creates the marker file and waits there (up to 10 minutes) until a signal is recorded or
+/// ends it, so that a test can deliver a signal at exactly that point. Unset: nothing.
+void test_pause_point(const char* point);
+
 }  // namespace pdamp::report

@@ -58,6 +58,11 @@ class OutputDir {
   /// Moves every staged file into DIR, removes the previous run's files that this run
   /// did not write again, and records the new set. Returns the final paths.
   std::vector<std::string> commit();
+  /// The results are complete and costly (a DEM run): a signal that arrives from now on
+  /// no longer abandons the staged set; it is committed, and the signal ends pdamp after
+  /// (main says the results are complete). Without this a signal stops the staging and
+  /// removes it (a cheap command is simply run again).
+  void finish_despite_signals() { finish_despite_signals_ = true; }
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
@@ -71,6 +76,7 @@ class OutputDir {
   std::vector<std::string> in_place_;  // already in DIR
   bool writing_ = false;
   bool committed_ = false;
+  bool finish_despite_signals_ = false;
 };
 
 /// True when a gnuplot executable is on PATH.
