@@ -409,8 +409,15 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     return true;
   };
 
+  // A stop asked while the bed settles or approaches (no checkpoint can hold those phases)
+  // ends the run at once without one: a big bed's settling can take hours.
+  struct StoppedBeforeDrive {};
+  const auto stop_asked = [&](std::int64_t k) {
+    return checkpoints != nullptr && checkpoints->stop && k % kStopPollSteps == 0 && checkpoints->stop();
+  };
   const auto report_settling = [&](std::int64_t k) {
     reporter.maybe_report("settling", k, total_steps, static_cast<double>(k - settle_steps) * dt);
+    if (stop_asked(k + 1)) throw StoppedBeforeDrive{};
   };
   // A resumed run starts where its checkpoint was written; a new one settles first.
   const bool resuming = checkpoints != nullptr && !checkpoints->resume_state.empty();
@@ -419,13 +426,13 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   bool analysing = false;
   if (resuming) {
     saved.emplace(checkpoints->resume_state, "harmonic run state");
-    saved->expect_tag("harmonic run");
+    saved->expect_tag("harmonic run 2");  // 2: the drive bins and the block in progress
     analysing = saved->i32_in("phase", 1, 2) == 2;
     first_step = saved->i64("step") + 1;
-    // Checkpoints are written at period ends inside the transient (phase 1) or the analysis (phase 2).
+    // Checkpoints are written inside the transient (phase 1) or the analysis (phase 2): at
+    // period ends, or at any step when a stop was asked.
     const std::int64_t done = first_step - 1;
-    if (done < 1 || done >= transient_steps + plan.analysed_steps || done % steps_per_period != 0 ||
-        analysing != (done > transient_steps))
+    if (done < 1 || done >= transient_steps + plan.analysed_steps || analysing != (done > transient_steps))
       saved->fail("step", std::to_string(done) + " in phase " + (analysing ? "2" : "1") +
                               ": not a checkpoint of this run's " +
                               std::to_string(transient_steps + plan.analysed_steps) + " drive steps");
@@ -436,12 +443,19 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     const ContainerState drive_start =
         plan.approach_steps > 0 ? HarmonicMotion(axis, options.approach_amplitude_m, options.frequency_hz).state(0.0)
                                 : start;
-    if (!settle(world, drive_start, settle_steps, report_settling) && halted()) return result;  // false exactly when halted
-    if (plan.approach_steps > 0 && !approach(world, options, plan, [&](std::int64_t k) {
-          reporter.maybe_report("approach", settle_steps + k, total_steps,
-                                static_cast<double>(k - plan.approach_steps) * dt);
-        }) && halted())
+    try {
+      if (!settle(world, drive_start, settle_steps, report_settling) && halted()) return result;  // false exactly when halted
+      if (plan.approach_steps > 0 && !approach(world, options, plan, [&](std::int64_t k) {
+            reporter.maybe_report("approach", settle_steps + k, total_steps,
+                                  static_cast<double>(k - plan.approach_steps) * dt);
+            if (stop_asked(k)) throw StoppedBeforeDrive{};
+          }) && halted())
+        return result;
+    } catch (const StoppedBeforeDrive&) {
+      result.stopped = true;
+      finish(Outcome::kCompleted, "stopped before the drive started (no checkpoint)");
       return result;
+    }
   }
   // Built on the settled bed: its base contacts are the rolling criterion's reference.
   MotionModeAccumulator motion_modes(world, plan.step.world, axis);
@@ -460,11 +474,14 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     saved->expect_tag("end of harmonic run");
     saved->finish();
   }
-  // At a period end: a checkpoint when due, and the end of the run when asked.
+  // A checkpoint at a period end when due, and at any step once a stop is asked (polled
+  // every kStopPollSteps steps: a period of a big bed can take an hour); the run then ends.
   const auto checkpoint = [&](std::int64_t step) {
-    if (checkpoints == nullptr || step % steps_per_period != 0 || !checkpoints->due || !checkpoints->due()) return false;
+    if (checkpoints == nullptr) return false;
+    const bool stopping = stop_asked(step);
+    if (!stopping && (step % steps_per_period != 0 || !checkpoints->due || !checkpoints->due())) return false;
     StateWriter out;
-    out.tag("harmonic run");
+    out.tag("harmonic run 2");
     out.i32(analysing ? 2 : 1);
     out.i64(step);
     out.f64(wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count());
@@ -480,7 +497,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     }
     out.tag("end of harmonic run");
     checkpoints->write(out.bytes(), static_cast<double>(step) * dt);
-    return checkpoints->stop && checkpoints->stop();
+    return stopping || (checkpoints->stop && checkpoints->stop());
   };
   const auto stop_here = [&]() {
     result.stopped = true;

@@ -47,32 +47,59 @@ void DriveBinMeasure::add(std::int64_t step, double force_n, double velocity_m_s
   period_bin_.clear();
 }
 
-void DriveBinMeasure::save(StateWriter& out) const {
-  if (period_bin_.samples() != 0) throw std::logic_error("DriveBinMeasure::save: a period is in progress");
-  const auto sums = all_bin_.sums();
-  for (double v : {sums.force.real(), sums.force.imag(), sums.velocity.real(), sums.velocity.imag(), sums.max_abs_velocity})
+namespace {
+
+void save_sums(const formulas::DriveBinAccumulator::Sums& sums, StateWriter& out) {
+  for (double v : {sums.force.real(), sums.force.imag(), sums.velocity.real(), sums.velocity.imag(), sums.max_abs_velocity,
+                   sums.phase.real(), sums.phase.imag()})
     out.f64(v);
   out.i64(sums.samples);
+  out.i64(sums.next_step);
+  out.i32(sums.started ? 1 : 0);
+}
+
+formulas::DriveBinAccumulator::Sums restore_sums(StateReader& in, const std::string& name) {
+  formulas::DriveBinAccumulator::Sums sums;
+  const double fr = in.finite((name + ".force").c_str()), fi = in.finite((name + ".force").c_str());
+  const double vr = in.finite((name + ".velocity").c_str()), vi = in.finite((name + ".velocity").c_str());
+  sums.force = {fr, fi};
+  sums.velocity = {vr, vi};
+  sums.max_abs_velocity = in.finite((name + ".max_abs_velocity").c_str());
+  const double pr = in.finite((name + ".phase").c_str()), pi = in.finite((name + ".phase").c_str());
+  sums.phase = {pr, pi};
+  // The rotated phase stays on the unit circle to round-off (recomputed every 64 steps).
+  if (std::abs(std::abs(sums.phase) - 1.0) > 1e-9) in.fail(name + ".phase", "is not a unit phase");
+  sums.samples = in.i64((name + ".samples").c_str());
+  sums.next_step = in.i64((name + ".next_step").c_str());
+  sums.started = in.i32_in((name + ".started").c_str(), 0, 1) == 1;
+  if (sums.samples < 0) in.fail(name + ".samples", "must not be negative");
+  return sums;
+}
+
+}  // namespace
+
+// The whole state at any step (a checkpoint mid-period): both bins with their phases.
+void DriveBinMeasure::save(StateWriter& out) const {
+  save_sums(all_bin_.sums(), out);
+  save_sums(period_bin_.sums(), out);
   out.f64s(eta_star_per_period_);
 }
 
 void DriveBinMeasure::restore(StateReader& in) {
-  formulas::DriveBinAccumulator::Sums sums;
-  const double fr = in.finite("drive_bin.force"), fi = in.finite("drive_bin.force");
-  const double vr = in.finite("drive_bin.velocity"), vi = in.finite("drive_bin.velocity");
-  sums.force = {fr, fi};
-  sums.velocity = {vr, vi};
-  sums.max_abs_velocity = in.finite("drive_bin.max_abs_velocity");
-  sums.samples = in.i64("drive_bin.samples");
-  if (sums.samples < 0 || sums.samples % steps_per_period_ != 0)
-    in.fail("drive_bin.samples", std::to_string(sums.samples) + ": must be whole periods of " +
+  const auto all = restore_sums(in, "drive_bin");
+  if (all.samples % steps_per_period_ != 0)
+    in.fail("drive_bin.samples", std::to_string(all.samples) + ": must be whole periods of " +
                                      std::to_string(steps_per_period_) + " steps");
+  const auto period = restore_sums(in, "drive_bin.period");
+  if (period.samples >= steps_per_period_)
+    in.fail("drive_bin.period.samples", std::to_string(period.samples) + ": must be less than a period of " +
+                                            std::to_string(steps_per_period_) + " steps");
   const auto periods = in.finite_f64s_up_to("drive_bin.eta_star_per_period", 100000);
-  if (static_cast<std::int64_t>(periods.size()) != sums.samples / steps_per_period_)
+  if (static_cast<std::int64_t>(periods.size()) != all.samples / steps_per_period_)
     in.fail("drive_bin.eta_star_per_period", "holds " + std::to_string(periods.size()) + " periods, the sums " +
-                                                 std::to_string(sums.samples / steps_per_period_));
-  all_bin_.restore_sums(sums);
-  period_bin_.clear();
+                                                 std::to_string(all.samples / steps_per_period_));
+  all_bin_.restore_sums(all);
+  period_bin_.restore_sums(period);
   eta_star_per_period_ = periods;
 }
 

@@ -69,8 +69,9 @@ BlockRecorder::BlockRecorder(const BlockRecorderOptions& options) : options_(opt
 }
 
 void BlockRecorder::save(StateWriter& out) const {
-  if (step_in_block_ != 0) throw std::logic_error("BlockRecorder::save: a block is in progress");
   out.i64(step_);
+  out.i64(step_in_block_);  // a block in progress (a checkpoint at any step): its sums
+  for (double v : {force_sum_, velocity_sum_, position_sum_}) out.f64(v);
   for (const auto* v : {&series_.time_s, &series_.container_position_m, &series_.container_velocity_m_s, &series_.force_n,
                         &series_.bed_relative_position_m, &series_.bed_momentum_kg_m_s, &series_.kinetic_energy_j,
                         &sample_times_s_})
@@ -91,6 +92,12 @@ void BlockRecorder::save(StateWriter& out) const {
 void BlockRecorder::restore(StateReader& in) {
   step_ = in.i64("recorder.step");
   if (step_ < options_.start_step) in.fail("recorder.step", "is before the recorder's start");
+  step_in_block_ = in.i64("recorder.step_in_block");
+  if (step_in_block_ < 0 || step_in_block_ >= options_.steps_per_block)
+    in.fail("recorder.step_in_block", std::to_string(step_in_block_) + ": must be in [0, steps_per_block)");
+  force_sum_ = in.finite("recorder.force_sum");
+  velocity_sum_ = in.finite("recorder.velocity_sum");
+  position_sum_ = in.finite("recorder.position_sum");
   const auto blocks = static_cast<std::size_t>(block_count(options_));
   series_.time_s = in.finite_f64s_up_to("recorder.series", blocks);
   const std::size_t recorded = series_.time_s.size();
@@ -115,8 +122,6 @@ void BlockRecorder::restore(StateReader& in) {
     s.compartments = in.i32s("recorder.snapshot.compartments", n, 0, 1 << 20);
     snapshots_.push_back(std::move(s));
   }
-  step_in_block_ = 0;
-  force_sum_ = velocity_sum_ = position_sum_ = 0.0;
 }
 
 bool BlockRecorder::record_step(const World& world) {

@@ -284,7 +284,9 @@ void DriveBinAccumulator::restore_sums(const Sums& sums) {
   velocity_sum_ = sums.velocity;
   max_abs_velocity_ = sums.max_abs_velocity;
   samples_ = sums.samples;
-  started_ = false;  // the next add() takes its phase from its step index
+  phase_ = sums.phase;
+  next_step_ = sums.next_step;
+  started_ = sums.started;
 }
 
 void DriveBinAccumulator::clear() {

@@ -380,7 +380,7 @@ struct Cosimulation::Impl {
   /// T' and V of the structure at the run's present step.
   std::pair<double, double> structure_energy_now() const;
 
-  std::int64_t advance(std::int64_t steps);
+  std::int64_t advance(std::int64_t steps, const std::function<bool()>& stop);
   bool finished() const { return outcome_ != dem::Outcome::kCompleted || step_ >= end_step_; }
   /// The run so far; `release`: the measures' large parts moved out (the run is spent).
   CosimulationResult result(bool release);
@@ -680,7 +680,19 @@ void Cosimulation::Impl::build_and_settle_worlds() {
     const auto steps = static_cast<std::int64_t>(std::llround(settling / dt_));
     settling_steps_ = std::max(settling_steps_, steps);
     if (progress_) progress_(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps_) * dt_, 0.0});
-    if (!dem::settle(worlds[d], containers_[d], steps)) {
+    // A big bed settles for hours: a "settling" report about every progress_interval_s
+    // (read every kStopPollSteps steps), where the caller may also end the run by throwing.
+    auto last = Clock::now();
+    const auto observe = [&](std::int64_t k) {
+      if (!progress_ || (k + 1) % Cosimulation::kStopPollSteps != 0) return;
+      const auto now = Clock::now();
+      const double since = std::chrono::duration<double>(now - last).count();
+      if (since < options_.progress_interval_s) return;
+      last = now;
+      progress_(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps_) * dt_,
+                                     static_cast<double>(Cosimulation::kStopPollSteps) / since});
+    };
+    if (!dem::settle(worlds[d], containers_[d], steps, observe)) {
       outcome_ = worlds[d].status().outcome;
       message_ = "damper " + dampers_[d].name + " (settling): " + worlds[d].status().message;
     }
@@ -748,10 +760,13 @@ void Cosimulation::Impl::open_measures(const CosimulationResult* earlier) {
   measures_.push_back(std::move(history));
 }
 
-std::int64_t Cosimulation::Impl::advance(std::int64_t steps) {
+std::int64_t Cosimulation::Impl::advance(std::int64_t steps, const std::function<bool()>& stop) {
   const auto wall_start = Clock::now();
   std::int64_t taken = 0;
-  while (taken < steps && step_ < end_step_ && outcome_ == dem::Outcome::kCompleted && step()) ++taken;
+  while (taken < steps && step_ < end_step_ && outcome_ == dem::Outcome::kCompleted && step()) {
+    ++taken;
+    if (stop && taken % kStopPollSteps == 0 && stop()) break;
+  }
   wall_s_ += seconds_since(wall_start);
   return taken;
 }
@@ -1014,9 +1029,11 @@ Cosimulation::Cosimulation(Cosimulation&&) noexcept = default;
 Cosimulation& Cosimulation::operator=(Cosimulation&&) noexcept = default;
 Cosimulation::~Cosimulation() = default;
 
-std::int64_t Cosimulation::advance(std::int64_t steps) {
+std::int64_t Cosimulation::advance(std::int64_t steps) { return advance(steps, {}); }
+
+std::int64_t Cosimulation::advance(std::int64_t steps, const std::function<bool()>& stop) {
   if (impl_->state_.worlds.empty()) throw std::logic_error("Cosimulation::advance: the state was handed over");
-  return impl_->advance(steps);
+  return impl_->advance(steps, stop);
 }
 
 bool Cosimulation::finished() const { return impl_->finished(); }

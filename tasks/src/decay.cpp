@@ -71,7 +71,14 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
                                        const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
                                        st::CosimulationState* state = nullptr) {
   detail::check_cosimulation(c, modal, dampers, options);
-  const auto report = [&](const st::CosimulationProgress& p) { report_progress(hooks, label, p); };
+  // A stop asked while the beds settle ends the run there: no checkpoint holds that phase.
+  const auto report = [&](const st::CosimulationProgress& p) {
+    report_progress(hooks, label, p);
+    if (p.stage == "settling")
+      if (const int signal = hooks.stop_requested(); signal != 0)
+        throw strict_json::Interrupted(signal, "the run stopped while its beds settled, before its first checkpoint: run "
+                                               "the same command again");
+  };
   auto r = detail::call_dem(c, [&] {
     return state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
   });
@@ -97,7 +104,14 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
   const std::string shown = strict_json::printable(cp.file.path.string());
-  const auto report = [&](const st::CosimulationProgress& p) { report_progress(hooks, label, p); };
+  // A stop asked while the beds settle ends the run there: no checkpoint holds that phase.
+  const auto report = [&](const st::CosimulationProgress& p) {
+    report_progress(hooks, label, p);
+    if (p.stage == "settling")
+      if (const int signal = hooks.stop_requested(); signal != 0)
+        throw strict_json::Interrupted(signal, "the run stopped while its beds settled, before its first checkpoint: run "
+                                               "the same command again");
+  };
 
   std::optional<st::Cosimulation> run;
   if (cp.file.resume) {
@@ -126,7 +140,8 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
                                                                                 static_cast<double>(total / sample_every)));
   while (!run->finished()) {
     const auto started = std::chrono::steady_clock::now();
-    const std::int64_t steps = run->advance(segment);
+    // A stop request is met inside the segment (a segment of a big bed can be long).
+    const std::int64_t steps = run->advance(segment, [&] { return hooks.stop_requested() != 0; });
     if (run->finished() && run->steps_done() < total) {  // a World stopped
       const auto r = run->result();
       detail::check_outcome(r.outcome, r.message, label);

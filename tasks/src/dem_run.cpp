@@ -132,9 +132,11 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
     return hooks.stop_requested() != 0 || hooks.checkpoint_due(since);
   };
   saving.stop = [&] { return hooks.stop_requested() != 0; };
+  bool wrote_checkpoint = false;
   saving.write = [&](const std::string& state, double t) {
     header.simulated_time_s = t;
     write_checkpoint(checkpoint, header, state);
+    wrote_checkpoint = true;
     last_checkpoint = std::chrono::steady_clock::now();
   };
   if (checkpoint.resume) saving.resume_state = read_checkpoint(checkpoint, header);  // refused before any work
@@ -166,7 +168,12 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
   } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound, a resume that does not fit
     throw InputError(checkpoint.resume ? checkpoint.path.string() : c.path, checkpoint.resume ? "" : "/dem", e.what());
   }
-  if (out.dem.stopped) throw strict_json::Interrupted(hooks.stop_requested(), resume_advice(checkpoint, header));
+  if (out.dem.stopped)
+    throw strict_json::Interrupted(hooks.stop_requested(),
+                                   wrote_checkpoint || checkpoint.resume
+                                       ? resume_advice(checkpoint, header)
+                                       : "the run stopped while its bed settled, before its first checkpoint: run the "
+                                         "same command again");
   if (out.dem.summary.outcome == dem_reference::Outcome::kUnstable)
     throw strict_json::NumericalError("DEM unstable: " + case_key_names(out.dem.summary.message));
   if (out.dem.summary.outcome != dem_reference::Outcome::kCompleted)  // a step threw (on any thread)

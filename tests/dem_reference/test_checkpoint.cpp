@@ -232,21 +232,32 @@ TEST_CASE("a harmonic run stopped at checkpoints and resumed equals the uninterr
     written_at = t;
     ++checkpoints;
   };
-  // The first run stops at its first checkpoint (the transient's first period end; none is
-  // written at the transient's end), the second at its second (the analysis' second period
-  // end, after one at its first), the third runs to the end (none at the run's end).
-  int stops_left = 1;
-  hook.stop = [&] { return --stops_left == 0; };
+  // stop() is a state (a signal arrived), polled after each write and every
+  // kStopPollSteps steps. The first run stops at its first checkpoint (the transient's first
+  // period end). The second, with no periodic checkpoint due, is asked to stop at its
+  // poll that falls 2.5 periods on: it writes its state there, mid-period in the analysis
+  // (the drive bins and a block in progress). The third runs to the end (one checkpoint at
+  // the period end after 3.5 periods, none at the run's end).
+  hook.stop = [&] { return checkpoints == 1; };
   const dr::DamperResult first = dr::run_harmonic(o, {}, &hook);
   CHECK(first.stopped);
   CHECK(written_at == Approx(1.0 / o.frequency_hz).epsilon(1e-9));
   hook.resume_state = state;
-  stops_left = 2;
+  hook.due = [] { return false; };
+  const std::int64_t period = whole.steps_per_period;
+  const std::int64_t stop_poll = (5 * period / 2) / dr::kStopPollSteps;
+  std::int64_t polls = 0;
+  hook.stop = [&] { return ++polls == stop_poll; };
   const dr::DamperResult second = dr::run_harmonic(o, {}, &hook);
   CHECK(second.stopped);
-  CHECK(written_at == Approx(4.0 / o.frequency_hz).epsilon(1e-9));  // in the analysis
+  CHECK(checkpoints == 2);
+  const double periods_at_stop = written_at * o.frequency_hz;
+  CHECK(periods_at_stop > 3.0);  // in the analysis
+  CHECK(periods_at_stop < 4.0);
+  CHECK(std::abs(periods_at_stop - std::round(periods_at_stop)) > 1e-3);  // not at a period end
   hook.resume_state = state;
-  stops_left = 1000;
+  hook.due = [] { return true; };
+  hook.stop = [] { return false; };
   const dr::DamperResult last = dr::run_harmonic(o, {}, &hook);
   REQUIRE_FALSE(last.stopped);
   REQUIRE(last.summary.outcome == dr::Outcome::kCompleted);
@@ -263,6 +274,15 @@ TEST_CASE("a harmonic run stopped at checkpoints and resumed equals the uninterr
   REQUIRE(last.snapshots.size() == whole.snapshots.size());
   CHECK(last.snapshots.back().positions_m == whole.snapshots.back().positions_m);
   CHECK(checkpoints == 3);
+
+  // Asked to stop while the bed settles: the run ends at once, without a checkpoint.
+  hook.resume_state.clear();
+  hook.stop = [] { return true; };
+  const dr::DamperResult settling = dr::run_harmonic(o, {}, &hook);
+  CHECK(settling.stopped);
+  CHECK(checkpoints == 3);
+  CHECK(settling.summary.steps == dr::kStopPollSteps);  // at the first poll
+  CHECK_THAT(settling.summary.message, Catch::Contains("no checkpoint"));
 
   // A state of other options is refused naming the field.
   dr::DamperSimulationOptions other = o;

@@ -87,7 +87,8 @@ void check_same_history(const CosimulationHistory& a, const CosimulationHistory&
 }  // namespace
 
 // Reference: one cosimulate() call of a 0.3 s decay with real impacts, on two modes. The run
-// advanced in segments of 1, 777 and 4321 steps (none a whole number of sample intervals),
+// advanced in segments of 1, 777 and 4321 steps (none a whole number of sample intervals)
+// and one ended by a stop request after 48,
 // saved, the object destroyed, restored from the bytes into new worlds and advanced by 0, 3,
 // 10007 steps and then beyond its end must give the same bits: history, final modes and
 // particles, the energy ledger of the result and of the state, the counters. A segment
@@ -114,6 +115,10 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
       CHECK(run.advance(steps) == steps);
       done += steps;
     }
+    // A stop request ends a long segment at the next poll, a step boundary like any other.
+    int polls = 0;
+    CHECK(run.advance(1000000, [&] { return ++polls == 3; }) == 3 * Cosimulation::kStopPollSteps);
+    done += 3 * Cosimulation::kStopPollSteps;
     CHECK(run.steps_done() == done);
     CHECK(!run.finished());
     CHECK(run.result().steps == done);
@@ -276,4 +281,21 @@ TEST_CASE("the sampled bed force is the mean over its sample interval, so impact
     largest_difference = std::max(largest_difference, std::abs(mean - at_sample));
   }
   CHECK(largest_difference > 1e-3);
+}
+
+// The beds settle before any checkpoint can hold them; a big bed settles for hours. The
+// progress callback hears from the settling about every progress_interval_s, and an exception
+// it throws (a stop request) ends the construction there: here at the first report after the
+// one that opens the settling, kStopPollSteps steps in.
+TEST_CASE("the settling reports its progress, and a callback that throws ends it at once", "[cosimulation]") {
+  CosimulationOptions options = decay(0.3);
+  options.progress_interval_s = 1e-9;  // every poll
+  struct Stop {};
+  int settling_reports = 0;
+  const auto progress = [&](const CosimulationProgress& p) {
+    if (p.stage != "settling") return;
+    if (++settling_reports == 2) throw Stop{};
+  };
+  CHECK_THROWS_AS(Cosimulation(two_modes(), impacting_bed(), options, progress), Stop);
+  CHECK(settling_reports == 2);
 }

@@ -157,6 +157,12 @@ namespace {
 struct StopAtOnce : tasks::RunHooks {
   int stop_requested() override { return SIGINT; }
 };
+/// Hooks that ask the run to stop once its first checkpoint is due (a signal in the transient).
+struct StopAtFirstCheckpoint : tasks::RunHooks {
+  bool asked = false;
+  bool checkpoint_due(double) override { return asked = true; }
+  int stop_requested() override { return asked ? SIGINT : 0; }
+};
 /// Hooks that save a checkpoint at every chance and never stop.
 struct SaveAlways : tasks::RunHooks {
   bool checkpoint_due(double) override { return true; }
@@ -164,8 +170,8 @@ struct SaveAlways : tasks::RunHooks {
 
 }  // namespace
 
-// Reference: the uninterrupted run of the same plan. A run asked to stop saves its state and
-// throws Interrupted; resumed from that state it gives the uninterrupted result to the bit
+// Reference: the uninterrupted run of the same plan. A run asked to stop in its transient saves
+// its state and throws Interrupted; resumed from that state it gives the uninterrupted result to the bit
 // (the DEM is deterministic for a thread count).
 TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted run", "[tasks]") {
   const auto& c = low_intensity();
@@ -176,7 +182,11 @@ TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted r
   const auto reference = tasks::run_dem(c, plan, {}, tasks::silent_hooks());
   const test::TempDir dir("tasks_dem_checkpoint");
   const tasks::CheckpointFile file{dir.path / "dem.checkpoint", false};
-  StopAtOnce stop;
+  // Asked to stop while the bed settles: it stops at once, with no checkpoint to resume.
+  StopAtOnce at_once;
+  CHECK_THROWS_WITH(tasks::run_dem(c, plan, file, at_once), Catch::Contains("before its first checkpoint"));
+  CHECK_FALSE(std::filesystem::exists(file.path));
+  StopAtFirstCheckpoint stop;
   CHECK_THROWS_AS(tasks::run_dem(c, plan, file, stop), strict_json::Interrupted);
   REQUIRE(std::filesystem::exists(file.path));
   SaveAlways save;

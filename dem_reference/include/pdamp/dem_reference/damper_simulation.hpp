@@ -117,10 +117,14 @@ struct DamperResult {
 /// Checkpoints of a harmonic run (docs/dem.md "Checkpoints"). At the end of
 /// every drive period of the transient and the analysis the run asks `due()`; when it says
 /// so, the run passes its whole state to `write` (the World, the step, the motion-mode sums
-/// and, once analysing, the drive bin, the energy ledger's opening and the recorded series
-/// and snapshots) and then asks `stop()`: true ends the run there (DamperResult::stopped).
-/// With `resume_state` (bytes an earlier run of the same options wrote) the run starts
-/// there instead of settling: its result is bit for bit the uninterrupted run's.
+/// and, once analysing, the drive bins, the energy ledger's opening and the recorded series,
+/// block in progress and snapshots) and then asks `stop()`: true ends the run there
+/// (DamperResult::stopped). `stop()` is also asked every kStopPollSteps steps: true writes
+/// the state at that step and ends the run (a period of a big bed can take an hour), or,
+/// while the bed still settles or approaches (phases no checkpoint holds), ends it without
+/// a write. With `resume_state` (bytes an earlier run of the same options wrote) the run
+/// starts there instead of settling: its result is bit for bit the uninterrupted run's.
+inline constexpr std::int64_t kStopPollSteps = 16;
 struct HarmonicCheckpoints {
   std::function<bool()> due;
   std::function<bool()> stop;

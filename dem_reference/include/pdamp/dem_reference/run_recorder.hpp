@@ -70,9 +70,9 @@ class BlockRecorder {
   const TimeSeries& series() const { return series_; }
   /// Drive times of the block ends, where the bed's instantaneous samples are taken, s.
   const std::vector<double>& sample_times_s() const { return sample_times_s_; }
-  /// Checkpoints at a block's end (checkpoint.hpp): the step, the series and the snapshots
-  /// so far. restore throws std::invalid_argument for a state of another recorder (more
-  /// blocks or snapshots than its options hold, a block in progress, non-finite values).
+  /// Checkpoints at any step (checkpoint.hpp): the step, the block in progress, the series
+  /// and the snapshots so far. restore throws std::invalid_argument for a state of another
+  /// recorder (more blocks or snapshots than its options hold, non-finite values).
   void save(StateWriter& out) const;
   void restore(StateReader& in);
   /// Moves the series and the snapshots out (the recorder is spent afterwards).

@@ -83,16 +83,18 @@ class DriveBinAccumulator {
   void merge(const DriveBinAccumulator& other);
   void clear();
   std::int64_t samples() const { return samples_; }
-  /// The sums so far (a checkpoint of a run between periods): the step phase is not in
-  /// them, so restore_sums continues exactly only when the next add() starts a new run of
-  /// steps (after clear(), or on an accumulator only merged into).
+  /// The accumulator's whole state (a checkpoint of a run at any step): the sums and the
+  /// rotated step phase, so restore_sums continues to the bit wherever they were taken.
   struct Sums {
     std::complex<double> force{0.0, 0.0};
     std::complex<double> velocity{0.0, 0.0};
     double max_abs_velocity = 0.0;
     std::int64_t samples = 0;
+    std::complex<double> phase{1.0, 0.0};  ///< e^{−2πi k/M} of the next step, as rotated
+    std::int64_t next_step = 0;
+    bool started = false;                  ///< false: the next add() takes its phase from its step index
   };
-  Sums sums() const { return {force_sum_, velocity_sum_, max_abs_velocity_, samples_}; }
+  Sums sums() const { return {force_sum_, velocity_sum_, max_abs_velocity_, samples_, phase_, next_step_, started_}; }
   void restore_sums(const Sums& sums);
   /// The measures at frequency_hz from the sums so far. Throws std::invalid_argument
   /// unless the samples are a positive whole number of periods, are finite, and the

@@ -272,6 +272,8 @@ struct CosimulationProgress {
   double end_time_s = 0.0;         ///< planned end (harmonic: with all transient periods)
   double steps_per_s = 0.0;
 };
+/// Called about every progress_interval_s of wall time, settling included; an exception it
+/// throws ends the run there (a stop request while the beds settle, before any checkpoint).
 using CosimulationProgressCallback = std::function<void(const CosimulationProgress&)>;
 
 /// The end of a co-simulation run, to be continued by the next (a stepped sine: each

@@ -50,6 +50,13 @@ class Cosimulation {
   /// Runs min(steps, total_steps() − steps_done()) further coupled steps (fewer when a World
   /// stops: result().outcome says why) and returns how many it ran. steps <= 0 runs none.
   std::int64_t advance(std::int64_t steps);
+  /// The same, ending early once `stop` returns true: it is asked every kStopPollSteps
+  /// steps (a relaxed flag read costs nothing; a step of a million-sphere bed is tens of
+  /// milliseconds, so a stop request is met within about a second), and the run then
+  /// stands at a step boundary where save() may follow and a restored run continues it to
+  /// the bit.
+  std::int64_t advance(std::int64_t steps, const std::function<bool()>& stop);
+  static constexpr std::int64_t kStopPollSteps = 16;
   /// The run is at its end, or a World stopped.
   bool finished() const;
   /// Coupled steps of this run so far (a restored run counts its steps before the checkpoint).
