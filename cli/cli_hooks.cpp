@@ -12,8 +12,10 @@
 
 namespace pdamp::cli {
 
-CliHooks::CliHooks(double checkpoint_interval_s)
-    : checkpoint_interval_s_(checkpoint_interval_s), tty_(::isatty(STDERR_FILENO) == 1) {}
+CliHooks::CliHooks(double checkpoint_interval_s, bool accept_long_runs)
+    : checkpoint_interval_s_(checkpoint_interval_s),
+      accept_long_runs_(accept_long_runs),
+      tty_(::isatty(STDERR_FILENO) == 1) {}
 
 CliHooks::~CliHooks() {
   if (line_open_) std::cerr << "\n";

@@ -13,8 +13,9 @@ namespace pdamp::cli {
 
 class CliHooks : public tasks::RunHooks {
  public:
-  /// `checkpoint_interval_s`: wall-clock seconds between checkpoints (0: at every chance).
-  explicit CliHooks(double checkpoint_interval_s = 60.0);
+  /// `checkpoint_interval_s`: wall-clock seconds between checkpoints (0: at every chance);
+  /// `accept_long_runs`: --accept-long-run (a DEM run estimated beyond a week may start).
+  explicit CliHooks(double checkpoint_interval_s = 60.0, bool accept_long_runs = false);
   ~CliHooks() override;
   /// One line per report: rewritten in place on a terminal, else at most one line every
   /// 10 s per run (the first and the last of a run always). A run that gives no ETA gets
@@ -24,10 +25,12 @@ class CliHooks : public tasks::RunHooks {
   bool checkpoint_due(double seconds_since_checkpoint) override;
   /// The signal (SIGINT, SIGTERM, SIGHUP) that arrived while a run defers signals, or 0.
   int stop_requested() override;
+  bool long_runs_accepted() override { return accept_long_runs_; }
 
  private:
   std::mutex mutex_;
   double checkpoint_interval_s_;
+  bool accept_long_runs_;
   bool tty_;
   bool line_open_ = false;  // a terminal line being rewritten
   std::map<std::string, std::chrono::steady_clock::time_point> last_line_;

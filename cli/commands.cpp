@@ -231,7 +231,7 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
   // Checkpoints in the -o folder at period ends (docs/dem.md "Checkpoints"): every
   // --checkpoint-interval seconds and when a signal arrives (then pdamp ends by it).
   const tasks::CheckpointFile checkpoint = checkpoint_file(args, "dem");
-  CliHooks hooks(checkpoint_interval(args));
+  CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
   // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
   const std::optional<report::DeferredSignals> deferred =
       checkpoint.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
@@ -516,7 +516,8 @@ int run_sensitivity_merge(const ParsedArgs& args, CommandContext&) {
 /// Every check that run, dem and field make on a case, without the work.
 int run_validate(const ParsedArgs& args, CommandContext&) {
   const Case c = case_file::load_case(args.positional().at(0));
-  tasks::check_case(c);
+  CliHooks hooks;
+  tasks::check_case(c, hooks);
   std::cout << c.resolved.dump(2) << "\n";
   return kExitOk;
 }

@@ -40,12 +40,17 @@ const std::vector<FlagSpec> kDemSweepFlags{
     {"--dem-sweep-rate", "HZ/S", "--dem-signal linear: the sweep's rate, Hz/s, > 0 (default: 4 pi zeta^2 f^2 / 100\n"
                                  "                          at the formulas' resonance: quasi-stationary)"}};
 
+const FlagSpec kAcceptLongRunFlag{"--accept-long-run", "",
+                                  "start a DEM run whose estimated wall time is beyond a week (refused\n"
+                                  "                          otherwise, naming the keys that shorten it)"};
+
 const std::vector<FlagSpec> kCheckpointFlags{
     {"--resume", "", "continue the DEM run from its checkpoint in the -o folder (left by a run that\n"
                      "                          was interrupted or killed; same case, settings and thread count)"},
     {"--checkpoint-interval", "S", "wall-clock seconds between checkpoints of a DEM run in the -o folder,\n"
                                    "                          >= 0 (default 60; 0: after every segment of about 2 s); one is\n"
-                                   "                          also written when SIGINT, SIGTERM or SIGHUP arrives"}};
+                                   "                          also written when SIGINT, SIGTERM or SIGHUP arrives"},
+    kAcceptLongRunFlag};
 
 const FlagSpec kNoVerifyFlag{"--no-verify", "",
                              "skip the DEM verification the task's verify block asks for (the optimisation only)"};

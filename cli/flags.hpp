@@ -19,9 +19,12 @@ extern const FlagSpec kMethodFlag;
 /// The stepped sine's and the linear sweep's flags of pdamp frf --method dem; pdamp run
 /// accepts them on an frf task.
 extern const std::vector<FlagSpec> kDemSweepFlags;
-/// `--resume` and `--checkpoint-interval` (pdamp dem, decay --method dem, optimize --verify, run).
+/// The flags of long DEM runs: `--resume`, `--checkpoint-interval` and `--accept-long-run`
+/// (pdamp dem, decay --method dem, optimize --verify, run).
 extern const std::vector<FlagSpec> kCheckpointFlags;
 extern const FlagSpec kNoVerifyFlag;
+/// --accept-long-run: a DEM run estimated beyond tasks::kMaxDemWallTime_s may start.
+extern const FlagSpec kAcceptLongRunFlag;
 /// --calibration-cache DIR (pdamp optimize and pdamp run on a filling_ratios task).
 extern const FlagSpec kCalibrationCacheFlag;
 

@@ -115,7 +115,7 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
     if (!folder.path.empty()) options.checkpoint_dir = folder.path.parent_path();
     options.resume = folder.resume;
   }
-  CliHooks hooks(checkpoint_interval(args));
+  CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
   // Signals wait for a checkpoint during the runs, then for the commit (dem_results_ready).
   const std::optional<report::DeferredSignals> deferred =
       options.checkpoint_dir.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();

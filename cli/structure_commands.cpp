@@ -238,7 +238,7 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
   }
   auto files = output_dir(args, context);
   if (options.method == tasks::DecayMethod::kDem) options.checkpoint.file = checkpoint_file(args, "decay_dem");
-  CliHooks hooks(checkpoint_interval(args));
+  CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
   // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
   const std::optional<report::DeferredSignals> deferred =
       options.checkpoint.file.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();

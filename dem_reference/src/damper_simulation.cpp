@@ -209,8 +209,8 @@ std::vector<std::string> DamperSimulationOptions::validate(const std::string& pr
 namespace {
 
 /// Bytes of the world's arrays right after construction (World::Impl's reserves).
-void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
-  const auto n = static_cast<std::size_t>(plan.particles);
+void estimate_world_bytes(const WorldOptions& world, int particles, RunEstimate& e) {
+  const auto n = static_cast<std::size_t>(particles);
   // 23 double arrays (state, forces, radii, masses, rebuild positions, scratch) and 5 int
   // arrays (material, compartment, order, index_of, scratch) per particle.
   e.particle_bytes = n * (23 * sizeof(double) + 5 * sizeof(int));
@@ -221,7 +221,7 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
   // The cell grid: at most max(64, 8n) cells (CellGrid::configure), 3 ints per particle.
   double r_max = 0.0;
   std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (const auto& c : plan.step.world.compartments) {
+  for (const auto& c : world.compartments) {
     for (const auto& g : c.particles) r_max = std::max(r_max, g.radius_m * (1.0 + g.radius_spread));
     for (int a = 0; a < 3; ++a) {
       const auto k = static_cast<std::size_t>(a);
@@ -229,7 +229,7 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
       hi[k] = std::max(hi[k], c.offset_m[k] + 0.5 * c.container.inner_length(a));
     }
   }
-  const double cell = (2.0 + plan.step.world.integration.skin_fraction) * r_max;
+  const double cell = (2.0 + world.integration.skin_fraction) * r_max;
   double cells = 1.0;
   for (std::size_t a = 0; a < 3; ++a) cells *= std::max(1.0, std::ceil((hi[a] - lo[a]) / cell));
   cells = std::min(cells, std::max(64.0, 8.0 * static_cast<double>(n)));
@@ -237,8 +237,8 @@ void estimate_world_bytes(const RunPlan& plan, RunEstimate& e) {
   e.neighbour_bytes = offsets + slots + grid;
   // Contact pools as reserved: 2 pair contacts and n/2 + 16 wall contacts per particle,
   // each a Contact and a key (and a rolling torque with rolling resistance).
-  bool rolling = plan.step.world.default_pair.rolling_friction > 0.0;
-  for (const auto& p : plan.step.world.pairs) rolling = rolling || p.rolling_friction > 0.0;
+  bool rolling = world.default_pair.rolling_friction > 0.0;
+  for (const auto& p : world.pairs) rolling = rolling || p.rolling_friction > 0.0;
   const std::size_t entry = sizeof(detail::Contact) + sizeof(detail::ContactKey) + (rolling ? 3 * sizeof(double) : 0);
   e.contact_bytes = (2 * n + n / 2 + 16) * entry;
 }
@@ -270,7 +270,7 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   e.particle_steps = static_cast<double>(plan.total_steps) * plan.particles;
   e.recorded_samples = static_cast<std::int64_t>(options.analysed_periods) * options.samples_per_period;
   e.snapshots = options.snapshots;
-  estimate_world_bytes(plan, e);
+  estimate_world_bytes(plan.step.world, plan.particles, e);
   // Per sample: the 7 TimeSeries columns and the block-end times of BlockRecorder, and
   // the centred copy of x_r the motion indicators take at the end; η* per period.
   e.signal_bytes = static_cast<std::size_t>(e.recorded_samples) * 9 * sizeof(double) +
@@ -282,6 +282,17 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
   e.particle_steps_per_s = assumed_rate(plan.particles, options.world.threads);
   e.wall_time_s = e.particle_steps / e.particle_steps_per_s;
   return e;
+}
+
+WorldEstimate estimate_world(const WorldOptions& world) {
+  WorldEstimate w;
+  for (const auto& c : world.compartments)
+    for (const auto& g : c.particles) w.particles += g.count;
+  RunEstimate e;
+  estimate_world_bytes(world, w.particles, e);
+  w.memory_bytes = e.particle_bytes + e.neighbour_bytes + e.contact_bytes;
+  w.particle_steps_per_s = assumed_rate(w.particles, world.threads);
+  return w;
 }
 
 void check_initial_placement(const DamperSimulationOptions& options) {

@@ -3,12 +3,14 @@
 
 #include "pdamp/strict_json/input_error.hpp"
 #include "pdamp/tasks/damper_design.hpp"
+#include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/dem_run.hpp"
 #include "pdamp/tasks/field.hpp"
+#include "structure_support.hpp"
 
 namespace pdamp::tasks {
 
-void check_case(const case_file::Case& c) {
+void check_case(const case_file::Case& c, RunHooks& hooks) {
   if (c.task.kind == case_file::TaskKind::kDamperDesign) (void)run_damper_design(c);
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
   for (std::size_t i = 0; i < c.dampers.size(); ++i) {
@@ -17,6 +19,15 @@ void check_case(const case_file::Case& c) {
     // check_dem_field places the bed as every DEM run of the case would.
     (void)check_dem_field(c, i, grid, nullptr, c.field.threads);
   }
+  if (!c.structure) return;
+  const detail::Setup setup = detail::make_setup(c, case_file::LossMethod::kFormulas);
+  if (c.task.kind != case_file::TaskKind::kDecay || !c.task.decay) return;
+  const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
+  if (!(q0.cwiseAbs().maxCoeff() > 0.0))
+    throw strict_json::InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+  const auto options = dem_decay_options(c, setup.s.modal, q0, c.task.decay->duration_s);
+  hooks.note("pdamp validate: the DEM-in-the-loop decay (pdamp decay --method dem): " +
+             estimate_text(estimate_coupled_decay(c, setup.s.modal, detail::dem_dampers(c), options)));
 }
 
 void require_task(const case_file::Case& c, case_file::TaskKind kind) {

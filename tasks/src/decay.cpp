@@ -2,11 +2,13 @@
 #include "pdamp/tasks/decay.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <optional>
 #include <sstream>
 
 #include "pdamp/dem_reference/checkpoint.hpp"
+#include "pdamp/dem_reference/drive_time_step.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
@@ -15,6 +17,7 @@
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/tasks/case_checks.hpp"
+#include "pdamp/tasks/dem_run.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -92,7 +95,7 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
 st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& modal,
                                           const std::vector<st::CosimulationDamper>& dampers,
                                           const st::CosimulationOptions& options, const std::string& label,
-                                          const DemDecayCheckpoint& cp, RunHooks& hooks) {
+                                          const std::string& estimate, const DemDecayCheckpoint& cp, RunHooks& hooks) {
   detail::check_cosimulation(c, modal, dampers, options);
   const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
   const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(options.sample_interval_s / dt));
@@ -127,9 +130,11 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
     if (done <= 0 || done > total || run->total_steps() != total)
       throw InputError(cp.file.path.string(), "", "its step count " + std::to_string(done) + " does not fit this run's " +
                                                       std::to_string(total) + " steps");
+    hooks.note(estimate);
     hooks.note(label + ": resuming at t = " + format_number(static_cast<double>(done) * dt, 6) + " s of " +
                format_number(header.end_time_s, 6) + " s from " + shown);
   } else {
+    hooks.note(estimate);
     if (std::filesystem::exists(cp.file.path))
       hooks.note("pdamp: warning: " + shown + " of an earlier run is replaced (--resume continues it)");
     run.emplace(detail::call_dem(c, [&] { return st::Cosimulation(modal, dampers, options, report); }));
@@ -230,6 +235,66 @@ void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& 
 
 }  // namespace
 
+st::CosimulationOptions dem_decay_options(const Case& c, const st::ModalModel& modal, const Eigen::VectorXd& q0,
+                                          double duration_s) {
+  st::CosimulationOptions options;
+  options.excitation.kind = st::CosimulationExcitationKind::kFreeDecay;
+  options.initial_modal_displacements = q0;
+  options.initial_modal_velocities = Eigen::VectorXd::Zero(q0.size());
+  options.duration_s = duration_s;
+  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
+  options.sample_interval_s = duration_s / decay_samples(modal, duration_s);
+  return options;
+}
+
+CoupledDecayEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& modal,
+                                            const std::vector<st::CosimulationDamper>& dampers,
+                                            const st::CosimulationOptions& options) {
+  detail::check_cosimulation(c, modal, dampers, options);
+  CoupledDecayEstimate e;
+  e.beds = dampers.size();
+  e.time_step_s = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
+  double settling_s = 0.0;
+  for (const auto& d : dampers)
+    settling_s = std::max(settling_s, options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
+                                                                         : dem_reference::automatic_settling_time_s(d.world));
+  e.steps = std::llround((options.duration_s + settling_s) / e.time_step_s);
+  for (const auto& d : dampers) {
+    const dem_reference::WorldEstimate w = dem_reference::estimate_world(d.world);
+    e.particles += w.particles;
+    e.memory_bytes += static_cast<double>(w.memory_bytes);
+    e.wall_time_s += static_cast<double>(w.particles) * static_cast<double>(e.steps) / w.particle_steps_per_s;
+  }
+  e.particle_steps = static_cast<double>(e.particles) * static_cast<double>(e.steps);
+  // The sampled history: time, q and per bed its site's displacement, rotation, force and moment.
+  const double samples = options.duration_s / options.sample_interval_s + 1.0;
+  e.memory_bytes += samples * static_cast<double>(1 + modal.mode_count() + 4 * static_cast<Eigen::Index>(dampers.size())) *
+                    sizeof(double);
+  return e;
+}
+
+CoupledDecayEstimate check_coupled_decay(const Case& c, const st::ModalModel& modal,
+                                         const std::vector<st::CosimulationDamper>& dampers,
+                                         const st::CosimulationOptions& options, const std::string& label,
+                                         const std::string& duration_pointer, RunHooks& hooks) {
+  const CoupledDecayEstimate e = estimate_coupled_decay(c, modal, dampers, options);
+  if (const double available = available_memory_bytes(); e.memory_bytes > available)
+    throw InputError(c.path, "/dem",
+                     label + " needs about " + megabytes(e.memory_bytes) + " (" + std::to_string(e.particles) +
+                         " particles in " + std::to_string(e.beds) + " beds), more than the " + megabytes(available) +
+                         " available: fewer particles (/dampers/*/layers/*/particles/count)");
+  check_wall_time(c, e.wall_time_s, label, duration_pointer,
+                  "a shorter " + duration_pointer + ", softer contacts (/dem/stiffness_softening) or fewer particles", hooks);
+  return e;
+}
+
+std::string estimate_text(const CoupledDecayEstimate& e) {
+  return std::to_string(e.particles) + " particles in " + std::to_string(e.beds) + (e.beds == 1 ? " bed, " : " beds, ") +
+         std::to_string(e.steps) + " coupled steps of " + format_number(e.time_step_s, 3) + " s = " +
+         format_number(e.particle_steps, 3) + " particle-steps, about " + format_number(e.wall_time_s, 2) +
+         " s; memory about " + megabytes(e.memory_bytes);
+}
+
 DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
                    const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
@@ -246,16 +311,17 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   Eigen::Index dominant = 0;
   weights.cwiseProduct(q0.cwiseAbs()).maxCoeff(&dominant);
 
-  st::CosimulationOptions options;
-  options.excitation.kind = st::CosimulationExcitationKind::kFreeDecay;
-  options.initial_modal_displacements = q0;
-  options.initial_modal_velocities = Eigen::VectorXd::Zero(q0.size());
-  options.duration_s = task.duration_s;
-  options.bed_settling_time_s = c.dem.simulation.settling_time_s;
-  options.sample_interval_s = task.duration_s / decay_samples(modal, task.duration_s);
+  const st::CosimulationOptions options = dem_decay_options(c, modal, q0, task.duration_s);
+  // Refused here when it cannot fit; said once a resume's checkpoint is accepted.
+  const std::string estimate = label + ": " + estimate_text(check_coupled_decay(c, modal, dampers, options, label,
+                                                                                duration_pointer, hooks));
   DemDecay out;
-  out.cosimulation = checkpoint.file.path.empty() ? cosimulate_case(c, modal, dampers, options, label, hooks)
-                                                  : checkpointed_decay(c, modal, dampers, options, label, checkpoint, hooks);
+  if (checkpoint.file.path.empty()) {
+    hooks.note(estimate);
+    out.cosimulation = cosimulate_case(c, modal, dampers, options, label, hooks);
+  } else {
+    out.cosimulation = checkpointed_decay(c, modal, dampers, options, label, estimate, checkpoint, hooks);
+  }
   const auto& r = out.cosimulation;
   out.warnings = r.warnings;
 

@@ -82,6 +82,15 @@ std::string case_key_names(const std::string& advice) {
   return std::regex_replace(advice, kOption, "/dem/$1");
 }
 
+void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
+                     const std::string& reduce, RunHooks& hooks) {
+  if (!(wall_time_s > kMaxDemWallTime_s) || hooks.long_runs_accepted()) return;
+  throw InputError(c.path, pointer,
+                   what + " is estimated at about " + format_number(wall_time_s / 86400.0, 3) +
+                       " days of wall time, more than the limit of " + format_number(kMaxDemWallTime_s / 86400.0, 3) +
+                       " days: " + reduce + ", or pass --accept-long-run to start it anyway");
+}
+
 std::string estimate_text(const dem_reference::RunEstimate& e) {
   return std::to_string(e.particles) + " particles, " + std::to_string(e.total_steps) + " steps of " +
          format_number(e.time_step_s, 3) + " s = " + format_number(e.particle_steps, 3) + " particle-steps, about " +
@@ -140,6 +149,9 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
     last_checkpoint = std::chrono::steady_clock::now();
   };
   if (checkpoint.resume) saving.resume_state = read_checkpoint(checkpoint, header);  // refused before any work
+  check_wall_time(c, plan.estimate.wall_time_s, plan.label, "/dem",
+                  "fewer /dem/analysed_periods or /dem/transient_periods, a larger /dem/time_step_s, or fewer particles",
+                  hooks);
   hooks.note(plan.label + ": " + estimate_text(plan.estimate));
   if (checkpoint.resume) {
     hooks.note(plan.label + ": resuming from " + strict_json::printable(checkpoint.path.string()));

@@ -10,6 +10,7 @@
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
 #include "pdamp/tasks/decay.hpp"
+#include "pdamp/tasks/dem_run.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -134,6 +135,32 @@ VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioPro
   return verified_decay(dem_decay(dc, modes.modal, containers, detail::dem_dampers(dc), modes.initial_modal_displacements,
                                   decay, "pdamp optimize --verify (" + label + ")", "/task/verify/duration_s", checkpoint,
                                   hooks));
+}
+
+/// The cost of `decays` DEM decays over `duration_s` at each of `softenings`, each like one
+/// of the case's own design (its layers' initial slabs; the mass budget keeps the designs
+/// tried of about this size), `parallel` at a time: noted and checked (memory,
+/// kMaxDemWallTime_s for the whole) before any work. Each decay is checked again as it starts.
+void check_design_decays_cost(const Case& c, const case_file::FillingRatioProblem& p, double duration_s,
+                              const std::vector<double>& softenings, std::size_t decays, int parallel,
+                              const std::string& label, const std::string& duration_pointer, RunHooks& hooks) {
+  std::vector<long> slabs;
+  for (const auto& layer : p.options.layers) slabs.push_back(layer.initial_slabs);
+  const detail::DesignModes modes = detail::design_modes(c, p, slabs);
+  double wall_s = 0.0;
+  std::string each;
+  for (const double softening : softenings) {
+    const Case dc = case_file::with_design(c, slabs, softening);
+    const auto options = dem_decay_options(dc, modes.modal, modes.initial_modal_displacements, duration_s);
+    const CoupledDecayEstimate e = check_coupled_decay(dc, modes.modal, detail::dem_dampers(dc), options, label,
+                                                       duration_pointer, hooks);
+    wall_s += static_cast<double>(decays) * e.wall_time_s / std::max(parallel, 1);
+    each += (each.empty() ? "" : "; at softening " + format_number(softening, 3) + ": ") + estimate_text(e);
+  }
+  check_wall_time(c, wall_s, label, duration_pointer,
+                  "a shorter " + duration_pointer + ", softer contacts or fewer layers and slabs", hooks);
+  hooks.note(label + ": " + std::to_string(decays * softenings.size()) + " DEM decays, each about one of the case's "
+             "own design (" + each + "); about " + format_number(wall_s, 2) + " s in all");
 }
 
 /// How `objective` (with `end_envelope_m`) agrees with a reference: the objectives when both
@@ -446,6 +473,20 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   // same beds to choose the same design) and the design loop's later rounds run on each
   // process's own threads.
   Executor& own_threads = executor.processes() > 1 ? static_cast<Executor&>(local_executor()) : executor;
+  // The DEM verification: the task's verify block, or --verify with its defaults.
+  std::optional<case_file::VerifySpec> verify = task.verify;
+  if (!verify && o.force_verify) {
+    verify = case_file::VerifySpec{};
+    verify->duration_s = task.decay.duration_s;
+  }
+  if (o.skip_verify) verify.reset();
+  if (verify) {  // the first round: the chosen and the baseline design, at one or two softenings
+    std::vector<double> softenings = {verify->stiffness_softening};
+    if (verify->softening_check && c.dem.stiffness_softening * verify->stiffness_softening < 1.0)
+      softenings.push_back(std::min(10.0 * verify->stiffness_softening, 1.0 / c.dem.stiffness_softening));
+    check_design_decays_cost(c, out.problem, verify->duration_s, softenings, 2, executor.concurrency(2),
+                             "pdamp optimize --verify", "/task/verify/duration_s", hooks);
+  }
   if (o.calibrated.value_or(task.calibration.has_value())) {
     case_file::CalibrationSpec spec;
     if (task.calibration) {
@@ -454,6 +495,11 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
       spec.duration_s = task.verify ? task.verify->duration_s : task.decay.duration_s;
       spec.stiffness_softening = task.verify ? task.verify->stiffness_softening : 1.0;
     }
+    std::size_t beds = 0;  // every candidate bed, before the cache is read
+    for (const auto& layer : out.problem.options.layers) beds += static_cast<std::size_t>(std::max(layer.max_slabs(), 0));
+    check_design_decays_cost(c, out.problem, spec.duration_s, {spec.stiffness_softening}, beds, own_threads.concurrency(2),
+                             "the bed calibration", task.calibration ? "/task/calibration/duration_s" : "/task/verify/duration_s",
+                             hooks);
     out.calibration = calibrate_beds(c, out.problem, spec,
                                      o.calibration_cache.empty() ? default_calibration_cache() : o.calibration_cache,
                                      hooks, own_threads);
@@ -476,13 +522,6 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   };
   optimise();
 
-  // The DEM verification: the task's verify block, or --verify with its defaults.
-  std::optional<case_file::VerifySpec> verify = task.verify;
-  if (!verify && o.force_verify) {
-    verify = case_file::VerifySpec{};
-    verify->duration_s = task.decay.duration_s;
-  }
-  if (o.skip_verify) verify.reset();
   if (verify) {
     // The design loop: on calibrated beds a failed round recalibrates the chosen design's
     // beds where it operates, optimises and verifies again (docs/optimizer.md).

@@ -742,3 +742,48 @@ TEST_CASE("a write that fails (a file-size limit, a full disk) keeps the folder'
   args.back() = small.point.string();
   require_earlier_set_kept(run_pdamp(args), small.point, before);
 }
+
+// A DEM-in-the-loop run whose estimate is beyond a week (kMaxDemWallTime_s) does not start
+// unless the user accepts it; validate reports the cost. The link decay with 2016 spheres
+// over 1e5 s: about 160 days at the benchmark rate (before, it started and ran for months).
+// The verification of a filling_ratios task at full stiffness over 1e5 s: about 16 days,
+// refused before the optimisation.
+TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless --accept-long-run", "[cli]") {
+  TempDir tmp("long_runs");
+  const fs::path big = tmp.path / "big_bed_decay.json";
+  {
+    json c = json::parse(slurp(case_path("manipulator_link_decay.json")));
+    c["task"]["duration_s"] = 1e5;
+    json& layer = c["dampers"][0]["layers"][0];
+    layer["container"]["inner_size_m"] = {0.5, 1.01, 0.012};
+    layer["particles"]["count"] = 2000;
+    layer["particles"]["lattice"] = {20, 100, 1};
+    layer.erase("field_file");
+    std::ofstream(big) << c.dump(2);
+    fs::copy(std::string(PDAMP_SOURCE_DIR) + "/cases/fields", tmp.path / "fields", fs::copy_options::recursive);
+  }
+  require_one_line_error(run_pdamp({"decay", big.string(), "--method", "dem"}), "/task/duration_s");
+  const auto refused = run_pdamp({"decay", big.string(), "--method", "dem"});
+  CHECK_THAT(refused.err, Catch::Contains("more than the limit of 7 days") && Catch::Contains("--accept-long-run"));
+  const auto checked = run_pdamp({"validate", big.string()});
+  CHECK(checked.exit_code == 0);
+  CHECK_THAT(checked.err, Catch::Contains("2016 particles in 1 bed") && Catch::Contains("particle-steps"));
+  // Accepted, it starts (and is ended by the signal, not refused).
+  RunOptions accepted;
+  accepted.while_running = [](pid_t pid) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    ::kill(pid, SIGTERM);
+  };
+  CHECK(run_pdamp({"decay", big.string(), "--method", "dem", "--accept-long-run"}, accepted).exit_code == 128 + SIGTERM);
+  // --accept-long-run does nothing without the DEM: refused like the checkpoint flags.
+  require_one_line_error(run_pdamp({"decay", big.string(), "--accept-long-run"}), "--accept-long-run");
+
+  const fs::path verify = tmp.path / "long_verify.json";
+  {
+    json c = json::parse(slurp(case_path("manipulator_link_optimize.json")));
+    c["task"]["verify"]["duration_s"] = 1e5;
+    c["task"]["verify"]["stiffness_softening"] = 1.0;
+    std::ofstream(verify) << c.dump(2);
+  }
+  require_one_line_error(run_pdamp({"optimize", verify.string(), "--method", "formulas"}), "/task/verify/duration_s");
+}

@@ -187,6 +187,17 @@ struct RunEstimate {
 /// stability limit.
 RunEstimate estimate_run(const DamperSimulationOptions& options);
 
+/// One World of `world` right after construction, without building it: its particles,
+/// the bytes its arrays reserve (particles, neighbour rows and cell grid, contact pools: as
+/// RunEstimate counts them) and the assumed stepping rate (RunEstimate). For the cost of
+/// runs that step worlds inside another loop (the co-simulation).
+struct WorldEstimate {
+  int particles = 0;
+  std::size_t memory_bytes = 0;
+  double particle_steps_per_s = 0.0;
+};
+WorldEstimate estimate_world(const WorldOptions& world);
+
 /// Places the particles as run_harmonic would (lattice or random, inner structures and
 /// wall layers in place) without building the world, and throws std::invalid_argument
 /// as the world would when they do not fit ("compartments[0]: lattice site 0 at (...)

@@ -31,6 +31,14 @@ double available_memory_bytes();
 /// InputError naming /dem when `runs_at_once` runs of `estimate` do not fit in `available` bytes.
 void check_memory(const case_file::Case& c, std::size_t damper, const dem_reference::RunEstimate& estimate,
                   double runs_at_once);
+/// The longest estimated wall time a DEM run starts with unless the user accepts it
+/// (RunHooks::long_runs_accepted; the command line's --accept-long-run): a week. The estimate
+/// is at the benchmark rate of the machine class pdamp is measured on (RunEstimate).
+inline constexpr double kMaxDemWallTime_s = 7.0 * 86400.0;
+/// InputError naming `pointer` of the case when `wall_time_s` exceeds kMaxDemWallTime_s and
+/// the hooks do not accept it; `what` names the run and `reduce` the keys that shorten it.
+void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
+                     const std::string& reduce, RunHooks& hooks);
 /// "N particles, S steps of dt s = P particle-steps, about T s at R particle-steps/s; memory about M".
 std::string estimate_text(const dem_reference::RunEstimate& estimate);
 /// "1.2 MB" or "3.4 GB".

@@ -37,6 +37,8 @@ class RunHooks {
   /// Nonzero (the signal number) when the runs should stop at their next consistent point,
   /// save their checkpoint and throw strict_json::Interrupted; 0 to go on.
   virtual int stop_requested() { return 0; }
+  /// Whether a run estimated to take longer than kMaxDemWallTime_s (a week) may start.
+  virtual bool long_runs_accepted() { return false; }
 };
 
 /// The hooks that report nothing, save no checkpoint and never stop.
