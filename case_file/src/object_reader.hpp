@@ -92,9 +92,10 @@ class ObjectReader {
     resolved_[key] = values;
     return values;
   }
-  /// An array of objects; the callback reads each element with its own reader.
+  /// An array of at most `max_size` objects (refused before any is read: what a model can
+  /// use, so that a hostile length costs nothing); the callback reads each with its own reader.
   template <typename Fn>
-  void array(const std::string& key, Fn&& read) {
+  void array(const std::string& key, Fn&& read, std::size_t max_size = std::numeric_limits<std::size_t>::max()) {
     strict_.optional(key);
     if (!has(key)) {
       resolved_[key] = json::array();
@@ -102,6 +103,8 @@ class ObjectReader {
     }
     const json& items = object_.at(key);
     if (!items.is_array()) fail(key, "must be an array of objects, got " + json_type_name(items));
+    if (items.size() > max_size)
+      fail(key, "has " + std::to_string(items.size()) + " entries: at most " + std::to_string(max_size));
     resolved_[key] = json::array();
     for (std::size_t i = 0; i < items.size(); ++i) {
       resolved_[key].push_back(json::object());

@@ -223,8 +223,9 @@ std::string read_point_name(ObjectReader& r, const std::string& key, const Case&
   const std::string name = r.text(key, std::nullopt);
   const auto& names = c.structure->point_names;
   if (std::find(names.begin(), names.end(), name) == names.end()) {
-    std::string known;
-    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+    std::string known;  // the first few: a message stays one readable line
+    for (std::size_t k = 0; k < names.size() && k < 12; ++k) known += (k ? ", " : "") + names[k];
+    if (names.size() > 12) known += ", ... (" + std::to_string(names.size()) + " points)";
     r.fail(key, "'" + name + "' is no named point of the structure (known: " + known + ")");
   }
   return name;

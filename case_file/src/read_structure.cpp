@@ -72,7 +72,7 @@ void read_beam(ObjectReader& r, const Case& c, StructureSpec& s) {
     segment.material = read_beam_material(g, c);
     segment.elements = g.integer("elements", st::BeamSegment{}.elements, -kAnyInt, kAnyInt);
     beam.segments.push_back(segment);
-  });
+  }, st::beam_limits::kMaxSegments);
   r.array("supports", [&](ObjectReader& p) {
     st::Support support;
     const std::string kind = p.text("kind", std::nullopt, {"clamped", "pinned", "spring"});
@@ -86,7 +86,7 @@ void read_beam(ObjectReader& r, const Case& c, StructureSpec& s) {
       support.rotational_stiffness_n_m_rad = p.number("rotational_stiffness_n_m_rad", 0.0, kFinite, " N m/rad");
     }
     beam.supports.push_back(support);
-  });
+  }, st::beam_limits::kMaxSupports);
   r.array("point_masses", [&](ObjectReader& p) {
     st::PointMass mass;
     mass.name = p.text("name", std::nullopt);
@@ -94,13 +94,13 @@ void read_beam(ObjectReader& r, const Case& c, StructureSpec& s) {
     mass.mass_kg = p.number("mass_kg", std::nullopt, kFinite, " kg");
     mass.rotary_inertia_kg_m2 = p.number("rotary_inertia_kg_m2", 0.0, kFinite, " kg m^2");
     beam.point_masses.push_back(mass);
-  });
+  }, st::beam_limits::kMaxPoints);
   r.array("points", [&](ObjectReader& p) {
     st::NamedPoint point;
     point.name = p.text("name", std::nullopt);
     point.position_m = p.number("position_m", std::nullopt, kFinite, " m");
     beam.points.push_back(point);
-  });
+  }, st::beam_limits::kMaxPoints);
   beam.axial_gravity_m_s2 = r.number("axial_gravity_m_s2", 0.0, limits::kGravity, " m/s^2");
   beam.geometric_stiffness = r.boolean("geometric_stiffness", false);
   s.mode_count = r.integer("mode_count", StructureSpec{}.mode_count, 1, 100);

@@ -34,9 +34,6 @@ constexpr double kSliverFraction = 1e-2;
 /// round-off of about ε·λ_max ≈ 2e-16·λ_max, so the zero eigenvalues of rigid modes stay
 /// far inside this bound.
 constexpr double kNegativeEigenvalueFraction = 1e-10;
-/// Guards against absurd meshes: the eigenproblem is dense (3 DOFs per node, O(n³) work),
-/// and a few hundred elements already resolve the modes a damper design needs.
-constexpr int kMaxElementsPerSegment = 1000;
 
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 /// Local DOFs of the bending part (w1, θ1, w2, θ2) inside an element's (u1, w1, θ1, u2, w2, θ2).
@@ -56,6 +53,11 @@ void throw_if_any(const std::vector<std::string>& problems, const std::string& c
 
 bool positive_finite(double x) { return x > 0.0 && std::isfinite(x); }
 bool non_negative_finite(double x) { return x >= 0.0 && std::isfinite(x); }
+bool within(double x, double lo, double hi) { return std::isfinite(x) && x >= lo && x <= hi; }
+/// "must be in [lo, hi] unit".
+std::string interval(double lo, double hi, const std::string& unit) {
+  return "must be in [" + number(lo) + ", " + number(hi) + "] " + unit;
+}
 
 /// Adds "<field> = <value>: <rule>" unless `ok`.
 void require(std::vector<std::string>& problems, bool ok, const std::string& field, double value,
@@ -67,11 +69,13 @@ void section_problems(const Section& s, const std::string& at, std::vector<std::
   const bool rectangle = s.shape == SectionShape::kSolidRectangle || s.shape == SectionShape::kHollowRectangle;
   const bool hollow = s.shape == SectionShape::kHollowRectangle || s.shape == SectionShape::kHollowCircle;
   if (rectangle) {
-    require(problems, positive_finite(s.width_m), at + "width_m", s.width_m, "must be > 0 m");
-    require(problems, positive_finite(s.depth_m), at + "depth_m", s.depth_m, "must be > 0 m");
+    for (const auto& [field, value] : {std::pair<const char*, double>{"width_m", s.width_m}, {"depth_m", s.depth_m}})
+      require(problems, within(value, beam_limits::kMinSectionSize_m, beam_limits::kMaxSectionSize_m), at + field, value,
+              interval(beam_limits::kMinSectionSize_m, beam_limits::kMaxSectionSize_m, "m"));
     require(problems, s.diameter_m == 0.0, at + "diameter_m", s.diameter_m, "rectangles have no diameter, must be 0");
   } else {
-    require(problems, positive_finite(s.diameter_m), at + "diameter_m", s.diameter_m, "must be > 0 m");
+    require(problems, within(s.diameter_m, beam_limits::kMinSectionSize_m, beam_limits::kMaxSectionSize_m), at + "diameter_m",
+            s.diameter_m, interval(beam_limits::kMinSectionSize_m, beam_limits::kMaxSectionSize_m, "m"));
     require(problems, s.width_m == 0.0, at + "width_m", s.width_m, "circles use diameter_m, must be 0");
     require(problems, s.depth_m == 0.0, at + "depth_m", s.depth_m, "circles use diameter_m, must be 0");
   }
@@ -81,8 +85,10 @@ void section_problems(const Section& s, const std::string& at, std::vector<std::
     return;
   }
   const double half_size = 0.5 * (rectangle ? std::min(s.width_m, s.depth_m) : s.diameter_m);
-  require(problems, s.wall_thickness_m > 0.0 && s.wall_thickness_m < half_size, at + "wall_thickness_m",
-          s.wall_thickness_m, "must be in (0, " + number(half_size) + ") m (half the smallest outer size)");
+  require(problems, s.wall_thickness_m >= beam_limits::kMinSectionSize_m && s.wall_thickness_m < half_size,
+          at + "wall_thickness_m", s.wall_thickness_m,
+          "must be in [" + number(beam_limits::kMinSectionSize_m) + ", " + number(half_size) +
+              ") m (half the smallest outer size)");
 }
 
 /// True if the support carries axial load (it fixes x or has an axial spring).
@@ -515,18 +521,33 @@ double BeamModel::length_m() const {
 std::vector<std::string> BeamModel::validate() const {
   std::vector<std::string> problems;
   if (segments.empty()) problems.emplace_back("segments is empty: a beam needs at least one segment");
+  const auto count_at_most = [&](std::size_t count, std::size_t max, const std::string& field) {
+    if (count > max) problems.push_back(field + " has " + std::to_string(count) + " entries: at most " + std::to_string(max));
+  };
+  count_at_most(segments.size(), beam_limits::kMaxSegments, "segments");
+  count_at_most(supports.size(), beam_limits::kMaxSupports, "supports");
+  count_at_most(point_masses.size(), beam_limits::kMaxPoints, "point_masses");
+  count_at_most(points.size(), beam_limits::kMaxPoints, "points");
+  if (!problems.empty()) return problems;  // a hostile length is not walked
+  long total_elements = 0;
   for (std::size_t i = 0; i < segments.size(); ++i) {
     const BeamSegment& s = segments[i];
     const std::string at = "segments/" + std::to_string(i) + "/";
-    require(problems, positive_finite(s.length_m), at + "length_m", s.length_m, "must be > 0 m");
-    require(problems, s.elements >= 1 && s.elements <= kMaxElementsPerSegment, at + "elements", s.elements,
-            "must be in [1, " + std::to_string(kMaxElementsPerSegment) + "]");
+    require(problems, within(s.length_m, beam_limits::kMinSegmentLength_m, beam_limits::kMaxSegmentLength_m),
+            at + "length_m", s.length_m,
+            interval(beam_limits::kMinSegmentLength_m, beam_limits::kMaxSegmentLength_m, "m"));
+    require(problems, s.elements >= 1 && s.elements <= beam_limits::kMaxElements, at + "elements", s.elements,
+            "must be in [1, " + std::to_string(beam_limits::kMaxElements) + "]");
+    total_elements += std::max(s.elements, 0);
     require(problems, positive_finite(s.material.youngs_modulus_pa), at + "material/youngs_modulus_pa",
             s.material.youngs_modulus_pa, "must be > 0 Pa");
     require(problems, positive_finite(s.material.density_kg_m3), at + "material/density_kg_m3",
             s.material.density_kg_m3, "must be > 0 kg/m³");
     section_problems(s.section, at + "section/", problems);
   }
+  if (total_elements > beam_limits::kMaxElements)
+    problems.push_back("segments: " + std::to_string(total_elements) + " elements in all: at most " +
+                       std::to_string(beam_limits::kMaxElements) + " (the modal eigenproblem is dense: O(n^3) work)");
   const double length = length_m();
   const double tolerance = kMergeFraction * length;
   const std::string position_rule = "must be in [0, " + number(length) + "] m (on the beam)";
@@ -543,7 +564,8 @@ std::vector<std::string> BeamModel::validate() const {
          {"rotational_stiffness_n_m_rad", s.rotational_stiffness_n_m_rad}}};
     for (const auto& [field, value] : springs) {
       if (s.kind == Support::Kind::kSpring) {
-        require(problems, non_negative_finite(value), at + field, value, "must be >= 0 and finite");
+        require(problems, within(value, 0.0, beam_limits::kMaxStiffness), at + field, value,
+                interval(0.0, beam_limits::kMaxStiffness, ""));
       } else {
         require(problems, value == 0.0, at + field, value, "only spring supports take stiffnesses, must be 0");
       }
@@ -563,9 +585,10 @@ std::vector<std::string> BeamModel::validate() const {
     const std::string at = "point_masses/" + std::to_string(i) + "/";
     check_name(m.name, at);
     require(problems, on_beam(m.position_m), at + "position_m", m.position_m, position_rule);
-    require(problems, non_negative_finite(m.mass_kg), at + "mass_kg", m.mass_kg, "must be >= 0 kg and finite");
-    require(problems, non_negative_finite(m.rotary_inertia_kg_m2), at + "rotary_inertia_kg_m2",
-            m.rotary_inertia_kg_m2, "must be >= 0 kg m² and finite");
+    require(problems, within(m.mass_kg, 0.0, beam_limits::kMaxPointMass_kg), at + "mass_kg", m.mass_kg,
+            interval(0.0, beam_limits::kMaxPointMass_kg, "kg"));
+    require(problems, within(m.rotary_inertia_kg_m2, 0.0, beam_limits::kMaxRotaryInertia_kg_m2), at + "rotary_inertia_kg_m2",
+            m.rotary_inertia_kg_m2, interval(0.0, beam_limits::kMaxRotaryInertia_kg_m2, "kg m²"));
   }
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string at = "points/" + std::to_string(i) + "/";
@@ -593,16 +616,16 @@ std::vector<std::string> ModalDamping::validate() const {
   const bool rayleigh = rayleigh_alpha_1_s.has_value() || rayleigh_beta_s.has_value();
   if (!rayleigh && ratios.empty()) problems.emplace_back("ratios is empty: give one ratio at least, or Rayleigh terms");
   for (std::size_t j = 0; j < ratios.size(); ++j) {
-    require(problems, non_negative_finite(ratios[j]), "ratios/" + std::to_string(j), ratios[j],
-            "must be >= 0 and finite");
+    require(problems, within(ratios[j], 0.0, beam_limits::kMaxDampingRatio), "ratios/" + std::to_string(j), ratios[j],
+            interval(0.0, beam_limits::kMaxDampingRatio, "(a vibration mode's damping ratio)"));
   }
   if (rayleigh_alpha_1_s) {
-    require(problems, non_negative_finite(*rayleigh_alpha_1_s), "rayleigh_alpha_1_s", *rayleigh_alpha_1_s,
-            "must be >= 0 1/s and finite");
+    require(problems, within(*rayleigh_alpha_1_s, 0.0, beam_limits::kMaxRayleighAlpha_1_s), "rayleigh_alpha_1_s",
+            *rayleigh_alpha_1_s, interval(0.0, beam_limits::kMaxRayleighAlpha_1_s, "1/s"));
   }
   if (rayleigh_beta_s) {
-    require(problems, non_negative_finite(*rayleigh_beta_s), "rayleigh_beta_s", *rayleigh_beta_s,
-            "must be >= 0 s and finite");
+    require(problems, within(*rayleigh_beta_s, 0.0, beam_limits::kMaxRayleighBeta_s), "rayleigh_beta_s", *rayleigh_beta_s,
+            interval(0.0, beam_limits::kMaxRayleighBeta_s, "s"));
   }
   return problems;
 }

@@ -32,8 +32,21 @@ void reject_unknown_keys(const json& object, const std::string& at, const std::s
   }
 }
 
-/// What a value of an array must satisfy.
-enum class Range { kAny, kNonNegative, kPositive };
+/// What a value must satisfy: a closed interval [min, max] (a physical range: wide enough for
+/// any structure, narrow enough that a 1e-300 kg modal mass or a 1e308 Hz mode is refused
+/// by name instead of overflowing a response).
+struct Range {
+  double min;
+  double max;
+};
+constexpr Range kFrequency{1e-3, 1e5};     ///< Hz: a mHz mode to ultrasound
+constexpr Range kDampingRatio{0.0, 1.0};   ///< ζ of a vibration mode
+constexpr Range kModalMass{1e-6, 1e9};     ///< kg: a mg to a million tonnes
+constexpr Range kShape{-1e6, 1e6};         ///< m or rad per unit q
+constexpr Range kParticipation{-1e9, 1e9}; ///< kg per unit q
+/// Modes and points a modal model may hold (as a beam's mode_count and named points).
+constexpr std::size_t kMaxModes = 100;
+constexpr std::size_t kMaxPoints = 1000;
 
 double finite_number(const json& value, const std::string& at, Range range, std::string_view unit) {
   const std::string in_unit = unit.empty() ? "" : " (in " + std::string(unit) + ")";
@@ -42,8 +55,8 @@ double finite_number(const json& value, const std::string& at, Range range, std:
   }
   const double x = value.get<double>();
   if (!std::isfinite(x)) throw ModalDataError(at, "must be a finite number" + in_unit);
-  if (range == Range::kPositive && !(x > 0.0)) throw ModalDataError(at, number(x) + " must be > 0" + in_unit);
-  if (range == Range::kNonNegative && !(x >= 0.0)) throw ModalDataError(at, number(x) + " must be >= 0" + in_unit);
+  if (!(x >= range.min && x <= range.max))
+    throw ModalDataError(at, number(x) + " must be in [" + number(range.min) + ", " + number(range.max) + "]" + in_unit);
   return x;
 }
 
@@ -54,6 +67,8 @@ Eigen::VectorXd number_array(const json& value, const std::string& at, std::opti
   if (!value.is_array()) throw ModalDataError(at, std::string("must be a JSON array, got ") + value.type_name());
   const auto size = static_cast<Eigen::Index>(value.size());
   if (!modes && size == 0) throw ModalDataError(at, "must hold at least one mode, got an empty array");
+  if (!modes && value.size() > kMaxModes)
+    throw ModalDataError(at, "has " + std::to_string(size) + " modes: at most " + std::to_string(kMaxModes));
   if (modes && size != *modes) {
     throw ModalDataError(at, "has " + std::to_string(size) + " entries, must have " + std::to_string(*modes) +
                                  " (one per mode, as frequencies_hz)");
@@ -73,13 +88,13 @@ PointModeShape read_point(const std::string& name, const json& value, const std:
   shape.translation = Eigen::MatrixXd::Zero(2, modes);
   shape.rotation = Eigen::RowVectorXd::Zero(modes);
   if (const auto it = value.find("translation_x"); it != value.end()) {
-    shape.translation.row(0) = number_array(*it, at + "/translation_x", modes, Range::kAny, "m per unit q").transpose();
+    shape.translation.row(0) = number_array(*it, at + "/translation_x", modes, kShape, "m per unit q").transpose();
   }
   if (const auto it = value.find("translation_y"); it != value.end()) {
-    shape.translation.row(1) = number_array(*it, at + "/translation_y", modes, Range::kAny, "m per unit q").transpose();
+    shape.translation.row(1) = number_array(*it, at + "/translation_y", modes, kShape, "m per unit q").transpose();
   }
   if (const auto it = value.find("rotation"); it != value.end()) {
-    shape.rotation = number_array(*it, at + "/rotation", modes, Range::kAny, "rad per unit q").transpose();
+    shape.rotation = number_array(*it, at + "/rotation", modes, kShape, "rad per unit q").transpose();
   }
   return shape;
 }
@@ -104,7 +119,7 @@ ModalModel modal_model_from_json(const json& document) {
   };
 
   ModalModel model;
-  model.natural_frequencies_hz = number_array(required("frequencies_hz"), "/frequencies_hz", std::nullopt, Range::kPositive, "Hz");
+  model.natural_frequencies_hz = number_array(required("frequencies_hz"), "/frequencies_hz", std::nullopt, kFrequency, "Hz");
   const Eigen::Index modes = model.natural_frequencies_hz.size();
   for (Eigen::Index j = 1; j < modes; ++j) {
     if (model.natural_frequencies_hz[j] < model.natural_frequencies_hz[j - 1]) {
@@ -116,20 +131,22 @@ ModalModel modal_model_from_json(const json& document) {
 
   const json& damping = required("damping_ratios");
   if (damping.is_array()) {
-    model.damping_ratios = number_array(damping, "/damping_ratios", modes, Range::kNonNegative, "");
+    model.damping_ratios = number_array(damping, "/damping_ratios", modes, kDampingRatio, "");
   } else {
-    const double ratio = finite_number(damping, "/damping_ratios", Range::kNonNegative, "");
+    const double ratio = finite_number(damping, "/damping_ratios", kDampingRatio, "");
     model.damping_ratios = Eigen::VectorXd::Constant(modes, ratio);
   }
 
   if (const auto it = document.find("modal_masses_kg"); it != document.end()) {
-    model.modal_masses_kg = number_array(*it, "/modal_masses_kg", modes, Range::kPositive, "kg");
+    model.modal_masses_kg = number_array(*it, "/modal_masses_kg", modes, kModalMass, "kg");
   } else {
     model.modal_masses_kg = Eigen::VectorXd::Ones(modes);
   }
 
   const json& points = required("points");
   if (!points.is_object()) throw ModalDataError("/points", std::string("must be a JSON object, got ") + points.type_name());
+  if (points.size() > kMaxPoints)
+    throw ModalDataError("/points", "has " + std::to_string(points.size()) + " points: at most " + std::to_string(kMaxPoints));
   for (const auto& item : points.items()) {
     const std::string at = "/points/" + pointer_token(item.key());
     if (item.key().empty()) throw ModalDataError(at, "a point needs a non-empty name");
@@ -141,10 +158,10 @@ ModalModel modal_model_from_json(const json& document) {
   if (base_x != document.end() || base_y != document.end()) {
     model.base_participation = Eigen::MatrixXd::Zero(modes, 2);
     if (base_x != document.end()) {
-      model.base_participation.col(0) = number_array(*base_x, "/base_participation_x_kg", modes, Range::kAny, "kg per unit q");
+      model.base_participation.col(0) = number_array(*base_x, "/base_participation_x_kg", modes, kParticipation, "kg per unit q");
     }
     if (base_y != document.end()) {
-      model.base_participation.col(1) = number_array(*base_y, "/base_participation_y_kg", modes, Range::kAny, "kg per unit q");
+      model.base_participation.col(1) = number_array(*base_y, "/base_participation_y_kg", modes, kParticipation, "kg per unit q");
     }
   }
   return model;

@@ -102,11 +102,11 @@ TEST_CASE("format-2 errors name the file, the pointer and the rule", "[case_file
   const std::string file = (dir.path / kCantilever).string();
   // structure::BeamModel::validate() owns the beam's ranges.
   require_case_error(cantilever([](json& c) { c["structure"]["segments"][0]["length_m"] = -0.5; }), file,
-                     "/structure/segments/0/length_m", "must be > 0 m");
+                     "/structure/segments/0/length_m", "must be in [0.0001, 10000] m");
   require_case_error(cantilever([](json& c) { c["structure"]["points"][0]["position_m"] = 2.0; }), file,
                      "/structure/points/0/position_m", "on the beam");
   require_case_error(cantilever([](json& c) { c["structure"]["damping"] = {{"ratios", {-0.1}}}; }), file,
-                     "/structure/damping/ratios/0", "must be >= 0");
+                     "/structure/damping/ratios/0", "must be in [0, 1]");
   require_case_error(cantilever([](json& c) { c["structure"]["segments"][0]["section"]["diameter_m"] = 0.01; }), file,
                      "/structure/segments/0/section/diameter_m", "unknown key");
   require_case_error(cantilever([](json& c) { c["structure"]["kind"] = "plate"; }), file, "/structure/kind",

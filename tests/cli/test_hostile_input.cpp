@@ -15,6 +15,7 @@
 #include <map>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -786,4 +787,82 @@ TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless 
     std::ofstream(verify) << c.dump(2);
   }
   require_one_line_error(run_pdamp({"optimize", verify.string(), "--method", "formulas"}), "/task/verify/duration_s");
+}
+
+namespace {
+
+/// `validate` on the test data case `name` copied into `dir` with `edit` applied (its modal
+/// data file copied beside it, edited by `edit_modal`).
+RunResult validate_edited(const fs::path& dir, const std::string& name, const std::function<void(json&)>& edit,
+                          const std::function<void(json&)>& edit_modal = {}) {
+  const fs::path data = fs::path(PDAMP_SOURCE_DIR) / "tests" / "cli" / "data";
+  json c = json::parse(slurp(data / name));
+  edit(c);
+  const fs::path path = dir / ("edited_" + name);
+  std::ofstream(path) << c.dump(2);
+  if (c["structure"]["kind"] == "modal_data") {
+    json m = json::parse(slurp(data / c["structure"]["file"].get<std::string>()));
+    if (edit_modal) edit_modal(m);
+    std::ofstream(dir / c["structure"]["file"].get<std::string>()) << m.dump(2);
+  }
+  RunOptions bounded;
+  bounded.time_limit_s = 60.0;  // a hang guard: each is refused at once
+  return run_pdamp({"validate", path.string()}, bounded);
+}
+
+}  // namespace
+
+// Every structure and modal-data number has a physical range, and validate builds the modal
+// model as a run does (after the size checks), so it refuses what a run would. Before: each of
+// these passed validate and either failed at run time with exit 1 and no key ("the generalized
+// eigenproblem failed", "out of memory"), or ran to exit 0 with overflowing results.
+TEST_CASE("every structure and modal-data number has a range, and validate builds the modal model", "[cli]") {
+  TempDir tmp("structure_ranges");
+  const auto beam = [&](const std::function<void(json&)>& edit) { return validate_edited(tmp.path, "cantilever_decay.json", edit); };
+  require_one_line_error(beam([](json& c) { c["structure"]["segments"][0]["length_m"] = 1e308; }),
+                         "/structure/segments/0/length_m");
+  require_one_line_error(beam([](json& c) { c["structure"]["segments"][0]["section"]["width_m"] = 1e300; }),
+                         "/structure/segments/0/section/width_m");
+  require_one_line_error(beam([](json& c) { c["structure"]["segments"][0]["section"]["depth_m"] = 1e-320; }),
+                         "/structure/segments/0/section/depth_m");
+  require_one_line_error(beam([](json& c) { c["structure"]["segments"][0]["elements"] = 20000; }),
+                         "/structure/segments/0/elements");
+  require_one_line_error(beam([](json& c) {
+                           json s = c["structure"]["segments"][0];
+                           s["elements"] = 400;
+                           s["length_m"] = 0.25;
+                           c["structure"]["segments"] = {s, s};
+                         }),
+                         "800 elements in all");
+  require_one_line_error(beam([](json& c) {
+                           c["structure"]["point_masses"] = {{{"name", "heavy"}, {"position_m", 0.5}, {"mass_kg", 1e300}}};
+                         }),
+                         "/structure/point_masses/0/mass_kg");
+  require_one_line_error(beam([](json& c) {
+                           json supports = json::array();
+                           for (int k = 0; k < 200000; ++k) supports.push_back({{"kind", "pinned"}, {"position_m", 0.0}});
+                           c["structure"]["supports"] = supports;
+                         }),
+                         "at most 100");
+  require_one_line_error(beam([](json& c) { c["structure"]["damping"]["ratios"] = {1e300}; }), "ratios/0");
+  // Checks only the model's construction makes: more modes than one element has, initial
+  // amplitudes for more modes than the model keeps.
+  require_one_line_error(beam([](json& c) {
+                           c["structure"]["segments"][0]["elements"] = 1;
+                           c["structure"]["mode_count"] = 100;
+                         }),
+                         "/structure");
+  require_one_line_error(beam([](json& c) {
+                           c["task"]["initial_state"] = {{"kind", "modal_amplitudes"}, {"values", std::vector<double>(50, 0.001)}};
+                         }),
+                         "/task/initial_state");
+
+  const auto modal = [&](const std::function<void(json&)>& edit) {
+    return validate_edited(tmp.path, "modal_data_tip_damper.json", [](json&) {}, edit);
+  };
+  require_one_line_error(modal([](json& m) { m["modal_masses_kg"] = {1e-300}; }), "one_mode_tip.json: /modal_masses_kg/0");
+  require_one_line_error(modal([](json& m) { m["frequencies_hz"] = {1e308}; }), "/frequencies_hz/0");
+  require_one_line_error(modal([](json& m) { m["damping_ratios"] = 1e300; }), "/damping_ratios");
+  require_one_line_error(modal([](json& m) { m["points"]["tip"]["translation_y"] = {1e300}; }), "/points/tip/translation_y/0");
+  require_one_line_error(modal([](json& m) { m["frequencies_hz"] = std::vector<double>(200000, 2.0); }), "at most 100");
 }

@@ -162,44 +162,80 @@ struct TooDeep {
   std::string pointer;
 };
 
+/// nlohmann::json's own DOM builder with the strict reader's checks on the way: a key twice
+/// in one object, nesting deeper than kMaxNestingDepth (refused as it is met: a file of 20 MB
+/// of "[" parsed whole took a minute and 2 GB). A SAX handler, not the library's parser
+/// callback: the callback parser rescans the enclosing container at every object's end
+/// (nlohmann 3.11's json_sax_dom_callback_parser::end_object), O(n²) for an array of n
+/// objects (200,000 supports took 9 s, 400,000 a minute). The builder's methods are called
+/// statically by sax_parse, so shadowing them is enough.
+class StrictDomBuilder : public nlohmann::detail::json_sax_dom_parser<nlohmann::json> {
+  using Base = nlohmann::detail::json_sax_dom_parser<nlohmann::json>;
+
+ public:
+  explicit StrictDomBuilder(nlohmann::json& result) : Base(result, true) {}
+
+  bool start_object(std::size_t elements) {
+    enter(true);
+    return Base::start_object(elements);
+  }
+  bool start_array(std::size_t elements) {
+    enter(false);
+    return Base::start_array(elements);
+  }
+  bool key(std::string& name) {
+    Frame& top = frames_.back();
+    top.key = name;
+    if (!top.keys.insert(name).second) throw DuplicateKey{pointer_of(frames_) + "/" + pointer_token(name)};
+    return Base::key(name);
+  }
+  bool end_object() {
+    leave();
+    return Base::end_object();
+  }
+  bool end_array() {
+    leave();
+    return Base::end_array();
+  }
+  bool null() { return element_done(), Base::null(); }
+  bool boolean(bool value) { return element_done(), Base::boolean(value); }
+  bool number_integer(nlohmann::json::number_integer_t value) { return element_done(), Base::number_integer(value); }
+  bool number_unsigned(nlohmann::json::number_unsigned_t value) { return element_done(), Base::number_unsigned(value); }
+  bool number_float(nlohmann::json::number_float_t value, const std::string& text) {
+    return element_done(), Base::number_float(value, text);
+  }
+  bool string(std::string& value) { return element_done(), Base::string(value); }
+  bool binary(nlohmann::json::binary_t& value) { return element_done(), Base::binary(value); }
+
+ private:
+  void enter(bool object) {
+    if (frames_.size() >= kMaxNestingDepth) throw TooDeep{pointer_of(frames_)};
+    frames_.push_back({object, {}, {}, 0});
+  }
+  void leave() {
+    frames_.pop_back();
+    element_done();
+  }
+  void element_done() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::vector<Frame> frames_;
+};
+
 }  // namespace
 
 nlohmann::json parse_json_document(const std::string& text, const std::string& path) {
   using nlohmann::json;
-  std::vector<Frame> frames;
-  const auto element_done = [&] {
-    if (!frames.empty() && !frames.back().object) ++frames.back().index;
-  };
-  const json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start:
-        // Refused as it is met: a file of 20 MB of "[" parsed whole took a minute and 2 GB.
-        if (frames.size() >= kMaxNestingDepth) throw TooDeep{pointer_of(frames)};
-        frames.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
-        break;
-      case json::parse_event_t::key: {
-        Frame& top = frames.back();
-        top.key = parsed.get<std::string>();
-        if (!top.keys.insert(top.key).second) throw DuplicateKey{pointer_of(frames) + "/" + pointer_token(top.key)};
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames.pop_back();
-        element_done();
-        break;
-      case json::parse_event_t::value: element_done(); break;
-    }
-    return true;
-  };
   // The parser stops at a NUL byte as at the end of the text, so "{...}\0garbage" would
   // pass: a NUL has no place in JSON text (RFC 8259: control characters only escaped).
   if (const auto nul = text.find('\0'); nul != std::string::npos)
     throw InputError(path, "", "malformed JSON: a NUL byte at offset " + std::to_string(nul) +
                                    " (a binary file, or text with a NUL)");
   try {
-    return json::parse(text, track);
+    json result;
+    StrictDomBuilder builder(result);
+    json::sax_parse(text, &builder);  // a parse error throws (the builder allows exceptions)
+    return result;
   } catch (const DuplicateKey& duplicate) {
     throw InputError(path, duplicate.pointer, "duplicate key (each key may appear once in an object)");
   } catch (const TooDeep& deep) {

@@ -4,6 +4,7 @@
 // placed there). Input structs validate themselves; docs/structures.md documents them.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,30 @@
 #include "pdamp/structure/modal_model.hpp"
 
 namespace pdamp::structure {
+
+/// Physical ranges of a beam model (BeamModel::validate, ModalDamping::validate): wide
+/// enough for any structure a particle damper is fitted to, narrow enough that nonsense (a
+/// 1e308 m segment, a 1e-320 m section, a 1e300 kg point mass) is refused naming its field
+/// instead of failing in the eigen-solve or giving overflowing responses.
+namespace beam_limits {
+inline constexpr double kMinSegmentLength_m = 1e-4;  ///< 0.1 mm
+inline constexpr double kMaxSegmentLength_m = 1e4;   ///< 10 km
+inline constexpr double kMinSectionSize_m = 1e-5;    ///< 10 µm (a wall thickness)
+inline constexpr double kMaxSectionSize_m = 100.0;
+inline constexpr double kMaxStiffness = 1e15;        ///< spring supports, N/m and N m/rad (a rigid support)
+inline constexpr double kMaxPointMass_kg = 1e7;      ///< 10,000 t
+inline constexpr double kMaxRotaryInertia_kg_m2 = 1e7;
+/// Elements of the whole beam: the eigenproblem is dense (3 DOFs per node, O(n³) work and
+/// O(n²) memory): 500 elements solve in about 4 s, 1000 in over a minute (and lose the
+/// softest modes to round-off), while a few dozen resolve the modes a damper design needs.
+inline constexpr int kMaxElements = 500;
+inline constexpr std::size_t kMaxSegments = 100;
+inline constexpr std::size_t kMaxSupports = 100;
+inline constexpr std::size_t kMaxPoints = 1000;       ///< point masses, and named points
+inline constexpr double kMaxDampingRatio = 1.0;      ///< ζ of a vibration mode
+inline constexpr double kMaxRayleighAlpha_1_s = 1e4;
+inline constexpr double kMaxRayleighBeta_s = 1.0;
+}  // namespace beam_limits
 
 enum class SectionShape { kSolidRectangle, kHollowRectangle, kSolidCircle, kHollowCircle };
 
