@@ -54,7 +54,9 @@ RunResult run_mpi(int ranks, const std::vector<std::string>& args, RunOptions op
   if (::geteuid() == 0) argv.push_back("--allow-run-as-root");
   argv.push_back(PDAMP_BINARY);
   argv.insert(argv.end(), args.begin(), args.end());
-  if (options.time_limit_s > 90.0) options.time_limit_s = 90.0;  // a hang is a failure
+  // A hang guard, not a timing: about ten times the longest idle run here (under a minute:
+  // the killed-and-resumed DEM field), so a loaded machine does not fail the test.
+  if (options.time_limit_s > 600.0) options.time_limit_s = 600.0;
   return run_program(argv, options);
 }
 
