@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pdamp/case_file/ranges.hpp"
+#include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
@@ -202,7 +204,10 @@ structure::CosimulationDamper cosimulation_damper(const Case& c, std::size_t dam
   return out;
 }
 
-Eigen::VectorXd initial_modal_amplitudes(const Case& c, const StructureSetup& setup, const DecayTask& task) {
+namespace {
+
+/// The modal amplitudes of the task's release, as given or from the static deflection.
+Eigen::VectorXd release_amplitudes(const Case& c, const StructureSetup& setup, const DecayTask& task) {
   const Eigen::Index modes = setup.modal.mode_count();
   if (task.initial_state == DecayTask::InitialState::kModalAmplitudes) {
     if (static_cast<Eigen::Index>(task.modal_amplitudes.size()) > modes) {
@@ -233,6 +238,33 @@ Eigen::VectorXd initial_modal_amplitudes(const Case& c, const StructureSetup& se
   } catch (const std::invalid_argument& e) {
     throw CaseError(c.path, "/task/initial_state", e.what());
   }
+}
+
+/// The release must be one the dampers can meet: a site that starts more than the largest
+/// stroke any loss model or the DEM takes (limits::kStroke, 10 m) from rest is a load, a modal
+/// mass or a shape out of scale (each within its own range, their product is not), and would
+/// give decays of 1e21 m. Named by the site, the quantity and the keys to check.
+Eigen::VectorXd checked_release(const Case& c, const StructureSetup& setup, Eigen::VectorXd q) {
+  for (const auto& damper : setup.dampers) {
+    double envelope_m = 0.0;
+    for (const auto& p : setup.modal.points)
+      if (p.name == damper.point)
+        for (Eigen::Index j = 0; j < q.size(); ++j) envelope_m += p.translation.col(j).norm() * std::abs(q[j]);
+    if (!(envelope_m <= limits::kStroke.max))
+      throw CaseError(c.path, "/task/initial_state",
+                      "moves damper " + damper.name + "'s site '" + damper.point + "' by up to " +
+                          strict_json::format_number(envelope_m, 4) + " m, more than the " +
+                          strict_json::format_number(limits::kStroke.max) +
+                          " m any damper model takes: check the load or amplitudes against the structure's modal "
+                          "masses and shapes");
+  }
+  return q;
+}
+
+}  // namespace
+
+Eigen::VectorXd initial_modal_amplitudes(const Case& c, const StructureSetup& setup, const DecayTask& task) {
+  return checked_release(c, setup, release_amplitudes(c, setup, task));
 }
 
 }  // namespace pdamp::case_file

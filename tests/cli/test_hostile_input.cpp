@@ -865,4 +865,14 @@ TEST_CASE("every structure and modal-data number has a range, and validate build
   require_one_line_error(modal([](json& m) { m["damping_ratios"] = 1e300; }), "/damping_ratios");
   require_one_line_error(modal([](json& m) { m["points"]["tip"]["translation_y"] = {1e300}; }), "/points/tip/translation_y/0");
   require_one_line_error(modal([](json& m) { m["frequencies_hz"] = std::vector<double>(200000, 2.0); }), "at most 100");
+  // Each number in range, their product not: a 1 mHz mode of 1 mg with a shape of 1e6 released
+  // from a 2 N load starts the site 5e22 m out (before, the decay ran to exit 0 with a
+  // 2.5e21 m threshold). Refused naming the release, the site and the quantities to check.
+  const auto out_of_scale = modal([](json& m) {
+    m["frequencies_hz"] = {1e-3};
+    m["modal_masses_kg"] = {1e-6};
+    m["points"]["tip"]["translation_y"] = {1e6};
+  });
+  require_one_line_error(out_of_scale, "/task/initial_state");
+  CHECK_THAT(out_of_scale.err, Catch::Contains("site 'tip'") && Catch::Contains("modal masses and shapes"));
 }
