@@ -235,6 +235,22 @@ void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& 
 
 }  // namespace
 
+CoupledRunEstimate estimate_coupled_steps(const std::vector<st::CosimulationDamper>& dampers, double time_step_s,
+                                          std::int64_t steps) {
+  CoupledRunEstimate e;
+  e.beds = dampers.size();
+  e.time_step_s = time_step_s;
+  e.steps = steps;
+  for (const auto& d : dampers) {
+    const dem_reference::WorldEstimate w = dem_reference::estimate_world(d.world);
+    e.particles += w.particles;
+    e.memory_bytes += static_cast<double>(w.memory_bytes);
+    e.wall_time_s += static_cast<double>(w.particles) * static_cast<double>(steps) / w.particle_steps_per_s;
+  }
+  e.particle_steps = static_cast<double>(e.particles) * static_cast<double>(steps);
+  return e;
+}
+
 st::CosimulationOptions dem_decay_options(const Case& c, const st::ModalModel& modal, const Eigen::VectorXd& q0,
                                           double duration_s) {
   st::CosimulationOptions options;
@@ -247,25 +263,16 @@ st::CosimulationOptions dem_decay_options(const Case& c, const st::ModalModel& m
   return options;
 }
 
-CoupledDecayEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& modal,
+CoupledRunEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& modal,
                                             const std::vector<st::CosimulationDamper>& dampers,
                                             const st::CosimulationOptions& options) {
   detail::check_cosimulation(c, modal, dampers, options);
-  CoupledDecayEstimate e;
-  e.beds = dampers.size();
-  e.time_step_s = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
+  const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
   double settling_s = 0.0;
   for (const auto& d : dampers)
     settling_s = std::max(settling_s, options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
                                                                          : dem_reference::automatic_settling_time_s(d.world));
-  e.steps = std::llround((options.duration_s + settling_s) / e.time_step_s);
-  for (const auto& d : dampers) {
-    const dem_reference::WorldEstimate w = dem_reference::estimate_world(d.world);
-    e.particles += w.particles;
-    e.memory_bytes += static_cast<double>(w.memory_bytes);
-    e.wall_time_s += static_cast<double>(w.particles) * static_cast<double>(e.steps) / w.particle_steps_per_s;
-  }
-  e.particle_steps = static_cast<double>(e.particles) * static_cast<double>(e.steps);
+  CoupledRunEstimate e = estimate_coupled_steps(dampers, dt, std::llround((options.duration_s + settling_s) / dt));
   // The sampled history: time, q and per bed its site's displacement, rotation, force and moment.
   const double samples = options.duration_s / options.sample_interval_s + 1.0;
   e.memory_bytes += samples * static_cast<double>(1 + modal.mode_count() + 4 * static_cast<Eigen::Index>(dampers.size())) *
@@ -273,11 +280,11 @@ CoupledDecayEstimate estimate_coupled_decay(const Case& c, const st::ModalModel&
   return e;
 }
 
-CoupledDecayEstimate check_coupled_decay(const Case& c, const st::ModalModel& modal,
+CoupledRunEstimate check_coupled_decay(const Case& c, const st::ModalModel& modal,
                                          const std::vector<st::CosimulationDamper>& dampers,
                                          const st::CosimulationOptions& options, const std::string& label,
                                          const std::string& duration_pointer, RunHooks& hooks) {
-  const CoupledDecayEstimate e = estimate_coupled_decay(c, modal, dampers, options);
+  const CoupledRunEstimate e = estimate_coupled_decay(c, modal, dampers, options);
   if (const double available = available_memory_bytes(); e.memory_bytes > available)
     throw InputError(c.path, "/dem",
                      label + " needs about " + megabytes(e.memory_bytes) + " (" + std::to_string(e.particles) +
@@ -288,7 +295,7 @@ CoupledDecayEstimate check_coupled_decay(const Case& c, const st::ModalModel& mo
   return e;
 }
 
-std::string estimate_text(const CoupledDecayEstimate& e) {
+std::string estimate_text(const CoupledRunEstimate& e) {
   return std::to_string(e.particles) + " particles in " + std::to_string(e.beds) + (e.beds == 1 ? " bed, " : " beds, ") +
          std::to_string(e.steps) + " coupled steps of " + format_number(e.time_step_s, 3) + " s = " +
          format_number(e.particle_steps, 3) + " particle-steps, about " + format_number(e.wall_time_s, 2) +

@@ -152,7 +152,7 @@ void check_design_decays_cost(const Case& c, const case_file::FillingRatioProble
   for (const double softening : softenings) {
     const Case dc = case_file::with_design(c, slabs, softening);
     const auto options = dem_decay_options(dc, modes.modal, modes.initial_modal_displacements, duration_s);
-    const CoupledDecayEstimate e = check_coupled_decay(dc, modes.modal, detail::dem_dampers(dc), options, label,
+    const CoupledRunEstimate e = check_coupled_decay(dc, modes.modal, detail::dem_dampers(dc), options, label,
                                                        duration_pointer, hooks);
     wall_s += static_cast<double>(decays) * e.wall_time_s / std::max(parallel, 1);
     each += (each.empty() ? "" : "; at softening " + format_number(softening, 3) + ": ") + estimate_text(e);

@@ -12,6 +12,7 @@
 #include "pdamp/strict_json/number_text.hpp"
 #include "pdamp/strict_json/run_errors.hpp"
 #include "pdamp/tasks/case_checks.hpp"
+#include "pdamp/tasks/decay.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -204,6 +205,18 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
     directions.push_back({d, d == "up" ? out.frequencies_hz
                                        : std::vector<double>(out.frequencies_hz.rbegin(), out.frequencies_hz.rend())});
   out.parallel = parallel_jobs(executor, directions.size());
+  {
+    // At most max_transient_periods + analysed_periods a point (fewer once its transient
+    // has converged), every direction: an upper bound, said as one (not refused on it).
+    double simulated_s = 0.0;
+    for (const double f : out.frequencies_hz)
+      simulated_s += static_cast<double>(settling.max_transient_periods + options.analysed_periods) / f;
+    const auto steps = static_cast<std::int64_t>(std::ceil(static_cast<double>(directions.size()) * simulated_s /
+                                                           out.time_step_s));
+    CoupledRunEstimate e = estimate_coupled_steps(dampers, out.time_step_s, steps);
+    e.wall_time_s /= out.parallel ? 2.0 : 1.0;
+    hooks.note("pdamp frf (dem): at most " + estimate_text(e) + " (a point ends early once its transient converges)");
+  }
   // Two sweeps on two cores: one thread each (the worlds' own OpenMP would oversubscribe).
   // On several processes too, so that a direction run elsewhere is the serial run's bit for bit.
   if (out.parallel)

@@ -58,12 +58,11 @@ DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
                    const DemDecayCheckpoint& checkpoint, RunHooks& hooks);
 
-/// The cost of a DEM-in-the-loop free decay before it starts, computed without building
-/// its worlds: the coupled step (structure::cosimulation_time_step), the settling and decay
-/// steps, every bed's particles, and the memory of its worlds (dem_reference::estimate_world)
-/// and its sampled history; wall time at the benchmark rates (the worlds step one after the
-/// other, each at its own rate).
-struct CoupledDecayEstimate {
+/// The cost of a DEM-in-the-loop run before it starts, computed without building its
+/// worlds: the coupled step, the steps, every bed's particles, and the memory of its worlds
+/// (dem_reference::estimate_world) and its sampled history; wall time at the benchmark
+/// rates (the worlds step one after the other, each at its own rate).
+struct CoupledRunEstimate {
   int particles = 0;
   std::size_t beds = 0;
   double time_step_s = 0.0;
@@ -72,23 +71,26 @@ struct CoupledDecayEstimate {
   double wall_time_s = 0.0;
   double memory_bytes = 0.0;
 };
+/// `steps` coupled steps of `dt` with the worlds of `dampers` (no history).
+CoupledRunEstimate estimate_coupled_steps(const std::vector<structure::CosimulationDamper>& dampers, double time_step_s,
+                                          std::int64_t steps);
 /// The co-simulation options of a DEM-in-the-loop free decay of the case from q0 over
 /// duration_s (sampled finely enough for the settling measure).
 structure::CosimulationOptions dem_decay_options(const case_file::Case& c, const structure::ModalModel& modal,
                                                  const Eigen::VectorXd& q0, double duration_s);
 /// The estimate alone (InputError for options the co-simulation refuses).
-CoupledDecayEstimate estimate_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
+CoupledRunEstimate estimate_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
                                             const std::vector<structure::CosimulationDamper>& dampers,
                                             const structure::CosimulationOptions& options);
 /// The estimate of a decay of `options` (a free decay), and its checks: InputError naming
 /// /dem when it cannot fit in the memory available, and check_wall_time (`duration_pointer`
 /// names the duration to shorten). The one-line text for the user is estimate_text().
-CoupledDecayEstimate check_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
+CoupledRunEstimate check_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
                                          const std::vector<structure::CosimulationDamper>& dampers,
                                          const structure::CosimulationOptions& options,
                                          const std::string& label, const std::string& duration_pointer, RunHooks& hooks);
 /// "N particles in B beds, S coupled steps of dt s = P particle-steps, about T s; memory about M".
-std::string estimate_text(const CoupledDecayEstimate& estimate);
+std::string estimate_text(const CoupledRunEstimate& estimate);
 
 enum class DecayMethod { kFormulas, kField, kDem };
 
