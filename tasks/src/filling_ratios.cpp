@@ -137,6 +137,15 @@ VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioPro
                                   hooks));
 }
 
+/// The verification's softening check runs ten times stiffer, at most full stiffness
+/// (E·dem·verify <= E); none is possible when the judged runs are at full stiffness already.
+double stiffer_softening(const Case& c, const case_file::VerifySpec& verify) {
+  return std::min(10.0 * verify.stiffness_softening, 1.0 / c.dem.stiffness_softening);
+}
+bool at_full_stiffness(const Case& c, const case_file::VerifySpec& verify) {
+  return c.dem.stiffness_softening * verify.stiffness_softening >= 1.0;
+}
+
 /// The cost of `decays` DEM decays over `duration_s` at each of `softenings`, each like one
 /// of the case's own design (its layers' initial slabs; the mass budget keeps the designs
 /// tried of about this size), `parallel` at a time: noted and checked (memory,
@@ -252,9 +261,8 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   v.spec = verify;
   v.dem_stiffness_softening = c.dem.stiffness_softening;
   v.settling_objective = settling_objective(p);
-  // Ten times stiffer, at most full stiffness (E·dem·verify <= E).
-  const double stiffer_softening = std::min(10.0 * verify.stiffness_softening, 1.0 / c.dem.stiffness_softening);
-  const bool full_stiffness = c.dem.stiffness_softening * verify.stiffness_softening >= 1.0;
+  const double stiffer = stiffer_softening(c, verify);
+  const bool full_stiffness = at_full_stiffness(c, verify);
   v.softening_check = !verify.softening_check ? "off" : full_stiffness ? "full_stiffness" : "two_softenings";
   const std::size_t softenings = v.softening_check == "two_softenings" ? 2 : 1;
 
@@ -264,7 +272,7 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   std::vector<DemDecayCheckpoint> files(jobs);
   const detail::DesignModes modes[] = {detail::design_modes(c, p, whole_slabs(r.chosen)),
                                        detail::design_modes(c, p, whole_slabs(r.baseline))};
-  const auto softening_of = [&](std::size_t k) { return k < 2 ? verify.stiffness_softening : stiffer_softening; };
+  const auto softening_of = [&](std::size_t k) { return k < 2 ? verify.stiffness_softening : stiffer; };
   const auto suffix_of = [](std::size_t k) { return std::string(k < 2 ? "" : "_stiffer"); };
   for (std::size_t k = 0; k < jobs; ++k) {
     files[k] = verification_checkpoint(o, designs[k % 2].first, suffix_of(k), *designs[k % 2].second, softening_of(k), hooks);
@@ -294,14 +302,14 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   for (std::size_t k = 0; k < jobs; ++k) decays.push_back(runs.at(run_key(k)));
   v.softening_converged = true;
   for (std::size_t k = 0; k < 2; ++k) {
-    std::optional<SofteningCheck> stiffer;
+    std::optional<SofteningCheck> check;
     if (softenings == 2) {
-      stiffer.emplace();
-      stiffer->stiffness_softening = stiffer_softening;
-      stiffer->dem = decays[k + 2];
+      check.emplace();
+      check->stiffness_softening = stiffer;
+      check->dem = decays[k + 2];
     }
     v.designs.push_back(
-        check_design(p, verify, designs[k].first, *designs[k].second, modes[k], decays[k], std::move(stiffer)));
+        check_design(p, verify, designs[k].first, *designs[k].second, modes[k], decays[k], std::move(check)));
     if (v.designs.back().softening_check) v.softening_converged &= v.designs.back().softening_check->agreement.within;
   }
   const DesignCheck& a = v.designs[0];
@@ -482,8 +490,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   if (o.skip_verify) verify.reset();
   if (verify) {  // the first round: the chosen and the baseline design, at one or two softenings
     std::vector<double> softenings = {verify->stiffness_softening};
-    if (verify->softening_check && c.dem.stiffness_softening * verify->stiffness_softening < 1.0)
-      softenings.push_back(std::min(10.0 * verify->stiffness_softening, 1.0 / c.dem.stiffness_softening));
+    if (verify->softening_check && !at_full_stiffness(c, *verify)) softenings.push_back(stiffer_softening(c, *verify));
     check_design_decays_cost(c, out.problem, verify->duration_s, softenings, 2, executor.concurrency(2),
                              "pdamp optimize --verify", "/task/verify/duration_s", hooks);
   }
