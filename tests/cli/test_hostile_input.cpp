@@ -779,6 +779,14 @@ TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless 
   // --accept-long-run does nothing without the DEM: refused like the checkpoint flags.
   require_one_line_error(run_pdamp({"decay", big.string(), "--accept-long-run"}), "--accept-long-run");
 
+  // pdamp dem: 100,000 periods at 0.01 Hz (about 44 days), refused and then accepted.
+  const std::string dem_case = edited_case("pdamp_dem_long.json", [](json& c) { c["dem"]["samples_per_period"] = 16; });
+  const std::vector<std::string> dem_args = {"dem", dem_case, "--frequency", "0.01", "--periods", "100000", "--amplitude", "0.5"};
+  require_one_line_error(run_pdamp(dem_args), "more than the limit of 7 days");
+  std::vector<std::string> accepted_dem = dem_args;
+  accepted_dem.push_back("--accept-long-run");
+  CHECK(run_pdamp(accepted_dem, accepted).exit_code == 128 + SIGTERM);
+
   const fs::path verify = tmp.path / "long_verify.json";
   {
     json c = json::parse(slurp(case_path("manipulator_link_optimize.json")));
