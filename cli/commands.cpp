@@ -324,6 +324,7 @@ int run_field(const ParsedArgs& args, CommandContext& context) {
   if (source != "formulas" && source != "dem" && source != "measured")
     throw InputError("--source", "", "'" + source + "': must be formulas, dem or measured");
   if (source != "measured" && args.has("--measured")) throw InputError("--measured", "", "goes with --source measured");
+  if (source != "dem") refuse_flags(args, {kAcceptLongRunFlag}, "applies to --source dem (the DEM runs)");
   if (source == "measured" && args.has("--shard"))
     throw InputError("--shard", "", "goes with --source dem or formulas (a measured field is imported whole)");
   const auto [shard_index, shard_count] = shard_flag(args);
@@ -335,6 +336,7 @@ int run_field(const ParsedArgs& args, CommandContext& context) {
   }
   tasks::FieldOptions options;
   options.source = source;
+  options.accept_long_runs = args.has("--accept-long-run");
   options.sharded = args.has("--shard");
   options.shard_index = shard_index;
   options.shard_count = shard_count;
@@ -476,6 +478,8 @@ int run_sensitivity(const ParsedArgs& args, CommandContext& context) {
   const Case c = case_file::load_case(args.positional().at(0));
   tasks::SensitivityOptions options;
   options.source = sensitivity_source(args, "dem");
+  if (options.source != "dem") refuse_flags(args, {kAcceptLongRunFlag}, "applies to --source dem (the DEM runs)");
+  options.accept_long_runs = args.has("--accept-long-run");
   const std::string dir = args.optional_text("-o").value_or("out/" + report::safe_file_name(c.name) + "_sensitivity");
   std::tie(options.shard_index, options.shard_count) = shard_flag(args);
   options.sharded = args.has("--shard");
@@ -516,7 +520,7 @@ int run_sensitivity_merge(const ParsedArgs& args, CommandContext&) {
 /// Every check that run, dem and field make on a case, without the work.
 int run_validate(const ParsedArgs& args, CommandContext&) {
   const Case c = case_file::load_case(args.positional().at(0));
-  CliHooks hooks;
+  CliHooks hooks(60.0, args.has("--accept-long-run"));
   tasks::check_case(c, hooks);
   std::cout << c.resolved.dump(2) << "\n";
   return kExitOk;
@@ -614,7 +618,7 @@ const std::vector<Command>& commands() {
          {"-o", "DIR", "output folder (default out/<case name>_field_<source>): field.json,\n"
                        "                          field_table.csv, heat map and cuts (PNG, SVG); dem: also\n"
                        "                          field_sweep.jsonl (resume) and scattered_fit.json"},
-         kJsonFlag}, 1},
+         kAcceptLongRunFlag, kJsonFlag}, 1},
        run_field, true},
       {{"sensitivity", "pdamp sensitivity CASE.json [--source dem|formulas] [--shard I/N] [-o DIR] [--json]",
         "eta* and the motion mode of the damper with one parameter changed at a time (friction,\n"
@@ -626,7 +630,7 @@ const std::vector<Command>& commands() {
          {"-o", "DIR", "output folder (default out/<case name>_sensitivity): sensitivity.json,\n"
                        "                          sensitivity.csv, sensitivity_tornado.csv, sensitivity.png/svg,\n"
                        "                          sensitivity_sweep.jsonl (resume)"},
-         kJsonFlag}, 1},
+         kAcceptLongRunFlag, kJsonFlag}, 1},
        run_sensitivity, true},
       {{"field merge", "pdamp field merge SHARD_DIR... [-o DIR] [--json]  (or CASE.json [--source SRC] SHARD...)",
         "join the shards of one pdamp field --shard I/N sweep into its field (the same\n"
@@ -649,7 +653,7 @@ const std::vector<Command>& commands() {
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",
-        {kJsonFlag}, 1},
+        {kAcceptLongRunFlag, kJsonFlag}, 1},
        run_validate},
     };
     // Level III after the damper commands, before validate.

@@ -17,7 +17,7 @@ void check_case(const case_file::Case& c, RunHooks& hooks) {
     if (c.excitation.amplitude_m)
       (void)check_dem_run(c, i, case_file::dem_options(c, i, *c.excitation.amplitude_m, c.excitation.frequency_hz));
     // check_dem_field places the bed as every DEM run of the case would.
-    (void)check_dem_field(c, i, grid, nullptr, c.field.threads);
+    (void)check_dem_field(c, i, grid, nullptr, c.field.threads, hooks.long_runs_accepted());
   }
   if (!c.structure) return;
   const detail::Setup setup = detail::make_setup(c, case_file::LossMethod::kFormulas);

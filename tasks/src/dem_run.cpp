@@ -84,7 +84,12 @@ std::string case_key_names(const std::string& advice) {
 
 void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
                      const std::string& reduce, RunHooks& hooks) {
-  if (!(wall_time_s > kMaxDemWallTime_s) || hooks.long_runs_accepted()) return;
+  check_wall_time(c, wall_time_s, what, pointer, reduce, hooks.long_runs_accepted());
+}
+
+void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
+                     const std::string& reduce, bool accepted) {
+  if (!(wall_time_s > kMaxDemWallTime_s) || accepted) return;
   throw InputError(c.path, pointer,
                    what + " is estimated at about " + format_number(wall_time_s / 86400.0, 3) +
                        " days of wall time, more than the limit of " + format_number(kMaxDemWallTime_s / 86400.0, 3) +

@@ -30,7 +30,7 @@ surrogate::SweepOptions field_sweep_options(const case_file::Case& c, const std:
 }
 
 std::string check_dem_field(const case_file::Case& c, std::size_t damper, const surrogate::Grid& grid,
-                            const surrogate::SweepOptions* sweep, double at_once) {
+                            const surrogate::SweepOptions* sweep, double at_once, bool accept_long_runs) {
   auto options = case_file::dem_options(c, damper, 1.0, 1.0);
   const double clearance_m = c.dampers.at(damper).layers.front().clearance_m;
   options.world.threads = 1;  // as the sweep runs each point
@@ -53,6 +53,10 @@ std::string check_dem_field(const case_file::Case& c, std::size_t damper, const 
       const auto point = surrogate::dem_point_options(options, drive.frequency_hz, drive.amplitude_m);
       const auto e = check_dem_run(c, damper, point);
       if (evaluated++ == 0) check_dem_placement(c, damper, point);  // the same bed at every node
+      check_wall_time(c, e.wall_time_s, "a point of the DEM field sweep", "/dem",
+                      "fewer /dem/analysed_periods or /dem/transient_periods, a larger /dem/time_step_s, or fewer "
+                      "particles",
+                      accept_long_runs);
       wall_time_s += e.wall_time_s;
       particle_steps += e.particle_steps;
       if (e.memory_bytes > largest.memory_bytes) largest = e;
@@ -85,7 +89,8 @@ FieldPlan plan_field(const case_file::Case& c, const FieldOptions& options, cons
   plan.sweep.shard_count = options.shard_count;
   plan.sweep.results_path = options.results_log;
   if (options.source == "dem") {
-    plan.estimate = check_dem_field(c, 0, plan.grid, &plan.sweep, executor.concurrency(c.field.threads));
+    plan.estimate = check_dem_field(c, 0, plan.grid, &plan.sweep, executor.concurrency(c.field.threads),
+                                    options.accept_long_runs);
   } else {
     try {
       (void)surrogate::pending_sweep_points(plan.grid, plan.sweep);  // a stale log: refused before any work

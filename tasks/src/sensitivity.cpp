@@ -116,6 +116,10 @@ SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOpti
       o.world.threads = 1;
       const auto e = check_dem_run(v.variant, 0, o);
       check_dem_placement(v.variant, 0, o);
+      check_wall_time(v.variant, e.wall_time_s, "the DEM run of " + v.parameter, "/dem",
+                      "fewer /dem/analysed_periods or /dem/transient_periods, a larger /dem/time_step_s, or fewer "
+                      "particles",
+                      options.accept_long_runs);
       wall_time_s += e.wall_time_s;
       particle_steps += e.particle_steps;
     }

@@ -787,6 +787,20 @@ TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless 
   accepted_dem.push_back("--accept-long-run");
   CHECK(run_pdamp(accepted_dem, accepted).exit_code == 128 + SIGTERM);
 
+  // A DEM field whose every point is such a run (a point is saved only when it ends):
+  // refused by field and by validate, accepted by validate with the flag; the flag without
+  // the DEM is refused.
+  const std::string field_case = edited_case("pdamp_field_long.json", [](json& c) {
+    c["dem"]["samples_per_period"] = 16;
+    c["dem"]["analysed_periods"] = 100000;
+    c["field"] = {{"axis0", {{"min", 0.01}, {"max", 0.02}, {"count", 2}}}, {"axis1", {{"min", 0.4}, {"max", 0.5}, {"count", 2}}}};
+  });
+  require_one_line_error(run_pdamp({"field", field_case, "--source", "dem", "-o", (tmp.path / "field").string()}),
+                         "a point of the DEM field sweep is estimated at about");
+  require_one_line_error(run_pdamp({"validate", field_case}), "more than the limit of 7 days");
+  CHECK(run_pdamp({"validate", field_case, "--accept-long-run"}).exit_code == 0);
+  require_one_line_error(run_pdamp({"field", field_case, "--source", "formulas", "--accept-long-run"}), "--accept-long-run");
+
   const fs::path verify = tmp.path / "long_verify.json";
   {
     json c = json::parse(slurp(case_path("manipulator_link_optimize.json")));

@@ -39,6 +39,9 @@ inline constexpr double kMaxDemWallTime_s = 7.0 * 86400.0;
 /// the hooks do not accept it; `what` names the run and `reduce` the keys that shorten it.
 void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
                      const std::string& reduce, RunHooks& hooks);
+/// The same with the acceptance given directly (a sweep's options carry it).
+void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
+                     const std::string& reduce, bool accepted);
 /// "N particles, S steps of dt s = P particle-steps, about T s at R particle-steps/s; memory about M".
 std::string estimate_text(const dem_reference::RunEstimate& estimate);
 /// "1.2 MB" or "3.4 GB".

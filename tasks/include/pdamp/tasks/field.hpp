@@ -24,10 +24,11 @@ namespace pdamp::tasks {
 surrogate::SweepOptions field_sweep_options(const case_file::Case& c, const std::string& source);
 
 /// A DEM field's sweep checked before it starts: every point's run as check_dem_run, the
-/// memory of `at_once` runs at once. Returns the estimate of the work still to do (the
-/// points already in the results log of `sweep` excluded; all without `sweep`).
+/// memory of `at_once` runs at once, and no point beyond kMaxDemWallTime_s unless
+/// `accept_long_runs` (a point is saved only when it ends). Returns the estimate of the work
+/// still to do (the points already in the results log of `sweep` excluded; all without `sweep`).
 std::string check_dem_field(const case_file::Case& c, std::size_t damper, const surrogate::Grid& grid,
-                            const surrogate::SweepOptions* sweep, double at_once);
+                            const surrogate::SweepOptions* sweep, double at_once, bool accept_long_runs = false);
 
 struct FieldOptions {
   std::string source = "formulas";            ///< "formulas" or "dem"
@@ -36,6 +37,7 @@ struct FieldOptions {
   int shard_index = 0;                        ///< the nodes k with k % shard_count == shard_index
   int shard_count = 1;
   std::string label = "pdamp field";          ///< names the sweep in notes and progress
+  bool accept_long_runs = false;              ///< a point estimated beyond kMaxDemWallTime_s may start
 };
 
 /// A field sweep checked before any output.

@@ -34,6 +34,7 @@ struct SensitivityOptions {
   int shard_index = 0;
   int shard_count = 1;
   std::string label = "pdamp sensitivity";
+  bool accept_long_runs = false;        ///< a run estimated beyond kMaxDemWallTime_s may start
 };
 
 /// A study checked before any output: every variant's DEM options and cost.
