@@ -68,20 +68,25 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
   return s.str();
 }
 
-/// One co-simulation run of `options`, its refusals as the case's errors.
-st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
-                                       const std::vector<st::CosimulationDamper>& dampers,
-                                       const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
-                                       st::CosimulationState* state = nullptr) {
-  detail::check_cosimulation(c, modal, dampers, options);
-  // A stop asked while the beds settle ends the run there: no checkpoint holds that phase.
-  const auto report = [&](const st::CosimulationProgress& p) {
+/// The co-simulation's progress as the hooks' lines. A stop asked while the beds settle ends
+/// the run there (Interrupted): no checkpoint holds that phase.
+st::CosimulationProgressCallback progress_to_hooks(RunHooks& hooks, const std::string& label) {
+  return [&hooks, label](const st::CosimulationProgress& p) {
     report_progress(hooks, label, p);
     if (p.stage == "settling")
       if (const int signal = hooks.stop_requested(); signal != 0)
         throw strict_json::Interrupted(signal, "the run stopped while its beds settled, before its first checkpoint: run "
                                                "the same command again");
   };
+}
+
+/// One co-simulation run of `options`, its refusals as the case's errors.
+st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
+                                       const std::vector<st::CosimulationDamper>& dampers,
+                                       const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
+                                       st::CosimulationState* state = nullptr) {
+  detail::check_cosimulation(c, modal, dampers, options);
+  const auto report = progress_to_hooks(hooks, label);
   auto r = detail::call_dem(c, [&] {
     return state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
   });
@@ -107,14 +112,7 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
   const std::string shown = strict_json::printable(cp.file.path.string());
-  // A stop asked while the beds settle ends the run there: no checkpoint holds that phase.
-  const auto report = [&](const st::CosimulationProgress& p) {
-    report_progress(hooks, label, p);
-    if (p.stage == "settling")
-      if (const int signal = hooks.stop_requested(); signal != 0)
-        throw strict_json::Interrupted(signal, "the run stopped while its beds settled, before its first checkpoint: run "
-                                               "the same command again");
-  };
+  const auto report = progress_to_hooks(hooks, label);
 
   std::optional<st::Cosimulation> run;
   if (cp.file.resume) {
