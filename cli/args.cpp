@@ -44,17 +44,24 @@ ParsedArgs::ParsedArgs(const CommandSpec& spec, const std::vector<std::string>& 
       continue;
     }
     if (arg.size() > 1 && arg[0] == '-' && !parse_number(arg)) {
+      // "--flag=value" as well as "--flag value" (GNU style); only for long flags, and the
+      // value is everything after the first '=' (it may hold '=' itself).
+      const std::size_t equals = arg.rfind("--", 0) == 0 ? arg.find('=') : std::string::npos;
+      const std::string name = arg.substr(0, equals);
       const FlagSpec* flag = nullptr;
       for (const auto& f : spec.flags)
-        if (f.name == arg) flag = &f;
+        if (f.name == name) flag = &f;
       if (flag == nullptr)
-        throw InputError(arg, "", "unknown option for 'pdamp " + spec.name + "' (see pdamp " + spec.name + " --help)");
-      if (values_.count(arg)) throw InputError(arg, "", "given more than once");
+        throw InputError(name, "", "unknown option for 'pdamp " + spec.name + "' (see pdamp " + spec.name + " --help)");
+      if (values_.count(name)) throw InputError(name, "", "given more than once");
       if (flag->value_name.empty()) {
-        values_[arg] = "";
+        if (equals != std::string::npos) throw InputError(name, "", "takes no value");
+        values_[name] = "";
+      } else if (equals != std::string::npos) {
+        values_[name] = arg.substr(equals + 1);
       } else {
-        if (i + 1 >= args.size()) throw InputError(arg, "", "needs a value (" + flag->value_name + ")");
-        values_[arg] = args[++i];
+        if (i + 1 >= args.size()) throw InputError(name, "", "needs a value (" + flag->value_name + ")");
+        values_[name] = args[++i];
       }
       continue;
     }

@@ -376,3 +376,26 @@ TEST_CASE("the closed-form commands take the bed models' flags and refuse bad va
   CHECK(h["regime"] == "stuck");
   CHECK(h["eta_star"] == 0.0);
 }
+
+// GNU-style "--flag=value" is the same as "--flag value" (the value is all after the first
+// '='); a flag without a value refuses one. pdamp --version names what a bug report needs.
+TEST_CASE("a flag written --flag=value is --flag value, and pdamp --version names the build", "[cli]") {
+  const auto spaced = run_pdamp({"loss", "--model", "rolling", "--clearance", "0.01", "--amplitude", "0.004",
+                                 "--frequency", "10", "--json"});
+  const auto joined = run_pdamp({"loss", "--model=rolling", "--clearance=0.01", "--amplitude=0.004", "--frequency=10",
+                                 "--json"});
+  REQUIRE(spaced.exit_code == 0);
+  CHECK(joined.exit_code == 0);
+  CHECK(joined.out == spaced.out);
+  require_one_line_error(run_pdamp({"loss", "--model=rolling", "--clearance=0.01", "--amplitude=0.004",
+                                    "--frequency=10", "--json=1"}),
+                         "--json: takes no value");
+  require_one_line_error(run_pdamp({"loss", "--model=rolling", "--clearance=", "--amplitude=0.004", "--frequency=10"}),
+                         "--clearance: '': must be a finite number");
+
+  const auto version = run_pdamp(std::string("--version"));
+  CHECK(version.exit_code == 0);
+  CHECK_THAT(version.out, Catch::StartsWith("pdamp ") && Catch::Contains("\ncommit ") &&
+                              Catch::Contains("DEM physics model version ") && Catch::Contains("\nbuild "));
+  require_one_line_error(run_pdamp(std::string("--version extra")), "--version: takes no further arguments");
+}
