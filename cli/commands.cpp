@@ -85,7 +85,7 @@ int run_optimum(const ParsedArgs& args, CommandContext&) {
   const double h = args.number("--clearance", limits::kClearance);
   const auto result = fm::optimum_stroke(model, h, model_options(args, model));
   json out = tasks::to_json(result);
-  return finish(args, nullptr, out, {}, optimum_rows(result), kPrintOnly);
+  return finish(args, nullptr, out, length_scale_warnings(args, {"--clearance"}), optimum_rows(result), kPrintOnly);
 }
 
 int run_size(const ParsedArgs& args, CommandContext&) {
@@ -93,7 +93,7 @@ int run_size(const ParsedArgs& args, CommandContext&) {
   const double stroke = args.number("--stroke", limits::kStroke);
   const auto sizing = tasks::size_for_stroke(model, stroke, model_options(args, model));
   json out = tasks::to_json(sizing);
-  return finish(args, nullptr, out, {},
+  return finish(args, nullptr, out, length_scale_warnings(args, {"--stroke"}),
                 {{"model", std::string(fm::to_string(model))},
                  {"stroke_m", format_number(stroke)},
                  {"clearance_m", format_number(sizing.clearance_m)},
@@ -112,7 +112,8 @@ int run_loss(const ParsedArgs& args, CommandContext& context) {
   auto files = output_dir(args, context);
   options.with_curve = files != nullptr;
   const auto study = tasks::run_loss(options);
-  std::vector<std::string> warnings = study.warnings;
+  std::vector<std::string> warnings = length_scale_warnings(args, {"--clearance", "--amplitude"});
+  warnings.insert(warnings.end(), study.warnings.begin(), study.warnings.end());
   if (files)
     for (auto& w : report::write_files(*files, study)) warnings.push_back(w);
   json out = tasks::to_json(study);

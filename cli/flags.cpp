@@ -1,8 +1,11 @@
 // Flags several subcommands share (flags.hpp).
 #include "flags.hpp"
 
+#include <cstdlib>
+
 #include "errors.hpp"
 #include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/strict_json/number_text.hpp"
 
 namespace pdamp::cli {
 
@@ -98,6 +101,20 @@ tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string&
 
 double checkpoint_interval(const ParsedArgs& args) {
   return args.optional_number("--checkpoint-interval", Range{0.0, 1e9}).value_or(60.0);
+}
+
+std::vector<std::string> length_scale_warnings(const ParsedArgs& args, const std::vector<std::string>& flags) {
+  std::vector<std::string> warnings;
+  for (const auto& flag : flags) {
+    const auto text = args.optional_text(flag);
+    if (!text) continue;
+    const double metres = std::strtod(text->c_str(), nullptr);  // already checked by the command
+    if (metres > 1.0)
+      warnings.push_back(flag + " " + *text + " is " + *text + " m, larger than any particle damper's (millimetres to "
+                         "decimetres): flags take metres (" + strict_json::format_number(metres / 1000.0) + " for " +
+                         *text + " mm)");
+  }
+  return warnings;
 }
 
 void refuse_flags(const ParsedArgs& args, const std::vector<FlagSpec>& flags, const std::string& why) {

@@ -38,6 +38,10 @@ bool dem_method(const ParsedArgs& args);
 tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string& name);
 /// --checkpoint-interval, s (default 60; 0: at every chance).
 double checkpoint_interval(const ParsedArgs& args);
+/// A warning for each length flag of `flags` given above 1 m: larger than any particle
+/// damper's clearance or stroke (millimetres to decimetres), most likely millimetres typed
+/// where the flag takes metres (`--clearance 100` is 100 m).
+std::vector<std::string> length_scale_warnings(const ParsedArgs& args, const std::vector<std::string>& flags);
 /// InputError when a checkpoint flag is given to a run that makes no checkpoints.
 /// A flag that would do nothing is refused (exit 2) with `why`: the first of `flags` given.
 void refuse_flags(const ParsedArgs& args, const std::vector<FlagSpec>& flags, const std::string& why);

@@ -399,3 +399,20 @@ TEST_CASE("a flag written --flag=value is --flag value, and pdamp --version name
                               Catch::Contains("DEM physics model version ") && Catch::Contains("\nbuild "));
   require_one_line_error(run_pdamp(std::string("--version extra")), "--version: takes no further arguments");
 }
+
+// A length typed in millimetres where the flag takes metres (`--clearance 100`: a 40 m design
+// stroke) is answered, with a warning naming the flag and the metres it meant; a damper's
+// real sizes get none.
+TEST_CASE("a length flag above a metre warns that flags take metres", "[cli]") {
+  const auto mm = run_pdamp(std::string("optimum --model rolling --clearance 100 --json"));
+  REQUIRE(mm.exit_code == 0);
+  const auto warnings = nlohmann::json::parse(mm.out)["warnings"];
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0].get<std::string>(), Catch::Contains("--clearance 100 is 100 m") &&
+                                                 Catch::Contains("flags take metres (0.1 for 100 mm)"));
+  CHECK_THAT(mm.err, Catch::Contains("pdamp: warning: --clearance 100"));
+  const auto m = run_pdamp(std::string("loss --model rolling --clearance 0.01 --amplitude 0.004 --frequency 10 --json"));
+  REQUIRE(m.exit_code == 0);
+  CHECK(m.err.find("flags take metres") == std::string::npos);
+  CHECK(run_pdamp(std::string("size --model rolling --stroke 5")).err.find("--stroke 5 is 5 m") != std::string::npos);
+}
