@@ -109,6 +109,14 @@ struct RunPlan {
   int particles = 0;
 };
 
+/// Spheres of every compartment of `world`.
+int particle_count(const WorldOptions& world) {
+  int particles = 0;
+  for (const auto& c : world.compartments)
+    for (const auto& g : c.particles) particles += g.count;
+  return particles;
+}
+
 /// Validates (std::invalid_argument: all violations) and plans: the drive's time step
 /// (drive_time_step: the bound at the drive's largest impact speed, a period of whole
 /// blocks of whole steps), the settling time, the step counts.
@@ -127,9 +135,7 @@ RunPlan plan_run(const DamperSimulationOptions& options) {
   plan.transient_steps = plan.step.steps_per_period * options.transient_periods;
   plan.analysed_steps = plan.step.steps_per_period * options.analysed_periods;
   plan.total_steps = plan.settle_steps + plan.approach_steps + plan.transient_steps + plan.analysed_steps;
-  for (const auto& c : plan.step.world.compartments) {
-    for (const auto& g : c.particles) plan.particles += g.count;
-  }
+  plan.particles = particle_count(plan.step.world);
   return plan;
 }
 
@@ -286,8 +292,7 @@ RunEstimate estimate_run(const DamperSimulationOptions& options) {
 
 WorldEstimate estimate_world(const WorldOptions& world) {
   WorldEstimate w;
-  for (const auto& c : world.compartments)
-    for (const auto& g : c.particles) w.particles += g.count;
+  w.particles = particle_count(world);
   RunEstimate e;
   estimate_world_bytes(world, w.particles, e);
   w.memory_bytes = e.particle_bytes + e.neighbour_bytes + e.contact_bytes;
