@@ -15,11 +15,14 @@ class CliHooks : public tasks::RunHooks {
  public:
   /// `checkpoint_interval_s`: wall-clock seconds between checkpoints (0: at every chance);
   /// `accept_long_runs`: --accept-long-run (a DEM run estimated beyond a week may start).
-  explicit CliHooks(double checkpoint_interval_s = 60.0, bool accept_long_runs = false);
+  /// `terminal`: progress rewrites one line in place (default: stderr is a terminal).
+  explicit CliHooks(double checkpoint_interval_s = 60.0, bool accept_long_runs = false,
+                    bool terminal = stderr_is_terminal());
+  static bool stderr_is_terminal();
   ~CliHooks() override;
-  /// One line per report: rewritten in place on a terminal, else at most one line every
-  /// 10 s per run (the first and the last of a run always). A run that gives no ETA gets
-  /// one from its mean rate since its first report.
+  /// One progress line: rewritten in place on a terminal (at most four times a second),
+  /// else a new line at most every 5 s over all runs (a run's first and last reports
+  /// always). A run that gives no ETA gets one from its mean rate since its first report.
   void progress(const tasks::Progress& p) override;
   void note(const std::string& line) override;
   bool checkpoint_due(double seconds_since_checkpoint) override;
@@ -33,7 +36,7 @@ class CliHooks : public tasks::RunHooks {
   bool accept_long_runs_;
   bool tty_;
   bool line_open_ = false;  // a terminal line being rewritten
-  std::map<std::string, std::chrono::steady_clock::time_point> last_line_;
+  std::chrono::steady_clock::time_point last_line_{};
   /// Per run: the wall time and progress of its first report, for an ETA where the run gives none.
   std::map<std::string, std::pair<std::chrono::steady_clock::time_point, double>> first_report_;
 };

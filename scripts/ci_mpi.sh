@@ -5,5 +5,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${1:-build}
-scripts/setup.sh "$build_dir" --mpi
+scripts/setup.sh "$build_dir" --mpi --tests
 ctest --test-dir "$build_dir" -L mpi --output-on-failure --timeout 300

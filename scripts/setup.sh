@@ -8,11 +8,13 @@ cd "$(dirname "$0")/.."
 build_dir=build
 mpi=OFF
 list=no
+targets=(--target pdamp)
 for arg in "$@"; do
   case "$arg" in
     --mpi) mpi=ON ;;
     --list-packages) list=yes ;;
-    -*) echo "setup: unknown option $arg (usage: scripts/setup.sh [build-dir] [--mpi] [--list-packages])" >&2; exit 2 ;;
+    --tests) targets=() ;;
+    -*) echo "setup: unknown option $arg (usage: scripts/setup.sh [build-dir] [--mpi] [--tests] [--list-packages])" >&2; exit 2 ;;
     *) build_dir=$arg ;;
   esac
 done
@@ -43,4 +45,4 @@ mpi_flag=(); [ "$mpi" = ON ] && mpi_flag=(-DPDAMP_MPI=ON)
 # make); a folder made by an earlier setup keeps its generator.
 generator=(); [ -f "$build_dir/CMakeCache.txt" ] || generator=(-G Ninja)
 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "${mpi_flag[@]}" >/dev/null
-cmake --build "$build_dir" -j"$(nproc)"
+cmake --build "$build_dir" -j"$(nproc)" "${targets[@]}"

@@ -236,13 +236,18 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
           return "pdamp frf (dem) " + sweep + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
                  format_number(frequencies[i], 5) + " Hz";
         };
-        auto branch = detail::call_dem(c, [&] {
-          return st::stepped_sine_branch(modal, dampers, options, frequencies, sweep, out.time_step_s,
-                                         [&](std::size_t i, const st::CosimulationProgress& p) {
-                                           hooks.progress({label(i), std::string(p.stage), p.simulated_time_s,
-                                                           p.end_time_s, false, p.steps_per_s, NAN});
-                                         });
-        });
+        // One progress line per direction: the point and its stage, with the share of the
+        // sweep done for the ETA (a point's end time is an upper bound, so its share is capped).
+        const auto report = [&](std::size_t i, const st::CosimulationProgress& p) {
+          const double point_share = p.end_time_s > 0.0 ? std::min(1.0, p.simulated_time_s / p.end_time_s) : 0.0;
+          hooks.progress({"pdamp frf (dem) " + sweep,
+                          std::to_string(i + 1) + "/" + std::to_string(n) + " " + format_number(frequencies[i], 4) +
+                              " Hz " + std::string(p.stage),
+                          p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN,
+                          (static_cast<double>(i) + point_share) / static_cast<double>(n)});
+        };
+        auto branch = detail::call_dem(
+            c, [&] { return st::stepped_sine_branch(modal, dampers, options, frequencies, sweep, out.time_step_s, report); });
         // The point that stopped the branch is the first without a result; a completed branch has none.
         detail::check_outcome(branch.outcome, branch.message, label(std::min(branch.points.size(), n - 1)));
         for (std::size_t i = 0; i < branch.points.size(); ++i)

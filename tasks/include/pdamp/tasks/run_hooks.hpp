@@ -19,6 +19,9 @@ struct Progress {
   bool counts_points = false;  ///< a sweep: done and total count points, not seconds
   double steps_per_s = NAN;    ///< integration steps per wall-clock second (NaN: none yet)
   double eta_s = NAN;          ///< wall-clock seconds to the end (NaN: not known yet)
+  /// Share of the whole run done, in [0, 1], where done/total measure one part of it (a
+  /// stepped sine's point): the ETA of a run that gives none comes from it (NaN: done/total).
+  double fraction_done = NAN;
 };
 
 /// The hooks of a run. Runs that go in parallel (two DEM decays, a sweep's points) share one
