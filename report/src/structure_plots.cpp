@@ -230,6 +230,14 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
   return out.add_plot("frf.gp", gp.str(), {"frf.png", "frf.svg"});
 }
 
+void write_without_beds_csv(OutputDir& out, const st::FreeDecay& without_beds) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "time_s,envelope_m\n";
+  for (const auto& s : without_beds.samples) csv << s.time_s << ',' << s.threshold_measure_m << '\n';
+  out.add(kWithoutBedsCsv, csv.str());
+}
+
 std::vector<std::string> write_decay_files(OutputDir& out, const st::FreeDecay& decay,
                                            const std::vector<std::string>& damper_names, const std::string& title) {
   const Eigen::Index modes = decay.samples.empty() ? 0 : decay.samples.front().modal_amplitudes.size();
@@ -273,7 +281,8 @@ std::vector<std::string> write_decay_files(OutputDir& out, const st::FreeDecay& 
        << ", graph 1 nohead lw 2 lc rgb 'dark-green'\n"
        << "  set label 2 " << gnuplot_string("settled: " + format_number(decay.settling_time_s, 4) + " s") << " at "
        << decay.settling_time_s << ", graph 0.9 left offset 0.5,0 tc rgb 'dark-green'\n";
-  gp << "  plot 'decay.csv' using 1:2 with lines lw 2 lc rgb 'blue' title 'envelope'\n"
+  gp << "  plot 'decay.csv' using 1:2 with lines lw 2 lc rgb 'blue' title 'envelope', \\\n"
+     << "       '" << kWithoutBedsCsv << "' using 1:2 with lines lw 1.5 dt 2 lc rgb 'gray40' title 'without particles'\n"
      << "  unset arrow\n  unset label\n  unset logscale y\n  set key top left\n"
      << "  set ylabel 'dissipated energy / J'\n"
      << "  plot 'decay.csv' using 1:" << energy_column + 1 << " with lines lw 1.5 dt 2 lc rgb 'gray40' title 'structure'";
@@ -308,7 +317,10 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
        << settling_time_s << ", graph 0.9 left offset 0.5,0 tc rgb 'dark-green'\n";
   gp << "  plot 'decay_dem.csv' using 1:2 with lines lw 1 lc rgb 'blue' title 'site displacement', \\\n"
      << "       '' using 1:(" << offset_m << " + $" << envelope_column << ") with lines lw 2 lc rgb 'dark-orange' title 'envelope', \\\n"
-     << "       '' using 1:(" << offset_m << " - $" << envelope_column << ") with lines lw 2 lc rgb 'dark-orange' notitle\n"
+     << "       '' using 1:(" << offset_m << " - $" << envelope_column << ") with lines lw 2 lc rgb 'dark-orange' notitle, \\\n"
+     << "       '" << kWithoutBedsCsv << "' using 1:(" << offset_m << " + $2) with lines lw 1.5 dt 2 lc rgb 'gray40' "
+     << "title 'envelope without particles', \\\n"
+     << "       '' using 1:(" << offset_m << " - $2) with lines lw 1.5 dt 2 lc rgb 'gray40' notitle\n"
      << "  unset arrow\n  unset label\n}\n";
   return out.add_plot("decay_dem.gp", gp.str(), {"decay_dem.png", "decay_dem.svg"});
 }

@@ -209,6 +209,7 @@ Warnings write_files(OutputDir& out, const tasks::FrfResult& r) {
 }
 
 Warnings write_files(OutputDir& out, const tasks::DecayResult& r) {
+  write_without_beds_csv(out, r.without_beds);
   if (r.method != tasks::DecayMethod::kDem)
     return write_decay_files(out, r.decay, r.damper_names,
                              r.case_name + ": free decay (" +
@@ -283,15 +284,14 @@ Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
   return out.add_plot("decay_compare.gp", gp.str(), {"decay_compare.png", "decay_compare.svg"});
 }
 
-/// verify_decay.csv (one block per design: the DEM's site displacement and envelope and the
-/// predicted envelope at the same instants) and its plot.
+/// verify_decay.csv (one block per design, chosen then baseline, separated by two blank
+/// lines for gnuplot's `index`, one header: the DEM's site displacement and envelope and
+/// the predicted envelope at the same instants) and its plot.
 /// `predicted_by`: what predicted ("closed forms", "calibrated beds").
 Warnings verification_files(OutputDir& out, const std::string& case_name, const tasks::Verification& v,
                             const std::string& predicted_by) {
   std::ostringstream csv;
   csv.precision(10);
-  csv << "# design, time_s, site_displacement_m (DEM), dem_envelope_m, predicted_envelope_m, threshold_m; "
-         "one block per design (chosen, then baseline), blocks separated by two blank lines\n";
   csv << "design,time_s,site_displacement_m,dem_envelope_m,predicted_envelope_m,threshold_m\n";
   for (std::size_t k = 0; k < v.designs.size(); ++k) {
     const auto& d = v.designs[k];

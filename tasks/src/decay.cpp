@@ -198,10 +198,9 @@ void add_loss_messages(detail::Warnings& warnings, const detail::Setup& setup, c
   }
 }
 
-/// The free decay by averaging on the layers' loss models.
-void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& q0, DecayResult& out) {
+/// The averaged solver's options for the case's release from q0.
+st::FreeDecayOptions averaged_decay_options(const Case& c, const st::ModalModel& modal, const Eigen::VectorXd& q0) {
   const auto& task = *c.task.decay;
-  const auto& modal = setup.s.modal;
   st::FreeDecayOptions options;
   options.initial_modal_amplitudes = q0.cwiseAbs();  // released from rest: a_j = |q_j(0)|
   options.duration_s = task.duration_s;
@@ -209,6 +208,26 @@ void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& 
   options.sample_times_s = st::uniform_sample_times(task.duration_s, static_cast<int>(decay_samples(modal, task.duration_s)) + 1);
   if (const auto problems = options.validate(modal.mode_count()); !problems.empty())
     throw InputError(c.path, "/task", problems.front());
+  return options;
+}
+
+/// The same release with the containers empty (the beds removed), judged against the
+/// same threshold: what the particles are measured against. Without beds the model is
+/// linear (structural damping only), so the averaged solver is exact for it whatever the
+/// method of the decay with beds.
+st::FreeDecay decay_without_beds(const Case& c, const detail::Setup& setup, const Eigen::VectorXd& q0, double threshold_m) {
+  auto empty = setup.s.dampers;
+  for (auto& d : empty) d.layers.clear();
+  auto options = averaged_decay_options(c, setup.s.modal, q0);
+  options.threshold_m = threshold_m;
+  return detail::call_solver(c, "/task", [&] { return st::free_decay(setup.s.modal, empty, options); });
+}
+
+/// The free decay by averaging on the layers' loss models.
+void averaged_decay(const Case& c, detail::Setup& setup, const Eigen::VectorXd& q0, DecayResult& out) {
+  const auto& task = *c.task.decay;
+  const auto& modal = setup.s.modal;
+  const auto options = averaged_decay_options(c, modal, q0);
   out.decay = detail::call_solver(c, "/task", [&] { return st::free_decay(modal, setup.s.dampers, options); });
   const auto& decay = out.decay;
   for (const auto& s : decay.samples)
@@ -381,6 +400,8 @@ DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hook
   } else {
     averaged_decay(c, setup, out.initial_modal_amplitudes, out);
   }
+  out.without_beds = decay_without_beds(c, setup, out.initial_modal_amplitudes,
+                                        dem ? out.dem.threshold_m : out.decay.threshold_used_m);
   // A decay reaches every stroke from above: a DEM field built from rest (the ascending
   // branch) can hold another state near and below the onset.
   for (const auto& layer : setup.s.fields_from_rest)
@@ -408,6 +429,16 @@ json to_json(const st::CosimulationEnergy& e) {
 }
 
 namespace {
+
+json without_beds_json(const DecayResult& res, const OutputFolder& folder) {
+  const auto& bare = res.without_beds;
+  return {{"what", "the same release with the containers empty (beds removed), judged against the same threshold"},
+          {"file", folder.file("decay_without_beds.csv")},
+          {"settling_time_s", number_or_null(bare.settling_time_s)},
+          {"outcome", bare.outcome == st::FreeDecay::Outcome::kSettled ? "settled" : "not_settled"},
+          {"damping_ratio", number_or_null(bare.equivalent_damping_ratio)},
+          {"final_envelope_m", bare.samples.empty() ? json(nullptr) : json(bare.samples.back().threshold_measure_m)}};
+}
 
 json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
   const DemDecay& decay = res.dem;
@@ -449,6 +480,7 @@ json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
             {"time_step_s", r.time_step_s},
             {"solve_time_s", r.wall_time_s},
             {"warnings", res.warnings}};
+  d["without_beds"] = without_beds_json(res, folder);
   json result = {{"task", "decay"}, {"case", res.case_name}, {"method", "dem"}};
   result["file"] = d["file"];
   result["settling_time_s"] = d["settling_time_s"];
@@ -496,6 +528,7 @@ json averaged_decay_json(const DecayResult& res, const OutputFolder& folder) {
             {"solve_time_s", decay.solve_time_s},
             {"report", decay.brief_report()},
             {"warnings", res.warnings}};
+  d["without_beds"] = without_beds_json(res, folder);
   json result = {{"task", "decay"}, {"case", res.case_name}, {"method", method}};
   result["file"] = d["file"];
   result["settling_time_s"] = d["settling_time_s"];

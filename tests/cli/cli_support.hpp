@@ -34,4 +34,30 @@ inline void require_one_line_error(const RunResult& r, const std::string& must_c
   CHECK_THAT(r.err, Catch::Contains(must_contain));
 }
 
+/// Every .csv in `dir` reads as one table with pandas' and R's defaults: the first line
+/// is the header (no `#` line before it), every other non-blank line has its number of
+/// fields (blank lines only separate gnuplot's blocks and are skipped by those readers).
+inline void require_plain_csv_tables(const std::filesystem::path& dir) {
+  std::size_t tables = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".csv") continue;
+    ++tables;
+    INFO(entry.path().string());
+    std::ifstream in(entry.path());
+    std::string line;
+    REQUIRE(std::getline(in, line));
+    CHECK(line.rfind('#', 0) == std::string::npos);
+    const auto fields = std::count(line.begin(), line.end(), ',');
+    std::size_t row = 1;
+    while (std::getline(in, line)) {
+      ++row;
+      if (line.empty()) continue;
+      INFO("line " << row << ": " << line);
+      CHECK(std::count(line.begin(), line.end(), ',') == fields);
+      if (std::count(line.begin(), line.end(), ',') != fields) break;  // one message per file
+    }
+  }
+  CHECK(tables > 0);
+}
+
 }  // namespace pdamp::test

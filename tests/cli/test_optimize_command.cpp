@@ -191,6 +191,7 @@ TEST_CASE("pdamp optimize --verify runs the DEM on the chosen and baseline desig
   CHECK(v["passed"] == (v["designs"]["chosen"]["passed"].get<bool>() && v["designs"]["baseline"]["passed"].get<bool>() &&
                         chosen_lower));
   CHECK(fs::is_regular_file(dir.path / "out" / "verify_decay.csv"));
+  require_plain_csv_tables(dir.path / "out");
 }
 
 TEST_CASE("the task's verification is skipped with --no-verify, and --verify with --no-verify is exit 2", "[cli][optimizer]") {

@@ -40,16 +40,22 @@ std::vector<std::string> write_frf_files(OutputDir& out, const structure::Freque
                                          const std::vector<std::string>& damper_names,
                                          const std::string& magnitude_label, const std::string& title);
 
+/// The decay's reference without particles (the containers empty): time_s, envelope_m.
+/// The decay plots below draw it, so it is written first.
+inline constexpr const char* kWithoutBedsCsv = "decay_without_beds.csv";
+void write_without_beds_csv(OutputDir& out, const structure::FreeDecay& without_beds);
+
 /// decay.csv (time, the envelope at the threshold point, each mode's amplitude, each
 /// damper's amplitude, energies, each layer's cumulative dissipated energy and power) and
-/// decay.gp/png/svg: the envelope with threshold and settling time (log y) over the
-/// per-layer dissipated energies.
+/// decay.gp/png/svg: the envelope with threshold and settling time (log y), and the
+/// envelope without particles, over the per-layer dissipated energies.
 std::vector<std::string> write_decay_files(OutputDir& out, const structure::FreeDecay& decay,
                                            const std::vector<std::string>& damper_names, const std::string& title);
 
 /// decay_dem.gp/png/svg for decay_dem.csv (written by pdamp decay --method dem: time_s,
 /// site_displacement_m_<damper> x dampers, envelope_m, ...): the first damper's site
-/// displacement with offset ± envelope, offset ± threshold and the settling time.
+/// displacement with offset ± envelope, offset ± threshold, the settling time and the
+/// envelope without particles.
 std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, double threshold_m, double settling_time_s,
                                               std::size_t dampers, const std::string& title);
 

@@ -109,6 +109,7 @@ struct DecayResult {
   Eigen::Index modes = 0;
   structure::FreeDecay decay;            ///< kFormulas, kField
   DemDecay dem;                          ///< kDem
+  structure::FreeDecay without_beds;     ///< the same release with the containers empty, same threshold
   std::vector<std::string> warnings;
 };
 /// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
