@@ -10,14 +10,14 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "errors.hpp"
-#include "pdamp/dem_reference/world.hpp"
+#include "version.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 
 namespace {
 
 void print_overview() {
-  std::cout << "pdamp " << PDAMP_VERSION << (pdamp::cli::distributed::built_with_mpi() ? " (MPI build)" : "") << ": design and optimisation of particle dampers\n\n"
+  std::cout << "pdamp " << pdamp::cli::version() << (pdamp::cli::distributed::built_with_mpi() ? " (MPI build)" : "") << ": design and optimisation of particle dampers\n\n"
             << "usage: pdamp <command> [options]   (pdamp <command> --help for its options)\n\ncommands:\n";
   for (const auto& command : pdamp::cli::commands()) {
     std::string name = "  " + command.spec.name;
@@ -26,15 +26,6 @@ void print_overview() {
   }
   std::cout << "\nUnits are SI (m, s, kg, Hz, Pa). Exit codes: 0 success, 1 other failure,\n"
                "2 bad input, 3 numerical failure at run time.\n";
-}
-
-/// pdamp --version: what a bug report or a result's provenance needs.
-void print_version() {
-  std::cout << "pdamp " << PDAMP_VERSION << "\n"
-            << "commit " << PDAMP_GIT_COMMIT << " (the one the build was configured from)\n"
-            << "DEM physics model version " << pdamp::dem_reference::kPhysicsModelVersion << "\n"
-            << "build " << (std::string(PDAMP_BUILD_TYPE).empty() ? "default" : PDAMP_BUILD_TYPE) << ", " << PDAMP_COMPILER
-            << ", MPI " << (pdamp::cli::distributed::built_with_mpi() ? "on" : "off") << "\n";
 }
 
 /// One error line on stderr (docs/command_line.md); the message is made printable so that a
@@ -96,7 +87,7 @@ int run_command(const std::vector<std::string>& args) {
   }
   if (args[0] == "--version") {
     if (args.size() > 1) return print_error("--version: takes no further arguments", kExitBadInput);
-    print_version();
+    std::cout << pdamp::cli::version_text();
     return finished(kExitOk);
   }
   try {

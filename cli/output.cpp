@@ -1,14 +1,14 @@
 // The end every command shares, and readable tables (output.hpp).
 #include "output.hpp"
 
-#include "pdamp/report/external_program.hpp"
-
 #include <iostream>
 #include <sstream>
 
+#include "pdamp/report/external_program.hpp"
 #include "pdamp/report/html_report.hpp"
 #include "pdamp/strict_json/input_file.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
+#include "version.hpp"
 
 namespace pdamp::cli {
 
@@ -67,7 +67,7 @@ int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& res
     result["warnings"] = warnings;
     if (how.resolved) files->add_json("case_resolved.json", how.resolved->resolved);
     if (!how.json_name.empty()) files->add_json(how.json_name, result);
-    if (how.report && how.resolved) report::stage_report(*files, *how.resolved, result, warnings);
+    if (how.report && how.resolved) report::stage_report(*files, *how.resolved, result, warnings, provenance_line());
     paths = files->commit();
   }
   result["warnings"] = warnings;

@@ -2,7 +2,8 @@
 # Install what the CI-only sanitizer and fuzz builds need beyond scripts/setup.sh:
 # clang, the compiler-rt runtimes of ASan/UBSan/libFuzzer (libclang-rt-14-dev: only a
 # Recommends of clang, which --no-install-recommends skips, so it is named here) and
-# llvm-symbolizer (llvm-14) for readable reports. A no-op when all are present.
+# llvm-symbolizer (llvm-14) for readable reports; and chromium, which the report test uses
+# to render report.html where it is installed. A no-op when all are present.
 # With --all, first everything scripts/setup.sh and scripts/ci_mpi.sh install too, in the
 # same apt-get call: .ci/run starts with it on a fresh machine, so there is one
 # `apt-get update` and one install instead of three, and the later scripts find their
@@ -11,7 +12,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(clang libclang-rt-14-dev llvm-14 ninja-build)
+# chromium: the report test renders report.html headless in CI (skipped where it is missing).
+packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium)
 if [ "${1:-}" = --all ]; then
   read -r -a base <<<"$(scripts/setup.sh --list-packages --mpi)"
   packages=("${base[@]}" "${packages[@]}")

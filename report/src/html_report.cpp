@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "pdamp/strict_json/output_file.hpp"
+#include "report_answer.hpp"
 
 namespace pdamp::report {
 
@@ -38,12 +39,16 @@ std::string scalar_text(const json& v) {
   if (v.is_null()) return "–";
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
   if (v.is_number_integer() || v.is_number_unsigned()) return std::to_string(v.get<long long>());
-  if (v.is_number()) return format_number(v.get<double>(), 6);
+  if (v.is_number()) return three_digits(v.get<double>());
   if (v.is_string()) return v.get<std::string>();
   return v.dump();
 }
 
 bool is_scalar(const json& v) { return !v.is_object() && !v.is_array(); }
+
+bool ends_with(const std::string& text, std::string_view end) {
+  return text.size() > end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+}
 
 /// A short array of numbers ([x, y], per-layer slabs) reads as one value.
 bool is_short_number_list(const json& v) {
@@ -61,7 +66,9 @@ void flatten(const json& object, const std::string& prefix, int depth, std::vect
   for (const auto& [key, value] : object.items()) {
     if (rows.size() >= kMaxGenericRows || skipped_key(key)) continue;
     const std::string name = prefix.empty() ? key : prefix + " / " + key;
-    if (is_scalar(value)) rows.push_back({name, scalar_text(value)});
+    if (value.is_number() && ends_with(key, "_m")) rows.push_back({name.substr(0, name.size() - 2) + " (mm)", in_mm(value)});
+    else if (value.is_number() && ends_with(key, "_kg")) rows.push_back({name.substr(0, name.size() - 3) + " (g)", in_g(value)});
+    else if (is_scalar(value)) rows.push_back({name, scalar_text(value)});
     else if (is_short_number_list(value)) rows.push_back({name, list_text(value)});
     else if (value.is_object() && depth < 1) flatten(value, name, depth + 1, rows);
   }
@@ -112,14 +119,14 @@ std::string array_tables(const json& result) {
   return out.str();
 }
 
-std::string mm(const json& v) { return v.is_number() ? format_number(v.get<double>() * 1e3, 4) : "–"; }
-std::string seconds(const json& v) { return v.is_number() ? format_number(v.get<double>(), 5) : "not settled"; }
+std::string mm(const json& v) { return v.is_number() ? three_digits(v.get<double>() * 1e3) : "–"; }
+std::string seconds(const json& v) { return v.is_number() ? three_digits(v.get<double>()) : "not settled"; }
 
 /// filling_ratios: the designs side by side.
 std::string designs_section(const json& result) {
   if (!result.contains("designs") || !result["designs"].is_object()) return "";
   std::vector<std::vector<std::string>> rows;
-  for (const char* name : {"chosen", "relaxed", "baseline", "initial"}) {
+  for (const char* name : {"chosen", "baseline", "bare", "same_mass", "initial", "relaxed"}) {
     if (!result["designs"].contains(name)) continue;
     const json& d = result["designs"][name];
     std::string slabs, clearances;
@@ -127,12 +134,12 @@ std::string designs_section(const json& result) {
       slabs += (slabs.empty() ? "" : ", ") + scalar_text(l["slabs"]);
       clearances += (clearances.empty() ? "" : ", ") + mm(l["clearance_m"]);
     }
-    rows.push_back({name, slabs, clearances, mm(d["total_mass_kg"]) + " g", seconds(d["settling_time_s"]),
+    rows.push_back({name, slabs, clearances, in_g(d["total_mass_kg"]), seconds(d["settling_time_s"]),
                     scalar_text(d["objective"])});
   }
   std::string layers;
   for (const auto& l : result["designs"]["chosen"]["layers"]) layers += (layers.empty() ? "" : ", ") + scalar_text(l["name"]);
-  return "<h2>Designs</h2>\n<p>Layers: " + html_escape(layers) + " (whole slabs n, clearance h = L − n·2r).</p>\n" +
+  return "<h3>Designs</h3>\n<p>Layers: " + html_escape(layers) + " (whole slabs n, clearance h = L − n·2r).</p>\n" +
          table({"design", "slabs n", "clearance h / mm", "particle mass", "settling time / s", "objective"}, rows);
 }
 
@@ -145,7 +152,7 @@ std::string solver_section(const json& result) {
     rows.push_back({"rounding", scalar_text(result["rounding"]["rule"])});
   std::vector<std::vector<std::string>> cells;
   for (const auto& [k, v] : rows) cells.push_back({k, v});
-  return "<h2>Optimiser</h2>\n" + table({"", ""}, cells);
+  return "<h3>Optimiser</h3>\n" + table({"", ""}, cells);
 }
 
 std::string verification_section(const json& result) {
@@ -176,7 +183,7 @@ std::string verification_section(const json& result) {
   }
   const std::string unit = settling ? "settling time / s" : "½∫e² dt / m² s";
   std::ostringstream out;
-  out << "<h2>DEM verification</h2>\n<p>" << html_escape(scalar_text(v["what"])) << ". Simulated "
+  out << "<h3>DEM verification</h3>\n<p>" << html_escape(scalar_text(v["what"])) << ". Simulated "
       << html_escape(scalar_text(v["duration_s"])) << " s each, stiffness softening "
       << html_escape(scalar_text(v["effective_stiffness_softening"])) << ", tolerance "
       << html_escape(format_number(100.0 * v["tolerance_relative"].get<double>(), 3)) << " %.</p>\n"
@@ -202,7 +209,7 @@ std::string calibration_section(const json& result) {
       rows.push_back({html_escape(scalar_text(b["layer"])), scalar_text(b["slabs"]), scalar_text(b["extra_damping_ratio"]),
                       scalar_text(b["periods"]), mm(b["stroke_min_m"]) + " – " + mm(b["stroke_max_m"]),
                       b["cached"].get<bool>() ? "cache" : "run now (" + seconds(b["wall_time_s"]) + " s)"});
-    out << "<h2>Calibrated beds</h2>\n<p>" << html_escape(scalar_text(c["what"])) << ": "
+    out << "<h3>Calibrated beds</h3>\n<p>" << html_escape(scalar_text(c["what"])) << ": "
         << html_escape(scalar_text(c["duration_s"])) << " s each, stiffness softening "
         << html_escape(scalar_text(c["stiffness_softening"])) << "; " << html_escape(scalar_text(c["runs"]))
         << " DEM decays run now, the others from " << html_escape(scalar_text(c["cache_dir"])) << ".</p>\n"
@@ -225,7 +232,7 @@ std::string calibration_section(const json& result) {
                         std::string(name) == "chosen" ? std::to_string(r["recalibrated"].size()) : ""});
       }
     }
-    out << "<h2>Design loop</h2>\n<p>Outcome: " << html_escape(scalar_text(loop["outcome"])) << ".</p>\n"
+    out << "<h3>Design loop</h3>\n<p>Outcome: " << html_escape(scalar_text(loop["outcome"])) << ".</p>\n"
         << table({"round", "design", "slabs", "predicted", "DEM", "DEM − predicted", "result", "beds recalibrated after"},
                  rows);
   }
@@ -240,8 +247,8 @@ std::string caption(const std::string& file_name) {
       {"frf", "frequency response with the dampers and without the beds"},
       {"frf_dem", "frequency response, DEM in the loop"},
       {"frf_compare", "frequency response: closed forms, field and DEM"},
-      {"decay", "free decay with the dampers and without the beds"},
-      {"decay_dem", "free decay, DEM in the loop"},
+      {"decay", "free decay with the dampers, and without particles (dashed: the containers empty)"},
+      {"decay_dem", "free decay, DEM in the loop, and without particles (dashed: the containers empty)"},
       {"decay_compare", "free-decay envelopes: chosen design, best single layer, case start"},
       {"verify_decay", "DEM verification: envelopes by the DEM (solid) and as predicted (dashed: the closed forms or the calibrated beds)"},
       {"force_velocity", "DEM: container force and velocity"},
@@ -325,21 +332,27 @@ std::string report_html(const ReportInput& in) {
          "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #bbb;padding:2px 8px;text-align:left;"
          "vertical-align:top}th{background:#eee}img{max-width:100%;border:1px solid #ddd}"
          ".note{color:#555}.verdict{font-weight:bold}.pass{color:#060}.fail{color:#b00}"
+         ".answer{background:#f4f7fb;border-left:4px solid #36c;padding:0.3em 1em;font-size:1.05em}"
          "li.warning{color:#840}</style>\n</head>\n<body>\n";
   out << "<h1>" << html_escape(in.case_name) << "</h1>\n";
-  if (!in.case_description.empty()) out << "<p>" << html_escape(in.case_description) << "</p>\n";
   out << "<p class=\"note\">Task " << html_escape(task) << ", case file " << html_escape(in.case_file)
-      << "; written by pdamp run. All numbers in SI units as in the result JSON.</p>\n";
+      << ". Lengths in mm, masses in g, times in s; three significant digits (every digit in the result JSON).</p>\n";
 
-  std::vector<std::pair<std::string, std::string>> rows;
-  if (r.is_object()) flatten(r, "", 0, rows);
-  std::vector<std::vector<std::string>> cells;
-  for (const auto& [k, v] : rows) cells.push_back({k, v});
-  out << "<h2>Key numbers</h2>\n" << table({"quantity", "value"}, cells);
-  if (r.is_object())
-    out << designs_section(r) << solver_section(r) << calibration_section(r) << verification_section(r) << array_tables(r);
+  // 1. The answer: the design and what it gains, then the verdict of the check behind it.
+  const Answer answer = r.is_object() ? report_answer(r, in.case_resolved) : Answer{};
+  out << "<section class=\"answer\">\n<h2>Answer</h2>\n";
+  if (answer.paragraphs.empty()) out << "<p>The result's numbers are under Details below.</p>\n";
+  for (const auto& paragraph : answer.paragraphs) out << "<p>" << html_escape(paragraph) << "</p>\n";
+  if (!answer.verdict.empty())
+    out << "<p class=\"verdict" << (answer.passed ? (*answer.passed ? " pass" : " fail") : "") << "\">"
+        << html_escape(answer.verdict) << "</p>\n";
+  if (!in.warnings.empty())
+    out << "<p class=\"note\">" << in.warnings.size() << (in.warnings.size() == 1 ? " warning" : " warnings")
+        << " below: each says where a model leaves its range.</p>\n";
+  out << "</section>\n";
 
-  out << "<h2>Plots</h2>\n";
+  // 2. The evidence: plots, the DEM's check, the beds it rests on, the warnings.
+  out << "<h2>Evidence</h2>\n";
   if (!in.gnuplot_found)
     out << "<p class=\"note\">gnuplot was not found: this report has no plots. The data (CSV) and the gnuplot scripts "
            "(.gp) are in the output folder; run <code>gnuplot NAME.gp</code> there once gnuplot is installed.</p>\n";
@@ -351,24 +364,40 @@ std::string report_html(const ReportInput& in) {
         << ";base64," << base64(p.bytes) << "\">\n<figcaption>" << html_escape(caption(p.file_name)) << " ("
         << html_escape(p.file_name) << ")</figcaption>\n</figure>\n";
   }
-
-  out << "<h2>Warnings</h2>\n";
+  if (r.is_object()) out << verification_section(r) << calibration_section(r);
+  out << "<h3>Warnings</h3>\n";
   if (in.warnings.empty()) out << "<p>None.</p>\n";
   else {
     out << "<ul>\n";
     for (const auto& w : in.warnings) out << "<li class=\"warning\">" << html_escape(w) << "</li>\n";
     out << "</ul>\n";
   }
+
+  // 3. The details: the case, the solver, every number, provenance.
+  out << "<h2>Details</h2>\n";
+  if (!in.case_description.empty()) out << "<p>" << html_escape(in.case_description) << "</p>\n";
+  std::vector<std::pair<std::string, std::string>> rows;
+  if (r.is_object()) flatten(r, "", 0, rows);
+  std::vector<std::vector<std::string>> cells;
+  for (const auto& [k, v] : rows) cells.push_back({k, v});
+  if (r.is_object()) out << designs_section(r) << solver_section(r);
+  out << "<h3>Numbers</h3>\n" << table({"quantity", "value"}, cells);
+  if (r.is_object()) out << array_tables(r);
+  out << "<h3>Provenance</h3>\n<p class=\"note\">" << html_escape(in.provenance.empty() ? "pdamp" : in.provenance)
+      << "; case file " << html_escape(in.case_file) << "; written by pdamp run.</p>\n";
   out << "</body>\n</html>\n";
   return out.str();
 }
 
-void stage_report(OutputDir& files, const case_file::Case& c, const json& result, const std::vector<std::string>& warnings) {
+void stage_report(OutputDir& files, const case_file::Case& c, const json& result, const std::vector<std::string>& warnings,
+                  const std::string& provenance) {
   const fs::path page = files.staged_path("report.html");
   ReportInput in;
   in.case_name = c.name;
   in.case_description = c.description;
   in.case_file = c.path;
+  in.case_resolved = c.resolved;
+  in.provenance = provenance;
   in.result = result;
   in.warnings = warnings;
   in.pictures = staged_pictures(page.parent_path());

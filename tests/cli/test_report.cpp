@@ -1,12 +1,16 @@
-// The HTML report of pdamp run -o DIR (cli/report.cpp): escaping of hostile case text,
-// base64 against RFC 4648's vectors, embedded pictures, the no-gnuplot note, and that
-// only pdamp run writes it.
+// The HTML report of pdamp run -o DIR (report/src/html_report.cpp): escaping of hostile
+// case text, base64 against RFC 4648's vectors, embedded pictures, the no-gnuplot note,
+// that only pdamp run writes it, and the answer each shipped case's page opens with
+// (rendered by headless Chromium where it is installed).
 #include <catch2/catch.hpp>
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -37,7 +41,7 @@ void require_inert(const std::string& html) {
   CHECK(page.find("javascript:") == std::string::npos);
   static const std::vector<std::string> kOwnTags = {"!doctype", "html", "head", "meta", "title", "style", "body",
                                                     "h1", "h2", "h3", "p", "table", "tr", "th", "td", "figure",
-                                                    "img", "figcaption", "ul", "li", "code"};
+                                                    "img", "figcaption", "ul", "li", "code", "section"};
   for (std::size_t at = page.find('<'); at != std::string::npos; at = page.find('<', at + 1)) {
     std::size_t end = at + 1;
     if (end < page.size() && page[end] == '/') ++end;
@@ -76,14 +80,14 @@ TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs
   in.case_name = kHostile;
   in.case_description = "description " + kHostile;
   in.case_file = "/cases/" + kHostile + ".json";
-  in.result = {{"task", "decay"}, {"case", kHostile}, {"settling_time_s", 17.25}, {"decay", {{"outcome", kHostile}}}};
+  in.result = {{"task", "decay"}, {"case", kHostile}, {"settling_time_s", 17.31}, {"decay", {{"outcome", kHostile}}}};
   in.warnings = {"warning " + kHostile};
   in.pictures = {{"decay.png", "\x89PNG\r\n\x1a\n"}};
   const std::string html = pdamp::report::report_html(in);
   require_inert(html);
   CHECK(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;") != std::string::npos);
   CHECK(html.find("Content-Security-Policy") != std::string::npos);
-  CHECK(html.find("17.25") != std::string::npos);  // the key number
+  CHECK(html.find("17.3") != std::string::npos);  // the key number, to three significant digits
   // The PNG signature 89 50 4E 47 0D 0A 1A 0A is "iVBORw0KGgo=" in base64.
   CHECK(html.find("src=\"data:image/png;base64,iVBORw0KGgo=\"") != std::string::npos);
   CHECK(html.find("gnuplot was not found") == std::string::npos);
@@ -111,10 +115,10 @@ TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other 
   const std::string html = slurp(out / "report.html");
   require_inert(html);
   CHECK(html.find("&lt;script&gt;") != std::string::npos);
-  // The design table: the 36-sphere bed's clearance h_roll = 0.1 m (docs/cases.md) and
-  // the rolling design stroke 0.4 h = 0.04 m (docs/theory.md §3).
-  CHECK(html.find("clearance_m") != std::string::npos);
-  CHECK(html.find("0.04") != std::string::npos);
+  // The answer: the 36-sphere bed's clearance h_roll = 0.1 m (docs/cases.md) and the
+  // rolling design stroke 0.4 h = 0.04 m (docs/theory.md §3), in mm.
+  CHECK(html.find("with a clearance of 100 mm along the drive") != std::string::npos);
+  CHECK(html.find("with a stroke of 40 mm") != std::string::npos);
   if (fs::is_regular_file(out / "eta_curve.png")) {
     CHECK(html.find("data:image/png;base64,iVBORw0KGgo") != std::string::npos);  // the PNG, embedded
     CHECK(html.find("eta_curve.png") != std::string::npos);
@@ -163,4 +167,107 @@ TEST_CASE("a picture gnuplot leaves incomplete ends the run before the earlier r
   std::getline(kept, line);
   CHECK(line == "1,2");  // the earlier set is untouched
   CHECK_FALSE(fs::exists(dir.path / "cut.svg"));
+}
+
+namespace {
+
+/// The text of the page's answer section, tags removed and the five references undone.
+std::string answer_text(const std::string& html) {
+  const auto begin = html.find("<section class=\"answer\">");
+  const auto end = html.find("</section>");
+  REQUIRE(begin != std::string::npos);
+  REQUIRE(end != std::string::npos);
+  std::string text = std::regex_replace(html.substr(begin, end - begin), std::regex("<[^>]*>"), " ");
+  for (const auto& [ref, ch] : std::vector<std::pair<std::string, std::string>>{
+           {"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&#39;", "'"}, {"&amp;", "&"}})
+    for (std::size_t at; (at = text.find(ref)) != std::string::npos;) text.replace(at, ref.size(), ch);
+  return text;
+}
+
+/// `value` as the page should print it: three significant digits (C's %.3g, trailing zeros dropped).
+std::string three(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("the report of each shipped case opens with its answer in g, mm and s, three digits each", "[cli][report]") {
+  const TempDir dir("report_answers");
+  for (const char* name : {"low_intensity_36_spheres", "high_intensity_cylinder", "buffered_wall_60hz", "manipulator_link_decay",
+                           "beam_base_excited", "free_free_beam_shaker", "free_free_beam_placement"}) {
+    INFO(name);
+    const fs::path out = dir.path / name;
+    const auto r = run_pdamp({"run", case_path(std::string(name) + ".json"), "-o", out.string(), "--json"});
+    REQUIRE(r.exit_code == 0);
+    const json result = json::parse(r.out);
+    const std::string html = slurp(out / "report.html");
+    require_inert(html);
+    const std::string answer = answer_text(html);
+    INFO(answer);
+    // The answer comes first, then the evidence, then the details.
+    CHECK(html.find("<h2>Answer</h2>") < html.find("<h2>Evidence</h2>"));
+    CHECK(html.find("<h2>Evidence</h2>") < html.find("<h2>Details</h2>"));
+    // No decimal number in the answer carries more than three significant digits (counts are whole).
+    const std::regex decimal(R"((\d+)\.(\d+))");
+    for (auto it = std::sregex_iterator(answer.begin(), answer.end(), decimal); it != std::sregex_iterator(); ++it) {
+      std::string digits = (*it)[1].str() + (*it)[2].str();
+      digits.erase(0, digits.find_first_not_of('0'));
+      CHECK(digits.size() <= 3);
+    }
+    require_plain_csv_tables(out);
+    const std::string task = result["task"];
+    if (std::string(name) == "low_intensity_36_spheres") {
+      CHECK_THAT(answer, Catch::Contains("A bed of 36 steel spheres of 5 mm radius"));
+      CHECK_THAT(answer, Catch::Contains("η* = " + three(result["operating_point"]["eta_star"].get<double>())));
+      CHECK_THAT(answer, Catch::Contains("times the onset of collect-and-collide"));
+    }
+    if (std::string(name) == "buffered_wall_60hz")
+      CHECK_THAT(answer, Catch::Contains(three(result["buffer"]["layer_thickness_m"].get<double>() * 1e3) + " mm thick"));
+    if (task == "decay") {
+      // The link settles with particles and not within the 30 s without them (its structural
+      // damping alone, ζ = 0.003 at about 3.5 Hz, takes about 60 s to 5 %).
+      CHECK_THAT(answer, Catch::Contains("settles in " + three(result["settling_time_s"].get<double>()) + " s"));
+      CHECK(result["decay"]["without_beds"]["settling_time_s"].is_null());
+      CHECK_THAT(answer, Catch::Contains("without particles (empty containers) it does not settle within 30 s"));
+    }
+    if (task == "frf") {
+      // Each peak against the peak without particles nearest in frequency (the same mode).
+      const json& peak = result["frf"]["peaks"][0];
+      const json* bare = nullptr;
+      for (const auto& lin : result["frf"]["linear_peaks"])
+        if (!bare || std::abs(lin["frequency_hz"].get<double>() - peak["frequency_hz"].get<double>()) <
+                         std::abs((*bare)["frequency_hz"].get<double>() - peak["frequency_hz"].get<double>()))
+          bare = &lin;
+      REQUIRE(bare);
+      CHECK_THAT(answer, Catch::Contains("the particles lower the peak " +
+                                         three((*bare)["magnitude"].get<double>() / peak["magnitude"].get<double>()) + " times"));
+    }
+    if (task == "placement") CHECK_THAT(answer, Catch::Contains("Put the damper " + three(result["design"]["position_m"].get<double>()) + " m along"));
+  }
+
+  // Headless Chromium reads the page as a browser does: the answer is in its document,
+  // and its screenshot is a whole PNG (CI installs chromium; elsewhere this part is skipped).
+  const auto chromium = pdamp::report::find_executable("chromium");
+  if (!chromium) {
+    WARN("chromium is not installed: the page is not rendered");
+    return;
+  }
+  const fs::path page = dir.path / "manipulator_link_decay" / "report.html";
+  // --no-sandbox: CI runs as root, where Chromium's sandbox refuses to start.
+  const std::vector<std::string> common = {"--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                                           "--window-size=1100,1800"};
+  auto dump = common;
+  dump.insert(dump.end(), {"--dump-dom", "file://" + page.string()});
+  REQUIRE(pdamp::report::run_program(*chromium, dump, dir.path, dir.path / "dom.html") == 0);
+  const std::string dom = slurp(dir.path / "dom.html");
+  CHECK_THAT(dom, Catch::Contains("<h2>Answer</h2>"));
+  CHECK_THAT(dom, Catch::Contains("without particles (empty containers) it does not settle within 30 s"));
+  auto shot = common;
+  shot.insert(shot.end(), {"--screenshot=" + (dir.path / "report.png").string(), "file://" + page.string()});
+  REQUIRE(pdamp::report::run_program(*chromium, shot, dir.path, dir.path / "chromium.log") == 0);
+  const std::string png = slurp(dir.path / "report.png");
+  CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+  CHECK(png.find("IEND") != std::string::npos);  // the last chunk: the picture is whole
 }

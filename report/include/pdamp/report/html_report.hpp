@@ -1,6 +1,9 @@
-// The one-page HTML report of `pdamp run -o DIR` (DIR/report.html): case, key numbers of
-// the result, the run's plots embedded as data URIs (readable offline), the optimiser's
-// summary, the DEM verification and the warnings. Every text from the case is escaped.
+// The one-page HTML report of `pdamp run -o DIR` (DIR/report.html), written for the
+// engineer who asked: first the answer (the design in g and mm, what it gains over no
+// particles and over the best single layer, the verdict of the DEM's check), then the
+// evidence (the plots, embedded as data URIs so the page reads offline; the verification;
+// the warnings), then the details (the solver, every number, provenance). Every text from
+// the case is escaped.
 #pragma once
 
 #include <string>
@@ -17,8 +20,9 @@ namespace pdamp::report {
 /// Stages report.html built from the result JSON, the warnings and the pictures already
 /// staged in `files` (PNG, else SVG, as produced by gnuplot): call it just before
 /// files.commit().
+/// `provenance`: the program's version and commit, printed at the end.
 void stage_report(OutputDir& files, const case_file::Case& c, const nlohmann::json& result,
-                  const std::vector<std::string>& warnings);
+                  const std::vector<std::string>& warnings, const std::string& provenance);
 
 /// A picture for the report: its file name (caption key) and its bytes.
 struct ReportPicture {
@@ -31,6 +35,8 @@ struct ReportInput {
   std::string case_name;
   std::string case_description;
   std::string case_file;
+  nlohmann::json case_resolved;       ///< the resolved case (case_resolved.json): what was built
+  std::string provenance;             ///< "pdamp 0.1.0, commit ..."
   nlohmann::json result;              ///< the task's result JSON (results.json of the run)
   std::vector<std::string> warnings;
   std::vector<ReportPicture> pictures;

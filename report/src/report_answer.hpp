@@ -1,0 +1,28 @@
+// The answer paragraph of report.html (report_answer.cpp): what the case asked, answered
+// in the units a damper is built with, and the verdict of the check that backs it.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace pdamp::report {
+
+struct Answer {
+  std::vector<std::string> paragraphs;  ///< plain text (escaped by the page)
+  std::string verdict;                  ///< the DEM check's or the margin's, empty if none
+  std::optional<bool> passed;           ///< colours the verdict; none: neutral
+};
+
+/// From the task's result JSON and the resolved case (case_resolved.json); empty
+/// paragraphs for a task without a written answer.
+Answer report_answer(const nlohmann::json& result, const nlohmann::json& case_resolved);
+
+/// Numbers as the page prints them: three significant digits; lengths in mm, masses in g.
+std::string three_digits(double value);
+std::string in_mm(const nlohmann::json& metres);
+std::string in_g(const nlohmann::json& kilograms);
+
+}  // namespace pdamp::report
