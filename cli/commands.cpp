@@ -227,6 +227,8 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
     options.analysed_periods = static_cast<int>(*periods);
   if (const auto threads = args.optional_integer("--threads", 0, dem_reference::limits::kMaxThreads))
     options.threads = static_cast<int>(*threads);
+  if (const auto snapshots = args.optional_integer("--snapshots", 0, dem_reference::limits::kMaxSnapshots))
+    options.snapshots = static_cast<int>(*snapshots);
   const auto plan = tasks::plan_dem(c, options);
   auto files = output_dir(args, context);
   // Checkpoints in the -o folder at period ends (docs/dem.md "Checkpoints"): every
@@ -592,14 +594,17 @@ const std::vector<Command>& commands() {
          {"--impact-velocity", "M_S", "impact speed, m/s (default 2*X*Omega, the bouncing optimum)"},
          kJsonFlag}},
        run_buffer},
-      {{"dem", "pdamp dem CASE.json [--amplitude M] [--frequency HZ] [--resume] [-o DIR] [--json]",
+      {{"dem", "pdamp dem CASE.json [--amplitude M] [--frequency HZ] [--snapshots N] [--resume] [-o DIR] [--json]",
         "reference DEM of the case's damper under harmonic motion x = X sin(2 pi f t): eta*,\n"
         "its standard error, apparent mass, energy balance, motion mode (docs/dem.md)",
         concat_flags({{"--amplitude", "M", "stroke X, m (default: the case's excitation.amplitude_m)"},
                       {"--frequency", "HZ", "frequency f, Hz (default: the case's excitation.frequency_hz)"},
                       {"--periods", "N", "analysed periods (default: the case's dem.analysed_periods)"},
                       {"--threads", "N", "OpenMP threads, 0 = all (default: the case's dem.threads)"},
-                      {"-o", "DIR", "write summary.json, time_series.csv, particles_*.vtk (ParaView) and\n"
+                      {"--snapshots", "N", "particle snapshots for ParaView, evenly over the analysed periods\n"
+                                           "                          (default: the case's dem.snapshots)"},
+                      {"-o", "DIR", "write summary.json, time_series.csv, particles.pvd with particles_*.vtp\n"
+                                    "                          (ParaView: VTK XML, docs/dem.md) and\n"
                                     "                          force_velocity.png/.svg into DIR, atomically (and\n"
                                     "                          dem.checkpoint while the run lasts: --resume)"},
                       kJsonFlag},

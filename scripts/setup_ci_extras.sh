@@ -2,8 +2,8 @@
 # Install what the CI-only sanitizer and fuzz builds need beyond scripts/setup.sh:
 # clang, the compiler-rt runtimes of ASan/UBSan/libFuzzer (libclang-rt-14-dev: only a
 # Recommends of clang, which --no-install-recommends skips, so it is named here) and
-# llvm-symbolizer (llvm-14) for readable reports; and chromium, which the report test uses
-# to render report.html where it is installed. A no-op when all are present.
+# llvm-symbolizer (llvm-14) for readable reports; chromium, which the report test uses to
+# render report.html, and python3-vtk9, whose reader loads the ParaView files. A no-op when all are present.
 # With --all, first everything scripts/setup.sh and scripts/ci_mpi.sh install too, in the
 # same apt-get call: .ci/run starts with it on a fresh machine, so there is one
 # `apt-get update` and one install instead of three, and the later scripts find their
@@ -12,8 +12,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# chromium: the report test renders report.html headless in CI (skipped where it is missing).
-packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium)
+# chromium: the report test renders report.html headless; python3-vtk9: VTK's reader loads
+# pdamp dem's ParaView files (both tests are skipped where these are missing).
+packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium python3-vtk9)
 if [ "${1:-}" = --all ]; then
   read -r -a base <<<"$(scripts/setup.sh --list-packages --mpi)"
   packages=("${base[@]}" "${packages[@]}")

@@ -249,7 +249,7 @@ std::string caption(const std::string& file_name) {
       {"frf_compare", "frequency response: closed forms, field and DEM"},
       {"decay", "free decay with the dampers, and without particles (dashed: the containers empty)"},
       {"decay_dem", "free decay, DEM in the loop, and without particles (dashed: the containers empty)"},
-      {"decay_compare", "free-decay envelopes: chosen design, best single layer, case start"},
+      {"decay_compare", "free-decay envelopes: chosen design, best single layer, case start and without particles (the containers empty)"},
       {"verify_decay", "DEM verification: envelopes by the DEM (solid) and as predicted (dashed: the closed forms or the calibrated beds)"},
       {"force_velocity", "DEM: container force and velocity"},
       {"field_map", "effective field"},

@@ -38,11 +38,14 @@ Warnings write_files(OutputDir& out, const tasks::LossStudy& loss) {
 
 Warnings write_files(OutputDir& out, const tasks::DemRunResult& r) {
   dem_reference::write_time_series_csv(out.staged_path("time_series.csv").string(), r.dem.series);
+  std::vector<std::pair<double, std::string>> series;
   for (std::size_t i = 0; i < r.dem.snapshots.size(); ++i) {
     char name[64];
-    std::snprintf(name, sizeof name, "particles_%04zu.vtk", i);
-    dem_reference::write_vtk_snapshot(out.staged_path(name).string(), r.dem.snapshots[i]);
+    std::snprintf(name, sizeof name, "particles_%04zu.vtp", i);
+    dem_reference::write_vtp_snapshot(out.staged_path(name).string(), r.dem.snapshots[i]);
+    series.push_back({r.dem.snapshots[i].time_s, name});
   }
+  if (!series.empty()) dem_reference::write_pvd_series(out.staged_path("particles.pvd").string(), series);
   return write_force_velocity_plot(out, r.case_name + ": X = " + format_number(r.amplitude_m * 1e3, 4) + " mm, f = " +
                                             format_number(r.frequency_hz, 4) + " Hz");
 }
@@ -261,11 +264,11 @@ Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
   const auto& runs = res.comparison.decays;
   std::ostringstream env;
   env.precision(10);
-  env << "time_s,envelope_chosen_m,envelope_baseline_m,envelope_initial_m,threshold_m\n";
+  env << "time_s,envelope_chosen_m,envelope_baseline_m,envelope_initial_m,threshold_m,envelope_without_particles_m\n";
   for (std::size_t i = 0; i < runs.front().samples.size(); ++i)
     env << runs[0].samples[i].time_s << ',' << runs[0].samples[i].threshold_measure_m << ','
         << runs[1].samples[i].threshold_measure_m << ',' << runs[2].samples[i].threshold_measure_m << ','
-        << runs[0].threshold_used_m << '\n';
+        << runs[0].threshold_used_m << ',' << runs[3].samples[i].threshold_measure_m << '\n';
   out.add("decay_compare.csv", env.str());
   std::ostringstream gp;
   gp << "# free-decay envelopes of pdamp optimize (filling ratios); run: gnuplot decay_compare.gp\n"
@@ -279,6 +282,7 @@ Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
      << "  plot 'decay_compare.csv' using 1:($2*1e3) every ::1 with lines lw 2 lc rgb 'blue' title 'chosen', \\\n"
      << "       '' using 1:($3*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer', \\\n"
      << "       '' using 1:($4*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'gray40' title 'case start', \\\n"
+     << "       '' using 1:($6*1e3) every ::1 with lines lw 1.5 dt 4 lc rgb 'dark-orange' title 'without particles', \\\n"
      << "       '' using 1:($5*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
      << "}\n";
   return out.add_plot("decay_compare.gp", gp.str(), {"decay_compare.png", "decay_compare.svg"});

@@ -114,6 +114,7 @@ DemRunPlan plan_dem(const case_file::Case& c, const DemRunOptions& o) {
   plan.options = case_file::dem_options(c, 0, plan.amplitude_m, plan.frequency_hz);
   if (o.analysed_periods) plan.options.analysed_periods = *o.analysed_periods;
   if (o.threads) plan.options.world.threads = *o.threads;
+  if (o.snapshots) plan.options.snapshots = *o.snapshots;
   plan.estimate = check_dem_run(c, 0, plan.options);
   check_dem_placement(c, 0, plan.options);
   return plan;

@@ -411,12 +411,13 @@ json verification_json(const Verification& v) {
   return out;
 }
 
-/// The closed-form envelopes of the chosen, baseline and starting designs on one grid.
+/// The closed-form envelopes of the chosen, baseline and starting designs and of the
+/// structure without particles (the containers empty: linear, so exact) on one grid.
 DesignComparison compare_designs(const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r) {
   st::FreeDecayOptions decay = p.options.decay;
   decay.sample_times_s = st::uniform_sample_times(decay.duration_s, kComparisonSamples);
   DesignComparison out;
-  for (const auto* d : {&r.chosen, &r.baseline, &r.initial}) {
+  for (const auto* d : {&r.chosen, &r.baseline, &r.initial, &r.bare}) {
     std::vector<st::Damper> dampers = {opt::filling_damper(p.options, slabs_of(*d))};
     dampers.insert(dampers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
     out.decays.push_back(st::free_decay(p.modal, dampers, decay));

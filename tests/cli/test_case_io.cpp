@@ -158,7 +158,9 @@ TEST_CASE("pdamp dem reports the promised keys and writes its files", "[cli]") {
   // The DEM's own energy account closes to its target (< 2%).
   CHECK(d["energy_balance_error"].get<double>() < 0.02);
   CHECK(d["clearance_m"].get<double>() == Approx(0.100).margin(1e-9));
-  for (const char* name : {"summary.json", "time_series.csv", "particles_0000.vtk"}) CHECK(fs::exists(dir / name));
+  for (const char* name : {"summary.json", "time_series.csv", "particles.pvd", "particles_0000.vtp"}) CHECK(fs::exists(dir / name));
+  // --snapshots overrides the case's count, within its range.
+  require_one_line_error(run_pdamp("dem " + path + " --snapshots 10001"), "--snapshots: '10001': must be a whole number in [0, 10000]");
 }
 
 // Every shipped case runs in the DEM as shipped ("pdamp dem on the shipped cases

@@ -2,6 +2,9 @@
 // the low-intensity rolling sweep and the high-intensity bouncing sweep ([long]) — and
 // the error paths and result files of run_harmonic.
 #include <catch2/catch.hpp>
+#include <cstdint>
+#include <iterator>
+#include <cstring>
 
 #include <algorithm>
 #include <cmath>
@@ -123,9 +126,9 @@ TEST_CASE("result files are complete CSV and VTK written atomically", "[dem_refe
   const auto dir = std::filesystem::temp_directory_path() / "pdamp_dem_test_files";
   std::filesystem::create_directories(dir);
   const auto csv = (dir / "series.csv").string();
-  const auto vtk = (dir / "particles.vtk").string();
+  const auto vtp = (dir / "particles.vtp").string();
   dr::write_time_series_csv(csv, r.series);
-  dr::write_vtk_snapshot(vtk, r.snapshots.back());
+  dr::write_vtp_snapshot(vtp, r.snapshots.back());
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);
@@ -133,9 +136,22 @@ TEST_CASE("result files are complete CSV and VTK written atomically", "[dem_refe
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   CHECK(rows == 64);
-  std::ifstream v(vtk);
-  std::getline(v, line);
-  CHECK(line == "# vtk DataFile Version 3.0");
+  // The VTK XML layout: its header, one vertex per particle, the appended block whose
+  // first array (radius_m) is a UInt64 byte count then the radii as stored.
+  std::ifstream v(vtp, std::ios::binary);
+  const std::string file((std::istreambuf_iterator<char>(v)), std::istreambuf_iterator<char>());
+  CHECK(file.rfind("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\"", 0) == 0);
+  const std::size_t n = r.snapshots.back().radii_m.size();
+  CHECK_THAT(file, Catch::Contains("NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfVerts=\"" + std::to_string(n) + "\""));
+  const auto block = file.find("<AppendedData encoding=\"raw\">\n   _");
+  REQUIRE(block != std::string::npos);
+  const std::size_t at = block + std::string("<AppendedData encoding=\"raw\">\n   _").size();
+  std::uint64_t bytes = 0;
+  std::memcpy(&bytes, file.data() + at, sizeof bytes);
+  CHECK(bytes == n * sizeof(double));
+  double first_radius = 0.0;
+  std::memcpy(&first_radius, file.data() + at + sizeof bytes, sizeof first_radius);
+  CHECK(first_radius == r.snapshots.back().radii_m.front());
   CHECK_FALSE(std::filesystem::exists(csv + ".tmp"));
   CHECK_THROWS_AS(dr::write_time_series_csv((dir / "missing" / "x.csv").string(), r.series), std::runtime_error);
   std::filesystem::remove_all(dir);

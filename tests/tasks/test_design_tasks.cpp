@@ -32,9 +32,12 @@ TEST_CASE("filling ratios: the chosen design is within the budget and its decay 
   for (const auto& l : chosen.layers) CHECK(l.slabs == std::round(l.slabs));
   const auto again = optimizer::evaluate_filling_design(r.problem.modal, r.problem.options, tasks::slabs_of(chosen));
   CHECK(again.objective == chosen.objective);
-  REQUIRE(r.comparison.decays.size() == 3);
+  REQUIRE(r.comparison.decays.size() == 4);  // chosen, baseline, initial, without particles
   CHECK(r.comparison.decays[0].settling_time_s == Approx(chosen.settling_time_s).epsilon(1e-6));
   CHECK(r.comparison.decays[1].settling_time_s == Approx(r.optimum.baseline.settling_time_s).epsilon(1e-6));
+  // Without particles the comparison's envelope ends above every design's.
+  for (std::size_t k = 0; k < 3; ++k)
+    CHECK(r.comparison.decays[3].samples.back().threshold_measure_m > r.comparison.decays[k].samples.back().threshold_measure_m);
   // The references: without particles only the structure damps (its decay is slower than
   // any design's); the same mass in one compartment is scored at its own best clearance.
   CHECK(r.optimum.bare.total_mass_kg == 0.0);

@@ -1,7 +1,10 @@
-// Result files of a DEM run: time-series CSV and VTK particle snapshots, written atomically.
+// Result files of a DEM run: time-series CSV and VTK XML particle snapshots with their
+// ParaView series, written atomically.
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pdamp/dem_reference/damper_simulation.hpp"
 
@@ -13,9 +16,15 @@ namespace pdamp::dem_reference {
 /// std::runtime_error naming the path if writing fails.
 void write_time_series_csv(const std::string& path, const TimeSeries& series);
 
-/// VTK legacy ASCII POLYDATA (ParaView: Glyph filter scaled by the `radius_m` array gives
-/// spheres) with point data radius_m, velocity_m_s, angular_velocity_rad_s and
-/// compartment. Atomic as above.
-void write_vtk_snapshot(const std::string& path, const ParticleSnapshot& snapshot);
+/// VTK XML PolyData (.vtp, binary appended: ParaView and VTK's vtkXMLPolyDataReader), one
+/// vertex per particle at its centre in the world frame (the container moves in it: x_c(t)
+/// along the drive), with point data radius_m (ParaView: Glyph, sphere, scaled by it gives
+/// the spheres), velocity_m_s and angular_velocity_rad_s (world frame), compartment, and
+/// the time in the field TimeValue. Atomic as above.
+void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& snapshot);
+
+/// A ParaView data series (.pvd): `files` as (time in s, file name relative to the .pvd),
+/// so that ParaView's time controls step through the snapshots at their times.
+void write_pvd_series(const std::string& path, const std::vector<std::pair<double, std::string>>& files);
 
 }  // namespace pdamp::dem_reference

@@ -55,6 +55,7 @@ struct DemRunOptions {
   std::optional<double> frequency_hz;  ///< f, Hz (default: the case's excitation.frequency_hz)
   std::optional<int> analysed_periods; ///< default: the case's dem.analysed_periods
   std::optional<int> threads;          ///< OpenMP threads, 0 = all (default: the case's dem.threads)
+  std::optional<int> snapshots;        ///< particle snapshots kept (default: the case's dem.snapshots)
   std::string label = "pdamp dem";     ///< names the run in progress lines and notes
 };
 

@@ -108,7 +108,7 @@ struct Verification {
 /// The closed-form envelopes of the chosen, baseline and starting designs on one time grid
 /// (decay_compare.csv).
 struct DesignComparison {
-  std::vector<structure::FreeDecay> decays;  ///< chosen, baseline, initial
+  std::vector<structure::FreeDecay> decays;  ///< chosen, baseline, initial, bare (no particles)
 };
 
 /// One round of the design loop: the designs verified and how they agreed.
