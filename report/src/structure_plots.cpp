@@ -165,6 +165,7 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
   br << "branch,frequency_hz,stability";
   for (const auto& d : damper_names) br << ",amplitude_m_" << label(d);
   for (const auto& o : r.output_names) br << ",magnitude_" << label(o);
+  for (const auto& o : r.output_names) br << ",phase_deg_" << label(o);
   br << '\n';
   bool first = true;
   for (auto& [id, roots] : branches) {
@@ -175,6 +176,7 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
       br << id << ',' << f << ',' << st::to_string(root->stability);
       for (double x : root->damper_amplitudes_m) br << ',' << x;
       for (const auto& y : root->outputs) br << ',' << std::abs(y);
+      for (const auto& y : root->outputs) br << ',' << std::arg(y) * kRadToDeg;
       br << '\n';
     }
   }
@@ -186,6 +188,7 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
       br << -1 << ',' << p.frequency_hz << ",held_at_jump";
       for (std::size_t d = 0; d < damper_names.size(); ++d) br << ',' << (d == 0 ? held.damper_amplitude_m : std::nan(""));
       for (const auto& y : held.outputs) br << ',' << std::abs(y);
+      for (const auto& y : held.outputs) br << ',' << std::arg(y) * kRadToDeg;
       br << '\n';
     }
   out.add("frf_branches.csv", br.str());
@@ -205,28 +208,40 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
        << "set label " << marks << " '" << (end.kind == st::BranchEnd::Kind::kFold ? "fold" : "jump") << "' at "
        << end.frequency_hz << ", graph " << (marks % 2 ? 0.97 : 0.92) << " center font ',8' tc rgb 'gray30'\n";
   }
+  // Magnitude over phase, one x axis (as NLvib and test-rig software show an FRF). The
+  // phase of the output against the excitation, deg, in (-180, 180].
   gp << "state(s, c) = (stringcolumn(3) eq s) ? column(c) : 1/0\n"
      << "do for [t in 'pngcairo svg'] {\n"
-     << "  set terminal t size 1000,650 enhanced font 'Sans,11'\n"
+     << "  set terminal t size 1000,900 enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'frf.svg' : 'frf.png'\n"
+     << "  set multiplot layout 2,1\n  set lmargin 12\n"
+     << "  set size 1,0.62\n  set origin 0,0.38\n  set logscale y\n  unset xlabel\n"
      << "  plot ";
   const std::size_t first_magnitude = 4 + damper_names.size();
-  for (std::size_t o = 0; o < outputs; ++o) {
-    const std::string name = outputs > 1 ? " (" + r.output_names[o] + ")" : "";
-    const std::size_t c = first_magnitude + o;
-    gp << (o ? ", \\\n       " : "") << "'frf.csv' using 1:" << 2 + 2 * o << " with lines lw 1.5 dt 4 lc rgb '"
-       << colour(o) << "' title " << gnuplot_string("without beds" + name) << " noenhanced, \\\n"
-       << "       'frf_branches.csv' using 2:(state('stable', " << c << ")) with lines lw 2 lc rgb '" << colour(o)
-       << "' title " << gnuplot_string("with dampers, stable" + name) << " noenhanced, \\\n"
-       << "       '' using 2:(state('unstable', " << c << ")) with lines lw 2 dt 2 lc rgb '" << colour(o)
-       << "' title " << gnuplot_string("unstable" + name) << " noenhanced, \\\n"
-       << "       '' using 2:(state('marginal', " << c << ")) with points pt 6 ps 0.6 lc rgb '" << colour(o)
-       << "' notitle";
-    if (any_held)
-      gp << ", \\\n       '' using 2:(state('held_at_jump', " << c << ")) with points pt 7 ps 0.5 lc rgb '" << colour(o)
-         << "' title " << gnuplot_string("held at a jump" + name) << " noenhanced";
-  }
-  gp << "\n}\n";
+  const auto curves = [&](std::size_t linear_column, std::size_t first_column) {
+    for (std::size_t o = 0; o < outputs; ++o) {
+      const std::string name = outputs > 1 ? " (" + r.output_names[o] + ")" : "";
+      const std::size_t c = first_column + o;
+      gp << (o ? ", \\\n       " : "") << "'frf.csv' using 1:" << linear_column + 2 * o << " with lines lw 1.5 dt 4 lc rgb '"
+         << colour(o) << "' title " << gnuplot_string("without beds" + name) << " noenhanced, \\\n"
+         << "       'frf_branches.csv' using 2:(state('stable', " << c << ")) with lines lw 2 lc rgb '" << colour(o)
+         << "' title " << gnuplot_string("with dampers, stable" + name) << " noenhanced, \\\n"
+         << "       '' using 2:(state('unstable', " << c << ")) with lines lw 2 dt 2 lc rgb '" << colour(o)
+         << "' title " << gnuplot_string("unstable" + name) << " noenhanced, \\\n"
+         << "       '' using 2:(state('marginal', " << c << ")) with points pt 6 ps 0.6 lc rgb '" << colour(o)
+         << "' notitle";
+      if (any_held)
+        gp << ", \\\n       '' using 2:(state('held_at_jump', " << c << ")) with points pt 7 ps 0.5 lc rgb '" << colour(o)
+           << "' title " << gnuplot_string("held at a jump" + name) << " noenhanced";
+    }
+    gp << "\n";
+  };
+  curves(2, first_magnitude);
+  gp << "  unset title\n  unset logscale y\n  unset label\n  set key off\n  set xlabel 'frequency f / Hz'\n"
+     << "  set ylabel 'phase / deg'\n  set yrange [-180:180]\n  set ytics 90\n"
+     << "  set size 1,0.38\n  set origin 0,0\n  plot ";
+  curves(3, first_magnitude + outputs);
+  gp << "  unset multiplot\n  set yrange [*:*]\n  set ytics autofreq\n  set key top right\n}\n";
   return out.add_plot("frf.gp", gp.str(), {"frf.png", "frf.svg"});
 }
 
@@ -415,10 +430,25 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
         csv << source << ',' << id << ',' << f << ',' << st::to_string(root->stability) << ','
             << std::abs(root->outputs.front()) << ",0\n";
     }
+    // The states held at a jump (where no harmonic-balance root exists, the averaged
+    // bed stays at its onset): without them the curve has a gap there.
+    bool held_block = false;
+    for (const auto& p : r.points)
+      for (const auto& held : p.held_at_jump) {
+        if (held.outputs.empty()) continue;
+        if (!held_block && !first) csv << '\n';
+        held_block = true;
+        first = false;
+        csv << source << ",-1," << p.frequency_hz << ",held_at_jump," << std::abs(held.outputs.front()) << ",0\n";
+      }
   };
   branches(formulas, "formulas");
   if (field) branches(*field, "field");
+  // The structure without particles (the containers empty), the same for every source.
   if (!first) csv << '\n';
+  for (const auto& p : formulas.points)
+    if (!p.linear_outputs.empty()) csv << "without_beds,0," << p.frequency_hz << ",linear," << std::abs(p.linear_outputs.front()) << ",0\n";
+  csv << '\n';
   for (const auto& p : dem)
     csv << "dem_" << p.sweep << ",0," << p.frequency_hz << (p.converged ? ",dem," : ",dem_unconverged,") << p.magnitude
         << ',' << p.spread << '\n';
@@ -444,7 +474,13 @@ std::vector<std::string> write_frf_compare_files(OutputDir& out, const st::Frequ
     gp << "       '' using 3:(sel('field', 'stable', 5)) with lines lw 2 lc rgb '" << colour(1) << "' title 'field', \\\n"
        << "       '' using 3:(sel('field', 'unstable', 5)) with lines lw 2 dt 2 lc rgb '" << colour(1)
        << "' title 'field, unstable', \\\n";
-  gp << "       '' using 3:(sel('dem_up', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
+  gp << "       '' using 3:(sel('formulas', 'held_at_jump', 5)) with points pt 7 ps 0.5 lc rgb '" << colour(0)
+     << "' title 'formulas, held at a jump', \\\n";
+  if (field)
+    gp << "       '' using 3:(sel('field', 'held_at_jump', 5)) with points pt 7 ps 0.5 lc rgb '" << colour(1)
+       << "' title 'field, held at a jump', \\\n";
+  gp << "       '' using 3:(sel('without_beds', 'linear', 5)) with lines lw 1.5 dt 4 lc rgb 'gray40' title 'without particles', \\\n"
+     << "       '' using 3:(sel('dem_up', 'dem', 5)):6 with yerrorbars pt 7 ps 1.2 lc rgb '" << colour(2)
      << "' title 'DEM, stepped sine up', \\\n"
      << "       '' using 3:(sel('dem_down', 'dem', 5)):6 with yerrorbars pt 6 ps 1.2 lc rgb '" << colour(3)
      << "' title 'DEM, stepped sine down', \\\n"

@@ -73,40 +73,58 @@ Warnings write_files(OutputDir& out, const tasks::SensitivityResult& study) {
         << ',' << r.clearance_m << ',' << r.bed_mass_kg << ',' << r.status << '\n';
   out.add("sensitivity.csv", csv.str());
 
-  // Per parameter the lowest and highest eta* of its values, sorted by that range, about
-  // the baseline's eta*.
-  struct Bar {
-    std::string parameter;
-    double low = INFINITY, high = -INFINITY, low_value = NAN, high_value = NAN;
-  };
-  std::vector<Bar> bars;
-  for (const auto& r : study.rows) {
-    if (r.parameter == "baseline" || !std::isfinite(r.eta_star)) continue;
-    auto it = std::find_if(bars.begin(), bars.end(), [&](const Bar& b) { return b.parameter == r.parameter; });
-    if (it == bars.end()) it = bars.insert(bars.end(), Bar{r.parameter});
-    if (r.eta_star < it->low) it->low = r.eta_star, it->low_value = r.value;
-    if (r.eta_star > it->high) it->high = r.eta_star, it->high_value = r.value;
-  }
-  std::sort(bars.begin(), bars.end(), [](const Bar& a, const Bar& b) { return a.high - a.low < b.high - b.low; });
+  // The bars sorted by how far each parameter moves η* from the baseline, largest on top,
+  // each end labelled with its value and η*, the DEM's standard errors as error bars.
+  const tasks::Tornado t = tasks::tornado(study);
   std::ostringstream tornado;
   tornado.precision(10);
-  tornado << "parameter,eta_star_low,eta_star_high,value_at_low,value_at_high\n";
-  for (const auto& b : bars) tornado << b.parameter << ',' << b.low << ',' << b.high << ',' << b.low_value << ',' << b.high_value << '\n';
+  tornado << "parameter,eta_star_low,eta_star_high,value_at_low,value_at_high,eta_star_stderr_at_low,"
+             "eta_star_stderr_at_high,effect\n";
+  for (const auto& b : t.bars)
+    tornado << b.parameter << ',' << b.low << ',' << b.high << ',' << b.value_at_low << ',' << b.value_at_high << ','
+            << (std::isfinite(b.stderr_at_low) ? b.stderr_at_low : 0.0) << ','
+            << (std::isfinite(b.stderr_at_high) ? b.stderr_at_high : 0.0) << ',' << b.effect << '\n';
   out.add("sensitivity_tornado.csv", tornado.str());
   const double baseline = study.baseline_eta_star;
+  std::string without;
+  for (const auto& p : t.without_effect) without += (without.empty() ? "" : ", ") + p;
+  // The x range holds every bar, its error bars, labels and the baseline.
+  double x_min = baseline, x_max = baseline;
+  for (const auto& b : t.bars) {
+    x_min = std::min({x_min, b.low - (std::isfinite(b.stderr_at_low) ? b.stderr_at_low : 0.0)});
+    x_max = std::max({x_max, b.high + (std::isfinite(b.stderr_at_high) ? b.stderr_at_high : 0.0)});
+  }
+  const double pad = 0.25 * std::max(x_max - x_min, 1e-3 * std::max(1.0, std::abs(baseline)));
   std::ostringstream gp;
-  gp << "# tornado plot of pdamp sensitivity: eta* over each parameter's values; run: gnuplot sensitivity.gp\n"
+  gp.precision(10);
+  gp << "# tornado plot of pdamp sensitivity: eta* over each parameter's values, the largest effect on top;\n"
+     << "# run: gnuplot sensitivity.gp\n"
      << "set datafile separator ','\n"
-     << "set title " << gnuplot_string(study.case_name + ": sensitivity of eta* (one parameter at a time)") << " noenhanced\n"
-     << "set xlabel 'reduced loss factor {/Symbol h}*'\nset ytics noenhanced\nset grid x\nset key bottom right\n"
-     << "set offsets 0, 0, 0.5, 0.5\nset style fill solid 0.6 border -1\n"
-     << "set arrow from " << baseline << ", graph 0 to " << baseline << ", graph 1 nohead lc rgb 'black' dt 2\n"
-     << "do for [t in 'pngcairo svg'] {\n"
-     << "  set terminal t size 900," << 200 + 45 * static_cast<int>(bars.size()) << " enhanced font 'Sans,11'\n"
+     << "set title " << gnuplot_string(study.case_name + ": sensitivity of eta* (one parameter at a time, " + study.source + ")");
+  // A second title line (gnuplot's "\n" in a double-quoted piece) for what has no bar.
+  if (!without.empty())
+    gp << ".\"\\n\"."
+       << gnuplot_string((study.source == "formulas" ? "no effect in the closed forms: " : "no effect on eta*: ") + without);
+  gp << " noenhanced\n"
+     << "set xlabel 'reduced loss factor {/Symbol h}*'\nset ytics noenhanced\nset grid x\nset key below\n"
+     << "set xrange [" << x_min - pad << ":" << x_max + pad << "]\nset offsets 0, 0, 0.5, 0.5\n"
+     << "set style fill solid 0.6 border -1\n"
+     << "set arrow from " << baseline << ", graph 0 to " << baseline << ", graph 1 nohead lc rgb 'black' dt 2\n";
+  gp << "do for [t in 'pngcairo svg'] {\n"
+     // Wide enough for the second title line (about 7 px per character at 11 pt).
+     << "  set terminal t size " << std::max<std::size_t>(1000, 140 + 7 * (30 + without.size())) << ","
+     << 220 + 45 * static_cast<int>(t.bars.size()) << " enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'sensitivity.svg' : 'sensitivity.png'\n"
-     << "  plot 'sensitivity_tornado.csv' every ::1 using (($2+$3)/2):($0):2:3:($0-0.3):($0+0.3):ytic(1) "
-        "with boxxyerror lc rgb 'steelblue' title 'range over the values', \\\n"
-     << "       NaN with lines dt 2 lc rgb 'black' title " << gnuplot_string("baseline " + format_number(baseline, 4)) << "\n"
+     << "  base = " << baseline << "\n"
+     << "  plot 'sensitivity_tornado.csv' every ::1 using (base):($0):($2 < base ? $2 : base):($3 > base ? $3 : base):"
+        "($0-0.3):($0+0.3):ytic(1) with boxxyerror lc rgb 'steelblue' title 'from the baseline to each value', \\\n"
+     << "       '' every ::1 using 2:($0):6 with xerrorbars pt 7 ps 0.6 lc rgb 'black' title 'standard error', \\\n"
+     << "       '' every ::1 using 3:($0):7 with xerrorbars pt 7 ps 0.6 lc rgb 'black' notitle, \\\n"
+     << "       '' every ::1 using 2:($0):(sprintf('%.3g: %.3g ', $4, $2)) with labels right offset -1,0 font ',9' "
+        "notitle, \\\n"
+     << "       '' every ::1 using 3:($0):($5 == $4 ? '' : sprintf(' %.3g: %.3g', $5, $3)) with labels left offset 1,0 "
+        "font ',9' notitle, \\\n"
+     << "       NaN with lines dt 2 lc rgb 'black' title " << gnuplot_string("baseline " + format_number(baseline, 3)) << "\n"
      << "}\n";
   return out.add_plot("sensitivity.gp", gp.str(), {"sensitivity.png", "sensitivity.svg"});
 }

@@ -1,6 +1,8 @@
 // pdamp sensitivity as a study (sensitivity.hpp).
 #include "pdamp/tasks/sensitivity.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "job_codecs.hpp"
@@ -176,6 +178,34 @@ SensitivityResult merge_sensitivity(const case_file::Case& c, const std::string&
   return out;
 }
 
+Tornado tornado(const SensitivityResult& study) {
+  Tornado out;
+  const double baseline = study.baseline_eta_star;
+  for (const auto& r : study.rows) {
+    if (r.parameter == "baseline" || r.status != "ok" || !std::isfinite(r.eta_star)) continue;
+    auto it = std::find_if(out.bars.begin(), out.bars.end(), [&](const TornadoBar& b) { return b.parameter == r.parameter; });
+    if (it == out.bars.end())
+      it = out.bars.insert(out.bars.end(), TornadoBar{r.parameter, r.eta_star, r.eta_star, r.value, r.value,
+                                                      r.eta_star_stderr, r.eta_star_stderr, 0.0});
+    if (r.eta_star < it->low) it->low = r.eta_star, it->value_at_low = r.value, it->stderr_at_low = r.eta_star_stderr;
+    if (r.eta_star > it->high) it->high = r.eta_star, it->value_at_high = r.value, it->stderr_at_high = r.eta_star_stderr;
+    if (std::isfinite(baseline)) it->effect = std::max(it->effect, std::abs(r.eta_star - baseline));
+  }
+  // "No effect": within round-off of the baseline (1e-12 relative), what a closed form
+  // that does not take the parameter gives; a DEM run always moves η* more than that.
+  const double round_off = 1e-12 * std::max(1.0, std::abs(baseline));
+  for (auto it = out.bars.begin(); it != out.bars.end();) {
+    if (std::isfinite(baseline) && it->effect <= round_off) {
+      out.without_effect.push_back(it->parameter);
+      it = out.bars.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  std::stable_sort(out.bars.begin(), out.bars.end(), [](const TornadoBar& a, const TornadoBar& b) { return a.effect < b.effect; });
+  return out;
+}
+
 json to_json(const SensitivityResult& r) {
   json rows = json::array();
   for (const auto& row : r.rows)
@@ -193,8 +223,18 @@ json to_json(const SensitivityResult& r) {
                     {"clearance_m", row.clearance_m},
                     {"bed_mass_kg", row.bed_mass_kg},
                     {"intensity", row.intensity}});
+  const Tornado t = tornado(r);
+  json bars = json::array();
+  for (auto it = t.bars.rbegin(); it != t.bars.rend(); ++it)  // largest effect first
+    bars.push_back({{"parameter", it->parameter},
+                    {"effect", it->effect},
+                    {"eta_star_low", it->low},
+                    {"eta_star_high", it->high},
+                    {"value_at_low", detail::number_or_null(it->value_at_low)},
+                    {"value_at_high", detail::number_or_null(it->value_at_high)}});
   return {{"case", r.case_name}, {"source", r.source}, {"frequency_hz", r.frequency_hz},
-          {"amplitude_m", r.amplitude_m}, {"rows", rows}, {"sweep", r.sweep_report}};
+          {"amplitude_m", r.amplitude_m}, {"rows", rows}, {"tornado", bars}, {"without_effect", t.without_effect},
+          {"sweep", r.sweep_report}};
 }
 
 }  // namespace pdamp::tasks

@@ -59,6 +59,14 @@ TEST_CASE("pdamp sensitivity --source formulas gives a row per variant and the c
   }
   for (const char* file : {"sensitivity.json", "sensitivity.csv", "sensitivity_tornado.csv", "sensitivity.gp"})
     CHECK(fs::exists(dir.path / file));
+  // The tornado: the parameters the closed forms do not take are named, not drawn as flat bars.
+  REQUIRE(r["tornado"].size() == 1);
+  CHECK(r["tornado"][0]["parameter"] == "particle_radius_m");
+  for (const auto& row : rows)
+    if (row["parameter"] == "particle_radius_m")
+      CHECK(r["tornado"][0]["effect"].get<double>() == std::abs(row["eta_star"].get<double>() - base));
+  CHECK(r["without_effect"].size() == 7);
+  CHECK_THAT(slurp(dir.path / "sensitivity.gp"), Catch::Contains("no effect in the closed forms: friction, restitution"));
 }
 
 // Reference: a tilt about the container's z axis, along which gravity points, changes no
@@ -72,6 +80,9 @@ TEST_CASE("a DEM sensitivity study resumes from its log and a tilt about gravity
   CHECK(rows[2]["parameter"] == "tilt_z_deg");
   CHECK(rows[2]["eta_star"] == rows[0]["eta_star"]);
   CHECK(rows[1]["eta_star"] != rows[0]["eta_star"]);  // friction does change the bed
+  CHECK(first["without_effect"] == json::array({"tilt_z_deg"}));
+  REQUIRE(first["tornado"].size() == 1);
+  CHECK(first["tornado"][0]["parameter"] == "friction");
   CHECK(fs::exists(dir.path / "sensitivity_sweep.jsonl"));
   const json again = run_json({"sensitivity", path, "-o", dir.path.string()});
   CHECK_THAT(again["sweep"].get<std::string>(), Catch::Contains("3 resumed, 0 computed"));

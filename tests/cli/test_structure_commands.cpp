@@ -428,6 +428,19 @@ TEST_CASE("pdamp frf --compare: formulas, field and DEM in one figure with the p
     CHECK(c["agreement"][k]["field"].is_null());
   }
   require_files(dir.path, {"frf_compare.csv", "frf_compare.gp", "frf.json", "case_resolved.json"});
+  // The closed forms' states held at a jump are on the curve (a gap there before), and the
+  // structure without particles is drawn: one row per frequency of the formulas' sweep, the
+  // same as pdamp frf's linear columns.
+  const std::string table = slurp(dir.path / "frf_compare.csv");
+  const json plain = run_json("frf " + data("one_mode_dem_frf.json"));
+  const auto rows_of = [&](const std::string& start) {
+    std::size_t count = 0;
+    for (std::size_t at = table.find("\n" + start); at != std::string::npos; at = table.find("\n" + start, at + 1)) ++count;
+    return count;
+  };
+  CHECK(rows_of("formulas,-1,") == plain["frf"]["held_at_jump_points"].get<std::size_t>());
+  CHECK(rows_of("formulas,-1,") > 0);
+  CHECK(rows_of("without_beds,0,") == plain["frf"]["frequencies"]["points"].get<std::size_t>());
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --compare --method dem").exit_code == 2);
 }
 

@@ -70,12 +70,31 @@ struct SensitivityResult {
   std::vector<std::string> warnings;
   nlohmann::json mpi;  ///< how the variants spread over processes, or null
 };
+/// One parameter's bar of the tornado plot: the lowest and highest η* over its values, the
+/// values that gave them and their standard errors, and its effect, the farthest either
+/// moves η* from the baseline's.
+struct TornadoBar {
+  std::string parameter;
+  double low = 0.0, high = 0.0;                 ///< η*
+  double value_at_low = 0.0, value_at_high = 0.0;
+  double stderr_at_low = 0.0, stderr_at_high = 0.0;
+  double effect = 0.0;                          ///< max |η* − η*_baseline| over the values
+};
+struct Tornado {
+  std::vector<TornadoBar> bars;                 ///< with an effect, smallest first (drawn bottom up)
+  /// Parameters whose every value gives the baseline's η* to round-off: the closed forms
+  /// (source formulas) do not depend on them, so they get no flat bar.
+  std::vector<std::string> without_effect;
+};
+/// The bars of `result`'s rows (the failed and missing ones left out).
+Tornado tornado(const SensitivityResult& result);
+
 SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, RunHooks& hooks,
                                   Executor& executor);
 /// The shards of one study joined into the rows a single run gives.
 SensitivityResult merge_sensitivity(const case_file::Case& c, const std::string& source,
                                     const std::vector<std::filesystem::path>& logs);
-/// The result keys (case, source, frequency_hz, amplitude_m, rows, sweep).
+/// The result keys (case, source, frequency_hz, amplitude_m, rows, tornado, without_effect, sweep).
 nlohmann::json to_json(const SensitivityResult& result);
 
 }  // namespace pdamp::tasks
