@@ -13,8 +13,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # chromium: the report test renders report.html headless; python3-vtk9: VTK's reader loads
-# pdamp dem's ParaView files (both tests are skipped where these are missing).
-packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium python3-vtk9)
+# pdamp dem's ParaView files (both tests are skipped where these are missing); pybind11-dev,
+# python3-dev, python3-numpy, python3-pytest: the Python module and its tests (ci_python.sh).
+packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium python3-vtk9
+  pybind11-dev python3-dev python3-numpy python3-pytest)
 if [ "${1:-}" = --all ]; then
   read -r -a base <<<"$(scripts/setup.sh --list-packages --mpi)"
   packages=("${base[@]}" "${packages[@]}")

@@ -69,14 +69,16 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
 }
 
 /// The co-simulation's progress as the hooks' lines. A stop asked while the beds settle ends
-/// the run there (Interrupted): no checkpoint holds that phase.
-st::CosimulationProgressCallback progress_to_hooks(RunHooks& hooks, const std::string& label) {
-  return [&hooks, label](const st::CosimulationProgress& p) {
+/// the run there (Interrupted): no checkpoint holds that phase. A run without checkpoints
+/// (`checkpointed` false: a library caller's, docs/python.md) stops at any report.
+st::CosimulationProgressCallback progress_to_hooks(RunHooks& hooks, const std::string& label, bool checkpointed) {
+  return [&hooks, label, checkpointed](const st::CosimulationProgress& p) {
     report_progress(hooks, label, p);
-    if (p.stage == "settling")
+    if (p.stage == "settling" || !checkpointed)
       if (const int signal = hooks.stop_requested(); signal != 0)
-        throw strict_json::Interrupted(signal, "the run stopped while its beds settled, before its first checkpoint: run "
-                                               "the same command again");
+        throw strict_json::Interrupted(signal, checkpointed ? "the run stopped while its beds settled, before its first "
+                                                              "checkpoint: run the same command again"
+                                                            : "the run stopped; it had no checkpoint file, so nothing was kept");
   };
 }
 
@@ -86,7 +88,7 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
                                        const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
                                        st::CosimulationState* state = nullptr) {
   detail::check_cosimulation(c, modal, dampers, options);
-  const auto report = progress_to_hooks(hooks, label);
+  const auto report = progress_to_hooks(hooks, label, false);
   auto r = detail::call_dem(c, [&] {
     return state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
   });
@@ -112,7 +114,7 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
   const std::string shown = strict_json::printable(cp.file.path.string());
-  const auto report = progress_to_hooks(hooks, label);
+  const auto report = progress_to_hooks(hooks, label, true);
 
   std::optional<st::Cosimulation> run;
   if (cp.file.resume) {

@@ -142,13 +142,16 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
   header.end_time_s = (options.transient_periods + options.analysed_periods) / f;
   dem_reference::HarmonicCheckpoints saving;
   auto last_checkpoint = std::chrono::steady_clock::now();
+  // Without a checkpoint file the stop requests are still polled (a library caller's
+  // KeyboardInterrupt, docs/python.md), and nothing is written.
   saving.due = [&] {
     const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
-    return hooks.stop_requested() != 0 || hooks.checkpoint_due(since);
+    return hooks.stop_requested() != 0 || (checkpointing && hooks.checkpoint_due(since));
   };
   saving.stop = [&] { return hooks.stop_requested() != 0; };
   bool wrote_checkpoint = false;
   saving.write = [&](const std::string& state, double t) {
+    if (!checkpointing) return;
     header.simulated_time_s = t;
     write_checkpoint(checkpoint, header, state);
     wrote_checkpoint = true;
@@ -182,13 +185,14 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
           hooks.progress({plan.label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false,
                           p.stage == "setup" ? NAN : p.steps_per_s, p.eta_s});
         },
-        checkpointing ? &saving : nullptr);
+        &saving);
   } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound, a resume that does not fit
     throw InputError(checkpoint.resume ? checkpoint.path.string() : c.path, checkpoint.resume ? "" : "/dem", e.what());
   }
   if (out.dem.stopped)
     throw strict_json::Interrupted(hooks.stop_requested(),
-                                   wrote_checkpoint || checkpoint.resume
+                                   !checkpointing ? "the run stopped; it had no checkpoint file, so nothing was kept"
+                                   : wrote_checkpoint || checkpoint.resume
                                        ? resume_advice(checkpoint, header)
                                        : "the run stopped while its bed settled, before its first checkpoint: run the "
                                          "same command again");
