@@ -4,6 +4,7 @@
 #include "pdamp/dem_reference/result_files.hpp"
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <sstream>
@@ -118,6 +119,101 @@ void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
       << "      </PointData>\n      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
       << "      <Verts>\n" << data_array("Int64", "connectivity", 1, connectivity_at)
       << data_array("Int64", "offsets", 1, offsets_at) << "      </Verts>\n"
+      << "    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
+      << "\n  </AppendedData>\n</VTKFile>\n";
+  strict_json::write_file_atomically(path, out.str());
+}
+
+namespace {
+
+/// Polygons for the container geometry: points, each polygon's point indices, and per
+/// polygon the part (0 the container's walls, 1 a plate, 2 a pin) and the compartment.
+struct Polygons {
+  std::vector<double> points;
+  std::vector<std::int64_t> connectivity, offsets;
+  std::vector<std::int32_t> part, compartment;
+
+  std::int64_t point(const Vec3& p) {
+    points.insert(points.end(), p.begin(), p.end());
+    return static_cast<std::int64_t>(points.size() / 3 - 1);
+  }
+  void polygon(const std::vector<std::int64_t>& corners, int part_id, int compartment_id) {
+    connectivity.insert(connectivity.end(), corners.begin(), corners.end());
+    offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+    part.push_back(part_id);
+    compartment.push_back(compartment_id);
+  }
+  /// The six faces of an axis-aligned box of full edge lengths `size` about `centre`.
+  void box(const Vec3& centre, const Vec3& size, int part_id, int compartment_id) {
+    std::int64_t corner[8];
+    for (int k = 0; k < 8; ++k)
+      corner[k] = point({centre[0] + ((k & 1) ? 0.5 : -0.5) * size[0], centre[1] + ((k & 2) ? 0.5 : -0.5) * size[1],
+                         centre[2] + ((k & 4) ? 0.5 : -0.5) * size[2]});
+    static const int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : kFaces) polygon({corner[f[0]], corner[f[1]], corner[f[2]], corner[f[3]]}, part_id, compartment_id);
+  }
+  /// An axis-aligned cylinder (`axis` 0..2) as 48 side quads and its two end discs.
+  void cylinder(const Vec3& centre, int axis, double radius, double length, int part_id, int compartment_id) {
+    constexpr int kSides = 48;
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    std::vector<std::int64_t> ends[2];
+    for (int e = 0; e < 2; ++e)
+      for (int k = 0; k < kSides; ++k) {
+        Vec3 p = centre;
+        const double angle = 2.0 * M_PI * k / kSides;
+        p[axis] += (e ? 0.5 : -0.5) * length;
+        p[u] += radius * std::cos(angle);
+        p[v] += radius * std::sin(angle);
+        ends[e].push_back(point(p));
+      }
+    for (int k = 0; k < kSides; ++k) {
+      const int next = (k + 1) % kSides;
+      polygon({ends[0][k], ends[0][next], ends[1][next], ends[1][k]}, part_id, compartment_id);
+    }
+    polygon(ends[0], part_id, compartment_id);
+    polygon(ends[1], part_id, compartment_id);
+  }
+};
+
+}  // namespace
+
+void write_container_vtp(const std::string& path, const WorldOptions& world, const Vec3& displacement_m, double time_s) {
+  Polygons g;
+  for (std::size_t i = 0; i < world.compartments.size(); ++i) {
+    const auto& c = world.compartments[i];
+    const int id = static_cast<int>(i);
+    Vec3 centre{};
+    for (int k = 0; k < 3; ++k) centre[k] = c.offset_m[k] + displacement_m[k];
+    // Plates and pins are placed in the compartment frame, centred on the container.
+    const auto shifted = [&](const Vec3& p) { return Vec3{centre[0] + p[0], centre[1] + p[1], centre[2] + p[2]}; };
+    if (c.container.shape == formulas::ContainerShape::kBox)
+      g.box(centre, c.container.box_inner_size_m, 0, id);
+    else
+      g.cylinder(centre, c.container.cylinder_axis, c.container.cylinder_inner_radius_m, c.container.cylinder_inner_length_m, 0, id);
+    for (const auto& plate : c.plates) g.box(shifted(plate.centre_m), plate.size_m, 1, id);
+    for (const auto& pin : c.pins) g.cylinder(shifted(pin.centre_m), pin.axis, pin.radius_m, pin.length_m, 2, id);
+  }
+  AppendedArrays data;
+  const auto part = data.add(g.part);
+  const auto compartment = data.add(g.compartment);
+  const auto points = data.add(g.points);
+  const auto connectivity = data.add(g.connectivity);
+  const auto offsets = data.add(g.offsets);
+  std::ostringstream out;
+  out.precision(17);
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\""
+      << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n"
+      << "  <PolyData>\n"
+      << "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
+      << time_s << "</DataArray>\n    </FieldData>\n"
+      << "    <Piece NumberOfPoints=\"" << g.points.size() / 3 << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+      << "NumberOfPolys=\"" << g.offsets.size() << "\">\n"
+      << "      <CellData Scalars=\"part\">\n" << data_array("Int32", "part", 1, part)
+      << data_array("Int32", "compartment", 1, compartment) << "      </CellData>\n"
+      << "      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
+      << "      <Polys>\n" << data_array("Int64", "connectivity", 1, connectivity) << data_array("Int64", "offsets", 1, offsets)
+      << "      </Polys>\n"
       << "    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
       << "\n  </AppendedData>\n</VTKFile>\n";
   strict_json::write_file_atomically(path, out.str());

@@ -245,6 +245,20 @@ std::vector<std::string> write_frf_files(OutputDir& out, const st::FrequencyResp
   return out.add_plot("frf.gp", gp.str(), {"frf.png", "frf.svg"});
 }
 
+void write_frf_without_beds_csv(OutputDir& out, const st::FrequencyResponse& without_beds) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "frequency_hz";
+  for (const auto& o : without_beds.output_names) csv << ",magnitude_" << label(o) << ",phase_deg_" << label(o);
+  csv << '\n';
+  for (const auto& p : without_beds.points) {
+    csv << p.frequency_hz;
+    for (const auto& y : p.linear_outputs) csv << ',' << std::abs(y) << ',' << std::arg(y) * kRadToDeg;
+    csv << '\n';
+  }
+  out.add(kFrfWithoutBedsCsv, csv.str());
+}
+
 void write_without_beds_csv(OutputDir& out, const st::FreeDecay& without_beds) {
   std::ostringstream csv;
   csv.precision(10);
@@ -340,6 +354,18 @@ std::vector<std::string> write_decay_dem_plot(OutputDir& out, double offset_m, d
   return out.add_plot("decay_dem.gp", gp.str(), {"decay_dem.png", "decay_dem.svg"});
 }
 
+namespace {
+
+/// The DEM plots' curves of the structure without particles (frf_without_particles.csv,
+/// one magnitude per damper's site), appended to a plot command.
+void without_beds_curves(std::ostream& gp, const std::vector<std::string>& damper_names) {
+  for (std::size_t d = 0; d < damper_names.size(); ++d)
+    gp << ", \\\n       '" << kFrfWithoutBedsCsv << "' using 1:" << 2 + 2 * d << " every ::1 with lines lw 1.5 dt 4 lc rgb '"
+       << colour(d) << "' title " << gnuplot_string(damper_names[d] + ", without particles") << " noenhanced";
+}
+
+}  // namespace
+
 std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<std::string>& damper_names,
                                             const std::string& magnitude_label, const std::string& title) {
   // frf_dem.csv: sweep, frequency_hz, then magnitude and phase per damper, then the spread, the
@@ -378,6 +404,7 @@ std::vector<std::string> write_frf_dem_plot(OutputDir& out, const std::vector<st
          << "' title " << gnuplot_string(damper_names[d] + ", " + sweep + ": unconverged (not on the curve)")
          << " noenhanced";
     }
+  without_beds_curves(gp, damper_names);
   gp << "\n}\n";
   return out.add_plot("frf_dem.gp", gp.str(), {"frf_dem.png", "frf_dem.svg"});
 }
@@ -405,6 +432,7 @@ std::vector<std::string> write_frf_dem_sweep_plot(OutputDir& out, const std::vec
          << (std::string(sweep) == "up" ? 1 : 2) << " lc rgb '" << colour(d) << "' title "
          << gnuplot_string(damper_names[d] + ", " + sweep) << " noenhanced";
     }
+  without_beds_curves(gp, damper_names);
   gp << "\n}\n";
   return out.add_plot("frf_dem_sweep.gp", gp.str(), {"frf_dem_sweep.png", "frf_dem_sweep.svg"});
 }

@@ -38,14 +38,36 @@ Warnings write_files(OutputDir& out, const tasks::LossStudy& loss) {
 
 Warnings write_files(OutputDir& out, const tasks::DemRunResult& r) {
   dem_reference::write_time_series_csv(out.staged_path("time_series.csv").string(), r.dem.series);
-  std::vector<std::pair<double, std::string>> series;
+  // ParaView: the particles and the containers at each snapshot, each a .pvd series. The
+  // container's displacement along the drive at a snapshot's time is the recorded
+  // container_position_m there (linear between samples).
+  std::vector<std::pair<double, std::string>> particles, containers;
+  const auto& s = r.dem.series;
   for (std::size_t i = 0; i < r.dem.snapshots.size(); ++i) {
+    const double t = r.dem.snapshots[i].time_s;
     char name[64];
     std::snprintf(name, sizeof name, "particles_%04zu.vtp", i);
     dem_reference::write_vtp_snapshot(out.staged_path(name).string(), r.dem.snapshots[i]);
-    series.push_back({r.dem.snapshots[i].time_s, name});
+    particles.push_back({t, name});
+    double x = 0.0;
+    if (!s.time_s.empty()) {
+      const auto at = std::lower_bound(s.time_s.begin(), s.time_s.end(), t) - s.time_s.begin();
+      const auto k = std::clamp<std::ptrdiff_t>(at, 1, static_cast<std::ptrdiff_t>(s.time_s.size()) - 1);
+      if (s.time_s.size() == 1) x = s.container_position_m.front();
+      else {
+        const double w = (t - s.time_s[k - 1]) / (s.time_s[k] - s.time_s[k - 1]);
+        x = s.container_position_m[k - 1] + std::clamp(w, 0.0, 1.0) * (s.container_position_m[k] - s.container_position_m[k - 1]);
+      }
+    }
+    std::snprintf(name, sizeof name, "container_%04zu.vtp", i);
+    dem_reference::write_container_vtp(out.staged_path(name).string(), r.world,
+                                       {x * r.drive_axis[0], x * r.drive_axis[1], x * r.drive_axis[2]}, t);
+    containers.push_back({t, name});
   }
-  if (!series.empty()) dem_reference::write_pvd_series(out.staged_path("particles.pvd").string(), series);
+  if (!particles.empty()) {
+    dem_reference::write_pvd_series(out.staged_path("particles.pvd").string(), particles);
+    dem_reference::write_pvd_series(out.staged_path("container.pvd").string(), containers);
+  }
   return write_force_velocity_plot(out, r.case_name + ": X = " + format_number(r.amplitude_m * 1e3, 4) + " mm, f = " +
                                             format_number(r.frequency_hz, 4) + " Hz");
 }
@@ -223,7 +245,9 @@ Warnings write_files(OutputDir& out, const tasks::FrfResult& r) {
       return write_frf_files(out, r.harmonic->response, r.harmonic->damper_names, tasks::magnitude_label(r),
                              r.case_name + ": frequency response (" +
                                  std::string(case_file::to_string(r.harmonic->method)) + ")");
-    case tasks::FrfMethod::kDem: return r.linear ? linear_sweep_files(out, r) : stepped_sine_files(out, r);
+    case tasks::FrfMethod::kDem:
+      write_frf_without_beds_csv(out, *r.without_beds);
+      return r.linear ? linear_sweep_files(out, r) : stepped_sine_files(out, r);
     case tasks::FrfMethod::kCompare: return compare_files(out, r);
   }
   return {};
@@ -341,7 +365,10 @@ Warnings verification_files(OutputDir& out, const std::string& case_name, const 
      << "       '' index 1 using 2:($4*1e3) every ::1 with lines lw 2 lc rgb 'red' title 'best single layer, DEM', \\\n"
      << "       '' index 1 using 2:($5*1e3) every ::1 with lines lw 1 dt 2 lc rgb 'red' title "
      << gnuplot_string("best single layer, " + predicted_by) << ", \\\n"
-     << "       '' index 0 using 2:($6*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold'\n"
+     << "       '' index 0 using 2:($6*1e3) every ::1 with lines lw 1 dt 3 lc rgb 'black' title 'threshold', \\\n"
+     // Without particles (linear: exact by the closed forms), from decay_compare.csv beside it.
+     << "       'decay_compare.csv' using 1:($6*1e3) every ::1 with lines lw 1.5 dt 4 lc rgb 'dark-orange' "
+        "title 'without particles'\n"
      << "}\n";
   return out.add_plot("verify_decay.gp", gp.str(), {"verify_decay.png", "verify_decay.svg"});
 }

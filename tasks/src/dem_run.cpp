@@ -173,6 +173,8 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
   out.case_name = c.name;
   out.amplitude_m = x;
   out.frequency_hz = f;
+  out.world = options.world;
+  out.drive_axis = options.drive_axis;
   if (options.approach_amplitude_m > 0.0) {
     out.approach_amplitude_m = options.approach_amplitude_m;
     out.approach_hold_periods = options.approach_hold_periods;

@@ -66,6 +66,22 @@ st::FrequencyResponse task_harmonic_balance(const Case& c, const detail::Setup& 
   return detail::call_solver(c, "/task", [&] { return st::harmonic_balance(setup.s.modal, setup.s.dampers, excitation, options); });
 }
 
+/// The structure without particles over the task's band (the containers empty): linear,
+/// so only each frequency's linear outputs count; the stroke range, which the solver asks
+/// of dampers without layers, is a formality.
+st::FrequencyResponse without_beds_response(const Case& c, detail::Setup setup) {
+  for (auto& d : setup.s.dampers) d.layers.clear();
+  const auto& task = *c.task.frf;
+  st::HarmonicBalanceOptions options;
+  options.frequencies_hz = detail::spaced(task.min_frequency_hz, task.max_frequency_hz, task.points,
+                                          task.spacing == surrogate::AxisSpacing::kLog);
+  options.stroke_min_m = 1e-6;
+  options.stroke_max_m = 1.0;
+  return detail::call_solver(c, "/task", [&] {
+    return st::harmonic_balance(setup.s.modal, setup.s.dampers, task_excitation(c, setup.s.modal), options);
+  });
+}
+
 /// pdamp frf --method formulas|field: the harmonic balance, its checks and warnings.
 HarmonicFrf harmonic_frf(const Case& c, detail::Setup& setup) {
   HarmonicFrf out;
@@ -697,6 +713,7 @@ FrfResult run_frf(const Case& c, const FrfOptions& options, RunHooks& hooks, Exe
       detail::Setup setup = detail::make_setup(c, case_file::LossMethod::kFormulas, false);
       if (options.dem.linear_sweep) out.linear = linear_sweep(c, setup, options.dem, hooks);
       else out.stepped = stepped_sine(c, setup, options.dem, hooks, executor);
+      out.without_beds = without_beds_response(c, setup);
       out.warnings = setup.warnings.list();
       break;
     }

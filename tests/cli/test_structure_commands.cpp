@@ -316,6 +316,23 @@ TEST_CASE("pdamp frf --method dem: a stepped sine of --dem-points frequencies, u
     CHECK(peak["indistinguishable_low_hz"].get<double>() <= peak["largest_point_frequency_hz"].get<double>());
   }
   require_files(dir.path, {"frf_dem.csv", "frf_dem.gp", "frf.json", "case_resolved.json"});
+  // The structure without particles beside the DEM's points: the same linear response as
+  // pdamp frf's (formulas) without-beds columns, frequency by frequency.
+  const TempDir formulas_dir("frf_formulas_linear");
+  REQUIRE(run_pdamp("frf " + data("one_mode_dem_frf.json") + " -o " + formulas_dir.path.string()).exit_code == 0);
+  std::ifstream bare(dir.path / "frf_without_particles.csv"), linear(formulas_dir.path / "frf.csv");
+  std::string bare_line, linear_line;
+  std::getline(bare, bare_line);
+  CHECK(bare_line == "frequency_hz,magnitude_damper_1,phase_deg_damper_1");
+  std::getline(linear, linear_line);
+  std::size_t rows = 0;
+  while (std::getline(bare, bare_line) && std::getline(linear, linear_line)) {
+    ++rows;
+    // frf.csv starts frequency_hz, linear_magnitude, linear_phase_deg: the same three numbers.
+    CHECK(bare_line == linear_line.substr(0, bare_line.size()));
+    CHECK(linear_line[bare_line.size()] == ',');
+  }
+  CHECK(rows > 10);
   // Bad input is exit 2: --dem-points out of range, an unknown direction, an empty band.
   CHECK(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-points 1").exit_code == 2);
   require_one_line_error(run_pdamp("frf " + data("one_mode_dem_frf.json") + " --method dem --dem-sweep sideways"),

@@ -3,7 +3,9 @@
 Runs `pdamp dem` on a softened copy of the shipped low-intensity case with --snapshots 3,
 then reads particles.pvd (a ParaView collection) and each particles_NNNN.vtp with
 vtkXMLPolyDataReader: one vertex per particle, the radius, velocity, spin and compartment
-arrays, the times of the series equal to each file's TimeValue and increasing.
+arrays, the times of the series equal to each file's TimeValue and increasing; and
+container.pvd: the box's six faces at the same times, its size the case's, displaced along
+the drive by the recorded container position.
 Usage: check_paraview_series.py PDAMP_BINARY SOURCE_DIR WORK_DIR
 """
 import json
@@ -58,7 +60,45 @@ def main():
         assert abs(field[0] - time) <= 1e-12 * max(1.0, time), (field[0], time)
         speeds = vtk_to_numpy(points.GetArray("velocity_m_s"))
         assert speeds.shape == (count, 3)
-    print("ParaView series: %d snapshots of %d particles read by VTK %s" % (len(datasets), count, vtk.vtkVersion.GetVTKVersion()))
+    # The container at the same times: the 160 x 61 x 40 mm box's six inner faces, moved
+    # along the drive (x) by the recorded container position at each snapshot.
+    containers = ElementTree.parse(os.path.join(out, "container.pvd")).getroot().find("Collection").findall("DataSet")
+    assert [float(d.get("timestep")) for d in containers] == times
+    size = case["damper"]["container"]["inner_size_m"]
+    with open(os.path.join(out, "time_series.csv")) as f:
+        header = f.readline().strip().split(",")
+        rows = [[float(x) for x in line.split(",")] for line in f if line.strip()]
+    column = header.index("container_position_m")
+    for dataset, time in zip(containers, times):
+        reader = vtk.vtkXMLPolyDataReader()
+        reader.SetFileName(os.path.join(out, dataset.get("file")))
+        reader.Update()
+        data = reader.GetOutput()
+        assert data.GetNumberOfPolys() == 6, data.GetNumberOfPolys()
+        bounds = data.GetBounds()  # xmin, xmax, ymin, ymax, zmin, zmax
+        for axis in range(3):
+            assert abs((bounds[2 * axis + 1] - bounds[2 * axis]) - size[axis]) < 1e-12, (axis, bounds)
+        # The box's centre is its rest centre (0) plus the container's displacement, which
+        # lies between the two recorded samples around the snapshot's time.
+        centre = 0.5 * (bounds[0] + bounds[1])
+        before = max((r for r in rows if r[0] <= time), key=lambda r: r[0], default=rows[0])
+        after = min((r for r in rows if r[0] >= time), key=lambda r: r[0], default=rows[-1])
+        low, high = sorted((before[column], after[column]))
+        assert low - 1e-12 <= centre <= high + 1e-12, (centre, low, high)
+        assert abs(0.5 * (bounds[2] + bounds[3])) < 1e-12 and abs(0.5 * (bounds[4] + bounds[5])) < 1e-12
+        part = vtk_to_numpy(data.GetCellData().GetArray("part"))
+        assert (part == 0).all()
+        # Same frame as the particles: every sphere is inside the box at that instant (its
+        # centre at least a radius from each face, less the contact overlap, < 10 % of r).
+        spheres = vtk.vtkXMLPolyDataReader()
+        spheres.SetFileName(os.path.join(out, dataset.get("file").replace("container", "particles")))
+        spheres.Update()
+        centres = vtk_to_numpy(spheres.GetOutput().GetPoints().GetData())
+        for axis in range(3):
+            assert (centres[:, axis] >= bounds[2 * axis] + 0.9 * radius).all(), axis
+            assert (centres[:, axis] <= bounds[2 * axis + 1] - 0.9 * radius).all(), axis
+    print("ParaView series: %d snapshots of %d particles and the container read by VTK %s"
+          % (len(datasets), count, vtk.vtkVersion.GetVTKVersion()))
 
 
 if __name__ == "__main__":

@@ -23,6 +23,13 @@ void write_time_series_csv(const std::string& path, const TimeSeries& series);
 /// the time in the field TimeValue. Atomic as above.
 void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& snapshot);
 
+/// The containers' inner walls (box faces, or a cylinder's mantle and ends), plates and
+/// pins as VTK XML polygons in the world frame, moved by `displacement_m` from their
+/// position at rest (the container's translation at `time_s`), with cell data `part`
+/// (0 wall, 1 plate, 2 pin) and `compartment`. Not drawn: polymer wall layers (the inner
+/// walls are the hard ones). Atomic as above.
+void write_container_vtp(const std::string& path, const WorldOptions& world, const Vec3& displacement_m, double time_s);
+
 /// A ParaView data series (.pvd): `files` as (time in s, file name relative to the .pvd),
 /// so that ParaView's time controls step through the snapshots at their times.
 void write_pvd_series(const std::string& path, const std::vector<std::pair<double, std::string>>& files);

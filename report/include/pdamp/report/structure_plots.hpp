@@ -52,6 +52,12 @@ void write_without_beds_csv(OutputDir& out, const structure::FreeDecay& without_
 std::vector<std::string> write_decay_files(OutputDir& out, const structure::FreeDecay& decay,
                                            const std::vector<std::string>& damper_names, const std::string& title);
 
+/// The DEM frequency responses' reference without particles (the containers empty):
+/// frequency_hz, then magnitude_<output> and phase_deg_<output>. The DEM FRF plots below
+/// draw it, so it is written first.
+inline constexpr const char* kFrfWithoutBedsCsv = "frf_without_particles.csv";
+void write_frf_without_beds_csv(OutputDir& out, const structure::FrequencyResponse& without_beds);
+
 /// decay_dem.gp/png/svg for decay_dem.csv (written by pdamp decay --method dem: time_s,
 /// site_displacement_m_<damper> x dampers, envelope_m, ...): the first damper's site
 /// displacement with offset ± envelope, offset ± threshold, the settling time and the

@@ -76,6 +76,8 @@ struct DemRunResult {
   double amplitude_m = 0.0;
   double frequency_hz = 0.0;
   dem_reference::DamperResult dem;
+  dem_reference::WorldOptions world;  ///< the run's world (the containers' geometry for ParaView)
+  dem_reference::Vec3 drive_axis{1.0, 0.0, 0.0};
   /// The drive's approach (/dem/approach): 0 from rest, else the stroke it came down from.
   double approach_amplitude_m = 0.0;
   int approach_hold_periods = 0, approach_ramp_periods = 0;

@@ -81,6 +81,9 @@ struct FrfResult {
   std::optional<HarmonicFrf> field;     ///< kCompare: when every layer has a field_file
   std::optional<SteppedSineFrf> stepped;  ///< kDem (stepped), kCompare
   std::optional<LinearSweepFrf> linear;   ///< kDem with linear_sweep
+  /// kDem: the structure without particles (the containers empty; linear, so the harmonic
+  /// balance is exact) over the task's band, for the plots.
+  std::optional<structure::FrequencyResponse> without_beds;
   std::vector<std::string> warnings;
 };
 
