@@ -10,6 +10,7 @@
 #include "errors.hpp"
 #include "flags.hpp"
 #include "output.hpp"
+#include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/task_files.hpp"
 #include "pdamp/tasks/case_checks.hpp"
@@ -234,8 +235,10 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
     options.method = tasks::DecayMethod::kDem;
   } else {
     refuse_checkpoint_flags(args, "applies to --method dem (the DEM runs checkpoint)");
+    refuse_flags(args, {{"--snapshots", "N", ""}}, "applies to --method dem (the beds' particles)");
     options.method = loss_method(args) == case_file::LossMethod::kField ? tasks::DecayMethod::kField : tasks::DecayMethod::kFormulas;
   }
+  options.snapshots = static_cast<int>(args.optional_integer("--snapshots", 0, dem_reference::limits::kMaxSnapshots).value_or(0));
   auto files = output_dir(args, context);
   if (options.method == tasks::DecayMethod::kDem) options.checkpoint.file = checkpoint_file(args, "decay_dem");
   CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
@@ -319,12 +322,15 @@ std::vector<Command> structure_commands() {
                        "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, kDemSweepFlags), 1},
        run_frf, true},
-      {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [--resume] [--checkpoint-interval S] [-o DIR] [--json]",
+      {{"decay", "pdamp decay CASE.json [--method formulas|field|dem] [--snapshots N] [--resume] [--checkpoint-interval S] [-o DIR] [--json]",
         "free decay of the structure with its dampers (task kind decay): envelope, settling time,\n"
         "equivalent damping ratio and the energy each layer dissipates",
-        concat_flags({kMethodFlag, {"-o", "DIR", "write decay.csv, decay.gp/png/svg (dem: decay_dem.csv,\n"
-                                                  "                          decay_dem.gp/png/svg), decay.json and case_resolved.json\n"
-                                                  "                          into DIR, atomically (dem: decay_dem.checkpoint while running)"},
+        concat_flags({kMethodFlag,
+                      {"--snapshots", "N", "--method dem: every bed's particles N times over the decay, for\n"
+                                           "                          ParaView (particles_<damper>.pvd, container_<damper>.pvd)"},
+                      {"-o", "DIR", "write decay.csv, decay.gp/png/svg (dem: decay_dem.csv,\n"
+                                    "                          decay_dem.gp/png/svg), decay.json and case_resolved.json\n"
+                                    "                          into DIR, atomically (dem: decay_dem.checkpoint while running)"},
                       kJsonFlag},
                      kCheckpointFlags), 1},
        run_decay},

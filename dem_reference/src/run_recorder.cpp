@@ -14,19 +14,6 @@ namespace {
 
 using detail::dot;
 
-ParticleSnapshot snapshot_of(const World& world, double time_s) {
-  ParticleSnapshot s;
-  s.time_s = time_s;
-  const int n = world.particle_count();
-  for (int i = 0; i < n; ++i) {
-    s.positions_m.push_back(world.position(i));
-    s.velocities_m_s.push_back(world.velocity(i));
-    s.angular_velocities_rad_s.push_back(world.angular_velocity(i));
-    s.radii_m.push_back(world.radius(i));
-    s.compartments.push_back(world.compartment(i));
-  }
-  return s;
-}
 
 std::int64_t block_count(const BlockRecorderOptions& o) {
   return static_cast<std::int64_t>(o.periods) * o.blocks_per_period;
@@ -152,12 +139,26 @@ bool BlockRecorder::record_step(const World& world) {
   series_.kinetic_energy_j.push_back(world.energy().kinetic_j);
   const std::int64_t block = recorded_blocks() - 1;
   if (next_snapshot_ < options_.snapshots && snapshot_block(options_, next_snapshot_) == block) {
-    snapshots_.push_back(snapshot_of(world, t_end));
+    snapshots_.push_back(particle_snapshot(world, t_end));
     ++next_snapshot_;
   }
   step_in_block_ = 0;
   force_sum_ = velocity_sum_ = position_sum_ = 0.0;
   return true;
+}
+
+ParticleSnapshot particle_snapshot(const World& world, double time_s) {
+  ParticleSnapshot s;
+  s.time_s = time_s;
+  const int n = world.particle_count();
+  for (int i = 0; i < n; ++i) {
+    s.positions_m.push_back(world.position(i));
+    s.velocities_m_s.push_back(world.velocity(i));
+    s.angular_velocities_rad_s.push_back(world.angular_velocity(i));
+    s.radii_m.push_back(world.radius(i));
+    s.compartments.push_back(world.compartment(i));
+  }
+  return s;
 }
 
 }  // namespace pdamp::dem_reference

@@ -25,6 +25,27 @@ namespace {
 
 void append(Warnings& to, const Warnings& from) { to.insert(to.end(), from.begin(), from.end()); }
 
+/// particles<suffix>.pvd and container<suffix>.pvd, ParaView series of one bed: its
+/// particles at each snapshot and its containers moved by `container_positions_m` there.
+void write_paraview_series(OutputDir& out, const std::string& suffix, const dem_reference::WorldOptions& world,
+                           const std::vector<const dem_reference::ParticleSnapshot*>& particles,
+                           const std::vector<dem_reference::Vec3>& container_positions_m) {
+  if (particles.empty()) return;
+  std::vector<std::pair<double, std::string>> particle_files, container_files;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const double t = particles[i]->time_s;
+    char number[32];
+    std::snprintf(number, sizeof number, "_%04zu.vtp", i);
+    const std::string particle_file = "particles" + suffix + number, container_file = "container" + suffix + number;
+    dem_reference::write_vtp_snapshot(out.staged_path(particle_file).string(), *particles[i]);
+    dem_reference::write_container_vtp(out.staged_path(container_file).string(), world, container_positions_m[i], t);
+    particle_files.push_back({t, particle_file});
+    container_files.push_back({t, container_file});
+  }
+  dem_reference::write_pvd_series(out.staged_path("particles" + suffix + ".pvd").string(), particle_files);
+  dem_reference::write_pvd_series(out.staged_path("container" + suffix + ".pvd").string(), container_files);
+}
+
 }  // namespace
 
 Warnings write_files(OutputDir& out, const tasks::DamperDesignResult& d) {
@@ -38,36 +59,26 @@ Warnings write_files(OutputDir& out, const tasks::LossStudy& loss) {
 
 Warnings write_files(OutputDir& out, const tasks::DemRunResult& r) {
   dem_reference::write_time_series_csv(out.staged_path("time_series.csv").string(), r.dem.series);
-  // ParaView: the particles and the containers at each snapshot, each a .pvd series. The
-  // container's displacement along the drive at a snapshot's time is the recorded
-  // container_position_m there (linear between samples).
-  std::vector<std::pair<double, std::string>> particles, containers;
+  // ParaView: the container's displacement along the drive at a snapshot's time is the
+  // recorded container_position_m there (linear between samples).
   const auto& s = r.dem.series;
-  for (std::size_t i = 0; i < r.dem.snapshots.size(); ++i) {
-    const double t = r.dem.snapshots[i].time_s;
-    char name[64];
-    std::snprintf(name, sizeof name, "particles_%04zu.vtp", i);
-    dem_reference::write_vtp_snapshot(out.staged_path(name).string(), r.dem.snapshots[i]);
-    particles.push_back({t, name});
+  std::vector<const dem_reference::ParticleSnapshot*> particles;
+  std::vector<dem_reference::Vec3> containers;
+  for (const auto& snapshot : r.dem.snapshots) {
+    const double t = snapshot.time_s;
     double x = 0.0;
-    if (!s.time_s.empty()) {
+    if (s.time_s.size() == 1) {
+      x = s.container_position_m.front();
+    } else if (s.time_s.size() > 1) {
       const auto at = std::lower_bound(s.time_s.begin(), s.time_s.end(), t) - s.time_s.begin();
       const auto k = std::clamp<std::ptrdiff_t>(at, 1, static_cast<std::ptrdiff_t>(s.time_s.size()) - 1);
-      if (s.time_s.size() == 1) x = s.container_position_m.front();
-      else {
-        const double w = (t - s.time_s[k - 1]) / (s.time_s[k] - s.time_s[k - 1]);
-        x = s.container_position_m[k - 1] + std::clamp(w, 0.0, 1.0) * (s.container_position_m[k] - s.container_position_m[k - 1]);
-      }
+      const double w = std::clamp((t - s.time_s[k - 1]) / (s.time_s[k] - s.time_s[k - 1]), 0.0, 1.0);
+      x = s.container_position_m[k - 1] + w * (s.container_position_m[k] - s.container_position_m[k - 1]);
     }
-    std::snprintf(name, sizeof name, "container_%04zu.vtp", i);
-    dem_reference::write_container_vtp(out.staged_path(name).string(), r.world,
-                                       {x * r.drive_axis[0], x * r.drive_axis[1], x * r.drive_axis[2]}, t);
-    containers.push_back({t, name});
+    particles.push_back(&snapshot);
+    containers.push_back({x * r.drive_axis[0], x * r.drive_axis[1], x * r.drive_axis[2]});
   }
-  if (!particles.empty()) {
-    dem_reference::write_pvd_series(out.staged_path("particles.pvd").string(), particles);
-    dem_reference::write_pvd_series(out.staged_path("container.pvd").string(), containers);
-  }
+  write_paraview_series(out, "", r.world, particles, containers);
   return write_force_velocity_plot(out, r.case_name + ": X = " + format_number(r.amplitude_m * 1e3, 4) + " mm, f = " +
                                             format_number(r.frequency_hz, 4) + " Hz");
 }
@@ -281,6 +292,17 @@ Warnings write_files(OutputDir& out, const tasks::DecayResult& r) {
     csv << '\n';
   }
   out.add("decay_dem.csv", csv.str());
+  // Every bed's ParaView series (--snapshots): particles_<damper>.pvd, container_<damper>.pvd.
+  for (std::size_t d = 0; d < r.damper_names.size() && d < r.bed_worlds.size(); ++d) {
+    std::vector<const dem_reference::ParticleSnapshot*> particles;
+    std::vector<dem_reference::Vec3> containers;
+    for (const auto& beds : decay.cosimulation.bed_snapshots) {
+      particles.push_back(&beds[d].particles);
+      containers.push_back(beds[d].container_position_m);
+    }
+    const std::string suffix = std::string(1, '_').append(csv_name(r.damper_names[d]));  // GCC 12: no -Wrestrict on "_" + s
+    write_paraview_series(out, suffix, r.bed_worlds[d], particles, containers);
+  }
   return write_decay_dem_plot(out, decay.static_offset_m, decay.threshold_m, decay.settling.settling_time_s,
                               r.damper_names.size(), r.case_name + ": free decay (dem co-simulation)");
 }

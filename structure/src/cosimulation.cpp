@@ -203,6 +203,9 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
     p.push_back(at + "time_step_s = " + number(time_step_s) + ": must be 0 (automatic) or in [1e-10, 1e-3] s");
   if (!(progress_interval_s > 0.0 && std::isfinite(progress_interval_s)))
     p.push_back(at + "progress_interval_s = " + number(progress_interval_s) + ": must be > 0 and finite");
+  if (snapshots < 0 || snapshots > dem::limits::kMaxSnapshots)
+    p.push_back(at + "snapshots = " + std::to_string(snapshots) + ": must be in [0, " +
+                std::to_string(dem::limits::kMaxSnapshots) + "]");
   return p;
 }
 
@@ -599,7 +602,8 @@ CosimulationState restore_cosimulation_state(const ModalModel& model, const std:
 }
 
 void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out) {
-  out.tag("cosimulation result");
+  // "2": with the beds' snapshots (an older checkpoint is refused at this tag).
+  out.tag("cosimulation result 2");
   out.i32(static_cast<std::int32_t>(r.outcome));
   out.text(r.message);
   out.f64(r.time_step_s);
@@ -621,12 +625,25 @@ void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out
   out.i64(h.pending_steps);
   out.i64(static_cast<std::int64_t>(r.warnings.size()));
   for (const auto& w : r.warnings) out.text(w);
+  out.i64(static_cast<std::int64_t>(r.bed_snapshots.size()));
+  for (const auto& beds : r.bed_snapshots)
+    for (const auto& bed : beds) {
+      const auto& s = bed.particles;
+      out.f64(s.time_s);
+      for (double x : bed.container_position_m) out.f64(x);
+      out.i64(static_cast<std::int64_t>(s.positions_m.size()));
+      for (const auto* vectors : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
+        for (const auto& v : *vectors)
+          for (double x : v) out.f64(x);
+      out.f64s(s.radii_m);
+      out.i32s(s.compartments);
+    }
   out.tag("end of cosimulation result");
 }
 
 CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Index modes, std::size_t dampers) {
   CosimulationResult r;
-  in.expect_tag("cosimulation result");
+  in.expect_tag("cosimulation result 2");
   r.outcome = static_cast<dem::Outcome>(in.i32_in("outcome", 0, 2));
   r.message = in.text("message", kMaxWarningBytes);
   r.time_step_s = in.finite("time_step_s");
@@ -656,6 +673,26 @@ CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Inde
   if (h.pending_steps < 0) in.fail("history.pending_steps", "must not be negative");
   const std::size_t warnings = in.count("warnings", 10000, 8);
   for (std::size_t k = 0; k < warnings; ++k) r.warnings.push_back(in.text("warnings", kMaxWarningBytes));
+  const std::size_t snapshots = in.count("bed_snapshots", static_cast<std::size_t>(dem::limits::kMaxSnapshots), 8);
+  const auto vec3 = [&](const char* what) {
+    dem::Vec3 v{};
+    for (double& x : v) x = in.finite(what);
+    return v;
+  };
+  for (std::size_t k = 0; k < snapshots; ++k) {
+    std::vector<BedSnapshot> beds(dampers);
+    for (auto& bed : beds) {
+      auto& s = bed.particles;
+      s.time_s = in.finite("bed_snapshot.time_s");
+      bed.container_position_m = vec3("bed_snapshot.container_position_m");
+      const std::size_t n = in.count("bed_snapshot.particles", 100000000, 9 * 8);
+      for (auto* vectors : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
+        for (std::size_t i = 0; i < n; ++i) vectors->push_back(vec3("bed_snapshot.particle"));
+      s.radii_m = in.finite_f64s("bed_snapshot.radii_m", n);
+      s.compartments = in.i32s("bed_snapshot.compartments", n, 0, 1 << 20);
+    }
+    r.bed_snapshots.push_back(std::move(beds));
+  }
   in.expect_tag("end of cosimulation result");
   return r;
 }

@@ -350,6 +350,7 @@ struct Cosimulation::Impl {
   void build_and_settle_worlds();
   void open_ledger();
   void open_measures(const CosimulationResult* earlier);
+  void open_snapshots(const CosimulationResult* earlier);
 
   // --- A coupled step: the stages in order (docs/cosimulation.md §3). Inlined into step():
   // out of line, their calls and a view of the state built per step cost about 170
@@ -362,6 +363,13 @@ struct Cosimulation::Impl {
   [[gnu::always_inline]] void commit_step();
   [[gnu::always_inline]] void feed_measures();
   void report_progress();
+  /// Every bed's particles and container now (CosimulationOptions::snapshots): at the
+  /// planned steps only, so the copy is outside the step loop's allocation-free path.
+  void take_snapshots();
+  std::int64_t snapshot_step(std::size_t s) const {
+    return static_cast<std::int64_t>((static_cast<double>(s) + 1.0) * static_cast<double>(planned_steps_) /
+                                     options_.snapshots);
+  }
 
   // --- Kinematics, loads and energies.
   double time_at(std::int64_t k) const { return static_cast<double>(steps0_ + k) * dt_; }
@@ -434,6 +442,8 @@ struct Cosimulation::Impl {
   std::vector<std::unique_ptr<RunMeasure>> measures_;  ///< the kind's measure first, the histories last
   /// What they read after each step.
   const StepView view_{step_, t_next_, drive_now_, drive_next_, q_, site_y_, site_theta_, force_, moment_};
+  std::vector<std::vector<BedSnapshot>> snapshots_;
+  std::int64_t next_snapshot_step_ = -1;  ///< -1: no more snapshots
   std::int64_t untimed_steps_ = 0;  ///< steps until the next timed one (CosimulationStageTimes)
   dem::Outcome outcome_ = dem::Outcome::kCompleted;
   std::string message_;
@@ -472,6 +482,7 @@ Cosimulation::Impl::Impl(const ModalModel& model, const std::vector<Cosimulation
   if (!continuation_ && !restored_) build_and_settle_worlds();
   open_ledger();
   open_measures(earlier);
+  open_snapshots(earlier);
   wall_s_ = (earlier ? earlier->wall_time_s : 0.0) + seconds_since(wall_start);
   last_report_ = Clock::now();
 }
@@ -760,6 +771,25 @@ void Cosimulation::Impl::open_measures(const CosimulationResult* earlier) {
   measures_.push_back(std::move(history));
 }
 
+// The snapshots taken so far (a restored run's from its checkpoint), the next one's step.
+void Cosimulation::Impl::open_snapshots(const CosimulationResult* earlier) {
+  if (options_.snapshots <= 0) return;
+  if (options_.snapshots > planned_steps_)
+    throw std::invalid_argument("cosimulation.snapshots = " + std::to_string(options_.snapshots) +
+                                ": more than the run's " + std::to_string(planned_steps_) + " steps");
+  if (earlier) snapshots_ = earlier->bed_snapshots;
+  if (snapshots_.size() < static_cast<std::size_t>(options_.snapshots)) next_snapshot_step_ = snapshot_step(snapshots_.size());
+}
+
+void Cosimulation::Impl::take_snapshots() {
+  std::vector<BedSnapshot> beds;
+  for (std::size_t d = 0; d < dcount_; ++d)
+    beds.push_back({dem::particle_snapshot(state_.worlds[d], t_next_), state_.worlds[d].container().position_m});
+  snapshots_.push_back(std::move(beds));
+  next_snapshot_step_ =
+      snapshots_.size() < static_cast<std::size_t>(options_.snapshots) ? snapshot_step(snapshots_.size()) : -1;
+}
+
 std::int64_t Cosimulation::Impl::advance(std::int64_t steps, const std::function<bool()>& stop) {
   const auto wall_start = Clock::now();
   std::int64_t taken = 0;
@@ -873,6 +903,7 @@ inline void Cosimulation::Impl::commit_step() {
 
 inline void Cosimulation::Impl::feed_measures() {
   for (const auto& measure : measures_) measure->after_step(view_, end_step_);
+  if (step_ == next_snapshot_step_) [[unlikely]] take_snapshots();
 }
 
 // About every progress_interval_s of wall time, read every kProgressStride steps.
@@ -964,6 +995,7 @@ CosimulationResult Cosimulation::Impl::result(bool release) {
       measure->write(r, step_);
     }
   }
+  r.bed_snapshots = release ? std::move(snapshots_) : snapshots_;
   const auto [kinetic_end, potential_end] = structure_energy_now();
   r.energy = ledger(work_, damping_, kinetic0_, potential0_, opening_, kinetic_end, potential_end);
   for (const auto& world : state_.worlds) {

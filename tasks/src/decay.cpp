@@ -62,7 +62,7 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
   s.precision(17);
   s << "structure " << surrogate::case_hash(c.resolved.value("structure", json())) << "; task "
     << surrogate::case_hash(c.resolved.value("task", json())) << "; duration_s " << o.duration_s
-    << "; sample_interval_s " << o.sample_interval_s << "; time_step_s " << dt << "; q0";
+    << "; sample_interval_s " << o.sample_interval_s << "; time_step_s " << dt << "; snapshots " << o.snapshots << "; q0";
   for (Eigen::Index j = 0; j < o.initial_modal_displacements.size(); ++j) s << ' ' << o.initial_modal_displacements[j];
   if (!own.empty()) s << "; " << own;
   return s.str();
@@ -324,7 +324,7 @@ std::string estimate_text(const CoupledRunEstimate& e) {
 DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
                    const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
-                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks, int snapshots) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -337,7 +337,8 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   Eigen::Index dominant = 0;
   weights.cwiseProduct(q0.cwiseAbs()).maxCoeff(&dominant);
 
-  const st::CosimulationOptions options = dem_decay_options(c, modal, q0, task.duration_s);
+  st::CosimulationOptions options = dem_decay_options(c, modal, q0, task.duration_s);
+  options.snapshots = snapshots;
   // Refused here when it cannot fit; said once a resume's checkpoint is accepted.
   const std::string estimate = label + ": " + estimate_text(check_coupled_decay(c, modal, dampers, options, label,
                                                                                 duration_pointer, hooks));
@@ -396,8 +397,11 @@ DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hook
   if (!(out.initial_modal_amplitudes.cwiseAbs().maxCoeff() > 0.0))
     throw InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
   if (dem) {
-    out.dem = dem_decay(c, setup.s.modal, setup.s.dampers, detail::dem_dampers(c), out.initial_modal_amplitudes,
-                        *c.task.decay, "pdamp decay (dem)", "/task/duration_s", options.checkpoint, hooks);
+    const auto beds = detail::dem_dampers(c);
+    for (const auto& d : beds) out.bed_worlds.push_back(d.world);
+    out.dem = dem_decay(c, setup.s.modal, setup.s.dampers, beds, out.initial_modal_amplitudes,
+                        *c.task.decay, "pdamp decay (dem)", "/task/duration_s", options.checkpoint, hooks,
+                        options.snapshots);
     setup.warnings.add(out.dem.warnings);
   } else {
     averaged_decay(c, setup, out.initial_modal_amplitudes, out);

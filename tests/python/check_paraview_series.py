@@ -5,7 +5,8 @@ then reads particles.pvd (a ParaView collection) and each particles_NNNN.vtp wit
 vtkXMLPolyDataReader: one vertex per particle, the radius, velocity, spin and compartment
 arrays, the times of the series equal to each file's TimeValue and increasing; and
 container.pvd: the box's six faces at the same times, its size the case's, displaced along
-the drive by the recorded container position.
+the drive by the recorded container position. Then the same for a DEM-in-the-loop decay
+(pdamp decay --method dem --snapshots 4): each bed's series, its spheres inside its box.
 Usage: check_paraview_series.py PDAMP_BINARY SOURCE_DIR WORK_DIR
 """
 import json
@@ -97,8 +98,51 @@ def main():
         for axis in range(3):
             assert (centres[:, axis] >= bounds[2 * axis] + 0.9 * radius).all(), axis
             assert (centres[:, axis] <= bounds[2 * axis + 1] - 0.9 * radius).all(), axis
-    print("ParaView series: %d snapshots of %d particles and the container read by VTK %s"
-          % (len(datasets), count, vtk.vtkVersion.GetVTKVersion()))
+    decay_snapshots = check_decay_series(pdamp, source, work)
+    print("ParaView series: %d snapshots of %d particles and the container, and %d of a DEM-in-the-loop decay, "
+          "read by VTK %s" % (len(datasets), count, decay_snapshots, vtk.vtkVersion.GetVTKVersion()))
+
+
+def read_polydata(path):
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    assert reader.GetErrorCode() == 0, path
+    return reader.GetOutput()
+
+
+def check_decay_series(pdamp, source, work):
+    """pdamp decay --method dem --snapshots 4: each bed's particles and container over the
+    decay; the box follows the site (it moves along the drive, y here) and holds its spheres."""
+    out = os.path.join(work, "decay")
+    case = os.path.join(source, "tests", "cli", "data", "one_mode_dem_decay.json")
+    subprocess.run([pdamp, "decay", case, "--method", "dem", "--snapshots", "4", "-o", out, "--overwrite", "--json"],
+                   check=True, stdout=subprocess.DEVNULL)
+    with open(case) as f:
+        document = json.load(f)
+    layer = document["dampers"][0]["layers"][0]
+    size, radius, count = layer["container"]["inner_size_m"], layer["particles"]["radius_m"], layer["particles"]["count"]
+    name = "damper_1"
+    particles = ElementTree.parse(os.path.join(out, "particles_%s.pvd" % name)).getroot().find("Collection").findall("DataSet")
+    containers = ElementTree.parse(os.path.join(out, "container_%s.pvd" % name)).getroot().find("Collection").findall("DataSet")
+    assert len(particles) == len(containers) == 4, (len(particles), len(containers))
+    times = [float(d.get("timestep")) for d in particles]
+    assert times == sorted(times) and times == [float(d.get("timestep")) for d in containers], times
+    centres_along = []
+    for p, c in zip(particles, containers):
+        spheres = read_polydata(os.path.join(out, p.get("file")))
+        box = read_polydata(os.path.join(out, c.get("file")))
+        assert spheres.GetNumberOfPoints() == count
+        bounds = box.GetBounds()
+        for axis in range(3):
+            assert abs((bounds[2 * axis + 1] - bounds[2 * axis]) - size[axis]) < 1e-12, (axis, bounds)
+        centres = vtk_to_numpy(spheres.GetPoints().GetData())
+        for axis in range(3):
+            assert (centres[:, axis] >= bounds[2 * axis] + 0.9 * radius).all(), (p.get("file"), axis)
+            assert (centres[:, axis] <= bounds[2 * axis + 1] - 0.9 * radius).all(), (p.get("file"), axis)
+        centres_along.append(0.5 * (bounds[0] + bounds[1]))
+    assert len(set(centres_along)) > 1, centres_along  # the container moves with the decaying structure
+    return len(particles)
 
 
 if __name__ == "__main__":

@@ -98,7 +98,8 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
           "[cosimulation]") {
   const ModalModel model = two_modes();
   const auto dampers = impacting_bed();
-  const CosimulationOptions options = decay(0.3);
+  CosimulationOptions options = decay(0.3);
+  options.snapshots = 40;  // the beds for ParaView, some before the checkpoint and some after
   CosimulationState whole_state;
   const CosimulationResult whole = cosimulate(model, dampers, options, whole_state);
   REQUIRE(whole.outcome == dem::Outcome::kCompleted);
@@ -122,6 +123,8 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
     CHECK(run.steps_done() == done);
     CHECK(!run.finished());
     CHECK(run.result().steps == done);
+    CHECK(!run.result().bed_snapshots.empty());
+    CHECK(run.result().bed_snapshots.size() < 40);
     dem::StateWriter out;
     run.save(out);
     bytes = out.take();
@@ -152,6 +155,20 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
   CHECK(r.final_modal_displacements == whole.final_modal_displacements);
   CHECK(r.final_modal_velocities == whole.final_modal_velocities);
   check_same_energy(r.energy, whole.energy);
+  // The snapshots: evenly spaced, the last at the end, those taken before the checkpoint
+  // restored with it: the bits of the whole run's.
+  REQUIRE(r.bed_snapshots.size() == 40);
+  REQUIRE(whole.bed_snapshots.size() == 40);
+  CHECK(whole.bed_snapshots.back().front().particles.time_s == whole.start_time_s + whole.simulated_time_s);
+  for (std::size_t k = 0; k < 40; ++k) {
+    const auto& a = r.bed_snapshots[k].front();
+    const auto& b = whole.bed_snapshots[k].front();
+    CHECK(a.particles.time_s == b.particles.time_s);
+    CHECK(a.particles.positions_m == b.particles.positions_m);
+    CHECK(a.particles.velocities_m_s == b.particles.velocities_m_s);
+    CHECK(a.particles.radii_m == b.particles.radii_m);
+    CHECK(a.container_position_m == b.container_position_m);
+  }
   const CosimulationState& state = run.state();
   CHECK(state.worlds[0].state_hash() == whole_state.worlds[0].state_hash());
   CHECK(state.steps == whole_state.steps);

@@ -33,6 +33,9 @@ struct ParticleSnapshot {
   std::vector<int> compartments;
 };
 
+/// The particles of `world` now, stamped `time_s` (positions and velocities in the world frame).
+ParticleSnapshot particle_snapshot(const World& world, double time_s);
+
 /// What a BlockRecorder records: the drive axis, the block clock and the snapshots.
 struct BlockRecorderOptions {
   Vec3 drive_axis{1.0, 0.0, 0.0};   ///< unit vector the signals are projected on

@@ -15,6 +15,7 @@
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/summary.hpp"
+#include "pdamp/dem_reference/run_recorder.hpp"
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/dem_reference/world_options.hpp"
 #include "pdamp/structure/modal_model.hpp"
@@ -122,6 +123,9 @@ struct CosimulationOptions {
   /// historical sin Ωt. A continuation of a harmonic CosimulationState ignores it: its drive
   /// starts at the state's excitation_phase_rad (the signal continues, docs/cosimulation.md §6).
   double excitation_phase_rad = 0.0;
+  /// Particle snapshots of every bed, evenly spaced over the coupled run (the last at its
+  /// planned end), for ParaView; in [0, dem_reference::limits::kMaxSnapshots]. 0: none.
+  int snapshots = 0;
 
   /// All violations, one line each, "field = value: rule" (prefix "cosimulation.").
   std::vector<std::string> validate(const ModalModel& model) const;
@@ -236,6 +240,12 @@ struct CosimulationStageTimes {
 /// Steps per timed step of CosimulationStageTimes.
 inline constexpr std::int64_t kCosimulationTimingStride = 31;
 
+/// One bed at one instant: its particles (world frame) and its container's position.
+struct BedSnapshot {
+  dem_reference::ParticleSnapshot particles;
+  dem_reference::Vec3 container_position_m{0.0, 0.0, 0.0};
+};
+
 struct CosimulationResult {
   /// kCompleted; kUnstable / kFailed when a World stopped (message: the damper and the
   /// World's own reason and advice); the histories end there.
@@ -262,6 +272,8 @@ struct CosimulationResult {
   std::vector<dem_reference::WorldStatus> world_status;            ///< per damper
   std::vector<dem_reference::ContainerState> final_container_states;  ///< per damper
   std::vector<std::string> warnings;
+  /// CosimulationOptions::snapshots: per snapshot time, every bed (damper order).
+  std::vector<std::vector<BedSnapshot>> bed_snapshots;
   /// Where the wall time went, s (not in checkpoints: a restored run's are its own process's).
   CosimulationStageTimes stage_times;
 };

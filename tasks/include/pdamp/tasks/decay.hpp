@@ -51,12 +51,14 @@ struct DemDecay {
 /// throws strict_json::Interrupted; with file.resume it continues from the file (bit for
 /// bit the uninterrupted run). `containers`: the same dampers as the structure sees them
 /// (drive shapes and the static offset of the case's beds). Progress lines carry `label`;
-/// `duration_pointer` is named in the not-settled warning. InputError for refused options,
+/// `duration_pointer` is named in the not-settled warning; `snapshots`: every bed's particles
+/// that many times, evenly over the decay (CosimulationResult::bed_snapshots, for ParaView).
+/// InputError for refused options,
 /// strict_json::NumericalError for a World that stops.
 DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal, std::vector<structure::Damper> containers,
                    const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
-                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks);
+                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks, int snapshots = 0);
 
 /// The cost of a DEM-in-the-loop run before it starts, computed without building its
 /// worlds: the coupled step, the steps, every bed's particles, and the memory of its worlds
@@ -96,6 +98,7 @@ enum class DecayMethod { kFormulas, kField, kDem };
 
 struct DecayOptions {
   DecayMethod method = DecayMethod::kFormulas;
+  int snapshots = 0;  ///< kDem: every bed's particles this many times over the decay (ParaView)
   DemDecayCheckpoint checkpoint;  ///< kDem: where it saves its state (empty file: none)
 };
 
@@ -110,6 +113,7 @@ struct DecayResult {
   structure::FreeDecay decay;            ///< kFormulas, kField
   DemDecay dem;                          ///< kDem
   structure::FreeDecay without_beds;     ///< the same release with the containers empty, same threshold
+  std::vector<dem_reference::WorldOptions> bed_worlds;  ///< kDem: each damper's bed (the containers for ParaView)
   std::vector<std::string> warnings;
 };
 /// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
