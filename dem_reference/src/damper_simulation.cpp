@@ -442,7 +442,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   bool analysing = false;
   if (resuming) {
     saved.emplace(checkpoints->resume_state, "harmonic run state");
-    saved->expect_tag("harmonic run 2");  // 2: the drive bins and the block in progress
+    saved->expect_tag("harmonic run 3");  // 2: the drive bins and the block in progress; 3: snapshots' contacts
     analysing = saved->i32_in("phase", 1, 2) == 2;
     first_step = saved->i64("step") + 1;
     // Checkpoints are written inside the transient (phase 1) or the analysis (phase 2): at
@@ -497,7 +497,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     const bool stopping = stop_asked(step);
     if (!stopping && (step % steps_per_period != 0 || !checkpoints->due || !checkpoints->due())) return false;
     StateWriter out;
-    out.tag("harmonic run 2");
+    out.tag("harmonic run 3");
     out.i32(analysing ? 2 : 1);
     out.i64(step);
     out.f64(wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count());

@@ -86,7 +86,7 @@ std::string data_array(const char* type, const char* name, int components, std::
 void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
   const std::size_t n = s.positions_m.size();
   if (s.radii_m.size() != n || s.velocities_m_s.size() != n || s.angular_velocities_rad_s.size() != n ||
-      s.compartments.size() != n) {
+      s.compartments.size() != n || s.contacts.size() != n) {
     throw std::invalid_argument(path + ": snapshot arrays differ in length");
   }
   std::vector<std::int64_t> connectivity(n), offsets(n);
@@ -95,11 +95,13 @@ void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
     offsets[i] = static_cast<std::int64_t>(i + 1);  // one vertex cell per particle
   }
   std::vector<std::int32_t> compartments(s.compartments.begin(), s.compartments.end());
+  std::vector<std::int32_t> contacts(s.contacts.begin(), s.contacts.end());
   AppendedArrays data;
   const auto radius = data.add(s.radii_m);
   const auto velocity = data.add(flat(s.velocities_m_s));
   const auto spin = data.add(flat(s.angular_velocities_rad_s));
   const auto compartment = data.add(compartments);
+  const auto contact = data.add(contacts);
   const auto points = data.add(flat(s.positions_m));
   const auto connectivity_at = data.add(connectivity);
   const auto offsets_at = data.add(offsets);
@@ -116,6 +118,7 @@ void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
       << "      <PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
       << data_array("Float64", "radius_m", 1, radius) << data_array("Float64", "velocity_m_s", 3, velocity)
       << data_array("Float64", "angular_velocity_rad_s", 3, spin) << data_array("Int32", "compartment", 1, compartment)
+      << data_array("Int32", "contacts", 1, contact)
       << "      </PointData>\n      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
       << "      <Verts>\n" << data_array("Int64", "connectivity", 1, connectivity_at)
       << data_array("Int64", "offsets", 1, offsets_at) << "      </Verts>\n"

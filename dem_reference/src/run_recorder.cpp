@@ -73,6 +73,7 @@ void BlockRecorder::save(StateWriter& out) const {
         for (double x : p) out.f64(x);
     out.f64s(s.radii_m);
     out.i32s(s.compartments);
+    out.i32s(s.contacts);
   }
 }
 
@@ -107,6 +108,7 @@ void BlockRecorder::restore(StateReader& in) {
     }
     s.radii_m = in.finite_f64s("recorder.snapshot.radii_m", n);
     s.compartments = in.i32s("recorder.snapshot.compartments", n, 0, 1 << 20);
+    s.contacts = in.i32s("recorder.snapshot.contacts", n, 0, 1 << 20);
     snapshots_.push_back(std::move(s));
   }
 }
@@ -158,6 +160,7 @@ ParticleSnapshot particle_snapshot(const World& world, double time_s) {
     s.radii_m.push_back(world.radius(i));
     s.compartments.push_back(world.compartment(i));
   }
+  s.contacts = world.contacts_per_particle();
   return s;
 }
 

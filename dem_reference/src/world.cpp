@@ -1617,6 +1617,21 @@ ContactCensus World::contact_census(const Vec3& down) const {
   return census;
 }
 
+std::vector<int> World::contacts_per_particle() const {
+  const Impl& w = *impl_;
+  std::vector<int> count(static_cast<std::size_t>(w.n), 0);
+  const auto& pairs = w.pairs.pool;
+  for (std::size_t e = 0; e < pairs.size(); ++e) {
+    if (pairs.state[e].history.gamma < 0.0) continue;  // listed, not touching
+    ++count[static_cast<std::size_t>(w.order[static_cast<std::size_t>(pairs.keys[e].i)])];
+    ++count[static_cast<std::size_t>(w.order[static_cast<std::size_t>(pairs.keys[e].j)])];
+  }
+  const auto& walls = w.wall_rows.pool;
+  for (std::size_t e = 0; e < walls.size(); ++e)
+    if (walls.state[e].history.gamma >= 0.0) ++count[static_cast<std::size_t>(w.order[static_cast<std::size_t>(walls.keys[e].i)])];
+  return count;
+}
+
 int World::contact_count() const {
   int count = 0;
   for (const auto& c : impl_->pairs.pool.state) count += c.history.gamma >= 0.0 ? 1 : 0;

@@ -637,6 +637,7 @@ void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out
           for (double x : v) out.f64(x);
       out.f64s(s.radii_m);
       out.i32s(s.compartments);
+      out.i32s(s.contacts);
     }
   out.tag("end of cosimulation result");
 }
@@ -690,6 +691,7 @@ CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Inde
         for (std::size_t i = 0; i < n; ++i) vectors->push_back(vec3("bed_snapshot.particle"));
       s.radii_m = in.finite_f64s("bed_snapshot.radii_m", n);
       s.compartments = in.i32s("bed_snapshot.compartments", n, 0, 1 << 20);
+      s.contacts = in.i32s("bed_snapshot.contacts", n, 0, 1 << 20);
     }
     r.bed_snapshots.push_back(std::move(beds));
   }

@@ -81,6 +81,17 @@ TEST_CASE("the run machinery fed the harmonic drive step by step reproduces run_
   const auto settle_steps =
       static_cast<std::int64_t>(std::ceil(dr::automatic_settling_time_s(plan.world) / dt));
   REQUIRE(dr::settle(world, start, settle_steps));
+  // The settled bed's contacts per sphere (the ParaView snapshots' `contacts`): every sphere
+  // rests on something; a pair contact counts for both spheres, the rest are wall contacts,
+  // at least one for each sphere touching a wall.
+  const std::vector<int> contacts = world.contacts_per_particle();
+  REQUIRE(contacts.size() == static_cast<std::size_t>(world.particle_count()));
+  int total = 0;
+  for (const int c : contacts) {
+    CHECK(c >= 1);
+    total += c;
+  }
+  CHECK(total - 2 * world.contact_count() >= world.contact_census({0.0, 0.0, -1.0}).touching_walls);
   dr::MotionModeAccumulator modes(world, plan.world, motion.axis());
   const std::int64_t transient = plan.steps_per_period * o.transient_periods;
   for (std::int64_t k = 1; k <= transient; ++k) world.step(motion.state(static_cast<double>(k) * dt));

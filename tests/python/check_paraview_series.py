@@ -52,13 +52,15 @@ def main():
         points = data.GetPointData()
         radii = vtk_to_numpy(points.GetArray("radius_m"))
         assert abs(radii.mean() - radius) < 0.01 * radius, radii.mean()  # the case's radius, within its spread
-        for name, components in (("velocity_m_s", 3), ("angular_velocity_rad_s", 3), ("compartment", 1)):
+        for name, components in (("velocity_m_s", 3), ("angular_velocity_rad_s", 3), ("compartment", 1), ("contacts", 1)):
             array = points.GetArray(name)
             assert array is not None, name
             assert array.GetNumberOfComponents() == components, name
             assert array.GetNumberOfTuples() == count, name
         field = vtk_to_numpy(data.GetFieldData().GetArray("TimeValue"))
         assert abs(field[0] - time) <= 1e-12 * max(1.0, time), (field[0], time)
+        contacts = vtk_to_numpy(points.GetArray("contacts"))
+        assert (contacts >= 0).all() and contacts.max() >= 1, contacts  # a bed in a box touches it somewhere
         speeds = vtk_to_numpy(points.GetArray("velocity_m_s"))
         assert speeds.shape == (count, 3)
     # The container at the same times: the 160 x 61 x 40 mm box's six inner faces, moved

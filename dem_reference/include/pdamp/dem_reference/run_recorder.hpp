@@ -31,6 +31,7 @@ struct ParticleSnapshot {
   std::vector<Vec3> angular_velocities_rad_s;
   std::vector<double> radii_m;
   std::vector<int> compartments;
+  std::vector<int> contacts;  ///< per particle: its contacts (particles and walls) at time_s
 };
 
 /// The particles of `world` now, stamped `time_s` (positions and velocities in the world frame).

@@ -132,6 +132,9 @@ class World {
   ContactCensus contact_census(const Vec3& down) const;
   /// Particle pairs currently in contact.
   int contact_count() const;
+  /// Per particle (the caller's numbering): the contacts it has now, with other particles
+  /// and with walls, plates, pins and layers.
+  std::vector<int> contacts_per_particle() const;
 
   std::int64_t neighbour_rebuilds() const;
   const StageTimes& stage_times() const;
