@@ -81,6 +81,22 @@ std::string data_array(const char* type, const char* name, int components, std::
   return out.str();
 }
 
+/// A VTK XML PolyData file at `time_s` (its TimeValue field): `piece`, the <Piece> element
+/// with its arrays' declarations, then the appended arrays themselves. Written atomically.
+void write_polydata(const std::string& path, double time_s, const std::string& piece, const AppendedArrays& data) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\""
+      << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n"
+      << "  <PolyData>\n"
+      << "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
+      << time_s << "</DataArray>\n    </FieldData>\n"
+      << piece << "  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
+      << "\n  </AppendedData>\n</VTKFile>\n";
+  strict_json::write_file_atomically(path, out.str());
+}
+
 }  // namespace
 
 void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
@@ -105,26 +121,17 @@ void write_vtp_snapshot(const std::string& path, const ParticleSnapshot& s) {
   const auto points = data.add(flat(s.positions_m));
   const auto connectivity_at = data.add(connectivity);
   const auto offsets_at = data.add(offsets);
-  std::ostringstream out;
-  out.precision(17);
-  out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\""
-      << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n"
-      << "  <PolyData>\n"
-      << "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
-      << s.time_s << "</DataArray>\n    </FieldData>\n"
-      << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
-      << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
-      << "      <PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
-      << data_array("Float64", "radius_m", 1, radius) << data_array("Float64", "velocity_m_s", 3, velocity)
-      << data_array("Float64", "angular_velocity_rad_s", 3, spin) << data_array("Int32", "compartment", 1, compartment)
-      << data_array("Int32", "contacts", 1, contact)
-      << "      </PointData>\n      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
-      << "      <Verts>\n" << data_array("Int64", "connectivity", 1, connectivity_at)
-      << data_array("Int64", "offsets", 1, offsets_at) << "      </Verts>\n"
-      << "    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
-      << "\n  </AppendedData>\n</VTKFile>\n";
-  strict_json::write_file_atomically(path, out.str());
+  std::ostringstream piece;
+  piece << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
+        << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+        << "      <PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
+        << data_array("Float64", "radius_m", 1, radius) << data_array("Float64", "velocity_m_s", 3, velocity)
+        << data_array("Float64", "angular_velocity_rad_s", 3, spin) << data_array("Int32", "compartment", 1, compartment)
+        << data_array("Int32", "contacts", 1, contact)
+        << "      </PointData>\n      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
+        << "      <Verts>\n" << data_array("Int64", "connectivity", 1, connectivity_at)
+        << data_array("Int64", "offsets", 1, offsets_at) << "      </Verts>\n    </Piece>\n";
+  write_polydata(path, s.time_s, piece.str(), data);
 }
 
 namespace {
@@ -202,24 +209,15 @@ void write_container_vtp(const std::string& path, const WorldOptions& world, con
   const auto points = data.add(g.points);
   const auto connectivity = data.add(g.connectivity);
   const auto offsets = data.add(g.offsets);
-  std::ostringstream out;
-  out.precision(17);
-  out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\""
-      << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n"
-      << "  <PolyData>\n"
-      << "    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
-      << time_s << "</DataArray>\n    </FieldData>\n"
-      << "    <Piece NumberOfPoints=\"" << g.points.size() / 3 << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-      << "NumberOfPolys=\"" << g.offsets.size() << "\">\n"
-      << "      <CellData Scalars=\"part\">\n" << data_array("Int32", "part", 1, part)
-      << data_array("Int32", "compartment", 1, compartment) << "      </CellData>\n"
-      << "      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
-      << "      <Polys>\n" << data_array("Int64", "connectivity", 1, connectivity) << data_array("Int64", "offsets", 1, offsets)
-      << "      </Polys>\n"
-      << "    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
-      << "\n  </AppendedData>\n</VTKFile>\n";
-  strict_json::write_file_atomically(path, out.str());
+  std::ostringstream piece;
+  piece << "    <Piece NumberOfPoints=\"" << g.points.size() / 3
+        << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" << g.offsets.size() << "\">\n"
+        << "      <CellData Scalars=\"part\">\n" << data_array("Int32", "part", 1, part)
+        << data_array("Int32", "compartment", 1, compartment) << "      </CellData>\n"
+        << "      <Points>\n" << data_array("Float64", "", 3, points) << "      </Points>\n"
+        << "      <Polys>\n" << data_array("Int64", "connectivity", 1, connectivity) << data_array("Int64", "offsets", 1, offsets)
+        << "      </Polys>\n    </Piece>\n";
+  write_polydata(path, time_s, piece.str(), data);
 }
 
 void write_pvd_series(const std::string& path, const std::vector<std::pair<double, std::string>>& files) {
