@@ -123,14 +123,14 @@ std::string mm(const json& v) { return v.is_number() ? three_digits(v.get<double
 std::string seconds(const json& v) { return v.is_number() ? three_digits(v.get<double>()) : "not settled"; }
 
 /// filling_ratios: the designs side by side.
-std::string designs_section(const json& result) {
+std::string designs_section(json& result) {
   if (!result.contains("designs") || !result["designs"].is_object()) return "";
   std::vector<std::vector<std::string>> rows;
   for (const char* name : {"chosen", "baseline", "bare", "same_mass", "initial", "relaxed"}) {
     if (!result["designs"].contains(name)) continue;
-    const json& d = result["designs"][name];
+    json& d = result["designs"][name];
     std::string slabs, clearances;
-    for (const auto& l : d["layers"]) {
+    for (auto& l : d["layers"]) {
       slabs += (slabs.empty() ? "" : ", ") + scalar_text(l["slabs"]);
       clearances += (clearances.empty() ? "" : ", ") + mm(l["clearance_m"]);
     }
@@ -138,12 +138,12 @@ std::string designs_section(const json& result) {
                     scalar_text(d["objective"])});
   }
   std::string layers;
-  for (const auto& l : result["designs"]["chosen"]["layers"]) layers += (layers.empty() ? "" : ", ") + scalar_text(l["name"]);
+  for (auto& l : result["designs"]["chosen"]["layers"]) layers += (layers.empty() ? "" : ", ") + scalar_text(l["name"]);
   return "<h3>Designs</h3>\n<p>Layers: " + html_escape(layers) + " (whole slabs n, clearance h = L − n·2r).</p>\n" +
          table({"design", "slabs n", "clearance h / mm", "particle mass", "settling time / s", "objective"}, rows);
 }
 
-std::string solver_section(const json& result) {
+std::string solver_section(json& result) {
   if (!result.contains("solver") || !result["solver"].is_object()) return "";
   std::vector<std::pair<std::string, std::string>> rows;
   flatten(result["solver"], "", 1, rows);
@@ -155,15 +155,15 @@ std::string solver_section(const json& result) {
   return "<h3>Optimiser</h3>\n" + table({"", ""}, cells);
 }
 
-std::string verification_section(const json& result) {
+std::string verification_section(json& result) {
   if (!result.contains("verification") || !result["verification"].is_object()) return "";
-  const json& v = result["verification"];
+  json& v = result["verification"];
   const bool settling = v.value("objective", std::string()) == "settling_time";
   std::vector<std::vector<std::string>> rows;
   for (const char* name : {"chosen", "baseline"}) {
     if (!v["designs"].contains(name)) continue;
-    const json& d = v["designs"][name];
-    const auto objective = [&](const json& side) {
+    json& d = v["designs"][name];
+    const auto objective = [&](json& side) {
       return settling ? seconds(side["settling_time_s"]) : scalar_text(side["objective"]);
     };
     rows.push_back({name, objective(d["predicted"]), objective(d["dem"]), mm(d["predicted"]["end_envelope_m"]),
@@ -172,7 +172,7 @@ std::string verification_section(const json& result) {
                                                          : "only one settled",
                     d["passed"].get<bool>() ? "pass" : "FAIL"});
     if (d.contains("softening_check")) {
-      const json& s = d["softening_check"];
+      json& s = d["softening_check"];
       rows.push_back({std::string(name) + ", check at softening " + scalar_text(s["stiffness_softening"]), "",
                       objective(s["dem"]), "", mm(s["dem"]["end_envelope_m"]), scalar_text(s["dem"]["energy_error"]),
                       s["relative_difference"].is_number()
@@ -190,7 +190,7 @@ std::string verification_section(const json& result) {
       << table({"design", "predicted " + unit, "DEM " + unit, "predicted envelope at end / mm", "DEM envelope at end / mm",
                 "DEM energy error", "DEM − predicted", "result"},
                rows);
-  const json& r = v["ranking"];
+  json& r = v["ranking"];
   out << "<p>Ranking (chosen design ahead of the best single layer): predicted "
       << (r["predicted_chosen_ahead"].get<bool>() ? "yes" : "no") << ", DEM "
       << (r["dem_chosen_ahead"].get<bool>() ? "yes" : "no") << ": " << (r["passed"].get<bool>() ? "pass" : "FAIL")
@@ -200,12 +200,12 @@ std::string verification_section(const json& result) {
 }
 
 /// filling_ratios on calibrated beds: the beds, and the rounds of the design loop.
-std::string calibration_section(const json& result) {
+std::string calibration_section(json& result) {
   std::ostringstream out;
   if (result.contains("calibration") && result["calibration"].is_object()) {
-    const json& c = result["calibration"];
+    json& c = result["calibration"];
     std::vector<std::vector<std::string>> rows;
-    for (const auto& b : c["beds"])
+    for (auto& b : c["beds"])
       rows.push_back({html_escape(scalar_text(b["layer"])), scalar_text(b["slabs"]), scalar_text(b["extra_damping_ratio"]),
                       scalar_text(b["periods"]), mm(b["stroke_min_m"]) + " – " + mm(b["stroke_max_m"]),
                       b["cached"].get<bool>() ? "cache" : "run now (" + seconds(b["wall_time_s"]) + " s)"});
@@ -216,14 +216,14 @@ std::string calibration_section(const json& result) {
         << table({"layer", "slabs", "extra damping ratio", "periods", "strokes / mm", "source"}, rows);
   }
   if (result.contains("design_loop") && result["design_loop"].is_object()) {
-    const json& loop = result["design_loop"];
+    json& loop = result["design_loop"];
     std::vector<std::vector<std::string>> rows;
-    for (const auto& r : loop["rounds"]) {
+    for (auto& r : loop["rounds"]) {
       for (const char* name : {"chosen", "baseline"}) {
         if (!r["designs"].contains(name)) continue;
-        const json& d = r["designs"][name];
+        json& d = r["designs"][name];
         std::string slabs;
-        for (const auto& n : d["slabs"]) slabs += (slabs.empty() ? "" : ", ") + scalar_text(n);
+        for (auto& n : d["slabs"]) slabs += (slabs.empty() ? "" : ", ") + scalar_text(n);
         rows.push_back({scalar_text(r["round"]), name, slabs, seconds(d["predicted_objective"]), seconds(d["dem_objective"]),
                         d["relative_difference"].is_number()
                             ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
@@ -239,12 +239,21 @@ std::string calibration_section(const json& result) {
   return out.str();
 }
 
+/// A section, or a note where the result lacks what it needs (an older or partial result).
+std::string guarded(std::string (*section)(json&), json& result) {
+  try {
+    return section(result);
+  } catch (const json::exception&) {
+    return "<p class=\"note\">(A section is left out: the result lacks some of its numbers.)</p>\n";
+  }
+}
+
 /// What a picture shows, by its file name.
 std::string caption(const std::string& file_name) {
   static const std::map<std::string, std::string> kCaptions = {
       {"eta_curve", "η*(X) of the closed forms: the onset (the cliff to the scattered state), the ideal peak and the design stroke"},
       {"backbone", "backbones: natural frequency and added damping against the damper's amplitude"},
-      {"frf", "frequency response with the dampers and without the beds"},
+      {"frf", "frequency response with the dampers and without the beds: magnitude over phase"},
       {"frf_dem", "frequency response, DEM in the loop"},
       {"frf_compare", "frequency response: closed forms, field and DEM"},
       {"decay", "free decay with the dampers, and without particles (dashed: the containers empty)"},
@@ -321,7 +330,9 @@ std::string base64(std::string_view bytes) {
 }
 
 std::string report_html(const ReportInput& in) {
-  const json& r = in.result;
+  // A copy the sections may read with operator[]: a key missing from an incomplete result
+  // reads as null there, and a section that cannot be drawn says so (guarded below).
+  json r = in.result;
   const std::string task = r.is_object() && r.contains("task") ? scalar_text(r["task"]) : "";
   std::ostringstream out;
   out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
@@ -364,7 +375,7 @@ std::string report_html(const ReportInput& in) {
         << ";base64," << base64(p.bytes) << "\">\n<figcaption>" << html_escape(caption(p.file_name)) << " ("
         << html_escape(p.file_name) << ")</figcaption>\n</figure>\n";
   }
-  if (r.is_object()) out << verification_section(r) << calibration_section(r);
+  if (r.is_object()) out << guarded(verification_section, r) << guarded(calibration_section, r);
   out << "<h3>Warnings</h3>\n";
   if (in.warnings.empty()) out << "<p>None.</p>\n";
   else {
@@ -380,7 +391,7 @@ std::string report_html(const ReportInput& in) {
   if (r.is_object()) flatten(r, "", 0, rows);
   std::vector<std::vector<std::string>> cells;
   for (const auto& [k, v] : rows) cells.push_back({k, v});
-  if (r.is_object()) out << designs_section(r) << solver_section(r);
+  if (r.is_object()) out << guarded(designs_section, r) << guarded(solver_section, r);
   out << "<h3>Numbers</h3>\n" << table({"quantity", "value"}, cells);
   if (r.is_object()) out << array_tables(r);
   out << "<h3>Provenance</h3>\n<p class=\"note\">" << html_escape(in.provenance.empty() ? "pdamp" : in.provenance)

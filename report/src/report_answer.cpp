@@ -50,6 +50,7 @@ std::string words(const json& v) {
   return text;
 }
 std::string percent(double fraction) { return three_digits(100.0 * fraction) + " %"; }
+std::string percent_of(const json& fraction) { return number(fraction) ? percent(fraction.get<double>()) : "–"; }
 
 /// "X times faster" of a settling time t against a reference t_ref (both finite).
 std::string times_faster(double t, double t_ref) {
@@ -62,11 +63,11 @@ std::string times_faster(double t, double t_ref) {
 std::string layers_text(const json& design, bool skip_empty) {
   std::vector<std::string> parts;
   for (const auto& l : at(design, {"layers"})) {
-    const double slabs = number(l["slabs"]) ? l["slabs"].get<double>() : 0.0;
+    const double slabs = number(at(l, {"slabs"})) ? at(l, {"slabs"}).get<double>() : 0.0;
     if (skip_empty && slabs == 0.0) continue;
     std::ostringstream part;
-    part << three_digits(slabs) << (slabs == 1.0 ? " slab" : " slabs") << " (" << plain(l["particles"]) << " spheres, "
-         << in_g(l["bed_mass_kg"]) << ") in " << plain(l["name"]) << " (clearance " << in_mm(l["clearance_m"]) << ")";
+    part << three_digits(slabs) << (slabs == 1.0 ? " slab" : " slabs") << " (" << plain(at(l, {"particles"})) << " spheres, "
+         << in_g(at(l, {"bed_mass_kg"})) << ") in " << plain(at(l, {"name"})) << " (clearance " << in_mm(at(l, {"clearance_m"})) << ")";
     parts.push_back(part.str());
   }
   std::string out;
@@ -125,14 +126,14 @@ Answer filling_ratios_answer(const json& r, const json& c) {
     for (const char* name : {"chosen", "baseline"}) {
       const json& d = at(v, {"designs", name});
       if (d.is_null()) continue;
-      if (at(d, {"passed"}) != true) failed.push_back(std::string("the ") + (std::string(name) == "chosen" ? "chosen design" : "best single layer") + " differs from its prediction by more than " + percent(at(v, {"tolerance_relative"}).get<double>()));
+      if (at(d, {"passed"}) != true) failed.push_back(std::string("the ") + (std::string(name) == "chosen" ? "chosen design" : "best single layer") + " differs from its prediction by more than " + percent_of(at(v, {"tolerance_relative"})));
       if (at(d, {"softening_check", "converged"}) == false)
         failed.push_back(std::string("the ") + name + " design's DEM result changes with stiffer contacts (the softening has not converged)");
     }
     if (at(v, {"ranking", "passed"}) == false) failed.push_back("the DEM does not rank the chosen design ahead of the best single layer");
     if (passed)
       verdict << "The DEM in the loop agrees with the prediction within the case's "
-              << percent(at(v, {"tolerance_relative"}).get<double>())
+              << percent_of(at(v, {"tolerance_relative"}))
               << ", ranks the chosen design ahead of the best single layer"
               << (at(v, {"designs", "chosen", "softening_check"}).is_object() ? ", and gives the same with stiffer contacts" : "")
               << ": the prediction can be trusted for this design.";
@@ -222,20 +223,20 @@ Answer frf_answer(const json& r) {
   a.paragraphs.push_back("Response " + plain(at(f, {"magnitude"})) + ", with the particles and without them (empty containers):");
   for (const auto& peak : peaks) {
     std::ostringstream p;
-    p << "Peak of '" << plain(peak["output"]) << "': " << plain(peak["magnitude"]) << " at " << plain(peak["frequency_hz"])
-      << " Hz, equivalent damping ratio " << plain(peak["damping_ratio"]);
+    p << "Peak of '" << plain(at(peak, {"output"})) << "': " << plain(at(peak, {"magnitude"})) << " at " << plain(at(peak, {"frequency_hz"}))
+      << " Hz, equivalent damping ratio " << plain(at(peak, {"damping_ratio"}));
     // Without particles: the same output's peak nearest in frequency (the same mode).
     const json* nearest = nullptr;
     for (const auto& lin : linear)
-      if (lin["output"] == peak["output"] && number(lin["magnitude"]) && number(lin["frequency_hz"]) &&
-          number(peak["frequency_hz"]) &&
-          (!nearest || std::abs(lin["frequency_hz"].get<double>() - peak["frequency_hz"].get<double>()) <
-                           std::abs((*nearest)["frequency_hz"].get<double>() - peak["frequency_hz"].get<double>())))
+      if (at(lin, {"output"}) == at(peak, {"output"}) && number(at(lin, {"magnitude"})) && number(at(lin, {"frequency_hz"})) &&
+          number(at(peak, {"frequency_hz"})) &&
+          (!nearest || std::abs(at(lin, {"frequency_hz"}).get<double>() - at(peak, {"frequency_hz"}).get<double>()) <
+                           std::abs(at(*nearest, {"frequency_hz"}).get<double>() - at(peak, {"frequency_hz"}).get<double>())))
         nearest = &lin;
-    if (nearest && number(peak["magnitude"])) {
-      const double ratio = (*nearest)["magnitude"].get<double>() / peak["magnitude"].get<double>();
-      p << "; without particles " << plain((*nearest)["magnitude"]) << " at " << plain((*nearest)["frequency_hz"])
-        << " Hz (damping ratio " << plain((*nearest)["damping_ratio"]) << "): the particles lower the peak "
+    if (nearest && number(at(peak, {"magnitude"}))) {
+      const double ratio = at(*nearest, {"magnitude"}).get<double>() / at(peak, {"magnitude"}).get<double>();
+      p << "; without particles " << plain(at(*nearest, {"magnitude"})) << " at " << plain(at(*nearest, {"frequency_hz"}))
+        << " Hz (damping ratio " << plain(at(*nearest, {"damping_ratio"})) << "): the particles lower the peak "
         << three_digits(ratio) << " times (" << three_digits(-20.0 * std::log10(ratio)) << " dB)";
     }
     p << ".";
@@ -265,8 +266,8 @@ Answer modes_answer(const json& r) {
   Answer a;
   for (const auto& m : at(r, {"modes"})) {
     std::ostringstream p;
-    p << "Mode " << plain(m["mode"]) << ": " << plain(m["frequency_hz"]) << " Hz with the empty containers ("
-      << plain(m["bare_frequency_hz"]) << " Hz without them)";
+    p << "Mode " << plain(at(m, {"mode"})) << ": " << plain(at(m, {"frequency_hz"})) << " Hz with the empty containers ("
+      << plain(at(m, {"bare_frequency_hz"})) << " Hz without them)";
     if (number(at(m, {"backbone", "max_added_damping_ratio"})))
       p << "; the particles add up to ζ = " << plain(at(m, {"backbone", "max_added_damping_ratio"})) << " at a damper amplitude of "
         << in_mm(at(m, {"backbone", "max_added_damping_amplitude_m"}));

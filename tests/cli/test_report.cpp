@@ -95,6 +95,19 @@ TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs
   in.pictures.clear();
   in.gnuplot_found = false;
   CHECK(pdamp::report::report_html(in).find("gnuplot was not found") != std::string::npos);
+
+  // Results missing what an answer reads (an older JSON, a task cut short) still give a
+  // page: the missing numbers print as "–".
+  for (const char* partial : {R"({"task": "filling_ratios", "designs": {"chosen": {"layers": [{}]}}, "verification": {}})",
+                              R"({"task": "frf", "frf": {"peaks": [{}], "linear_peaks": [{}]}})",
+                              R"({"task": "damper_design", "operating_point": {"stroke_over_onset": 0.5}})",
+                              R"({"task": "modes", "modes": [{}]})", R"({"task": "placement"})"}) {
+    in.result = json::parse(partial);
+    INFO(partial);
+    std::string page;
+    CHECK_NOTHROW(page = pdamp::report::report_html(in));
+    CHECK(page.find("<h2>Answer</h2>") != std::string::npos);
+  }
 }
 
 TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {
