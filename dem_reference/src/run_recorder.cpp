@@ -65,16 +65,7 @@ void BlockRecorder::save(StateWriter& out) const {
     out.f64s(*v);
   out.i64(next_snapshot_);
   out.i64(static_cast<std::int64_t>(snapshots_.size()));
-  for (const auto& s : snapshots_) {
-    out.f64(s.time_s);
-    out.i64(static_cast<std::int64_t>(s.radii_m.size()));
-    for (const auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
-      for (const auto& p : *v)
-        for (double x : p) out.f64(x);
-    out.f64s(s.radii_m);
-    out.i32s(s.compartments);
-    out.i32s(s.contacts);
-  }
+  for (const auto& s : snapshots_) save_particle_snapshot(out, s);
 }
 
 void BlockRecorder::restore(StateReader& in) {
@@ -97,20 +88,7 @@ void BlockRecorder::restore(StateReader& in) {
   const std::size_t taken = in.count("recorder.snapshots", static_cast<std::size_t>(options_.snapshots), 8);
   if (next_snapshot_ != static_cast<std::int64_t>(taken)) in.fail("recorder.next_snapshot", "does not match the snapshots taken");
   snapshots_.clear();
-  for (std::size_t k = 0; k < taken; ++k) {
-    ParticleSnapshot s;
-    s.time_s = in.finite("recorder.snapshot.time_s");
-    const std::size_t n = in.count("recorder.snapshot.particles", 100000000, 9 * 8);
-    for (auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s}) {
-      v->resize(n);
-      for (auto& p : *v)
-        for (double& x : p) x = in.finite("recorder.snapshot");
-    }
-    s.radii_m = in.finite_f64s("recorder.snapshot.radii_m", n);
-    s.compartments = in.i32s("recorder.snapshot.compartments", n, 0, 1 << 20);
-    s.contacts = in.i32s("recorder.snapshot.contacts", n, 0, 1 << 20);
-    snapshots_.push_back(std::move(s));
-  }
+  for (std::size_t k = 0; k < taken; ++k) snapshots_.push_back(restore_particle_snapshot(in, "recorder.snapshot"));
 }
 
 bool BlockRecorder::record_step(const World& world) {
@@ -147,6 +125,32 @@ bool BlockRecorder::record_step(const World& world) {
   step_in_block_ = 0;
   force_sum_ = velocity_sum_ = position_sum_ = 0.0;
   return true;
+}
+
+void save_particle_snapshot(StateWriter& out, const ParticleSnapshot& s) {
+  out.f64(s.time_s);
+  out.i64(static_cast<std::int64_t>(s.radii_m.size()));
+  for (const auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
+    for (const auto& p : *v)
+      for (double x : p) out.f64(x);
+  out.f64s(s.radii_m);
+  out.i32s(s.compartments);
+  out.i32s(s.contacts);
+}
+
+ParticleSnapshot restore_particle_snapshot(StateReader& in, const std::string& what) {
+  ParticleSnapshot s;
+  s.time_s = in.finite((what + ".time_s").c_str());
+  const std::size_t n = in.count((what + ".particles").c_str(), 100000000, 9 * 8);
+  for (auto* v : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s}) {
+    v->resize(n);
+    for (auto& p : *v)
+      for (double& x : p) x = in.finite(what.c_str());
+  }
+  s.radii_m = in.finite_f64s((what + ".radii_m").c_str(), n);
+  s.compartments = in.i32s((what + ".compartments").c_str(), n, 0, 1 << 20);
+  s.contacts = in.i32s((what + ".contacts").c_str(), n, 0, 1 << 20);
+  return s;
 }
 
 ParticleSnapshot particle_snapshot(const World& world, double time_s) {

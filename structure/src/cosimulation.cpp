@@ -628,16 +628,8 @@ void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out
   out.i64(static_cast<std::int64_t>(r.bed_snapshots.size()));
   for (const auto& beds : r.bed_snapshots)
     for (const auto& bed : beds) {
-      const auto& s = bed.particles;
-      out.f64(s.time_s);
+      dem::save_particle_snapshot(out, bed.particles);
       for (double x : bed.container_position_m) out.f64(x);
-      out.i64(static_cast<std::int64_t>(s.positions_m.size()));
-      for (const auto* vectors : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
-        for (const auto& v : *vectors)
-          for (double x : v) out.f64(x);
-      out.f64s(s.radii_m);
-      out.i32s(s.compartments);
-      out.i32s(s.contacts);
     }
   out.tag("end of cosimulation result");
 }
@@ -675,23 +667,11 @@ CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Inde
   const std::size_t warnings = in.count("warnings", 10000, 8);
   for (std::size_t k = 0; k < warnings; ++k) r.warnings.push_back(in.text("warnings", kMaxWarningBytes));
   const std::size_t snapshots = in.count("bed_snapshots", static_cast<std::size_t>(dem::limits::kMaxSnapshots), 8);
-  const auto vec3 = [&](const char* what) {
-    dem::Vec3 v{};
-    for (double& x : v) x = in.finite(what);
-    return v;
-  };
   for (std::size_t k = 0; k < snapshots; ++k) {
     std::vector<BedSnapshot> beds(dampers);
     for (auto& bed : beds) {
-      auto& s = bed.particles;
-      s.time_s = in.finite("bed_snapshot.time_s");
-      bed.container_position_m = vec3("bed_snapshot.container_position_m");
-      const std::size_t n = in.count("bed_snapshot.particles", 100000000, 9 * 8);
-      for (auto* vectors : {&s.positions_m, &s.velocities_m_s, &s.angular_velocities_rad_s})
-        for (std::size_t i = 0; i < n; ++i) vectors->push_back(vec3("bed_snapshot.particle"));
-      s.radii_m = in.finite_f64s("bed_snapshot.radii_m", n);
-      s.compartments = in.i32s("bed_snapshot.compartments", n, 0, 1 << 20);
-      s.contacts = in.i32s("bed_snapshot.contacts", n, 0, 1 << 20);
+      bed.particles = dem::restore_particle_snapshot(in, "bed_snapshot");
+      for (double& x : bed.container_position_m) x = in.finite("bed_snapshot.container_position_m");
     }
     r.bed_snapshots.push_back(std::move(beds));
   }

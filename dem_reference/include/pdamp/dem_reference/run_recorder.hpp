@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -36,6 +37,11 @@ struct ParticleSnapshot {
 
 /// The particles of `world` now, stamped `time_s` (positions and velocities in the world frame).
 ParticleSnapshot particle_snapshot(const World& world, double time_s);
+/// A snapshot in a checkpoint (the recorder's and the co-simulation's): its time, particle
+/// count, vectors, radii, compartments and contacts. The read refuses non-finite numbers and
+/// counts the bytes left cannot hold; `what` prefixes the field names in its errors.
+void save_particle_snapshot(StateWriter& out, const ParticleSnapshot& snapshot);
+ParticleSnapshot restore_particle_snapshot(StateReader& in, const std::string& what);
 
 /// What a BlockRecorder records: the drive axis, the block clock and the snapshots.
 struct BlockRecorderOptions {
