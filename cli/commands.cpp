@@ -22,9 +22,11 @@
 #include "pdamp/tasks/damper_design.hpp"
 #include "pdamp/tasks/dem_run.hpp"
 #include "pdamp/tasks/field.hpp"
+#include "pdamp/tasks/liggghts.hpp"
 #include "pdamp/tasks/sensitivity.hpp"
 #include "cli_hooks.hpp"
 #include "structure_commands.hpp"
+#include "version.hpp"
 
 namespace pdamp::cli {
 
@@ -262,6 +264,68 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
       {"summary.json", nullptr, false, "files", false, false});
   remove_checkpoints({checkpoint.path});
   return code;
+}
+
+// ---------------------------------------------------------------- LIGGGHTS (docs/liggghts.md)
+
+/// `pdamp export liggghts CASE.json -o DIR`: the deck of pdamp dem's run for LIGGGHTS.
+/// pdamp does not run it (no shell, no external DEM started): README.txt says how.
+int run_export_liggghts(const ParsedArgs& args, CommandContext& context) {
+  const Case c = case_file::load_case(args.positional().at(0));
+  if (!args.has("-o")) throw InputError("-o", "", "required: the folder to write the LIGGGHTS deck into");
+  tasks::DemRunOptions options;
+  options.frequency_hz = args.optional_number("--frequency", limits::kFrequency);
+  options.amplitude_m = args.optional_number("--amplitude", limits::kStroke);
+  if (const auto periods = args.optional_integer("--periods", 1, dem_reference::limits::kMaxPeriods))
+    options.analysed_periods = static_cast<int>(*periods);
+  options.label = "pdamp export liggghts";
+  const auto deck = tasks::export_liggghts(c, options, version());  // every check before the folder is touched
+  auto files = output_dir(args, context);
+  for (const auto& [name, content] : deck.files) files->add(name, content);
+  std::vector<std::string> warnings = length_scale_warnings(args, {"--amplitude"});
+  warnings.insert(warnings.end(), deck.warnings.begin(), deck.warnings.end());
+  json out = deck.record;
+  const auto& r = deck.record;
+  return finish(args, files.get(), out, warnings,
+                {{"case", c.name},
+                 {"particles", std::to_string(r["particles"].get<int>()) + "  (" +
+                                   format_number(r["bed_mass_kg"].get<double>(), 4) + " kg)"},
+                 {"drive", "X = " + format_number(r["amplitude_m"].get<double>()) + " m, f = " +
+                               format_number(r["frequency_hz"].get<double>()) + " Hz along " +
+                               r["drive_axis"].get<std::string>()},
+                 {"periods", std::to_string(r["transient_periods"].get<int>()) + " transient + " +
+                                 std::to_string(r["analysed_periods"].get<int>()) + " analysed"},
+                 {"time_step_s", format_number(r["time_step_s"].get<double>()) + "  (" +
+                                     std::to_string(r["steps_per_period"].get<long long>()) + " steps a period)"},
+                 {"run it", "cd " + files->dir().string() + " && liggghts -in " + tasks::kLiggghtsInputFile +
+                                "  (or mpirun -np N liggghts ...; README.txt)"},
+                 {"then", "pdamp import liggghts " + files->dir().string()}},
+                {"", nullptr, false, "files", false, false});
+}
+
+/// `pdamp import liggghts DIR`: pdamp dem's measures from the deck's LIGGGHTS output.
+int run_import_liggghts(const ParsedArgs& args, CommandContext& context) {
+  const std::filesystem::path deck = args.positional().at(0);
+  if (const auto out_dir = args.optional_text("-o")) {
+    // The deck's folder belongs to the export: a commit there would remove its files.
+    std::error_code e1, e2;
+    if (std::filesystem::weakly_canonical(*out_dir, e1) == std::filesystem::weakly_canonical(deck, e2))
+      throw InputError("-o", "", "'" + strict_json::printable(*out_dir) +
+                                     "' is the deck's folder (pdamp export liggghts owns it): write the summary elsewhere");
+  }
+  const auto result = tasks::import_liggghts(deck);  // refused before -o is touched
+  auto files = output_dir(args, context);
+  json out = tasks::to_json(result);
+  const auto& m = result.measures;
+  return finish(args, files.get(), out, result.warnings,
+                {{"case", result.case_name},
+                 {"eta_star", format_number(m.eta_star, 4) + " +- " + format_number(m.eta_star_stderr, 2) + "  (LIGGGHTS)"},
+                 {"eta_star (container work)", format_number(result.eta_star_work, 4)},
+                 {"apparent_mass_kg", format_number(m.apparent_mass_kg, 4) + "  (" +
+                                          format_number(m.apparent_mass_kg / result.bed_mass_kg, 3) + " m_bed)"},
+                 {"e_diss_j", format_number(m.e_diss_j)},
+                 {"energy_per_cycle_j", format_number(m.energy_per_cycle_j)}},
+                {"summary.json", nullptr, false, "files", false, false});
 }
 
 // ---------------------------------------------------------------- effective fields and sensitivity
@@ -656,6 +720,25 @@ const std::vector<Command>& commands() {
          {"-o", "DIR", "output folder (default out/<case name>_sensitivity), not a shard's"},
          kJsonFlag}, 1, true},
        run_sensitivity_merge},
+      {{"export liggghts", "pdamp export liggghts CASE.json -o DIR [--amplitude M] [--frequency HZ] [--periods N] [--json]",
+        "write a LIGGGHTS-PUBLIC 3.8 input deck that runs the case's damper as pdamp dem does (the\n"
+        "bed at pdamp's initial positions, materials, Hertz-Mindlin contacts, time step, settling,\n"
+        "x = X sin(2 pi f t)), for a domain-decomposed run on a cluster (docs/liggghts.md);\n"
+        "pdamp does not start LIGGGHTS: DIR/README.txt says how",
+        {{"--amplitude", "M", "stroke X, m (default: the case's excitation.amplitude_m)"},
+         {"--frequency", "HZ", "frequency f, Hz (default: the case's excitation.frequency_hz)"},
+         {"--periods", "N", "analysed periods (default: the case's dem.analysed_periods)"},
+         {"-o", "DIR", "the deck's folder (required): in.pdamp, particles.data, container.stl,\n"
+                       "                          README.txt, pdamp_export.json; LIGGGHTS writes force.txt and\n"
+                       "                          energy.txt there"},
+         kJsonFlag}, 1},
+       run_export_liggghts},
+      {{"import liggghts", "pdamp import liggghts DIR [-o OUT] [--json]",
+        "pdamp dem's measures (eta*, its standard error over the periods, apparent mass,\n"
+        "E_diss, the container's work) from a LIGGGHTS run of the deck pdamp export liggghts\n"
+        "wrote into DIR, computed with pdamp dem's own drive-bin measure (docs/liggghts.md)",
+        {{"-o", "OUT", "write summary.json (the --json object) into OUT, atomically"}, kJsonFlag}, 1},
+       run_import_liggghts},
       {{"validate", "pdamp validate CASE.json",
         "check a case file and print it as JSON with every default resolved and the derived\n"
         "bed clearance, extent and mass",

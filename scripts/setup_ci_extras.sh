@@ -3,7 +3,8 @@
 # clang, the compiler-rt runtimes of ASan/UBSan/libFuzzer (libclang-rt-14-dev: only a
 # Recommends of clang, which --no-install-recommends skips, so it is named here) and
 # llvm-symbolizer (llvm-14) for readable reports; chromium, which the report test uses to
-# render report.html, and python3-vtk9, whose reader loads the ParaView files. A no-op when all are present.
+# render report.html, python3-vtk9, whose reader loads the ParaView files, and liggghts,
+# which runs the deck of pdamp export liggghts in its comparison test. A no-op when all are present.
 # With --all, first everything scripts/setup.sh and scripts/ci_mpi.sh install too, in the
 # same apt-get call: .ci/run starts with it on a fresh machine, so there is one
 # `apt-get update` and one install instead of three, and the later scripts find their
@@ -14,9 +15,11 @@ cd "$(dirname "$0")/.."
 
 # chromium: the report test renders report.html headless; python3-vtk9: VTK's reader loads
 # pdamp dem's ParaView files (both tests are skipped where these are missing); pybind11-dev,
-# python3-dev, python3-numpy, python3-pytest: the Python module and its tests (ci_python.sh).
+# python3-dev, python3-numpy, python3-pytest: the Python module and its tests (ci_python.sh);
+# liggghts: the LIGGGHTS run of an exported deck against pdamp dem (tests/cli/test_liggghts.cpp,
+# skipped where it is missing; users who only run pdamp do not need it).
 packages=(clang libclang-rt-14-dev llvm-14 ninja-build chromium python3-vtk9
-  pybind11-dev python3-dev python3-numpy python3-pytest)
+  pybind11-dev python3-dev python3-numpy python3-pytest liggghts)
 if [ "${1:-}" = --all ]; then
   read -r -a base <<<"$(scripts/setup.sh --list-packages --mpi)"
   packages=("${base[@]}" "${packages[@]}")
