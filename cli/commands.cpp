@@ -320,7 +320,6 @@ int run_import_liggghts(const ParsedArgs& args, CommandContext& context) {
   return finish(args, files.get(), out, result.warnings,
                 {{"case", result.case_name},
                  {"eta_star", format_number(m.eta_star, 4) + " +- " + format_number(m.eta_star_stderr, 2) + "  (LIGGGHTS)"},
-                 {"eta_star (container work)", format_number(result.eta_star_work, 4)},
                  {"apparent_mass_kg", format_number(m.apparent_mass_kg, 4) + "  (" +
                                           format_number(m.apparent_mass_kg / result.bed_mass_kg, 3) + " m_bed)"},
                  {"e_diss_j", format_number(m.e_diss_j)},

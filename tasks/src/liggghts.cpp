@@ -86,8 +86,12 @@ void check_exportable(const case_file::Case& c, const dr::DamperSimulationOption
 }
 
 /// ASCII STL of the container's inner walls, centred at `centre` (world frame at rest).
-/// A cylinder's mantle is a prism of `segments` flat facets with their corners on the
-/// mantle: a sphere touches a facet at most R(1 − cos(π/n)) outside the true mantle.
+/// A cylinder's mantle is a prism of `segments` flat facets tangent to the mantle at their
+/// middles (corners at R/cos(π/n)): no facet comes nearer the axis than the true mantle,
+/// so a lattice sphere that touches the mantle in pdamp's start overlaps no facet (with
+/// the corners on the mantle it would overlap one by up to R(1 − cos(π/n)), at full
+/// stiffness a force that scatters the bed in the first step); at the corners a sphere
+/// reaches at most R(1/cos(π/n) − 1) beyond the true mantle.
 std::string container_stl(const fm::Container& container, const dr::Vec3& centre, int segments) {
   std::ostringstream out;
   out.imbue(std::locale::classic());
@@ -117,7 +121,8 @@ std::string container_stl(const fm::Container& container, const dr::Vec3& centre
       }
   } else {
     const int k = container.cylinder_axis, u = (k + 1) % 3, v = (k + 2) % 3;
-    const double radius = container.cylinder_inner_radius_m, half = container.cylinder_inner_length_m / 2;
+    const double radius = container.cylinder_inner_radius_m / std::cos(std::numbers::pi / segments);
+    const double half = container.cylinder_inner_length_m / 2;
     const auto rim = [&](int i, double side) {
       dr::Vec3 p{0.0, 0.0, 0.0};
       const double angle = 2.0 * std::numbers::pi * i / segments;
@@ -141,10 +146,10 @@ std::string container_stl(const fm::Container& container, const dr::Vec3& centre
   return out.str();
 }
 
-/// Facets of a cylinder's mantle: the sagitta R(1 − cos(π/n)) at most 1% of the smallest
-/// radius, so that a facet lies within 1% of a sphere of the true mantle.
+/// Facets of a cylinder's mantle: the corners' excess R(1/cos(π/n) − 1) at most 1% of the
+/// smallest radius, so that the facets lie within 1% of a sphere of the true mantle.
 int mantle_segments(double cylinder_radius_m, double smallest_particle_radius_m) {
-  const double n = std::numbers::pi / std::acos(1.0 - 0.01 * smallest_particle_radius_m / cylinder_radius_m);
+  const double n = std::numbers::pi / std::acos(1.0 / (1.0 + 0.01 * smallest_particle_radius_m / cylinder_radius_m));
   return static_cast<int>(std::clamp(std::ceil(n), 32.0, 4096.0));
 }
 
@@ -153,12 +158,12 @@ std::string readme_text(const json& r, bool cylinder) {
   out << "LIGGGHTS deck of pdamp dem's run of case '" << r["case"].get<std::string>() << "'\n"
       << "written by pdamp " << r["pdamp_version"].get<std::string>() << " (export " << r["export_id"].get<std::string>()
       << "); docs/liggghts.md of pdamp explains every command.\n\n"
-      << "The run: " << r["particles"].get<int>() << " spheres (" << num(r["bed_mass_kg"].get<double>())
+      << "The run: " << r["particles"].get<int>() << " spheres (" << strict_json::format_number(r["bed_mass_kg"].get<double>(), 4)
       << " kg) settle for " << r["settling_steps"].get<long long>() << " steps with the container at rest, then the\n"
       << "container moves as x = X sin(2 pi f t) along " << r["drive_axis"].get<std::string>() << ", X = "
-      << num(r["amplitude_m"].get<double>()) << " m, f = " << num(r["frequency_hz"].get<double>()) << " Hz, for "
+      << strict_json::format_number(r["amplitude_m"].get<double>()) << " m, f = " << strict_json::format_number(r["frequency_hz"].get<double>()) << " Hz, for "
       << r["transient_periods"].get<int>() << " transient and " << r["analysed_periods"].get<int>()
-      << " analysed periods\nat a time step of " << num(r["time_step_s"].get<double>()) << " s ("
+      << " analysed periods\nat a time step of " << strict_json::format_number(r["time_step_s"].get<double>()) << " s ("
       << r["steps_per_period"].get<long long>() << " steps a period). It writes " << kLiggghtsForceFile
       << " (the force of the bed on the\ncontainer walls, mean over each of " << r["samples_per_period"].get<int>()
       << " samples a period) and " << kLiggghtsEnergyFile << " (kinetic energy and centre of\nmass at each sample).\n\n"
@@ -172,8 +177,8 @@ std::string readme_text(const json& r, bool cylinder) {
       << "On a cluster (Slurm), e.g. 2 nodes of 32 cores:\n"
       << "  #SBATCH --nodes=2\n  #SBATCH --ntasks-per-node=32\n  srun liggghts -in " << kLiggghtsInputFile
       << "       (or mpirun -np 64 liggghts -in " << kLiggghtsInputFile << ")\n"
-      << "Domain decomposition pays for large beds (about 1000 spheres a process or more); a few\n"
-      << "hundred spheres run fastest on one process.\n\n"
+      << "Domain decomposition is for large beds, where each process owns many spheres; a bed of\n"
+      << "a few dozen spheres gains nothing from a second process.\n\n"
       << "Then read the result into pdamp's measures (eta*, its standard error, apparent mass):\n"
       << "  pdamp import liggghts THIS_FOLDER [-o OUT] [--json]\n";
   return out.str();
@@ -589,8 +594,6 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   out.delta_kinetic_j = (end[1] + end[2]) - (start[1] + start[2]);
   out.delta_potential_j = 0.0;
   for (int k = 0; k < 3; ++k) out.delta_potential_j -= out.bed_mass_kg * g[k] * (end[3 + k] - start[3 + k]);
-  const double v = x * omega;
-  out.eta_star_work = out.container_work_j / (out.analysed_periods * std::numbers::pi * out.bed_mass_kg * v * v);
 
   // The drive bin weighs a sample as a force held over it (sinc(π/M)); a sample's mean of
   // a harmonic force is that force times sinc(π/M) already, so η* is low by 1 − sinc²(π/M).
@@ -612,7 +615,6 @@ json to_json(const LiggghtsImport& r) {
               {"eta_star", m.eta_star},
               {"eta_star_stderr", m.eta_star_stderr},
               {"eta_star_per_period", m.eta_star_per_period},
-              {"eta_star_energy_balance", r.eta_star_work},
               {"e_diss_j", m.e_diss_j},
               {"energy_per_cycle_j", m.energy_per_cycle_j},
               {"apparent_mass_kg", m.apparent_mass_kg},

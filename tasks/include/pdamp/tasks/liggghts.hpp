@@ -58,12 +58,13 @@ struct LiggghtsImport {
   /// per-period values, E_diss, apparent mass), from the force samples.
   dem_reference::DriveBinMeasures measures;
   /// Container work over the analysed periods, Σ F̄_k·Δx_c,k (the sample's mean force of the
-  /// container on the bed times the container's displacement over the sample), J.
+  /// container on the bed times the container's displacement over the sample), J. With the
+  /// container's harmonic motion this is the drive bin's n·2π·E_diss again, not an
+  /// independent check: LIGGGHTS counts no dissipation in its contacts, so pdamp dem's
+  /// energy balance (work against counted dissipation) has no counterpart here.
   double container_work_j = 0.0;
   double delta_kinetic_j = 0.0;    ///< translational + rotational, end minus start of the analysis, J
   double delta_potential_j = 0.0;  ///< −m_bed g·Δx_com, J
-  /// η* of the container work, W/(n·π·m_bed·V²): the time-domain check of the drive bin.
-  double eta_star_work = 0.0;
   std::vector<std::string> warnings;
 };
 
