@@ -203,8 +203,12 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   const auto& compartment = world_options.compartments.front();
 
   // pdamp's own initial bed: the World places the spheres exactly as pdamp dem's run does
-  // (lattice, ball-lot radii, seed), before it settles them.
-  const dr::World world(world_options);
+  // (lattice, ball-lot radii, seed), before it settles them. The placement does not depend
+  // on the step, so the World is built at its automatic one: it refuses a user step above
+  // its own bound, which pdamp dem accepts with a warning (estimate.warnings, passed on).
+  dr::WorldOptions placement_options = world_options;
+  placement_options.integration.time_step_s = 0.0;
+  const dr::World world(placement_options);
   const int n = world.particle_count();
   const double x = plan.amplitude_m, f = plan.frequency_hz, omega = 2.0 * std::numbers::pi * f;
   const dr::Vec3 d = sim.drive_axis;

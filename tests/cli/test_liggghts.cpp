@@ -164,6 +164,24 @@ TEST_CASE("pdamp import liggghts refuses a missing or garbled output with one li
   fs::remove_all(dir);
 }
 
+TEST_CASE("pdamp export liggghts takes a user time step above the automatic bound as pdamp dem does", "[cli][liggghts]") {
+  // Full stiffness at 1 us: above the automatic bound (50 steps per contact), below the
+  // stability limit (20 steps, the Rayleigh time): pdamp dem runs it with a warning, so
+  // the export must write it, with the same warning, not refuse it.
+  const auto stepped = edited_case("pdamp_liggghts_step.json", [](json& c) {
+    c["dem"]["stiffness_softening"] = 1.0;
+    c["dem"]["time_step_s"] = 1e-6;
+  });
+  const fs::path dir = fresh_dir("step");
+  const auto r = run_pdamp({"export", "liggghts", stepped, "-o", dir.string(), "--periods", "1", "--json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(json::parse(r.out)["time_step_s"].get<double>() == 1e-6);
+  CHECK_THAT(r.err, Catch::Contains("steps per contact"));
+  CHECK_THAT(slurp(dir / "in.pdamp"), Catch::Contains("timestep 9.9999999999999995e-07"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("pdamp export liggghts refuses what LIGGGHTS cannot run as pdamp does, before writing", "[cli][liggghts]") {
   const fs::path dir = fresh_dir("refused");
   const auto layered = edited_case("pdamp_liggghts_layer.json", [](json& c) {
