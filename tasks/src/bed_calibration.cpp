@@ -237,6 +237,10 @@ std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::F
   const auto start = std::chrono::steady_clock::now();
   // A design of one bed is that bed alone: its calibration already came down at its rate.
   if (std::count_if(slabs.begin(), slabs.end(), [](long n) { return n > 0; }) < 2) return {};
+  // A verification decay too short to give a rate (fewer than two envelope points) says
+  // nothing about what the other beds add: the beds keep their calibration (a NaN damping
+  // ratio would otherwise reach the recalibration runs' modal model).
+  if (!std::isfinite(design_damping_ratio)) return {};
   std::vector<CalibratedBed> beds;
   std::vector<std::size_t> index;  // into calibration.beds
   for (std::size_t b = 0; b < calibration.beds.size(); ++b) {

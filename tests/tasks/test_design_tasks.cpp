@@ -219,6 +219,16 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
                                                         tasks::slabs_of(first.optimum.chosen));
   CHECK(again.objective == first.optimum.chosen.objective);
 
+  // A verification decay too short to give the design's rate (NaN): the loop has nothing to
+  // recalibrate with, runs nothing and keeps every bed (it once ran the beds with NaN damping).
+  tasks::BedCalibration unchanged = calibration;
+  CHECK(tasks::recalibrate_in_design(c, first.problem, unchanged, {1, 3, 2}, NAN, 1e-3, tasks::silent_hooks(),
+                                     tasks::local_executor())
+            .empty());
+  CHECK(unchanged.runs == calibration.runs);
+  for (std::size_t b = 0; b < calibration.beds.size(); ++b)
+    CHECK(unchanged.beds[b].extra_damping_ratio == calibration.beds[b].extra_damping_ratio);
+
   // Again: every bed from the cache, the same fields, the same choice.
   const auto second = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
   CHECK(second.calibration->runs == 0);

@@ -77,7 +77,8 @@ double decay_damping_ratio(std::span<const double> time_s, std::span<const doubl
 /// settling threshold `design_damping_ratio` (from its DEM verification) less the bed's own
 /// alone over the same span, down to the stroke `design_threshold_m` (never below 0).
 /// Replaces those beds in `calibration` (cached like the others) and returns one line per bed
-/// replaced; none for a design of one bed (its calibration is that design already).
+/// replaced; none for a design of one bed (its calibration is that design already) or for a
+/// design_damping_ratio that is not finite (a decay too short to give a rate).
 std::vector<std::string> recalibrate_in_design(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                                                BedCalibration& calibration, const std::vector<long>& slabs,
                                                double design_damping_ratio, double design_threshold_m, RunHooks& hooks,
