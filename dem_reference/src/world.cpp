@@ -786,38 +786,106 @@ double World::Impl::displacement_bound(const ContainerState& previous) const {
   return std::sqrt(max_d2) + std::sqrt(max_u2) + std::sqrt(dc2) + std::sqrt(dr2) * reach;
 }
 
-void World::Impl::integrate(int begin, int end, Partition& part) {
-  const double h = dt;
-  const double g0 = options.gravity_m_s2[0], g1 = options.gravity_m_s2[1], g2 = options.gravity_m_s2[2];
-  double d2_max = part.max_d2;
-  for (int i = begin; i < end; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (i % kDoublesPerLine == 0 && i + kIntegratePrefetch < n) {
-      const std::size_t a = k + kIntegratePrefetch;
-      for (const auto* v : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz}) {
-        __builtin_prefetch(v->data() + a, 1);
-      }
-      for (const auto* v : {&inv_mass, &inv_inertia, &mass, &rx, &ry, &rz}) __builtin_prefetch(v->data() + a, 0);
+namespace {
+
+/// The particle arrays integrate_rows reads and writes (raw: the rows of one call never
+/// alias, which lets the compiler put neighbouring particles in the lanes of a register).
+struct IntegrationArrays {
+  double* __restrict x;
+  double* __restrict y;
+  double* __restrict z;
+  double* __restrict vx;
+  double* __restrict vy;
+  double* __restrict vz;
+  double* __restrict wx;
+  double* __restrict wy;
+  double* __restrict wz;
+  double* __restrict fx;
+  double* __restrict fy;
+  double* __restrict fz;
+  double* __restrict tx;
+  double* __restrict ty;
+  double* __restrict tz;
+  const double* __restrict inv_mass;
+  const double* __restrict inv_inertia;
+  const double* __restrict mass;
+  const double* __restrict rx;
+  const double* __restrict ry;
+  const double* __restrict rz;
+};
+
+/// One step of rows [begin, end) (at most kDoublesPerLine, one cache line): the kick with the forces and torques of the current
+/// positions, the drift, the squared displacement since the last rebuild (in the container's
+/// body frame: R^T (x − c), R the container's orientation when kRotated, else x − c) into
+/// d2_max, and the forces reset to gravity for the next sweep. Each particle takes the
+/// operations of the scalar update in the same order whatever the lanes, so the bits do not
+/// depend on how the compiler vectorises the loop; the largest displacement is a max, which
+/// does not depend on the order either.
+template <bool kRotated>
+void integrate_rows(const IntegrationArrays a, int begin, int end, double h, const double* g, const double* c,
+                    const double* R, double& d2_max) {
+  // The rows' squared displacements, their max taken after the loop: a max reduction inside
+  // it would keep the loop scalar (without -ffinite-math-only the compiler may not reorder it).
+  double u2_of[kDoublesPerLine];
+  for (int k = begin; k < end; ++k) {
+    const double im = a.inv_mass[k] * h;
+    const double ii = a.inv_inertia[k] * h;
+    a.vx[k] += a.fx[k] * im;
+    a.vy[k] += a.fy[k] * im;
+    a.vz[k] += a.fz[k] * im;
+    a.wx[k] += a.tx[k] * ii;
+    a.wy[k] += a.ty[k] * ii;
+    a.wz[k] += a.tz[k] * ii;
+    a.x[k] += a.vx[k] * h;
+    a.y[k] += a.vy[k] * h;
+    a.z[k] += a.vz[k] * h;
+    const double d0 = a.x[k] - c[0], d1 = a.y[k] - c[1], d2 = a.z[k] - c[2];
+    double b0 = d0, b1 = d1, b2 = d2;
+    if constexpr (kRotated) {
+      b0 = R[0] * d0 + R[3] * d1 + R[6] * d2;
+      b1 = R[1] * d0 + R[4] * d1 + R[7] * d2;
+      b2 = R[2] * d0 + R[5] * d1 + R[8] * d2;
     }
-    const double im = inv_mass[k] * h;
-    const double ii = inv_inertia[k] * h;
-    vx[k] += fx[k] * im;
-    vy[k] += fy[k] * im;
-    vz[k] += fz[k] * im;
-    wx[k] += tx[k] * ii;
-    wy[k] += ty[k] * ii;
-    wz[k] += tz[k] * ii;
-    x[k] += vx[k] * h;
-    y[k] += vy[k] * h;
-    z[k] += vz[k] * h;
-    double body[3];
-    to_body(x[k], y[k], z[k], body);
-    const double dx = body[0] - rx[k], dy = body[1] - ry[k], dz = body[2] - rz[k];
-    d2_max = std::max(d2_max, dx * dx + dy * dy + dz * dz);
-    fx[k] = mass[k] * g0;
-    fy[k] = mass[k] * g1;
-    fz[k] = mass[k] * g2;
-    tx[k] = ty[k] = tz[k] = 0.0;
+    const double ux = b0 - a.rx[k], uy = b1 - a.ry[k], uz = b2 - a.rz[k];
+    u2_of[k - begin] = ux * ux + uy * uy + uz * uz;
+    a.fx[k] = a.mass[k] * g[0];
+    a.fy[k] = a.mass[k] * g[1];
+    a.fz[k] = a.mass[k] * g[2];
+    a.tx[k] = 0.0;
+    a.ty[k] = 0.0;
+    a.tz[k] = 0.0;
+  }
+  for (int r = 0; r < end - begin; ++r) d2_max = std::max(d2_max, u2_of[r]);
+}
+
+}  // namespace
+
+void World::Impl::integrate(int begin, int end, Partition& part) {
+  const IntegrationArrays arrays{x.data(),  y.data(),  z.data(),  vx.data(),       vy.data(),          vz.data(),
+                                 wx.data(), wy.data(), wz.data(), fx.data(),       fy.data(),          fz.data(),
+                                 tx.data(), ty.data(), tz.data(), inv_mass.data(), inv_inertia.data(), mass.data(),
+                                 rx.data(), ry.data(), rz.data()};
+  const double* const g = options.gravity_m_s2.data();
+  const double* const c = container.position_m.data();
+  const double* const R = container.orientation.data();
+  double d2_max = part.max_d2;
+  // Cache line by cache line, the lines kIntegratePrefetch particles ahead requested first
+  // (a large bed streams its arrays through the step).
+  for (int line = begin; line < end;) {
+    const int line_end = std::min(end, (line / kDoublesPerLine + 1) * kDoublesPerLine);
+    if (line % kDoublesPerLine == 0 && line + kIntegratePrefetch < n) {
+      const auto ahead = static_cast<std::size_t>(line + kIntegratePrefetch);
+      for (const auto* v : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz}) {
+        __builtin_prefetch(v->data() + ahead, 1);
+      }
+      for (const auto* v : {&inv_mass, &inv_inertia, &mass, &rx, &ry, &rz}) __builtin_prefetch(v->data() + ahead, 0);
+    }
+    if (rotated) {
+      integrate_rows<true>(arrays, line, line_end, dt, g, c, R, d2_max);
+    } else {
+      integrate_rows<false>(arrays, line, line_end, dt, g, c, R, d2_max);
+    }
+    line = line_end;
   }
   part.max_d2 = d2_max;
 }
