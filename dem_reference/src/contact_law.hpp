@@ -186,9 +186,17 @@ template <class W, bool kMasked>
     const Mask unloading = ratio < one;
     const W loss_unloading = half * s2 * inv_k_prev * (one - ratio);
     const W loss_loading = half * s2 * (inv_k_prev - inv_k);
-    loss = select(turn, select(unloading, loss_unloading, loss_loading), zero);
+    const W turned_loss = select(unloading, loss_unloading, loss_loading);
     const W scale = select(unloading, keep * ratio, keep);
-    for (int c = 0; c < 3; ++c) s[c] = select(turn, r[c] * scale, s[c]);
+    // Every lane turning (a persisting contact in each: the common case) needs no select,
+    // which costs three instructions a value without SSE4.1; the values are the same.
+    if (all(turn)) {
+      loss = turned_loss;
+      for (int c = 0; c < 3; ++c) s[c] = r[c] * scale;
+    } else {
+      loss = select(turn, turned_loss, zero);
+      for (int c = 0; c < 3; ++c) s[c] = select(turn, r[c] * scale, s[c]);
+    }
   }
   for (int c = 0; c < 3; ++c) s[c] = s[c] - k * du[c];
   const W t2 = s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
@@ -197,9 +205,15 @@ template <class W, bool kMasked>
   if (any(sliding)) {
     const W t = sqrt(t2);
     // Energy of sliding: the mean Coulomb limit of the step times the slip (t − cap)/k.
-    loss = select(sliding, loss + half * (cap + cap_prev) * (t - cap) * inv_k, loss);
+    const W slid_loss = loss + half * (cap + cap_prev) * (t - cap) * inv_k;
     const W scale = cap / t;
-    for (int c = 0; c < 3; ++c) s[c] = select(sliding, s[c] * scale, s[c]);
+    if (all(sliding)) {  // as above: the same values without selects
+      loss = slid_loss;
+      for (int c = 0; c < 3; ++c) s[c] = s[c] * scale;
+    } else {
+      loss = select(sliding, slid_loss, loss);
+      for (int c = 0; c < 3; ++c) s[c] = select(sliding, s[c] * scale, s[c]);
+    }
   }
   return loss;
 }

@@ -35,7 +35,7 @@ namespace pdamp::dem_reference::detail::simd {
 //   W::kWidth, W::Mask (a lane mask: all bits set where true),
 //   W::splat(x), W::gather(f): lane l = f(l), lane(v, l), scatter(v, f): f(l) = lane l
 //   (f returns a double&), + − × ÷, unary −, sqrt, < > (to a Mask), select(m, yes, no),
-//   and for masks & | andnot(a, b) = ¬a ∧ b, any(m), lane(m, l).
+//   and for masks & | andnot(a, b) = ¬a ∧ b, any(m), all(m), lane(m, l).
 
 // ---- one lane: the scalar kernel ----------------------------------------------------
 struct Lanes1 {
@@ -62,6 +62,7 @@ PDAMP_LANE_INLINE Lanes1::Mask operator&(Lanes1::Mask a, Lanes1::Mask b) { retur
 PDAMP_LANE_INLINE Lanes1::Mask operator|(Lanes1::Mask a, Lanes1::Mask b) { return {a.m || b.m}; }
 PDAMP_LANE_INLINE Lanes1::Mask andnot(Lanes1::Mask a, Lanes1::Mask b) { return {!a.m && b.m}; }
 PDAMP_LANE_INLINE bool any(Lanes1::Mask a) { return a.m; }
+PDAMP_LANE_INLINE bool all(Lanes1::Mask a) { return a.m; }
 PDAMP_LANE_INLINE bool lane(Lanes1::Mask a, int) { return a.m; }
 PDAMP_LANE_INLINE Lanes1 select(Lanes1::Mask m, Lanes1 yes, Lanes1 no) { return m.m ? yes : no; }
 PDAMP_LANE_INLINE double lane(Lanes1 a, int) { return a.v; }
@@ -98,6 +99,7 @@ PDAMP_LANE_INLINE P2::Mask operator&(P2::Mask a, P2::Mask b) { return {{a.m[0] &
 PDAMP_LANE_INLINE P2::Mask operator|(P2::Mask a, P2::Mask b) { return {{a.m[0] || b.m[0], a.m[1] || b.m[1]}}; }
 PDAMP_LANE_INLINE P2::Mask andnot(P2::Mask a, P2::Mask b) { return {{!a.m[0] && b.m[0], !a.m[1] && b.m[1]}}; }
 PDAMP_LANE_INLINE bool any(P2::Mask a) { return a.m[0] || a.m[1]; }
+PDAMP_LANE_INLINE bool all(P2::Mask a) { return a.m[0] && a.m[1]; }
 PDAMP_LANE_INLINE bool lane(P2::Mask a, int l) { return a.m[l]; }
 PDAMP_LANE_INLINE P2 select(P2::Mask m, P2 yes, P2 no) {
   return {{m.m[0] ? yes.v[0] : no.v[0], m.m[1] ? yes.v[1] : no.v[1]}};
@@ -136,6 +138,7 @@ PDAMP_LANE_INLINE S2::Mask operator&(S2::Mask a, S2::Mask b) { return {_mm_and_p
 PDAMP_LANE_INLINE S2::Mask operator|(S2::Mask a, S2::Mask b) { return {_mm_or_pd(a.m, b.m)}; }
 PDAMP_LANE_INLINE S2::Mask andnot(S2::Mask a, S2::Mask b) { return {_mm_andnot_pd(a.m, b.m)}; }
 PDAMP_LANE_INLINE bool any(S2::Mask a) { return _mm_movemask_pd(a.m) != 0; }
+PDAMP_LANE_INLINE bool all(S2::Mask a) { return _mm_movemask_pd(a.m) == 3; }
 PDAMP_LANE_INLINE bool lane(S2::Mask a, int l) { return ((_mm_movemask_pd(a.m) >> l) & 1) != 0; }
 PDAMP_LANE_INLINE S2 select(S2::Mask m, S2 yes, S2 no) {
   return {_mm_or_pd(_mm_and_pd(m.m, yes.v), _mm_andnot_pd(m.m, no.v))};
@@ -177,6 +180,7 @@ PDAMP_LANE_INLINE N2::Mask operator&(N2::Mask a, N2::Mask b) { return {vandq_u64
 PDAMP_LANE_INLINE N2::Mask operator|(N2::Mask a, N2::Mask b) { return {vorrq_u64(a.m, b.m)}; }
 PDAMP_LANE_INLINE N2::Mask andnot(N2::Mask a, N2::Mask b) { return {vbicq_u64(b.m, a.m)}; }
 PDAMP_LANE_INLINE bool any(N2::Mask a) { return (vgetq_lane_u64(a.m, 0) | vgetq_lane_u64(a.m, 1)) != 0; }
+PDAMP_LANE_INLINE bool all(N2::Mask a) { return (vgetq_lane_u64(a.m, 0) & vgetq_lane_u64(a.m, 1)) != 0; }
 PDAMP_LANE_INLINE bool lane(N2::Mask a, int l) {
   return (l == 0 ? vgetq_lane_u64(a.m, 0) : vgetq_lane_u64(a.m, 1)) != 0;
 }
@@ -216,6 +220,7 @@ PDAMP_LANE_INLINE A4::Mask operator&(A4::Mask a, A4::Mask b) { return {_mm256_an
 PDAMP_LANE_INLINE A4::Mask operator|(A4::Mask a, A4::Mask b) { return {_mm256_or_pd(a.m, b.m)}; }
 PDAMP_LANE_INLINE A4::Mask andnot(A4::Mask a, A4::Mask b) { return {_mm256_andnot_pd(a.m, b.m)}; }
 PDAMP_LANE_INLINE bool any(A4::Mask a) { return _mm256_movemask_pd(a.m) != 0; }
+PDAMP_LANE_INLINE bool all(A4::Mask a) { return _mm256_movemask_pd(a.m) == 15; }
 PDAMP_LANE_INLINE bool lane(A4::Mask a, int l) { return ((_mm256_movemask_pd(a.m) >> l) & 1) != 0; }
 PDAMP_LANE_INLINE A4 select(A4::Mask m, A4 yes, A4 no) { return {_mm256_blendv_pd(no.v, yes.v, m.m)}; }
 PDAMP_LANE_INLINE double lane(A4 a, int l) {
