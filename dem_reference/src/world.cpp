@@ -814,10 +814,11 @@ struct IntegrationArrays {
   const double* __restrict rz;
 };
 
-/// One step of rows [begin, end) (at most kDoublesPerLine, one cache line): the kick with the forces and torques of the current
-/// positions, the drift, the squared displacement since the last rebuild (in the container's
-/// body frame: R^T (x − c), R the container's orientation when kRotated, else x − c) into
-/// d2_max, and the forces reset to gravity for the next sweep. Each particle takes the
+/// One step of rows [begin, end) (at most kDoublesPerLine, one cache line): the kick with the
+/// forces and torques of the current positions, the drift, the squared displacement since the
+/// last rebuild (in the container's body frame as to_body gives it: R^T (x − c), R the
+/// container's orientation when kRotated, else x − c) into d2_max, and the forces reset to
+/// gravity for the next sweep. Each particle takes the
 /// operations of the scalar update in the same order whatever the lanes, so the bits do not
 /// depend on how the compiler vectorises the loop; the largest displacement is a max, which
 /// does not depend on the order either.
