@@ -113,7 +113,7 @@ void BM_FillingRatiosVerified(benchmark::State& state, double verify_duration_s)
   options.calibrated = false;  // the verification's DEM alone, on the closed forms' designs
   for (auto _ : state) {
     const auto r =
-        pdamp::tasks::run_filling_ratios(c, options, pdamp::tasks::silent_hooks(), pdamp::tasks::local_executor());
+        pdamp::tasks::run_filling_ratios(c, options, pdamp::base::silent_hooks(), pdamp::base::local_executor());
     for (const auto& d : r.verification->designs) {
       steps += static_cast<double>(d.dem.steps);
       dem_wall_s += d.dem.wall_time_s;

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "pdamp/report/external_program.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::cli {
 
@@ -37,7 +37,7 @@ CliHooks::~CliHooks() {
   if (line_open_) std::cerr << "\n";
 }
 
-void CliHooks::progress(const tasks::Progress& p) {
+void CliHooks::progress(const base::Progress& p) {
   using namespace std::chrono_literals;
   std::lock_guard lock(mutex_);
   const auto now = std::chrono::steady_clock::now();
@@ -77,7 +77,7 @@ void CliHooks::progress(const tasks::Progress& p) {
 void CliHooks::note(const std::string& line) {
   std::lock_guard lock(mutex_);
   std::ostringstream text;  // one write, so that another thread's line is not split
-  text << (line_open_ ? "\n" : "") << strict_json::printable(line) << "\n";
+  text << (line_open_ ? "\n" : "") << base::printable(line) << "\n";
   std::cerr << text.str() << std::flush;
   line_open_ = false;
 }

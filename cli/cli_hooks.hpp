@@ -7,11 +7,11 @@
 #include <mutex>
 #include <string>
 
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::cli {
 
-class CliHooks : public tasks::RunHooks {
+class CliHooks : public base::RunHooks {
  public:
   /// `checkpoint_interval_s`: wall-clock seconds between checkpoints (0: at every chance);
   /// `accept_long_runs`: --accept-long-run (a DEM run estimated beyond a week may start).
@@ -23,7 +23,7 @@ class CliHooks : public tasks::RunHooks {
   /// One progress line: rewritten in place on a terminal (at most four times a second),
   /// else a new line at most every 5 s over all runs (a run's first and last reports
   /// always). A run that gives no ETA gets one from its mean rate since its first report.
-  void progress(const tasks::Progress& p) override;
+  void progress(const base::Progress& p) override;
   void note(const std::string& line) override;
   bool checkpoint_due(double seconds_since_checkpoint) override;
   /// The signal (SIGINT, SIGTERM, SIGHUP) that arrived while a run defers signals, or 0.

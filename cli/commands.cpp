@@ -15,7 +15,7 @@
 #include "output.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/task_files.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/surrogate/scattered_fit.hpp"
 #include "pdamp/tasks/case_checks.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
@@ -310,7 +310,7 @@ int run_import_liggghts(const ParsedArgs& args, CommandContext& context) {
     // The deck's folder belongs to the export: a commit there would remove its files.
     std::error_code e1, e2;
     if (std::filesystem::weakly_canonical(*out_dir, e1) == std::filesystem::weakly_canonical(deck, e2))
-      throw InputError("-o", "", "'" + strict_json::printable(*out_dir) +
+      throw InputError("-o", "", "'" + base::printable(*out_dir) +
                                      "' is the deck's folder (pdamp export liggghts owns it): write the summary elsewhere");
   }
   const auto result = tasks::import_liggghts(deck);  // refused before -o is touched
@@ -359,7 +359,7 @@ std::pair<int, int> shard_flag(const ParsedArgs& args) {
 std::string default_dir(const Case& c, const std::string& suffix) {
   const std::string safe = report::safe_file_name(c.name);
   if (safe != c.name)
-    print_warnings({"case name '" + strict_json::printable(c.name) + "' is not a safe folder name: writing to out/" + safe +
+    print_warnings({"case name '" + base::printable(c.name) + "' is not a safe folder name: writing to out/" + safe +
                     suffix});
   return "out/" + safe + suffix;
 }

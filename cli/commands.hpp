@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "args.hpp"
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 
 namespace pdamp::cli {
 
 /// What a command runs with besides its flags (main sets it up).
 struct CommandContext {
-  tasks::Executor& executor;  ///< where independent jobs run (this process, or MPI ranks)
+  base::Executor& executor;  ///< where independent jobs run (this process, or MPI ranks)
   /// This process writes and prints the results (under mpirun: rank 0; the other ranks only
   /// compute the jobs they are sent).
   bool primary = true;

@@ -35,7 +35,7 @@ int launcher_rank() {
   return -1;
 }
 
-/// What a job is asked by: its index and the asker's fingerprint (tasks::Jobs), as raw
+/// What a job is asked by: its index and the asker's fingerprint (base::Jobs), as raw
 /// doubles, so a worker computes bit for bit what rank 0 would.
 using Request = std::array<double, 2>;
 
@@ -63,7 +63,7 @@ Session::Session(int*, char***) {
 }
 Session::~Session() = default;
 
-tasks::Executor& executor() { return tasks::local_executor(); }
+base::Executor& executor() { return base::local_executor(); }
 
 #else
 
@@ -151,7 +151,7 @@ bool serve_one(const std::function<std::vector<char>(const Request&)>& answer) {
 }
 
 /// Rank 0's jobs: each to a free rank, or here when none is free; the balance per rank.
-class RankChannel : public tasks::JobChannel {
+class RankChannel : public base::JobChannel {
  public:
   RankChannel() : points_(static_cast<std::size_t>(g_ranks), 0), busy_s_(static_cast<std::size_t>(g_ranks), 0.0) {
     for (int r = g_ranks - 1; r >= 1; --r) free_.push_back(r);
@@ -214,12 +214,12 @@ class RankChannel : public tasks::JobChannel {
   bool started_ = false;
 };
 
-class MpiExecutor : public tasks::Executor {
+class MpiExecutor : public base::Executor {
  public:
   int concurrency(int local_jobs) const override { return g_ranks > 1 ? g_ranks : local_jobs; }
   int processes() const override { return g_ranks; }
-  std::unique_ptr<tasks::JobChannel> open(EncodedJob encoded_job) override {
-    if (!g_mpi || g_ranks == 1) return tasks::local_executor().open(std::move(encoded_job));
+  std::unique_ptr<base::JobChannel> open(EncodedJob encoded_job) override {
+    if (!g_mpi || g_ranks == 1) return base::local_executor().open(std::move(encoded_job));
     if (g_rank == 0) return std::make_unique<RankChannel>();
     // A worker: compute what rank 0 sends until it says stop; it has no result of its own.
     const auto answer = [&](const Request& request) {
@@ -233,7 +233,7 @@ class MpiExecutor : public tasks::Executor {
     };
     while (serve_one(answer)) {
     }
-    throw tasks::JobsServedElsewhere();
+    throw base::JobsServedElsewhere();
   }
 };
 
@@ -241,7 +241,7 @@ class MpiExecutor : public tasks::Executor {
 
 bool built_with_mpi() { return true; }
 
-tasks::Executor& executor() {
+base::Executor& executor() {
   static MpiExecutor mpi;
   return mpi;
 }

@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 
 namespace pdamp::cli::distributed {
 
@@ -40,6 +40,6 @@ void note_failure(const std::string& message);
 /// The executor of this process: the ranks of mpirun (rank 0 hands jobs out, one at a time
 /// to whichever rank is free, and works itself when none is; a worker serves them), or this
 /// process alone. One task per command opens its jobs.
-tasks::Executor& executor();
+base::Executor& executor();
 
 }  // namespace pdamp::cli::distributed

@@ -4,7 +4,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 
 namespace pdamp::cli {
 
@@ -19,7 +19,7 @@ ErrorOutcome classify_error(const std::exception_ptr& error, const std::string& 
     return {kExitNumerical, e.what()};
   } catch (const Interrupted& e) {  // the OutputDir's destructor removed what was staged
     return {kExitOther, e.what(), e.signal_number()};
-  } catch (const tasks::JobsServedElsewhere&) {  // an MPI worker: rank 0 reports
+  } catch (const base::JobsServedElsewhere&) {  // an MPI worker: rank 0 reports
     return {kExitOk, ""};
   } catch (const std::bad_alloc&) {
     return {kExitOther, "out of memory (see the run's estimate on stderr; reduce the case's sizes)"};

@@ -1,19 +1,19 @@
 // The command line's exit codes and the one table that maps pdamp's error classes to them
-// (docs/command_line.md): the classes are the libraries' own (strict_json: InputError,
+// (docs/command_line.md): the classes are the libraries' own (base: InputError,
 // NumericalError, Interrupted; tasks: JobsServedElsewhere).
 #pragma once
 
 #include <exception>
 #include <string>
 
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 namespace pdamp::cli {
 
-using strict_json::InputError;
-using strict_json::Interrupted;
-using strict_json::NumericalError;
+using base::InputError;
+using base::Interrupted;
+using base::NumericalError;
 
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitOther = 1;
@@ -27,7 +27,7 @@ struct ErrorOutcome {
   int end_by_signal = 0;  ///< nonzero: end by this signal's default action after the line
 };
 
-/// The table: strict_json::InputError (a file, flag or key breaks a rule) and a library's
+/// The table: base::InputError (a file, flag or key breaks a rule) and a library's
 /// std::invalid_argument (it refuses a value it was given) exit 2; NumericalError exits 3;
 /// Interrupted ends by its signal; JobsServedElsewhere (an MPI worker) exits 0 silently;
 /// std::bad_alloc and anything else exit 1. `command` names the subcommand for a bare

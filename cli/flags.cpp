@@ -4,8 +4,8 @@
 #include <cstdlib>
 
 #include "errors.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
 
 namespace pdamp::cli {
 
@@ -92,7 +92,7 @@ tasks::CheckpointFile checkpoint_file(const ParsedArgs& args, const std::string&
                        (!error && status.type() == std::filesystem::file_type::not_found);
   const bool dangling = std::filesystem::is_symlink(std::filesystem::symlink_status(out.path, link_error)) && missing;
   if (dangling || (!missing && (error || !std::filesystem::is_regular_file(status))))
-    throw InputError("-o", "", "'" + strict_json::printable(out.path.string()) + "' is in the way of the checkpoint (" +
+    throw InputError("-o", "", "'" + base::printable(out.path.string()) + "' is in the way of the checkpoint (" +
                                    (dangling ? std::string("a link to nothing")
                                              : error ? error.message() : std::string("not a regular file")) +
                                    "): move it away");
@@ -111,7 +111,7 @@ std::vector<std::string> length_scale_warnings(const ParsedArgs& args, const std
     const double metres = std::strtod(text->c_str(), nullptr);  // already checked by the command
     if (metres > 1.0)
       warnings.push_back(flag + " " + *text + " is " + *text + " m, larger than any particle damper's (millimetres to "
-                         "decimetres): flags take metres (" + strict_json::format_number(metres / 1000.0) + " for " +
+                         "decimetres): flags take metres (" + base::format_number(metres / 1000.0) + " for " +
                          *text + " mm)");
   }
   return warnings;

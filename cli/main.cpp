@@ -12,7 +12,7 @@
 #include "errors.hpp"
 #include "version.hpp"
 #include "pdamp/report/external_program.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace {
 
@@ -32,7 +32,7 @@ void print_overview() {
 /// quoted input (a name with a newline, a binary CSV) cannot break it into lines.
 int print_error(const std::string& what, int exit_code) {
   pdamp::cli::distributed::note_failure(what);  // a worker rank tells rank 0 in its replies
-  std::cerr << "pdamp: error: " << pdamp::strict_json::printable(what) << "\n";
+  std::cerr << "pdamp: error: " << pdamp::base::printable(what) << "\n";
   return exit_code;
 }
 

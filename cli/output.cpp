@@ -6,7 +6,7 @@
 
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/html_report.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
 #include "version.hpp"
 
@@ -21,7 +21,7 @@ std::string key_value_table(const Rows& rows) {
 }
 
 void print_warnings(const std::vector<std::string>& warnings) {
-  for (const auto& w : warnings) std::cerr << "pdamp: warning: " << strict_json::printable(w) << "\n";
+  for (const auto& w : warnings) std::cerr << "pdamp: warning: " << base::printable(w) << "\n";
 }
 
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context) {
@@ -29,8 +29,8 @@ std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const Comm
   const auto dir = args.optional_text("-o");
   if (!dir) return nullptr;
   // Results name their files in JSON, which holds UTF-8 only: refused now, not after the work.
-  if (!strict_json::valid_utf8(*dir))
-    throw strict_json::InputError("-o", "", "'" + strict_json::printable(*dir) +
+  if (!base::valid_utf8(*dir))
+    throw base::InputError("-o", "", "'" + base::printable(*dir) +
                                    "' is not valid UTF-8: the results record their paths in JSON; rename the folder");
   // The owner of the folder's outputs: the command and the file it ran on (its first
   // argument, made absolute, so that another spelling of the same path is the same case).

@@ -19,19 +19,19 @@
 
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/dem_run.hpp"
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 #include "pdamp/tasks/field.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/frf.hpp"
 #include "pdamp/tasks/modes.hpp"
 #include "pdamp/tasks/placement.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace py = pybind11;
 using nlohmann::json;
@@ -80,10 +80,10 @@ json from_python(const py::handle& object) {
 /// The hooks of a run started from Python: progress to the callback (with the GIL), a
 /// pending KeyboardInterrupt (Python's SIGINT handler, run by PyErr_CheckSignals) as a stop
 /// request, whose exception is restored when the run has ended.
-class PythonHooks : public tasks::RunHooks {
+class PythonHooks : public base::RunHooks {
  public:
   explicit PythonHooks(py::object progress) : progress_(std::move(progress)) {}
-  void progress(const tasks::Progress& p) override {
+  void progress(const base::Progress& p) override {
     if (progress_.is_none()) return;
     py::gil_scoped_acquire gil;
     try {
@@ -136,7 +136,7 @@ auto run_study(PythonHooks& hooks, Study&& study) {
     }();
     hooks.rethrow();
     return result;
-  } catch (const strict_json::Interrupted&) {
+  } catch (const base::Interrupted&) {
     hooks.rethrow();
     throw;
   }
@@ -168,20 +168,20 @@ PYBIND11_MODULE(pdamp, m) {
 
   // Errors: InputError (a ValueError) names the file, the JSON pointer and the rule broken;
   // NumericalError (a RuntimeError) a run that failed on valid input.
-  static py::exception<strict_json::InputError> input_error(m, "InputError", PyExc_ValueError);
-  static py::exception<strict_json::NumericalError> numerical_error(m, "NumericalError", PyExc_RuntimeError);
+  static py::exception<base::InputError> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<base::NumericalError> numerical_error(m, "NumericalError", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
-    } catch (const strict_json::InputError& e) {
+    } catch (const base::InputError& e) {
       py::object error = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
       error.attr("file") = e.file();
       error.attr("pointer") = e.pointer();
       error.attr("rule") = e.rule();
       PyErr_SetObject(input_error.ptr(), error.ptr());
-    } catch (const strict_json::NumericalError& e) {
+    } catch (const base::NumericalError& e) {
       numerical_error(e.what());
-    } catch (const strict_json::Interrupted& e) {
+    } catch (const base::Interrupted& e) {
       PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
     }
   });
@@ -270,7 +270,7 @@ PYBIND11_MODULE(pdamp, m) {
       [](const case_file::Case& c, const std::string& source, py::object progress) {
         tasks::FieldOptions o;
         o.source = source;
-        auto& executor = tasks::local_executor();
+        auto& executor = base::local_executor();
         const auto plan = tasks::plan_field(c, o, executor);
         PythonHooks hooks(progress);
         const auto r = run_study(hooks, [&] { return tasks::run_field(c, plan, hooks, executor); });
@@ -300,7 +300,7 @@ PYBIND11_MODULE(pdamp, m) {
           o.method = method == "field" ? tasks::FrfMethod::kField : tasks::FrfMethod::kFormulas;
         }
         PythonHooks hooks(progress);
-        const auto r = run_study(hooks, [&] { return tasks::run_frf(c, o, hooks, tasks::local_executor()); });
+        const auto r = run_study(hooks, [&] { return tasks::run_frf(c, o, hooks, base::local_executor()); });
         json out = tasks::to_json(r, tasks::OutputFolder{});
         if (r.harmonic) {
           // The curves: per frequency, the structure without particles and the largest stable
@@ -356,7 +356,7 @@ PYBIND11_MODULE(pdamp, m) {
         }
         tasks::FillingRatiosOptions o;
         o.skip_verify = !verify;
-        const auto r = run_study(hooks, [&] { return tasks::run_filling_ratios(c, o, hooks, tasks::local_executor()); });
+        const auto r = run_study(hooks, [&] { return tasks::run_filling_ratios(c, o, hooks, base::local_executor()); });
         json out = tasks::to_json(r);
         out["warnings"] = r.warnings;
         return to_python(out);

@@ -1,4 +1,4 @@
-// The case reader's object: strict_json::StrictObject (unknown keys, pointers) plus
+// The case reader's object: base::StrictObject (unknown keys, pointers) plus
 // the case's conventions: a default per key, a range per number, and every value read
 // recorded in the resolved case. Private to case_file.
 #pragma once
@@ -16,7 +16,7 @@
 
 #include "pdamp/case_file/case_error.hpp"
 #include "pdamp/case_file/ranges.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/strict_object.hpp"
 
 namespace pdamp::case_file::detail {
 
@@ -247,7 +247,7 @@ class ObjectReader {
     return out + ")";
   }
 
-  strict_json::StrictObject strict_;  ///< records the keys read
+  base::StrictObject strict_;  ///< records the keys read
   const std::string& file_;
   const json& object_;
   std::string pointer_;

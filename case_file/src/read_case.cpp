@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "readers.hpp"
 
@@ -166,19 +166,19 @@ Case load_case_document(const json& document, const std::string& path) {
     return read_case(document, path);
   } catch (const CaseError&) {
     throw;
-  } catch (const strict_json::InputError& e) {  // the reader's own checks: unknown keys, file, JSON
+  } catch (const base::InputError& e) {  // the reader's own checks: unknown keys, file, JSON
     throw CaseError(e.file(), e.pointer(), e.rule());
   }
 }
 
 Case load_case(const std::string& path) {
   // Results and resolved cases record the case's path in JSON, which holds UTF-8 only.
-  if (!strict_json::valid_utf8(path))
+  if (!base::valid_utf8(path))
     throw CaseError(path, "", "the file's path is not valid UTF-8 (results record it in JSON): rename the file");
   json document;
   try {
-    document = strict_json::parse_json_document(strict_json::read_input_file(path), path);
-  } catch (const strict_json::InputError& e) {
+    document = base::parse_json_document(base::read_input_file(path), path);
+  } catch (const base::InputError& e) {
     throw CaseError(e.file(), e.pointer(), e.rule());
   }
   return load_case_document(document, path);

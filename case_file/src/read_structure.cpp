@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "pdamp/structure/imported_modal_data.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "readers.hpp"
 
 namespace pdamp::case_file::detail {
@@ -132,7 +132,7 @@ void read_modal_data(ObjectReader& r, StructureSpec& s) {
   const std::string file = r.text("file", std::nullopt);
   if (file.empty()) r.fail("file", "must not be empty (the path of the modal data file)");
   s.modal_data_file = resolve_case_relative(r, file);
-  const nlohmann::json document = strict_json::parse_json_document(strict_json::read_input_file(s.modal_data_file),
+  const nlohmann::json document = base::parse_json_document(base::read_input_file(s.modal_data_file),
                                                                     s.modal_data_file);
   try {
     s.modal_data = st::modal_model_from_json(document);

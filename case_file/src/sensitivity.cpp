@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "pdamp/case_file/case.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::case_file {
 

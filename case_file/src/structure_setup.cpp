@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "pdamp/case_file/ranges.hpp"
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
@@ -38,7 +38,7 @@ std::shared_ptr<const sg::LossModel> field_loss_model(const Case& c, std::size_t
   sg::EffectiveField field;
   try {
     field = sg::read_effective_field(layer.field_file);
-  } catch (const strict_json::InputError&) {
+  } catch (const base::InputError&) {
     throw;  // names the field file and the pointer in it
   } catch (const std::exception& e) {
     throw CaseError(c.path, layer_pointer(d, l) + "/field_file", e.what());
@@ -253,8 +253,8 @@ Eigen::VectorXd checked_release(const Case& c, const StructureSetup& setup, Eige
     if (!(envelope_m <= limits::kStroke.max))
       throw CaseError(c.path, "/task/initial_state",
                       "moves damper " + damper.name + "'s site '" + damper.point + "' by up to " +
-                          strict_json::format_number(envelope_m, 4) + " m, more than the " +
-                          strict_json::format_number(limits::kStroke.max) +
+                          base::format_number(envelope_m, 4) + " m, more than the " +
+                          base::format_number(limits::kStroke.max) +
                           " m any damper model takes: check the load or amplitudes against the structure's modal "
                           "masses and shapes");
   }

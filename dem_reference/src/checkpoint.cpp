@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/strict_object.hpp"
 
 namespace pdamp::dem_reference {
 
@@ -153,7 +153,7 @@ std::vector<int> StateReader::i32s(const char* field, std::size_t expected, int 
 void StateReader::expect_tag(std::string_view name) {
   const std::string field = "section " + std::string(name);
   const std::string found = text(field.c_str(), 64);
-  if (found != name) fail(field, "found '" + strict_json::printable(found) + "': damaged or of another layout");
+  if (found != name) fail(field, "found '" + base::printable(found) + "': damaged or of another layout");
 }
 
 void StateReader::finish() const {
@@ -188,13 +188,13 @@ std::string encode_checkpoint(const CheckpointHeader& header, std::string_view p
 
 DecodedCheckpoint decode_checkpoint(std::string_view bytes, const std::string& file) {
   if (bytes.substr(0, kMagic.size()) != kMagic)
-    throw strict_json::InputError(file, "", "not a pdamp checkpoint (it must start with 'PDAMP-CHECKPOINT 1')");
+    throw base::InputError(file, "", "not a pdamp checkpoint (it must start with 'PDAMP-CHECKPOINT 1')");
   const std::size_t start = kMagic.size();
   const std::size_t end = bytes.find('\n', start);
   if (end == std::string_view::npos || end - start > kMaxHeaderBytes)
-    throw strict_json::InputError(file, "", "the checkpoint's header line is missing or longer than 64 KiB");
-  const nlohmann::json json = strict_json::parse_json_document(std::string(bytes.substr(start, end - start)), file);
-  strict_json::StrictObject h(json, "", file);
+    throw base::InputError(file, "", "the checkpoint's header line is missing or longer than 64 KiB");
+  const nlohmann::json json = base::parse_json_document(std::string(bytes.substr(start, end - start)), file);
+  base::StrictObject h(json, "", file);
   DecodedCheckpoint out;
   out.header.kind = h.string("kind");
   out.header.case_hash = h.string("case_hash");
@@ -207,11 +207,11 @@ DecodedCheckpoint decode_checkpoint(std::string_view bytes, const std::string& f
   h.finish();
   const std::string_view payload = bytes.substr(end + 1);
   if (payload.size() != size)
-    strict_json::fail_at(file, "/payload_bytes",
+    base::fail_at(file, "/payload_bytes",
                          "= " + std::to_string(size) + " but the file holds " + std::to_string(payload.size()) +
                              " payload bytes: the checkpoint is truncated or damaged");
   if (hex(fnv1a64(payload)) != hash)
-    strict_json::fail_at(file, "/payload_fnv1a64", "does not match the payload: the checkpoint is damaged");
+    base::fail_at(file, "/payload_fnv1a64", "does not match the payload: the checkpoint is damaged");
   out.payload = std::string(payload);
   return out;
 }

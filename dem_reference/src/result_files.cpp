@@ -1,5 +1,5 @@
 // Result files of a DEM run (time-series CSV, VTK XML snapshots and their series), written to a
-// temporary file beside the target and renamed over it (strict_json::write_file_atomically),
+// temporary file beside the target and renamed over it (base::write_file_atomically),
 // so no reader sees a partial file.
 #include "pdamp/dem_reference/result_files.hpp"
 
@@ -10,18 +10,18 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/output_file.hpp"
 
 namespace pdamp::dem_reference {
 
 namespace {
 
-/// The text `body` writes, stored atomically (strict_json::write_file_atomically).
+/// The text `body` writes, stored atomically (base::write_file_atomically).
 void write_atomically(const std::string& path, const std::function<void(std::ostream&)>& body) {
   std::ostringstream out;
   out.precision(17);
   body(out);
-  strict_json::write_file_atomically(path, out.str());
+  base::write_file_atomically(path, out.str());
 }
 
 }  // namespace
@@ -94,7 +94,7 @@ void write_polydata(const std::string& path, double time_s, const std::string& p
       << time_s << "</DataArray>\n    </FieldData>\n"
       << piece << "  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _" << data.bytes()
       << "\n  </AppendedData>\n</VTKFile>\n";
-  strict_json::write_file_atomically(path, out.str());
+  base::write_file_atomically(path, out.str());
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Complex power P = ½F*·conj(V*) from sampled force and velocity: period folding and an FFTW r2c transform.
 #include "pdamp/formulas/complex_power.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 #include <fftw3.h>
 
@@ -64,7 +64,7 @@ class PlanCache {
     fftw_free(in);
     fftw_free(out);
     if (!plan)
-      throw strict_json::NumericalError("complex_power: FFTW could not plan a transform of length " +
+      throw base::NumericalError("complex_power: FFTW could not plan a transform of length " +
                                std::to_string(n));
     plans_.emplace(n, plan);
     return plan;

@@ -1,6 +1,6 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/formulas/root_finding.hpp"
 #include "pdamp/formulas/csv_text.hpp"
 #include "pdamp/formulas/input_file.hpp"
@@ -273,10 +273,10 @@ void run_optimizer(nlopt::opt& optimizer, std::vector<double>& x,
     // Converged as far as floating point allows: x is the best point, keep it.
   } catch (const nlopt::forced_stop&) {
     rethrow_callback_error();
-    throw strict_json::NumericalError("restitution fit: NLopt stopped without a reason");
+    throw base::NumericalError("restitution fit: NLopt stopped without a reason");
   } catch (const std::exception& error) {
     rethrow_callback_error();
-    throw strict_json::NumericalError(std::string("restitution fit: NLopt failed: ") + error.what());
+    throw base::NumericalError(std::string("restitution fit: NLopt failed: ") + error.what());
   }
 }
 
@@ -595,7 +595,7 @@ double integrate_restitution(double damping, double tolerance) {
     }
     return -end.v;
   }
-  throw strict_json::NumericalError("realised_restitution: no end of contact after " +
+  throw base::NumericalError("realised_restitution: no end of contact after " +
                            std::to_string(kMaxSteps) + " steps at damping " +
                            format_number(damping));
 }
@@ -819,7 +819,7 @@ double damping_for_restitution(double restitution) {
   double hi = std::min(-target / 1.3, max_u), f_hi = residual(hi);
   while (f_hi > 0.0) {
     if (hi == max_u) {
-      throw strict_json::NumericalError("damping_for_restitution: restitution " +
+      throw base::NumericalError("damping_for_restitution: restitution " +
                                format_number(restitution) + " not reached at damping " +
                                format_number(kMaxDampingCoefficient));
     }
@@ -851,7 +851,7 @@ DampingTable::DampingTable() : damping_(kPoints) {
     log_restitution[j] = std::log(integrate_restitution(gamma, kTableTolerance));
   }
   if (!(log_restitution.front() < std::log(kMinRestitution))) {
-    throw strict_json::NumericalError(
+    throw base::NumericalError(
         "DampingTable: realised restitution at damping " + format_number(kMaxDamping) + " is " +
         format_number(std::exp(log_restitution.front())) + ", not below the table's lower end");
   }

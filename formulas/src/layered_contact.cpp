@@ -1,6 +1,6 @@
 // Sphere on an elastic layer bonded to a rigid wall: kernel, thin-layer limits, exact Nyström solution, table.
 #include "pdamp/formulas/layered_contact.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/formulas/root_finding.hpp"
 
 #include <Eigen/Dense>
@@ -363,12 +363,12 @@ std::shared_ptr<const LayeredContact::Table> build_table(double nu, double share
     g[i] = s.force_over_hertz;
     lam[i] = lambda;
     if (i > 0 && !(chi[i] > chi[i - 1])) {
-      throw strict_json::NumericalError("LayeredContact: overlap parameter not increasing with a/t at a/t = " +
+      throw base::NumericalError("LayeredContact: overlap parameter not increasing with a/t at a/t = " +
                                number(lambda));
     }
   }
   if (!(chi.back() > LayeredContact::kMaxTabulatedOverlapParameter)) {
-    throw strict_json::NumericalError("LayeredContact: the a/t range does not cover the table");
+    throw base::NumericalError("LayeredContact: the a/t range does not cover the table");
   }
   const int n = kTableIntervals + 1;
   table->step = LayeredContact::kMaxTabulatedOverlapParameter / kTableIntervals;
@@ -642,7 +642,7 @@ double realised_restitution(const LayeredContact& contact, double mass, double s
     x = nx;
     v = nv;
   }
-  throw strict_json::NumericalError("layered_realised_restitution: contact did not end");
+  throw base::NumericalError("layered_realised_restitution: contact did not end");
 }
 
 }  // namespace
@@ -669,7 +669,7 @@ double layered_damping_for_restitution(const LayeredContact& contact, double mas
     return std::log(layered_realised_restitution(contact, mass, speed, std::min(std::expm1(u), 100.0))) - target;
   };
   double lo = 0.0, f_lo = -target, hi = std::log1p(100.0), f_hi = residual(hi);
-  if (f_hi > 0.0) throw strict_json::NumericalError("layered_damping_for_restitution: not reached at damping 100");
+  if (f_hi > 0.0) throw base::NumericalError("layered_damping_for_restitution: not reached at damping 100");
   const double u = illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
   return std::min(std::expm1(u), 100.0);
 }

@@ -1,7 +1,7 @@
 // Clearance on a structure: the single-mode closed form, the harmonic-balance response at
 // one clearance, and the 1-variable sizing problem.
 #include "pdamp/optimizer/clearance_on_structure.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -200,7 +200,7 @@ ClearanceResponse clearance_response(const st::ModalModel& model, const Clearanc
     }
   }
   if (r.peak_transmissibility < 0.0) {
-    throw strict_json::NumericalError("clearance-on-structure: no stable or held response in the frequency band at h = " +
+    throw base::NumericalError("clearance-on-structure: no stable or held response in the frequency band at h = " +
                              detail::format_number(clearance_m) + " m");
   }
   return r;

@@ -2,7 +2,7 @@
 #include "pdamp/optimizer/filling_ratios.hpp"
 
 #include "pdamp/structure/sampled_decay.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -390,7 +390,7 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
     }
     if (out.neighbours.empty()) {
       // Cannot happen for a feasible relaxed point (flooring only lowers mass and slabs).
-      throw strict_json::NumericalError("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
+      throw base::NumericalError("optimize_filling_ratios: no rounded neighbour of the relaxed optimum is feasible (" +
                                out.summary.brief_report() + ")");
     }
 

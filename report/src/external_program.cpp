@@ -13,7 +13,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 namespace pdamp::report {
 
@@ -125,7 +125,7 @@ void end_output_phase() { --g_output_phase; }
 int pending_interrupt() { return g_pending_signal; }
 
 void stop_if_interrupted() {
-  if (const int s = g_pending_signal; s != 0) throw strict_json::Interrupted(s);
+  if (const int s = g_pending_signal; s != 0) throw base::Interrupted(s);
 }
 
 void test_pause_point(const char* point) {

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/output_file.hpp"
 #include "report_answer.hpp"
 
 namespace pdamp::report {
@@ -413,7 +413,7 @@ void stage_report(OutputDir& files, const case_file::Case& c, const json& result
   in.warnings = warnings;
   in.pictures = staged_pictures(page.parent_path());
   in.gnuplot_found = gnuplot_available();
-  strict_json::write_file_synced(page, report_html(in), files.dir() / "report.html");
+  base::write_file_synced(page, report_html(in), files.dir() / "report.html");
 }
 
 }  // namespace pdamp::report

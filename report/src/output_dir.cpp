@@ -17,9 +17,9 @@
 #include <system_error>
 
 #include "pdamp/report/external_program.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/output_file.hpp"
 
 namespace pdamp::report {
 
@@ -37,7 +37,7 @@ void remove_stale_staging(const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir, error)) {
     const std::string name = entry.path().filename().string();
     if (name.rfind(kStagingPrefix, 0) != 0) continue;
-    if (strict_json::names_a_dead_process(std::string_view(name).substr(std::string(kStagingPrefix).size())))
+    if (base::names_a_dead_process(std::string_view(name).substr(std::string(kStagingPrefix).size())))
       fs::remove_all(entry.path(), error);
   }
 }
@@ -51,7 +51,7 @@ struct PreviousOutputs {
 PreviousOutputs previous_outputs(const fs::path& dir) {
   PreviousOutputs out;
   try {
-    const auto doc = strict_json::parse_json_document(strict_json::read_input_file((dir / kManifest).string()), kManifest);
+    const auto doc = base::parse_json_document(base::read_input_file((dir / kManifest).string()), kManifest);
     for (const auto& item : doc.at("files")) {
       const std::string name = item.get<std::string>();
       if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name[0] == '.') continue;
@@ -66,7 +66,7 @@ PreviousOutputs previous_outputs(const fs::path& dir) {
 }
 
 std::string owner_text(const OutputOwner& owner) {
-  return "pdamp " + owner.command + (owner.input.empty() ? "" : " on " + strict_json::printable(owner.input));
+  return "pdamp " + owner.command + (owner.input.empty() ? "" : " on " + base::printable(owner.input));
 }
 
 /// Whether a picture gnuplot wrote is whole: a PNG ends with its IEND chunk, an SVG with its
@@ -104,15 +104,15 @@ class SignalBlock {
 
 OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool overwrite)
     : dir_(std::move(dir)), owner_(std::move(owner)) {
-  const std::string shown = strict_json::printable(dir_.string());
-  if (dir_.empty()) throw strict_json::InputError(flag, "", "'': an empty path is not an output directory");
+  const std::string shown = base::printable(dir_.string());
+  if (dir_.empty()) throw base::InputError(flag, "", "'': an empty path is not an output directory");
   std::error_code error;
   const auto status = fs::status(dir_, error);
   if (fs::exists(status) && !fs::is_directory(status))
-    throw strict_json::InputError(flag, "", "'" + shown + "' exists and is not a directory");
+    throw base::InputError(flag, "", "'" + shown + "' exists and is not a directory");
   fs::create_directories(dir_, error);
   if (error || !fs::is_directory(dir_))
-    throw strict_json::InputError(flag, "", "'" + shown + "': cannot create the output directory (" +
+    throw base::InputError(flag, "", "'" + shown + "': cannot create the output directory (" +
                                    (error ? error.message() : std::string("not a directory")) + ")");
   // One run writes a folder at a time: two runs into one folder would overwrite each
   // other's checkpoint and set (each saying it wrote them). The lock goes with the process.
@@ -121,12 +121,12 @@ OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool ove
   if (lock_fd_ < 0) {
     std::ostringstream what;  // a stream: GCC 12 flags this chain of + with a false -Wrestrict
     what << "'" << shown << "': cannot open the folder to lock it (" << std::strerror(errno) << ")";
-    throw strict_json::InputError(flag, "", what.str());
+    throw base::InputError(flag, "", what.str());
   }
   if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(lock_fd_);
     lock_fd_ = -1;
-    throw strict_json::InputError(flag, "", "'" + shown + "': another pdamp run is writing into this folder; wait for "
+    throw base::InputError(flag, "", "'" + shown + "': another pdamp run is writing into this folder; wait for "
                                                 "it, or use another folder");
   }
   // A commit removes the previous set: refused when that set is another owner's (a user who
@@ -135,9 +135,9 @@ OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool ove
       !overwrite && !previous.owner.command.empty() && !owner_.command.empty() && !(previous.owner == owner_)) {
     std::string files;
     for (std::size_t k = 0; k < previous.files.size() && k < 4; ++k)
-      files += (k ? ", " : "") + strict_json::printable(previous.files[k]);
+      files += (k ? ", " : "") + base::printable(previous.files[k]);
     if (previous.files.size() > 4) files += ", ... (" + std::to_string(previous.files.size()) + " files)";
-    throw strict_json::InputError(flag, "", "'" + shown + "' holds the outputs of " + owner_text(previous.owner) + " (" +
+    throw base::InputError(flag, "", "'" + shown + "' holds the outputs of " + owner_text(previous.owner) + " (" +
                                                 files + "), which this run would replace: pass --overwrite, or choose "
                                                 "another folder");
   }
@@ -146,7 +146,7 @@ OutputDir::OutputDir(fs::path dir, std::string flag, OutputOwner owner, bool ove
   fs::remove_all(staging_, error);
   if (!fs::create_directory(staging_, error) || ::access(staging_.c_str(), W_OK) != 0) {
     fs::remove(staging_, error);
-    throw strict_json::InputError(flag, "", "'" + shown + "': cannot write into the output directory");
+    throw base::InputError(flag, "", "'" + shown + "': cannot write into the output directory");
   }
 }
 
@@ -171,7 +171,7 @@ fs::path OutputDir::add(const std::string& name, const std::string& content) {
   start_writing();
   // Written in full and fsynced now (an ofstream reports a full disk for the last buffer
   // only at close, unchecked): a failure ends the run before any rename.
-  strict_json::write_file_synced(staging_ / name, content, dir_ / name);
+  base::write_file_synced(staging_ / name, content, dir_ / name);
   names_.push_back(name);
   return dir_ / name;
 }
@@ -221,7 +221,7 @@ std::vector<std::string> OutputDir::add_plot(const std::string& script_name, con
     // gnuplot exits 0 with a picture cut short when the disk fills: such a set must not
     // replace a good one (an exception here ends the run before any rename).
     if (!complete_picture(staging_ / name))
-      throw std::runtime_error(strict_json::printable((dir_ / name).string()) +
+      throw std::runtime_error(base::printable((dir_ / name).string()) +
                                ": gnuplot wrote it incomplete (a full disk?); the folder's earlier results are kept");
     names_.push_back(name);
   }
@@ -239,17 +239,17 @@ std::vector<std::string> OutputDir::commit() {
   for (const auto& name : targets) {
     const auto status = fs::symlink_status(dir_ / name, error);
     if (fs::exists(status) && !fs::is_regular_file(status))
-      throw strict_json::InputError("-o", "", "'" + strict_json::printable((dir_ / name).string()) +
+      throw base::InputError("-o", "", "'" + base::printable((dir_ / name).string()) +
                                      "' exists and is not a file: move it away (pdamp writes " + name + " there)");
   }
   // Every staged file whole on disk before the first rename (a delayed write error of a
   // full disk shows in fsync), the record of the new set staged with them: a failure here
   // leaves the earlier set as it was.
-  for (const auto& name : names_) strict_json::sync_file(staging_ / name, dir_ / name);
+  for (const auto& name : names_) base::sync_file(staging_ / name, dir_ / name);
   std::set<std::string> current(names_.begin(), names_.end());
   current.insert(in_place_.begin(), in_place_.end());
   const PreviousOutputs previous = previous_outputs(dir_);
-  strict_json::write_file_synced(staging_ / kManifest,
+  base::write_file_synced(staging_ / kManifest,
                                  nlohmann::json{{"format", "pdamp.outputs"}, {"files", current},
                                                 {"command", owner_.command}, {"input", owner_.input}}
                                          .dump(2) + "\n",
@@ -259,7 +259,7 @@ std::vector<std::string> OutputDir::commit() {
     const SignalBlock whole;
     for (const auto& name : names_) fs::rename(staging_ / name, dir_ / name);
     fs::rename(staging_ / kManifest, dir_ / kManifest);
-    strict_json::sync_parent_folder(dir_ / kManifest);
+    base::sync_parent_folder(dir_ / kManifest);
   }
   // The earlier set's files this run did not write again go last: a crash before here
   // leaves them as strays beside a complete new set, never a set with holes.

@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/number_text.hpp"
 
 namespace pdamp::report {
 
 namespace {
 
 using nlohmann::json;
-using strict_json::format_number;
+using base::format_number;
 
 /// The value at `path` ("a/b/0/c") or null: a missing key is "not known", never an error.
 const json& at(const json& object, std::initializer_list<const char*> path) {

@@ -2,7 +2,7 @@
 // consistent masses), gravity's geometric stiffness and the modal reduction of the beam.
 // Model, conventions and limits: docs/structures.md, "Beam models".
 #include "pdamp/structure/beam.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "numbers.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -13,7 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::structure {
 namespace {
@@ -48,7 +48,7 @@ std::string joined(const std::vector<std::string>& lines) {
 }
 
 void throw_if_any(const std::vector<std::string>& problems, const std::string& context) {
-  if (!problems.empty()) throw std::invalid_argument(strict_json::printable(context + ": " + joined(problems)));
+  if (!problems.empty()) throw std::invalid_argument(base::printable(context + ": " + joined(problems)));
 }
 
 bool positive_finite(double x) { return x > 0.0 && std::isfinite(x); }
@@ -426,7 +426,7 @@ FreeVibration free_vibration(const Assembly& a) {
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(
       stiffness, mass, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
   if (solver.info() != Eigen::Success) {
-    throw strict_json::NumericalError("beam model: the generalized eigenproblem failed (mass matrix not positive definite?)");
+    throw base::NumericalError("beam model: the generalized eigenproblem failed (mass matrix not positive definite?)");
   }
   const Eigen::VectorXd& lambda = solver.eigenvalues();  // ascending
   const Eigen::Index rigid = a.rigid_modes;

@@ -1,6 +1,6 @@
 // Dampers attached to a modal model: layer impedances and the coupled modal arrays.
 #include "pdamp/structure/damper_coupling.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "numbers.hpp"
 
 #include <algorithm>
@@ -215,7 +215,7 @@ Eigen::VectorXd natural_frequencies_with_containers_hz(const CoupledModel& coupl
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, coupled.mass_with_containers_kg,
                                                                          Eigen::EigenvaluesOnly);
   if (solver.info() != Eigen::Success) {
-    throw strict_json::NumericalError("natural_frequencies_with_containers_hz: the eigenproblem with the containers failed");
+    throw base::NumericalError("natural_frequencies_with_containers_hz: the eigenproblem with the containers failed");
   }
   return solver.eigenvalues().cwiseMax(0.0).cwiseSqrt() / kTwoPi;
 }

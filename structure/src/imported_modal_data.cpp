@@ -9,8 +9,8 @@
 #include <sstream>
 #include <string_view>
 
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::structure {
 namespace {
@@ -19,7 +19,7 @@ using nlohmann::json;
 
 using detail::number;
 
-using strict_json::pointer_token;
+using base::pointer_token;
 
 /// Checks the keys of one object: every key must be in `allowed`.
 void reject_unknown_keys(const json& object, const std::string& at, const std::set<std::string>& allowed) {
@@ -102,7 +102,7 @@ PointModeShape read_point(const std::string& name, const json& value, const std:
 }  // namespace
 
 ModalDataError::ModalDataError(std::string pointer, const std::string& rule)
-    : std::invalid_argument(strict_json::printable((pointer.empty() ? "/" : pointer) + ": " + rule)),
+    : std::invalid_argument(base::printable((pointer.empty() ? "/" : pointer) + ": " + rule)),
       pointer_(std::move(pointer)) {}
 
 ModalModel modal_model_from_json(const json& document) {
@@ -171,7 +171,7 @@ json modal_model_to_json(const ModalModel& model) {
   if (const auto problems = model.validate(); !problems.empty()) {
     std::string text;
     for (const auto& line : problems) text += (text.empty() ? "" : "; ") + line;
-    throw std::invalid_argument(strict_json::printable("modal model export: " + text));
+    throw std::invalid_argument(base::printable("modal model export: " + text));
   }
   const auto array = [](const auto& values) {
     json out = json::array();

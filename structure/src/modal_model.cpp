@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::structure {
 namespace {
@@ -44,7 +44,7 @@ const PointModeShape& ModalModel::point(const std::string& name) const {
   }
   std::string known;
   for (const auto& p : points) known += (known.empty() ? "" : ", ") + p.name;
-  throw std::invalid_argument(strict_json::printable("modal model: no point named \"" + name + "\" (known: " +
+  throw std::invalid_argument(base::printable("modal model: no point named \"" + name + "\" (known: " +
                                                   (known.empty() ? "none" : known) + ")"));
 }
 
@@ -85,7 +85,7 @@ std::vector<std::string> ModalModel::validate() const {
     const std::string field = "points/" + std::to_string(i);
     if (p.name.empty()) problems.push_back(field + "/name is empty: every point needs a name");
     if (!names.insert(p.name).second) {
-      problems.push_back(strict_json::printable(field + "/name = \"" + p.name + "\": must be unique"));
+      problems.push_back(base::printable(field + "/name = \"" + p.name + "\": must be unique"));
     }
     if (p.translation.rows() != 2) {
       problems.push_back(field + "/translation has " + std::to_string(p.translation.rows()) +

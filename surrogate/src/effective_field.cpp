@@ -11,8 +11,8 @@
 
 #include "field_format.hpp"
 #include "file_io.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/strict_object.hpp"
 #include "text_util.hpp"
 
 #ifndef PDAMP_VERSION
@@ -114,7 +114,7 @@ nlohmann::ordered_json axis_json(const Axis& axis) {
 }
 
 Axis read_axis(const json& value, const std::string& pointer, const std::string& file, int index) {
-  strict_json::StrictObject object(value, pointer, file);
+  base::StrictObject object(value, pointer, file);
   Axis axis;
   const std::string name = object.string("name");
   const auto quantity = axis_quantity_from_string(name);
@@ -140,7 +140,7 @@ Axis read_axis(const json& value, const std::string& pointer, const std::string&
     const std::string at = object.pointer("values") + "/" + std::to_string(k);
     axis.values.push_back(object.number_value(values[k], at, true, unit_of(axis.quantity)));
     if (k > 0 && !(axis.values[k] > axis.values[k - 1])) {
-      strict_json::fail_at(file, at,
+      base::fail_at(file, at,
                       number(axis.values[k]) + " must be > the previous node " + number(axis.values[k - 1]) +
                           " (axis values strictly increasing)");
     }
@@ -154,7 +154,7 @@ Axis read_axis(const json& value, const std::string& pointer, const std::string&
 namespace {
 
 Provenance read_provenance(const json& value, const std::string& pointer, const std::string& file) {
-  strict_json::StrictObject object(value, pointer, file);
+  base::StrictObject object(value, pointer, file);
   Provenance p;
   const std::string source = object.string("source");
   const auto parsed = field_source_from_string(source);
@@ -191,7 +191,7 @@ TableLayout read_columns(const json& columns, const std::string& pointer, const 
   constexpr std::size_t kAbsent = static_cast<std::size_t>(-1);
   layout.position.assign(layout.names.size(), kAbsent);
   for (std::size_t k = 0; k < columns.size(); ++k) {
-    strict_json::StrictObject column(columns[k], pointer + "/" + std::to_string(k), file);
+    base::StrictObject column(columns[k], pointer + "/" + std::to_string(k), file);
     const std::string name = column.string("name");
     const auto it = std::find(layout.names.begin(), layout.names.end(), name);
     if (it == layout.names.end()) {
@@ -207,7 +207,7 @@ TableLayout read_columns(const json& columns, const std::string& pointer, const 
   }
   for (std::size_t c = 0; c < layout.names.size(); ++c) {
     if (layout.position[c] == kAbsent) {
-      strict_json::fail_at(file, pointer, "missing column \"" + std::string(layout.names[c]) + "\"");
+      base::fail_at(file, pointer, "missing column \"" + std::string(layout.names[c]) + "\"");
     }
   }
   return layout;
@@ -217,7 +217,7 @@ TableLayout read_columns(const json& columns, const std::string& pointer, const 
 FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const TableLayout& layout, const Grid& grid,
                     const std::string& file) {
   if (!row.is_array() || row.size() != layout.names.size()) {
-    strict_json::fail_at(file, at,
+    base::fail_at(file, at,
                     "must be an array of " + std::to_string(layout.names.size()) + " entries (one per column)");
   }
   auto cell_at = [&](std::size_t c) { return at + "/" + std::to_string(layout.position[c]); };
@@ -226,18 +226,18 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
     const json& v = cell(c);
     if (!v.is_number() || !std::isfinite(v.get<double>())) {
       const std::string unit = layout.units[c] == "1" ? "" : " (in " + std::string(layout.units[c]) + ")";
-      strict_json::fail_at(file, cell_at(c),
+      base::fail_at(file, cell_at(c),
                       "must be a finite number" + unit + ", got " +
                           (v.is_number() ? number(v.get<double>()) : std::string(v.type_name())));
     }
     const double x = v.get<double>();
-    if (positive && !(x > 0.0)) strict_json::fail_at(file, cell_at(c), "must be > 0");
+    if (positive && !(x > 0.0)) base::fail_at(file, cell_at(c), "must be > 0");
     return x;
   };
   auto nullable_number = [&](std::size_t c) { return cell(c).is_null() ? FieldPoint::kUnknown : finite(c, false); };
   auto text = [&](std::size_t c) {
     if (!cell(c).is_string()) {
-      strict_json::fail_at(file, cell_at(c), std::string("must be a string, got ") + cell(c).type_name());
+      base::fail_at(file, cell_at(c), std::string("must be a string, got ") + cell(c).type_name());
     }
     return cell(c).get<std::string>();
   };
@@ -247,7 +247,7 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
   for (std::size_t c = 0; c < 2; ++c) {
     const double x = finite(c, true);
     if (std::abs(x - nodes[c]) > kCoordinateTolerance * nodes[c]) {
-      strict_json::fail_at(file, cell_at(c),
+      base::fail_at(file, cell_at(c),
                       std::string(layout.names[c]) + " = " + number(x) + " does not match the axis node " +
                           number(nodes[c]) + " (rows in storage order, row i0*n1 + i1 = " + std::to_string(k / n1) +
                           "*" + std::to_string(n1) + " + " + std::to_string(k % n1) + ")");
@@ -258,7 +258,7 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
   const std::string status = text(kFirstValue + kStatus);
   const auto parsed_status = point_status_from_string(status);
   if (!parsed_status) {
-    strict_json::fail_at(file, cell_at(kFirstValue + kStatus),
+    base::fail_at(file, cell_at(kFirstValue + kStatus),
                     "is \"" + status + "\", must be \"ok\", \"missing\" or \"failed\"");
   }
   p.status = *parsed_status;
@@ -269,22 +269,22 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
   p.apparent_mass_fraction = nullable_number(kFirstValue + kApparentMassFraction);
   p.motion_mode = text(kFirstValue + kMotionMode);
   if (detail::has_control_byte(p.motion_mode)) {
-    strict_json::fail_at(file, cell_at(kFirstValue + kMotionMode),
-                    "\"" + strict_json::printable(p.motion_mode) +
+    base::fail_at(file, cell_at(kFirstValue + kMotionMode),
+                    "\"" + base::printable(p.motion_mode) +
                         "\" holds control characters; a motion mode must be printable text");
   }
   const bool ok = p.status == PointStatus::kOk;
   for (const int c : {kEtaStar, kEDiss}) {
     const bool missing = std::isnan(c == kEtaStar ? p.eta_star : p.e_diss_j);
     if (ok && missing)
-      strict_json::fail_at(file, cell_at(kFirstValue + c), "null: must be a finite number for status \"ok\"");
+      base::fail_at(file, cell_at(kFirstValue + c), "null: must be a finite number for status \"ok\"");
   }
   if (!ok && !std::isnan(p.eta_star)) {
-    strict_json::fail_at(file, cell_at(kFirstValue + kEtaStar), "must be null for status \"" + status + "\"");
+    base::fail_at(file, cell_at(kFirstValue + kEtaStar), "must be null for status \"" + status + "\"");
   }
-  if (p.eta_star_stderr < 0.0) strict_json::fail_at(file, cell_at(kFirstValue + kEtaStarStderr), "must be >= 0 or null");
+  if (p.eta_star_stderr < 0.0) base::fail_at(file, cell_at(kFirstValue + kEtaStarStderr), "must be >= 0 or null");
   if (const std::string problem = field_value_problem(p.eta_star, p.apparent_mass_fraction); !problem.empty())
-    strict_json::fail_at(file, cell_at(kFirstValue + (problem.starts_with("eta_star") ? kEtaStar : kApparentMassFraction)),
+    base::fail_at(file, cell_at(kFirstValue + (problem.starts_with("eta_star") ? kEtaStar : kApparentMassFraction)),
                          problem);
   return p;
 }
@@ -427,7 +427,7 @@ json to_json(const EffectiveField& field) {
 }
 
 EffectiveField effective_field_from_json(const json& document, const std::string& file_name) {
-  strict_json::StrictObject root(document, "", file_name);
+  base::StrictObject root(document, "", file_name);
   root.expect_string("format", kFormat);
   root.integer("format_version", kFormatVersion, kFormatVersion);
   EffectiveField field;

@@ -2,16 +2,16 @@
 #include "file_io.hpp"
 
 
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 namespace pdamp::surrogate::detail {
 
-std::string file_label(const std::filesystem::path& path) { return strict_json::printable(path.string()); }
+std::string file_label(const std::filesystem::path& path) { return base::printable(path.string()); }
 
-std::string read_text_file(const std::filesystem::path& path) { return strict_json::read_input_file(path.string()); }
+std::string read_text_file(const std::filesystem::path& path) { return base::read_input_file(path.string()); }
 
 nlohmann::json read_json_file(const std::filesystem::path& path) {
-  return strict_json::parse_json_document(read_text_file(path), path.string());
+  return base::parse_json_document(read_text_file(path), path.string());
 }
 
 }  // namespace pdamp::surrogate::detail

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/output_file.hpp"
 
 namespace pdamp::surrogate::detail {
 
@@ -24,9 +24,9 @@ std::string read_text_file(const std::filesystem::path& path);
 /// "<path>: malformed JSON: ..." or "<path>: <pointer>: duplicate key".
 nlohmann::json read_json_file(const std::filesystem::path& path);
 
-/// The atomic writer and synced appends of strict_json (output_file.hpp).
-using strict_json::sync_parent_folder;
-using strict_json::write_all_synced;
-using strict_json::write_file_atomically;
+/// The atomic writer and synced appends of base (output_file.hpp).
+using base::sync_parent_folder;
+using base::write_all_synced;
+using base::write_file_atomically;
 
 }  // namespace pdamp::surrogate::detail

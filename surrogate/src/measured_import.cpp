@@ -2,7 +2,7 @@
 #include "pdamp/surrogate/measured_import.hpp"
 
 #include "pdamp/formulas/csv_text.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -47,7 +47,7 @@ class CsvReader {
   /// The message goes through printable(): a file name, column name or cell from a
   /// binary file must not cut (NUL) or break (newline) the one-line message.
   [[noreturn]] void fail(std::size_t line, std::string_view column, const std::string& rule) const {
-    throw std::invalid_argument(strict_json::printable(file_ + ": line " + std::to_string(line) +
+    throw std::invalid_argument(base::printable(file_ + ": line " + std::to_string(line) +
                                                     (column.empty() ? "" : ", column " + std::string(column)) + ": " +
                                                     rule));
   }

@@ -1,6 +1,6 @@
 // Scattered-state law: samples below the onset, weighted least squares (NLopt), coefficient file.
 #include "pdamp/surrogate/scattered_fit.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "file_io.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/strict_object.hpp"
 #include "text_util.hpp"
 
 namespace pdamp::surrogate {
@@ -166,7 +166,7 @@ ScatteredFitResult fit_scattered_law(std::span<const ScatteredSample> samples, s
     // The optimum is resolved to rounding: x holds the best point found, which is the answer.
     chi2 = objective(x[0], x[1], nullptr);
   } catch (const std::exception& e) {
-    throw strict_json::NumericalError(std::string("scattered fit: NLopt failed (") + e.what() + ")");
+    throw base::NumericalError(std::string("scattered fit: NLopt failed (") + e.what() + ")");
   }
   ScatteredFitResult result;
   result.fit.jump_fraction = x[0];
@@ -204,7 +204,7 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   const std::string file = detail::file_label(path);
   // read_json_file refuses directories, FIFOs and duplicate keys ("<path>: ...").
   const json doc = detail::read_json_file(path);
-  strict_json::StrictObject root(doc, "", file);
+  base::StrictObject root(doc, "", file);
   if (root.optional("format") != nullptr) root.expect_string("format", kFormat);
   if (root.optional("format_version") != nullptr) root.integer("format_version", kFormatVersion, kFormatVersion);
   ScatteredFitResult result;
@@ -214,7 +214,7 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
   result.fit.s_max = root.number("s_max", false);
   result.fit.source = root.string("source");
   if (detail::has_control_byte(result.fit.source)) {
-    root.fail("source", "\"" + strict_json::printable(result.fit.source) +
+    root.fail("source", "\"" + base::printable(result.fit.source) +
                             "\" holds control characters (must be printable text: it is printed in reports)");
   }
   result.fit.provisional = false;

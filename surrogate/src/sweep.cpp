@@ -1,6 +1,6 @@
 // Parallel, resumable sweeps over a grid or a list of points with a JSON-lines results file.
 #include "pdamp/surrogate/sweep.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -24,8 +24,8 @@
 
 #include "field_format.hpp"
 #include "file_io.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/strict_object.hpp"
 #include "text_util.hpp"
 
 namespace pdamp::surrogate {
@@ -113,14 +113,14 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
   const std::string where =
       "evaluator at frequency_hz = " + number(drive.frequency_hz) + ", amplitude_m = " + number(drive.amplitude_m);
   if (p.status == PointStatus::kMissing) {
-    throw strict_json::NumericalError(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
+    throw base::NumericalError(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
   }
   if (p.status == PointStatus::kFailed) {
     p.eta_star = p.eta_star_stderr = p.e_diss_j = p.apparent_mass_kg = p.apparent_mass_fraction = FieldPoint::kUnknown;
     return p;
   }
   if (!std::isfinite(p.eta_star))
-    throw strict_json::NumericalError(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
+    throw base::NumericalError(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
   if (std::isnan(p.e_diss_j)) {
     const double velocity = 2.0 * formulas::kPi * drive.frequency_hz * drive.amplitude_m;  // |V*| = XΩ
     p.e_diss_j = p.eta_star * 0.5 * options.bed_mass_kg * velocity * velocity;
@@ -130,7 +130,7 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
   }
   if (!std::isfinite(p.e_diss_j) || std::isinf(p.apparent_mass_kg) || std::isinf(p.apparent_mass_fraction) ||
       !(std::isnan(p.eta_star_stderr) || (p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr)))) {
-    throw strict_json::NumericalError(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
+    throw base::NumericalError(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
                              ", eta_star_stderr = " + number(p.eta_star_stderr) + ")");
   }
   return p;
@@ -233,7 +233,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
     json value;
     try {
       // parse_json_document also refuses a repeated key, which no writer of ours produces.
-      value = strict_json::parse_json_document(line, context);
+      value = base::parse_json_document(line, context);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(e.what() + damaged);
     }
@@ -241,14 +241,14 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       if (value != header) {
         // printable(): the difference quotes the file's values, and dump() leaves DEL and
         // other bytes that are not JSON control characters as they are (fuzz_sweep_log).
-        throw std::invalid_argument(strict_json::printable(
+        throw std::invalid_argument(base::printable(
             file_name + ": line 1: this results file belongs to another sweep (" + header_difference(value, header) +
             "); delete or move it to start a new sweep, its points are not mixed in"));
       }
       continue;
     }
     try {
-      strict_json::StrictObject object(value, "", context);
+      base::StrictObject object(value, "", context);
       const long long index = object.integer("index", 0, static_cast<long long>(nodes.count) - 1);
       const auto k = static_cast<std::size_t>(index);
       if (done[k]) object.fail("index", std::to_string(index) + " appears twice");
@@ -257,7 +257,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
                                  "/" + std::to_string(options.shard_count));
       }
       const DrivePoint node = nodes.drive(k);
-      strict_json::StrictObject drive(object.required("drive"), "/drive", context);
+      base::StrictObject drive(object.required("drive"), "/drive", context);
       const double f = drive.number("frequency_hz", true, "Hz");
       const double x = drive.number("amplitude_m", true, "m");
       drive.finish();
@@ -310,7 +310,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
 /// returns how many were resumed and adds a warning for a dropped partial last line.
 std::size_t resume(ResultsFile& file, const std::filesystem::path& path, const Points& nodes, const SweepOptions& options,
                    std::vector<FieldPoint>& points, std::vector<bool>& done, std::vector<std::string>& warnings) {
-  // read_text_file (strict_json::read_input_file) again refuses anything but a regular file.
+  // read_text_file (base::read_input_file) again refuses anything but a regular file.
   const std::string text = detail::read_text_file(path);
   const SavedPoints saved = read_saved_points(text, detail::file_label(path), nodes, options, points, done);
   if (!saved.warning.empty()) warnings.push_back(saved.warning);
@@ -554,7 +554,7 @@ ShardLog read_shard_log(const std::filesystem::path& path) {
   const std::size_t newline = log.text.find('\n');
   if (newline == std::string::npos)
     throw std::invalid_argument(context + ": no complete sweep header (an empty or cut file); not a shard's results file");
-  log.header = strict_json::parse_json_document(log.text.substr(0, newline), context);
+  log.header = base::parse_json_document(log.text.substr(0, newline), context);
   if (!log.header.is_object() || log.header.value("format", json()) != kSweepFormat)
     throw std::invalid_argument(context + ": not a sweep results file (format must be \"" + std::string(kSweepFormat) +
                                 "\")");
@@ -617,7 +617,7 @@ PointSweepResult merge_points(const Points& all, const SweepOptions& options,
   const ShardLog& first = logs.front();
   for (std::size_t i = 1; i < logs.size(); ++i) {
     if (logs[i].header != first.header) {
-      throw std::invalid_argument(strict_json::printable(
+      throw std::invalid_argument(base::printable(
           first.label + " and " + logs[i].label + ": are not shards of one sweep (" +
           identity_difference(first.header, first.label, logs[i].header, logs[i].label) +
           "); merge only the shards of one pdamp field command"));
@@ -625,7 +625,7 @@ PointSweepResult merge_points(const Points& all, const SweepOptions& options,
   }
   const json expected = sweep_header(all, wanted);
   if (first.header != expected) {
-    throw std::invalid_argument(strict_json::printable(
+    throw std::invalid_argument(base::printable(
         first.label + ": line 1: is a shard of another sweep than " + expected_label + " (" +
         identity_difference(first.header, first.label, expected, expected_label) + ")"));
   }

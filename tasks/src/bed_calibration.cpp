@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <numbers>
 
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/output_file.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/output_file.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/sampled_decay.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/tasks/decay.hpp"
@@ -88,7 +88,7 @@ bool bed_from_document(const json& d, CalibratedBed& bed, std::string& why) {
 bool read_cached(CalibratedBed& bed, std::string& why) {
   if (!std::filesystem::exists(bed.file)) return false;
   try {
-    const json d = strict_json::parse_json_document(strict_json::read_input_file(bed.file.string()), bed.file.string());
+    const json d = base::parse_json_document(base::read_input_file(bed.file.string()), bed.file.string());
     return bed.cached = bed_from_document(d, bed, why);
   } catch (const std::exception& e) {
     why = e.what();
@@ -98,7 +98,7 @@ bool read_cached(CalibratedBed& bed, std::string& why) {
 
 /// Runs bed's DEM decay, builds its field and writes its cache file.
 json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
-                   CalibratedBed bed, RunHooks& hooks) {
+                   CalibratedBed bed, base::RunHooks& hooks) {
   std::vector<long> slabs(p.options.layers.size(), 0);
   slabs[static_cast<std::size_t>(bed.layer_index)] = bed.slabs;
   const Case design = case_file::with_design(c, slabs, spec.stiffness_softening, true);
@@ -124,7 +124,7 @@ json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const
                                                                   surrogate::dem_model_version()),
                                        spec.strokes_per_decade);
   } catch (const std::invalid_argument& e) {
-    throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+    throw base::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
                                       std::to_string(bed.slabs) + " slabs gives no field: " + e.what() +
                                       " (/task/calibration/duration_s)");
   }
@@ -132,7 +132,7 @@ json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const
   bed.energy_error = r.energy.relative_error;
   bed.wall_time_s = r.wall_time_s;
   const json document = cache_document(bed);
-  strict_json::write_file_atomically(bed.file, document.dump(1));
+  base::write_file_atomically(bed.file, document.dump(1));
   return document;
 }
 
@@ -162,8 +162,8 @@ namespace {
 /// Reads or runs `beds` (their key and file set here): cached ones from the cache, the others
 /// as jobs of `executor`. Returns how many ran.
 int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
-                const std::filesystem::path& cache_dir, std::vector<CalibratedBed>& beds, RunHooks& hooks,
-                Executor& executor) {
+                const std::filesystem::path& cache_dir, std::vector<CalibratedBed>& beds, base::RunHooks& hooks,
+                base::Executor& executor) {
   std::error_code error;
   std::filesystem::create_directories(cache_dir, error);
   if (error)
@@ -183,8 +183,8 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
       to_run.push_back(b);
     }
   }
-  const auto documents = run_jobs<json>(
-      executor, to_run.size(), parallel_jobs(executor, to_run.size()),
+  const auto documents = base::run_jobs<json>(
+      executor, to_run.size(), base::parallel_jobs(executor, to_run.size()),
       [&](std::size_t j) { return calibrate_bed(c, p, spec, beds[to_run[j]], hooks); }, nullptr,
       [&](std::size_t j) { return static_cast<double>(to_run[j]); },
       static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
@@ -193,7 +193,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
     std::string why;
     // What the job returned is what it wrote to the cache (on this process or another).
     if (!bed_from_document(documents[j], bed, why))
-      throw strict_json::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+      throw base::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
                                         std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
   }
   return static_cast<int>(to_run.size());
@@ -203,7 +203,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
 
 BedCalibration calibrate_beds(const Case& c, const case_file::FillingRatioProblem& p,
                               const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
-                              RunHooks& hooks, Executor& executor) {
+                              base::RunHooks& hooks, base::Executor& executor) {
   const auto start = std::chrono::steady_clock::now();
   BedCalibration out;
   out.spec = spec;
@@ -232,8 +232,8 @@ double decay_damping_ratio(std::span<const double> time_s, std::span<const doubl
 
 std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::FillingRatioProblem& p,
                                                BedCalibration& calibration, const std::vector<long>& slabs,
-                                               double design_damping_ratio, double design_threshold_m, RunHooks& hooks,
-                                               Executor& executor) {
+                                               double design_damping_ratio, double design_threshold_m, base::RunHooks& hooks,
+                                               base::Executor& executor) {
   const auto start = std::chrono::steady_clock::now();
   // A design of one bed is that bed alone: its calibration already came down at its rate.
   if (std::count_if(slabs.begin(), slabs.end(), [](long n) { return n > 0; }) < 2) return {};
@@ -270,7 +270,7 @@ std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::F
   std::vector<std::string> changed;
   for (std::size_t b = 0; b < beds.size(); ++b) {
     changed.push_back(beds[b].layer + " " + std::to_string(beds[b].slabs) + " slabs: extra damping ratio " +
-                      strict_json::format_number(beds[b].extra_damping_ratio, 3));
+                      base::format_number(beds[b].extra_damping_ratio, 3));
     calibration.beds[index[b]] = std::move(beds[b]);
   }
   calibration.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,7 +1,7 @@
 // The checks of a case without the work (case_checks.hpp).
 #include "pdamp/tasks/case_checks.hpp"
 
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 #include "pdamp/tasks/damper_design.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/dem_run.hpp"
@@ -10,7 +10,7 @@
 
 namespace pdamp::tasks {
 
-void check_case(const case_file::Case& c, RunHooks& hooks) {
+void check_case(const case_file::Case& c, base::RunHooks& hooks) {
   if (c.task.kind == case_file::TaskKind::kDamperDesign) (void)run_damper_design(c);
   const auto grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
   for (std::size_t i = 0; i < c.dampers.size(); ++i) {
@@ -24,7 +24,7 @@ void check_case(const case_file::Case& c, RunHooks& hooks) {
   if (c.task.kind != case_file::TaskKind::kDecay || !c.task.decay) return;
   const Eigen::VectorXd q0 = case_file::initial_modal_amplitudes(c, setup.s, *c.task.decay);
   if (!(q0.cwiseAbs().maxCoeff() > 0.0))
-    throw strict_json::InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
+    throw base::InputError(c.path, "/task/initial_state", "gives no modal amplitude (the load does not excite any kept mode)");
   const auto options = dem_decay_options(c, setup.s.modal, q0, c.task.decay->duration_s);
   hooks.note("pdamp validate: the DEM-in-the-loop decay (pdamp decay --method dem): " +
              estimate_text(estimate_coupled_decay(c, setup.s.modal, detail::dem_dampers(c), options)));
@@ -41,7 +41,7 @@ void require_task(const case_file::Case& c, case_file::TaskKind kind) {
   const std::string needed = kind == TaskKind::kFrf     ? "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\""
                              : kind == TaskKind::kDecay ? "\"initial_state\", \"duration_s\""
                                                         : "...";
-  throw strict_json::InputError(c.path, "/task",
+  throw base::InputError(c.path, "/task",
                                 "pdamp " + name + " needs a task of kind " + name + " (this case's task is '" +
                                     std::string(case_file::to_string(t.kind)) + "'): give \"task\": {\"kind\": \"" + name +
                                     "\", " + needed + "} (docs/cases.md, Format 2)");

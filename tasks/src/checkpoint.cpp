@@ -1,22 +1,22 @@
 // Checkpoint files of long runs (checkpoint.hpp).
 #include "pdamp/tasks/checkpoint.hpp"
 
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/output_file.hpp"
 
 namespace pdamp::tasks {
 
 std::string read_checkpoint(const CheckpointFile& file, const dem_reference::CheckpointHeader& expected) {
-  const std::string shown = strict_json::printable(file.path.string());
+  const std::string shown = base::printable(file.path.string());
   if (!std::filesystem::exists(file.path))
-    throw strict_json::InputError("--resume", "", "no checkpoint " + shown + " to continue (the run completed, or never started)");
+    throw base::InputError("--resume", "", "no checkpoint " + shown + " to continue (the run completed, or never started)");
   auto decoded = dem_reference::decode_checkpoint(
-      strict_json::read_input_file(file.path.string(), dem_reference::kMaxCheckpointBytes), file.path.string());
+      base::read_input_file(file.path.string(), dem_reference::kMaxCheckpointBytes), file.path.string());
   const auto& h = decoded.header;
   const auto refuse = [&](const std::string& key, const std::string& saved, const std::string& here) {
-    throw strict_json::InputError(
+    throw base::InputError(
         file.path.string(), "/" + key,
         "'" + saved + "' in the checkpoint, '" + here + "' for this run: it belongs to another " +
             (key == "kind" ? "command" : key == "physics_model_version" ? "pdamp version" : "case or settings") +
@@ -31,12 +31,12 @@ std::string read_checkpoint(const CheckpointFile& file, const dem_reference::Che
 }
 
 void write_checkpoint(const CheckpointFile& file, const dem_reference::CheckpointHeader& header, const std::string& payload) {
-  strict_json::write_file_atomically(file.path, dem_reference::encode_checkpoint(header, payload));
+  base::write_file_atomically(file.path, dem_reference::encode_checkpoint(header, payload));
 }
 
 std::string resume_advice(const CheckpointFile& file, const dem_reference::CheckpointHeader& header) {
-  return "the run stopped at t = " + strict_json::format_number(header.simulated_time_s, 6) + " of " +
-         strict_json::format_number(header.end_time_s, 6) + " s and wrote " + strict_json::printable(file.path.string()) +
+  return "the run stopped at t = " + base::format_number(header.simulated_time_s, 6) + " of " +
+         base::format_number(header.end_time_s, 6) + " s and wrote " + base::printable(file.path.string()) +
          ": run the same command with --resume to continue";
 }
 

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks {
@@ -117,7 +117,7 @@ json to_json(const fm::BufferDesign& b) {
 
 void require_finite(const json& result) {
   if (const auto bad = detail::non_finite_number(result))
-    throw strict_json::NumericalError("the result " + *bad + " is not finite: the inputs lie where the model cannot be evaluated");
+    throw base::NumericalError("the result " + *bad + " is not finite: the inputs lie where the model cannot be evaluated");
 }
 
 }  // namespace pdamp::tasks

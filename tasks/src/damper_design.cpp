@@ -1,7 +1,7 @@
 // Task kind damper_design (damper_design.hpp).
 #include "pdamp/tasks/damper_design.hpp"
 
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks {
@@ -63,10 +63,10 @@ DamperDesignResult run_damper_design(const case_file::Case& c) {
                           model_options, c.design.sweep_min_over_clearance * layer.clearance_m,
                           c.design.sweep_max_over_clearance * layer.clearance_m, c.design.sweep_points);
   } catch (const std::invalid_argument& e) {
-    throw strict_json::InputError(c.path, "", std::string("the closed forms refuse this case: ") + e.what());
+    throw base::InputError(c.path, "", std::string("the closed forms refuse this case: ") + e.what());
   }
   if (const auto bad = detail::non_finite_number(to_json(out)))
-    throw strict_json::InputError(c.path, "", "the design result " + *bad + " is not finite: the case lies outside the closed forms");
+    throw base::InputError(c.path, "", "the design result " + *bad + " is not finite: the case lies outside the closed forms");
   return out;
 }
 

@@ -9,9 +9,9 @@
 
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/cosimulation_run.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
@@ -26,9 +26,9 @@ namespace st = structure;
 using case_file::Case;
 using detail::number_or_null;
 using nlohmann::json;
-using strict_json::format_number;
-using strict_json::InputError;
-using strict_json::NumericalError;
+using base::format_number;
+using base::InputError;
+using base::NumericalError;
 
 namespace {
 
@@ -51,7 +51,7 @@ constexpr double kFirstSegmentFraction = 0.01;
 /// A segment is at most this many times the last one.
 constexpr std::int64_t kSegmentGrowth = 4;
 
-void report_progress(RunHooks& hooks, const std::string& label, const st::CosimulationProgress& p) {
+void report_progress(base::RunHooks& hooks, const std::string& label, const st::CosimulationProgress& p) {
   hooks.progress({label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN});
 }
 
@@ -71,12 +71,12 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
 /// The co-simulation's progress as the hooks' lines. A stop asked while the beds settle ends
 /// the run there (Interrupted): no checkpoint holds that phase. A run without checkpoints
 /// (`checkpointed` false: a library caller's, docs/python.md) stops at any report.
-st::CosimulationProgressCallback progress_to_hooks(RunHooks& hooks, const std::string& label, bool checkpointed) {
+st::CosimulationProgressCallback progress_to_hooks(base::RunHooks& hooks, const std::string& label, bool checkpointed) {
   return [&hooks, label, checkpointed](const st::CosimulationProgress& p) {
     report_progress(hooks, label, p);
     if (p.stage == "settling" || !checkpointed)
       if (const int signal = hooks.stop_requested(); signal != 0)
-        throw strict_json::Interrupted(signal, checkpointed ? "the run stopped while its beds settled, before its first "
+        throw base::Interrupted(signal, checkpointed ? "the run stopped while its beds settled, before its first "
                                                               "checkpoint: run the same command again"
                                                             : "the run stopped; it had no checkpoint file, so nothing was kept");
   };
@@ -85,7 +85,7 @@ st::CosimulationProgressCallback progress_to_hooks(RunHooks& hooks, const std::s
 /// One co-simulation run of `options`, its refusals as the case's errors.
 st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
                                        const std::vector<st::CosimulationDamper>& dampers,
-                                       const st::CosimulationOptions& options, const std::string& label, RunHooks& hooks,
+                                       const st::CosimulationOptions& options, const std::string& label, base::RunHooks& hooks,
                                        st::CosimulationState* state = nullptr) {
   detail::check_cosimulation(c, modal, dampers, options);
   const auto report = progress_to_hooks(hooks, label, false);
@@ -102,7 +102,7 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
 st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& modal,
                                           const std::vector<st::CosimulationDamper>& dampers,
                                           const st::CosimulationOptions& options, const std::string& label,
-                                          const std::string& estimate, const DemDecayCheckpoint& cp, RunHooks& hooks) {
+                                          const std::string& estimate, const DemDecayCheckpoint& cp, base::RunHooks& hooks) {
   detail::check_cosimulation(c, modal, dampers, options);
   const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
   const std::int64_t sample_every = std::max<std::int64_t>(1, std::llround(options.sample_interval_s / dt));
@@ -113,7 +113,7 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.physics_model_version = dem_reference::kPhysicsModelVersion;
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
-  const std::string shown = strict_json::printable(cp.file.path.string());
+  const std::string shown = base::printable(cp.file.path.string());
   const auto report = progress_to_hooks(hooks, label, true);
 
   std::optional<st::Cosimulation> run;
@@ -173,7 +173,7 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
       write_checkpoint(cp.file, header, out.bytes());
       last_checkpoint = std::chrono::steady_clock::now();
     }
-    if (signal != 0) throw strict_json::Interrupted(signal, resume_advice(cp.file, header));
+    if (signal != 0) throw base::Interrupted(signal, resume_advice(cp.file, header));
   }
   auto result = std::move(*run).result();
   detail::check_outcome(result.outcome, result.message, label);
@@ -302,7 +302,7 @@ CoupledRunEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& m
 CoupledRunEstimate check_coupled_decay(const Case& c, const st::ModalModel& modal,
                                          const std::vector<st::CosimulationDamper>& dampers,
                                          const st::CosimulationOptions& options, const std::string& label,
-                                         const std::string& duration_pointer, RunHooks& hooks) {
+                                         const std::string& duration_pointer, base::RunHooks& hooks) {
   const CoupledRunEstimate e = estimate_coupled_decay(c, modal, dampers, options);
   if (const double available = available_memory_bytes(); e.memory_bytes > available)
     throw InputError(c.path, "/dem",
@@ -324,7 +324,7 @@ std::string estimate_text(const CoupledRunEstimate& e) {
 DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
                    const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
-                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks, int snapshots) {
+                   const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -381,7 +381,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   return out;
 }
 
-DecayResult run_decay(const Case& c, const DecayOptions& options, RunHooks& hooks) {
+DecayResult run_decay(const Case& c, const DecayOptions& options, base::RunHooks& hooks) {
   require_task(c, case_file::TaskKind::kDecay);
   const bool dem = options.method == DecayMethod::kDem;
   detail::Setup setup = detail::make_setup(

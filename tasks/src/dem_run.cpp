@@ -7,18 +7,18 @@
 #include <regex>
 #include <sstream>
 
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks {
 
 namespace fm = formulas;
 using nlohmann::json;
-using strict_json::format_number;
-using strict_json::InputError;
+using base::format_number;
+using base::InputError;
 
 double available_memory_bytes() {
   double available = std::numeric_limits<double>::infinity();
@@ -83,7 +83,7 @@ std::string case_key_names(const std::string& advice) {
 }
 
 void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
-                     const std::string& reduce, RunHooks& hooks) {
+                     const std::string& reduce, base::RunHooks& hooks) {
   check_wall_time(c, wall_time_s, what, pointer, reduce, hooks.long_runs_accepted());
 }
 
@@ -120,7 +120,7 @@ DemRunPlan plan_dem(const case_file::Case& c, const DemRunOptions& o) {
   return plan;
 }
 
-DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, RunHooks& hooks) {
+DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks) {
   const auto& options = plan.options;
   const double x = plan.amplitude_m, f = plan.frequency_hz;
   const bool checkpointing = !checkpoint.path.empty();
@@ -163,9 +163,9 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
                   hooks);
   hooks.note(plan.label + ": " + estimate_text(plan.estimate));
   if (checkpoint.resume) {
-    hooks.note(plan.label + ": resuming from " + strict_json::printable(checkpoint.path.string()));
+    hooks.note(plan.label + ": resuming from " + base::printable(checkpoint.path.string()));
   } else if (checkpointing && std::filesystem::exists(checkpoint.path)) {
-    hooks.note("pdamp: warning: " + strict_json::printable(checkpoint.path.string()) +
+    hooks.note("pdamp: warning: " + base::printable(checkpoint.path.string()) +
                " of an earlier run is replaced (--resume continues it)");
   }
 
@@ -192,16 +192,16 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
     throw InputError(checkpoint.resume ? checkpoint.path.string() : c.path, checkpoint.resume ? "" : "/dem", e.what());
   }
   if (out.dem.stopped)
-    throw strict_json::Interrupted(hooks.stop_requested(),
+    throw base::Interrupted(hooks.stop_requested(),
                                    !checkpointing ? "the run stopped; it had no checkpoint file, so nothing was kept"
                                    : wrote_checkpoint || checkpoint.resume
                                        ? resume_advice(checkpoint, header)
                                        : "the run stopped while its bed settled, before its first checkpoint: run the "
                                          "same command again");
   if (out.dem.summary.outcome == dem_reference::Outcome::kUnstable)
-    throw strict_json::NumericalError("DEM unstable: " + case_key_names(out.dem.summary.message));
+    throw base::NumericalError("DEM unstable: " + case_key_names(out.dem.summary.message));
   if (out.dem.summary.outcome != dem_reference::Outcome::kCompleted)  // a step threw (on any thread)
-    throw strict_json::NumericalError("DEM failed: " + case_key_names(out.dem.summary.message));
+    throw base::NumericalError("DEM failed: " + case_key_names(out.dem.summary.message));
 
   // The closed form at the same point, for comparison (same model family as the case).
   const auto& damper = c.dampers.front();

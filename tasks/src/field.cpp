@@ -2,8 +2,8 @@
 #include "pdamp/tasks/field.hpp"
 
 #include "job_codecs.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/surrogate/measured_import.hpp"
 #include "pdamp/tasks/dem_run.hpp"
@@ -12,8 +12,8 @@
 namespace pdamp::tasks {
 
 using nlohmann::json;
-using strict_json::format_number;
-using strict_json::InputError;
+using base::format_number;
+using base::InputError;
 
 surrogate::SweepOptions field_sweep_options(const case_file::Case& c, const std::string& source) {
   const detail::SingleDamper single = detail::single_damper(c, "pdamp field");
@@ -80,7 +80,7 @@ std::string check_dem_field(const case_file::Case& c, std::size_t damper, const 
          " points at once; memory about " + megabytes(at_once * static_cast<double>(largest.memory_bytes));
 }
 
-FieldPlan plan_field(const case_file::Case& c, const FieldOptions& options, const Executor& executor) {
+FieldPlan plan_field(const case_file::Case& c, const FieldOptions& options, const base::Executor& executor) {
   FieldPlan plan;
   plan.options = options;
   plan.grid = surrogate::Grid::from_ranges(c.field.axes, c.field.axis0, c.field.axis1);
@@ -120,7 +120,7 @@ void fit_scattered(const case_file::Case& c, FieldResult& r) {
 
 }  // namespace
 
-FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, RunHooks& hooks, Executor& executor) {
+FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::RunHooks& hooks, base::Executor& executor) {
   const detail::SingleDamper single = detail::single_damper(c, "pdamp field");
   const bool dem = plan.options.source == "dem";
   surrogate::PointEvaluator evaluator;
@@ -134,7 +134,7 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, RunHooks&
   }
   const auto& grid = plan.grid;
   surrogate::SweepOptions sweep = plan.sweep;
-  Jobs<surrogate::FieldPoint> jobs(executor, [&](std::size_t k) {
+  base::Jobs<surrogate::FieldPoint> jobs(executor, [&](std::size_t k) {
     const auto drive = surrogate::drive_point(grid, k, sweep.clearance_m);
     return evaluator(drive.frequency_hz, drive.amplitude_m);
   });

@@ -6,9 +6,9 @@
 #include <map>
 #include <sstream>
 
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/dem_run.hpp"
 #include "structure_support.hpp"
@@ -20,8 +20,8 @@ namespace st = structure;
 using case_file::Case;
 using detail::number_or_null;
 using nlohmann::json;
-using strict_json::format_number;
-using strict_json::InputError;
+using base::format_number;
+using base::InputError;
 
 void to_json(json& j, const VerifiedDecay& v) {
   const auto& s = v.settling;
@@ -105,7 +105,7 @@ double design_fingerprint(const opt::FillingDesign& design) {
 /// (`suffix` "" for the judged run, "_stiffer" for the softening check's).
 DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const std::string& name,
                                            const std::string& suffix, const opt::FillingDesign& design,
-                                           double softening, RunHooks& hooks) {
+                                           double softening, base::RunHooks& hooks) {
   DemDecayCheckpoint checkpoint;
   if (o.checkpoint_dir.empty()) return checkpoint;
   checkpoint.file = {o.checkpoint_dir / ("verify_" + name + suffix + ".checkpoint"), o.resume};
@@ -126,7 +126,7 @@ DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const 
 /// decay from its initial state, on the design's modes) at verify softening `softening`.
 VerifiedDecay verification_decay(const Case& c, const case_file::FillingRatioProblem& p, const case_file::VerifySpec& verify,
                                  const std::string& label, const opt::FillingDesign& design, const detail::DesignModes& modes,
-                                 double softening, const DemDecayCheckpoint& checkpoint, RunHooks& hooks) {
+                                 double softening, const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks) {
   const Case dc = case_file::with_design(c, whole_slabs(design), softening);
   std::vector<st::Damper> containers = {p.options.damper};
   containers.insert(containers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
@@ -152,7 +152,7 @@ bool at_full_stiffness(const Case& c, const case_file::VerifySpec& verify) {
 /// kMaxDemWallTime_s for the whole) before any work. Each decay is checked again as it starts.
 void check_design_decays_cost(const Case& c, const case_file::FillingRatioProblem& p, double duration_s,
                               const std::vector<double>& softenings, std::size_t decays, int parallel,
-                              const std::string& label, const std::string& duration_pointer, RunHooks& hooks) {
+                              const std::string& label, const std::string& duration_pointer, base::RunHooks& hooks) {
   std::vector<long> slabs;
   for (const auto& layer : p.options.layers) slabs.push_back(layer.initial_slabs);
   const detail::DesignModes modes = detail::design_modes(c, p, slabs);
@@ -254,8 +254,8 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
 using DecayRuns = std::map<std::string, VerifiedDecay>;
 
 Verification verify_designs(const Case& c, const case_file::FillingRatioProblem& p, const opt::FillingRatioResult& r,
-                            const case_file::VerifySpec& verify, const FillingRatiosOptions& o, RunHooks& hooks,
-                            Executor& executor, std::vector<std::filesystem::path>& checkpoints, DecayRuns& runs) {
+                            const case_file::VerifySpec& verify, const FillingRatiosOptions& o, base::RunHooks& hooks,
+                            base::Executor& executor, std::vector<std::filesystem::path>& checkpoints, DecayRuns& runs) {
   const auto start = std::chrono::steady_clock::now();
   Verification v;
   v.spec = verify;
@@ -287,7 +287,7 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   std::vector<std::size_t> to_run;
   for (std::size_t k = 0; k < jobs; ++k)
     if (!runs.contains(run_key(k))) to_run.push_back(k);
-  const auto ran = run_jobs<VerifiedDecay>(
+  const auto ran = base::run_jobs<VerifiedDecay>(
       executor, to_run.size(), true,
       [&](std::size_t j) {
         const std::size_t k = to_run[j];
@@ -471,7 +471,7 @@ std::vector<double> slabs_of(const opt::FillingDesign& d) {
   return n;
 }
 
-FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions& o, RunHooks& hooks, Executor& executor) {
+FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions& o, base::RunHooks& hooks, base::Executor& executor) {
   const case_file::FillingRatiosTask& task = *c.task.filling_ratios;
   FillingRatiosResult out;
   out.case_name = c.name;
@@ -481,7 +481,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   // ranks that is the first round's verification; the calibration (every rank needs the
   // same beds to choose the same design) and the design loop's later rounds run on each
   // process's own threads.
-  Executor& own_threads = executor.processes() > 1 ? static_cast<Executor&>(local_executor()) : executor;
+  base::Executor& own_threads = executor.processes() > 1 ? static_cast<base::Executor&>(base::local_executor()) : executor;
   // The DEM verification: the task's verify block, or --verify with its defaults.
   std::optional<case_file::VerifySpec> verify = task.verify;
   if (!verify && o.force_verify) {
@@ -526,7 +526,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     }
     for (const auto* d : {&out.optimum.chosen, &out.optimum.relaxed, &out.optimum.baseline})
       if (!std::isfinite(d->objective))
-        throw strict_json::NumericalError("pdamp optimize: a design's objective is not finite");
+        throw base::NumericalError("pdamp optimize: a design's objective is not finite");
   };
   optimise();
 
@@ -595,7 +595,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   try {
     out.comparison = compare_designs(p, r);
   } catch (const std::invalid_argument& e) {
-    throw strict_json::NumericalError(std::string("pdamp optimize: the comparison decays failed: ") + e.what());
+    throw base::NumericalError(std::string("pdamp optimize: the comparison decays failed: ") + e.what());
   }
   return out;
 }

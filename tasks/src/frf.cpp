@@ -9,8 +9,8 @@
 #include <numbers>
 
 #include "job_codecs.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/tasks/case_checks.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "structure_support.hpp"
@@ -21,9 +21,9 @@ namespace st = structure;
 using case_file::Case;
 using detail::number_or_null;
 using nlohmann::json;
-using strict_json::format_number;
-using strict_json::InputError;
-using strict_json::NumericalError;
+using base::format_number;
+using base::InputError;
+using base::NumericalError;
 
 namespace {
 
@@ -200,7 +200,7 @@ std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, co
 
 /// The stepped sine over the band, up and down, the directions as jobs of `executor` (a
 /// direction cannot be split: each frequency continues from the previous one's state).
-SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks, Executor& executor) {
+SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOptions& o, base::RunHooks& hooks, base::Executor& executor) {
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
   const st::SteadyStateSettling settling = case_settling(c, o.settling);
@@ -220,7 +220,7 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   for (const auto& d : o.directions)
     directions.push_back({d, d == "up" ? out.frequencies_hz
                                        : std::vector<double>(out.frequencies_hz.rbegin(), out.frequencies_hz.rend())});
-  out.parallel = parallel_jobs(executor, directions.size());
+  out.parallel = base::parallel_jobs(executor, directions.size());
   {
     // At most max_transient_periods + analysed_periods a point (fewer once its transient
     // has converged), every direction: an upper bound, said as one (not refused on it).
@@ -242,7 +242,7 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
                std::to_string(executor.processes()) + " MPI ranks; progress lines only of a direction run on rank 0");
   const auto started = std::chrono::steady_clock::now();
   const std::size_t n = out.frequencies_hz.size();
-  out.branches = run_jobs<st::SteppedSineBranch>(
+  out.branches = base::run_jobs<st::SteppedSineBranch>(
       executor, directions.size(), out.parallel,
       [&](std::size_t k) {
         // Named references, not a structured binding: clang 14 cannot capture bindings in lambdas.
@@ -303,7 +303,7 @@ double default_sweep_rate(const Case& c, detail::Setup& formulas, const DemFrfOp
 
 /// --dem-signal linear: per direction, the structure brought to its steady state at the
 /// band's start, then a linear sine sweep to the other end; the directions in parallel.
-LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOptions& o, RunHooks& hooks) {
+LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOptions& o, base::RunHooks& hooks) {
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
   const st::SteadyStateSettling settling = case_settling(c, o.settling);
@@ -332,7 +332,7 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
     detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, run); });
   }
   const auto started = std::chrono::steady_clock::now();
-  for_each_concurrently(out.sweeps.size(), out.parallel, [&](std::size_t k) {
+  base::for_each_concurrently(out.sweeps.size(), out.parallel, [&](std::size_t k) {
     const std::string& direction = o.directions[k];
     const double start = direction == "up" ? o.min_frequency_hz : o.max_frequency_hz;
     const double end = direction == "up" ? o.max_frequency_hz : o.min_frequency_hz;
@@ -694,7 +694,7 @@ DemFrfOptions default_dem_frf_options(const Case& c) {
   return o;
 }
 
-FrfResult run_frf(const Case& c, const FrfOptions& options, RunHooks& hooks, Executor& executor) {
+FrfResult run_frf(const Case& c, const FrfOptions& options, base::RunHooks& hooks, base::Executor& executor) {
   require_task(c, case_file::TaskKind::kFrf);
   FrfResult out;
   out.case_name = c.name;

@@ -11,10 +11,10 @@
 
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/formulas/cor_models.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/input_file.hpp"
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/strict_object.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks {
@@ -22,7 +22,7 @@ namespace pdamp::tasks {
 namespace fm = formulas;
 namespace dr = dem_reference;
 using nlohmann::json;
-using strict_json::InputError;
+using base::InputError;
 
 namespace {
 
@@ -158,12 +158,12 @@ std::string readme_text(const json& r, bool cylinder) {
   out << "LIGGGHTS deck of pdamp dem's run of case '" << r["case"].get<std::string>() << "'\n"
       << "written by pdamp " << r["pdamp_version"].get<std::string>() << " (export " << r["export_id"].get<std::string>()
       << "); docs/liggghts.md of pdamp explains every command.\n\n"
-      << "The run: " << r["particles"].get<int>() << " spheres (" << strict_json::format_number(r["bed_mass_kg"].get<double>(), 4)
+      << "The run: " << r["particles"].get<int>() << " spheres (" << base::format_number(r["bed_mass_kg"].get<double>(), 4)
       << " kg) settle for " << r["settling_steps"].get<long long>() << " steps with the container at rest, then the\n"
       << "container moves as x = X sin(2 pi f t) along " << r["drive_axis"].get<std::string>() << ", X = "
-      << strict_json::format_number(r["amplitude_m"].get<double>()) << " m, f = " << strict_json::format_number(r["frequency_hz"].get<double>()) << " Hz, for "
+      << base::format_number(r["amplitude_m"].get<double>()) << " m, f = " << base::format_number(r["frequency_hz"].get<double>()) << " Hz, for "
       << r["transient_periods"].get<int>() << " transient and " << r["analysed_periods"].get<int>()
-      << " analysed periods\nat a time step of " << strict_json::format_number(r["time_step_s"].get<double>()) << " s ("
+      << " analysed periods\nat a time step of " << base::format_number(r["time_step_s"].get<double>()) << " s ("
       << r["steps_per_period"].get<long long>() << " steps a period). It writes " << kLiggghtsForceFile
       << " (the force of the bed on the\ncontainer walls, mean over each of " << r["samples_per_period"].get<int>()
       << " samples a period) and " << kLiggghtsEnergyFile << " (kinetic energy and centre of\nmass at each sample).\n\n"
@@ -246,7 +246,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   std::ostringstream data;
   data.imbue(std::locale::classic());
   data << std::setprecision(17);
-  data << "pdamp: the spheres of case '" << strict_json::printable(c.name) << "' at pdamp's initial positions\n\n"
+  data << "pdamp: the spheres of case '" << base::printable(c.name) << "' at pdamp's initial positions\n\n"
        << n << " atoms\n" << types << " atom types\n\n";
   for (int k = 0; k < 3; ++k)
     data << low[k] << ' ' << high[k] << ' ' << kAxisNames[k] << "lo " << kAxisNames[k] << "hi\n";
@@ -295,7 +295,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   std::ostringstream in;
   in.imbue(std::locale::classic());
   const auto line = [&](const std::string& text) { in << text << "\n"; };
-  line("# LIGGGHTS-PUBLIC 3.8 deck of pdamp dem's run of case '" + strict_json::printable(c.name) + "'");
+  line("# LIGGGHTS-PUBLIC 3.8 deck of pdamp dem's run of case '" + base::printable(c.name) + "'");
   line("# written by pdamp " + pdamp_version + "; README.txt says how to run it, docs/liggghts.md of pdamp");
   line("# maps every pdamp parameter to the commands below.");
   line("# Drive: x_c(t) = X sin(2 pi f t) along " + std::string(kAxisNames[axis]) + ", X = " + num(x) + " m, f = " + num(f) +
@@ -316,7 +316,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("");
   std::string names;
   for (int a = 0; a < types; ++a) names += (a ? ", " : "") + std::to_string(a + 1) + " " + world_options.materials[a].name;
-  line("# Atom types = the case's materials (" + strict_json::printable(names) + "); the walls are type " +
+  line("# Atom types = the case's materials (" + base::printable(names) + "); the walls are type " +
        std::to_string(wall_type) + ".");
   line("# Young's moduli include /dem/stiffness_softening = " + num(c.dem.stiffness_softening) + " as in pdamp's DEM.");
   line("fix pdamp_m1 all property/global youngsModulus peratomtype" +
@@ -448,7 +448,7 @@ std::vector<std::vector<double>> read_output_file(const std::filesystem::path& p
   const std::string file = path.string();
   if (!std::filesystem::exists(path))
     throw InputError(file, "", "missing: run LIGGGHTS on the deck in this folder first (README.txt)");
-  const std::string text = strict_json::read_input_file(file);
+  const std::string text = base::read_input_file(file);
   std::vector<std::vector<double>> rows;
   std::istringstream lines(text);
   std::string line;
@@ -461,7 +461,7 @@ std::vector<std::vector<double>> read_output_file(const std::filesystem::path& p
     if (number == 1) {
       if (line != "# pdamp export " + export_id)
         throw InputError(file, "",
-                         where + "'" + strict_json::printable(line.substr(0, 80)) + "' is not the title of export " +
+                         where + "'" + base::printable(line.substr(0, 80)) + "' is not the title of export " +
                              export_id + " (an earlier deck's output, or not LIGGGHTS's): run LIGGGHTS on this deck again");
       titled = true;
       continue;
@@ -479,7 +479,7 @@ std::vector<std::vector<double>> read_output_file(const std::filesystem::path& p
       const auto [parsed, error] = std::from_chars(at, token_end, value);
       if (error != std::errc() || parsed != token_end || !std::isfinite(value))
         throw InputError(file, "",
-                         where + "'" + strict_json::printable(std::string(at, token_end).substr(0, 40)) +
+                         where + "'" + base::printable(std::string(at, token_end).substr(0, 40)) +
                              "' is not a finite number");
       row.push_back(value);
       at = token_end;
@@ -503,8 +503,8 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
     throw InputError(dir.string(), "", "is not a folder (the folder pdamp export liggghts wrote)");
   if (!std::filesystem::exists(record_path))
     throw InputError(record_file, "", "missing: the folder holds no deck of pdamp export liggghts");
-  const json document = strict_json::parse_json_document(strict_json::read_input_file(record_file), record_file);
-  strict_json::StrictObject r(document, "", record_file);
+  const json document = base::parse_json_document(base::read_input_file(record_file), record_file);
+  base::StrictObject r(document, "", record_file);
   r.expect_string("format", kRecordFormat);
   if (r.integer("format_version", 1, 1000) != kRecordFormatVersion)
     r.fail("format_version", "must be " + std::to_string(kRecordFormatVersion) + " (an export of another pdamp version)");
@@ -564,7 +564,7 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
     const auto& row = force_rows[static_cast<std::size_t>(m - 1)];
     if (row[0] != static_cast<double>(m * per_sample))
       throw InputError(force_path.string(), "",
-                       "sample " + std::to_string(m) + " is at step " + strict_json::format_number(row[0], 12) +
+                       "sample " + std::to_string(m) + " is at step " + base::format_number(row[0], 12) +
                            ", expected " + std::to_string(m * per_sample) + " (a step every " + std::to_string(per_sample) +
                            " from the drive's start)");
     if (m < first) continue;
@@ -605,7 +605,7 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   const double bias = 1.0 - std::pow(std::sin(a) / a, 2);
   if (bias > 1e-3)
     out.warnings.push_back("with " + std::to_string(samples) + " samples a period the sampled force's mean lowers eta* by " +
-                           strict_json::format_number(100.0 * bias, 2) +
+                           base::format_number(100.0 * bias, 2) +
                            "%: export with more /dem/samples_per_period (1000 gives 3e-6)");
   return out;
 }

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
-#include "pdamp/strict_json/number_text.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "structure_support.hpp"
 
@@ -100,7 +100,7 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options) {
   }
   for (Eigen::Index j = 0; j < mode_count; ++j)
     if (!std::isfinite(out.frequencies_with_containers_hz[j]) || !std::isfinite(modal.natural_frequencies_hz[j]))
-      throw strict_json::NumericalError("pdamp modes: the natural frequency of mode " + std::to_string(j + 1) + " is not finite");
+      throw base::NumericalError("pdamp modes: the natural frequency of mode " + std::to_string(j + 1) + " is not finite");
   if (!out.converged) setup.warnings.add("some backbone points did not converge (converged = 0 in backbone_mode<j>.csv)");
   out.modal = modal;
   out.warnings = setup.warnings.list();

@@ -2,8 +2,8 @@
 #include "pdamp/tasks/placement.hpp"
 
 #include "pdamp/case_file/placement_problem.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/loss_model.hpp"
 #include "task_support.hpp"
 
@@ -49,12 +49,12 @@ PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& o
     out.result = p.beam ? opt::optimize_placement_on_beam(*p.beam, p.options, solver, p.current_position_m)
                         : opt::optimize_placement_at_points(p.modal, p.candidate_points, p.options);
   } catch (const std::invalid_argument& e) {
-    throw strict_json::InputError(c.path, "/task", e.what());
+    throw base::InputError(c.path, "/task", e.what());
   }
   out.warnings = p.warnings;
   out.warnings.insert(out.warnings.end(), out.result.warnings.begin(), out.result.warnings.end());
   if (!std::isfinite(out.result.best.objective))
-    throw strict_json::NumericalError("pdamp optimize: the placement objective is not finite");
+    throw base::NumericalError("pdamp optimize: the placement objective is not finite");
   return out;
 }
 

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "job_codecs.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/tasks/dem_run.hpp"
 #include "pdamp/tasks/field.hpp"
@@ -17,7 +17,7 @@ namespace pdamp::tasks {
 
 namespace fm = formulas;
 using nlohmann::json;
-using strict_json::format_number;
+using base::format_number;
 
 SensitivityStudy sensitivity_study(const case_file::Case& c) {
   const detail::SingleDamper single = detail::single_damper(c, "pdamp sensitivity");
@@ -100,7 +100,7 @@ SensitivityResult study_result(const case_file::Case& c, const SensitivityStudy&
 
 }  // namespace
 
-SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOptions& options, const Executor& executor) {
+SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOptions& options, const base::Executor& executor) {
   SensitivityPlan plan;
   plan.options = options;
   plan.study = sensitivity_study(c);
@@ -129,7 +129,7 @@ SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOpti
   try {
     pending = surrogate::pending_point_sweep(plan.study.points, plan.sweep);
   } catch (const std::invalid_argument& e) {
-    throw strict_json::InputError(c.path, "/sensitivity", e.what());
+    throw base::InputError(c.path, "/sensitivity", e.what());
   }
   if (dem) {
     const double variants = static_cast<double>(plan.study.variants.size());
@@ -144,13 +144,13 @@ SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOpti
   return plan;
 }
 
-SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, RunHooks& hooks,
-                                  Executor& executor) {
+SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, base::RunHooks& hooks,
+                                  base::Executor& executor) {
   const auto& study = plan.study;
   const bool dem = plan.options.source == "dem";
   std::vector<surrogate::PointEvaluator> evaluators;
   for (const auto& v : study.variants) evaluators.push_back(variant_evaluator(v, dem, study.amplitude_m, study.frequency_hz));
-  Jobs<surrogate::FieldPoint> jobs(
+  base::Jobs<surrogate::FieldPoint> jobs(
       executor, [&](std::size_t k) { return evaluators.at(k)(study.frequency_hz, study.amplitude_m); });
   surrogate::SweepOptions sweep = plan.sweep;
   sweep.threads = executor.concurrency(sweep.threads);

@@ -1,7 +1,7 @@
 // Private helpers of the structure tasks (structure_support.hpp).
 #include "structure_support.hpp"
 
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 
 namespace pdamp::tasks::detail {
@@ -38,18 +38,18 @@ std::vector<structure::CosimulationDamper> dem_dampers(const case_file::Case& c)
 void check_cosimulation(const case_file::Case& c, const structure::ModalModel& modal,
                         const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationOptions& options) {
   if (const auto problems = options.validate(modal); !problems.empty())
-    throw strict_json::InputError(c.path, "/task", problems.front());
+    throw base::InputError(c.path, "/task", problems.front());
   for (std::size_t d = 0; d < dampers.size(); ++d)
     if (const auto problems = dampers[d].validate(modal); !problems.empty())
-      throw strict_json::InputError(c.path, "/dampers/" + std::to_string(d), problems.front());
+      throw base::InputError(c.path, "/dampers/" + std::to_string(d), problems.front());
 }
 
 void check_outcome(dem_reference::Outcome outcome, const std::string& message, const std::string& label) {
   if (outcome == dem_reference::Outcome::kUnstable)
-    throw strict_json::NumericalError(label + ": DEM unstable: " + message +
+    throw base::NumericalError(label + ": DEM unstable: " + message +
                                       " (a smaller /dem/time_step_s, a larger /dem/steps_per_contact or "
                                       "/dem/max_impact_speed_m_s)");
-  if (outcome != dem_reference::Outcome::kCompleted) throw strict_json::NumericalError(label + ": DEM failed: " + message);
+  if (outcome != dem_reference::Outcome::kCompleted) throw base::NumericalError(label + ": DEM failed: " + message);
 }
 
 DesignModes design_modes(const case_file::Case& c, const case_file::FillingRatioProblem& p,

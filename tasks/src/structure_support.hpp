@@ -11,7 +11,7 @@
 #include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/cosimulation.hpp"
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks::detail {
@@ -36,7 +36,7 @@ auto call_solver(const case_file::Case& c, const std::string& pointer, F&& f) {
   try {
     return f();
   } catch (const std::invalid_argument& e) {
-    throw strict_json::InputError(c.path, pointer, e.what());
+    throw base::InputError(c.path, pointer, e.what());
   }
 }
 
@@ -55,11 +55,11 @@ auto call_dem(const case_file::Case& c, F&& f) {
   } catch (const std::invalid_argument& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
-    throw strict_json::InputError(c.path, "/dem", what);
+    throw base::InputError(c.path, "/dem", what);
   }
 }
 
-/// A co-simulation that stopped: strict_json::NumericalError with the advice on the case keys to change.
+/// A co-simulation that stopped: base::NumericalError with the advice on the case keys to change.
 void check_outcome(dem_reference::Outcome outcome, const std::string& message, const std::string& label);
 
 /// A filling-ratio design's modal model and release state (from rest at q(0)).

@@ -1,13 +1,13 @@
 // Private helpers shared by the tasks' sources (task_support.hpp).
 #include "task_support.hpp"
 
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 
 namespace pdamp::tasks::detail {
 
 SingleDamper single_damper(const case_file::Case& c, const std::string& study) {
   if (c.dampers.size() != 1 || c.dampers.front().layers.size() != 1)
-    throw strict_json::InputError(c.path, "/dampers",
+    throw base::InputError(c.path, "/dampers",
                                   study + " takes one damper of one layer (the case has " +
                                       std::to_string(c.dampers.size()) + " dampers, the first with " +
                                       std::to_string(c.dampers.front().layers.size()) + " layers)");

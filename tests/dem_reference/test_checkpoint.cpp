@@ -13,7 +13,7 @@
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/world.hpp"
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 
 namespace {
 
@@ -197,7 +197,7 @@ TEST_CASE("a checkpoint file carries its header and refuses damage", "[dem_refer
   CHECK(decoded.header.settings == "duration_s=2");
   CHECK(decoded.header.simulated_time_s == 0.5);
 
-  using pdamp::strict_json::InputError;
+  using pdamp::base::InputError;
   CHECK_THROWS_WITH(dr::decode_checkpoint("{}", "f"), Catch::Contains("f: not a pdamp checkpoint"));
   CHECK_THROWS_WITH(dr::decode_checkpoint(file.substr(0, file.size() - 1), "f"),
                     Catch::Contains("f: /payload_bytes") && Catch::Contains("truncated"));

@@ -2,7 +2,7 @@
 // and the regression test of the inputs they found (tests/case_file/test_fuzz_regressions.cpp).
 //
 // Contract checked (docs/bad_inputs.md): whatever the bytes, a reader either accepts the
-// file or throws std::invalid_argument (strict_json::InputError, case_file::CaseError,
+// file or throws std::invalid_argument (base::InputError, case_file::CaseError,
 // structure::ModalDataError and the readers' own std::invalid_argument are all of that
 // class, which the CLI maps to exit 2) with a message on one printable line that names
 // the file. Any other exception, a message that breaks the line, a sanitizer report or a
@@ -27,7 +27,7 @@
 #include "reader_kind.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/formulas/cor_models.hpp"
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/imported_modal_data.hpp"
@@ -162,7 +162,7 @@ class InputFolder {
 };
 
 /// The message of a clean refusal: non-empty, one line of printable text (valid UTF-8
-/// may stay, as strict_json::printable leaves it) naming the file when `file` is given.
+/// may stay, as base::printable leaves it) naming the file when `file` is given.
 inline std::string message_problem(const std::string& what, std::string_view file) {
   if (what.empty()) return "empty error message";
   for (const char c : what) {
@@ -198,7 +198,7 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
       case Reader::kImpactCsv: (void)formulas::read_impact_csv(path.string()); break;
       case Reader::kScatteredFit: (void)surrogate::read_scattered_fit(path); break;
       case Reader::kModalData: {
-        const auto document = strict_json::parse_json_document(strict_json::read_input_file(path.string()), path.string());
+        const auto document = base::parse_json_document(base::read_input_file(path.string()), path.string());
         try {
           (void)structure::modal_model_from_json(document);
         } catch (const structure::ModalDataError& e) {
@@ -212,7 +212,7 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
         (void)surrogate::merge_sweep_shards(sweep_grid(), sweep_options(path), {path}, "the fuzzed sweep");
         break;
       case Reader::kCheckpoint: {  // pdamp decay --method dem --resume: the file, then the state it carries
-        const std::string bytes = strict_json::read_input_file(path.string(), dem_reference::kMaxCheckpointBytes);
+        const std::string bytes = base::read_input_file(path.string(), dem_reference::kMaxCheckpointBytes);
         const auto restore = [](std::string_view payload) {
           dem_reference::StateReader in(payload, "checkpoint state");
           (void)structure::restore_cosimulation_state(checkpoint_model(), checkpoint_dampers(), in);
@@ -231,7 +231,7 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
         const auto decoded = dem_reference::decode_checkpoint(bytes, path.string());
         try {
           restore(decoded.payload);
-        } catch (const strict_json::InputError&) {
+        } catch (const base::InputError&) {
           throw;
         } catch (const std::invalid_argument& e) {
           throw std::invalid_argument(path.string() + ": " + e.what());  // as the CLI names the file
@@ -243,10 +243,10 @@ inline Outcome feed(Reader reader, const fs::path& folder, std::string_view byte
   } catch (const std::invalid_argument& e) {
     outcome.error = e.what();
     outcome.problem = message_problem(outcome.error, r.names_its_file ? r.file_name : std::string_view());
-    if (!outcome.problem.empty()) outcome.problem += ": " + strict_json::printable(outcome.error);
+    if (!outcome.problem.empty()) outcome.problem += ": " + base::printable(outcome.error);
   } catch (const std::exception& e) {
     outcome.problem = std::string("threw ") + typeid(e).name() + " (not std::invalid_argument): " +
-                      strict_json::printable(e.what());
+                      base::printable(e.what());
   } catch (...) {
     outcome.problem = "threw something that is not a std::exception";
   }

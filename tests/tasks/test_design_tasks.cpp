@@ -25,7 +25,7 @@ TEST_CASE("filling ratios: the chosen design is within the budget and its decay 
   tasks::FillingRatiosOptions options;
   options.skip_verify = true;
   options.calibrated = false;  // the closed forms
-  const auto r = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  const auto r = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   CHECK_FALSE(r.verification.has_value());
   const auto& chosen = r.optimum.chosen;
   CHECK(chosen.total_mass_kg <= r.mass_budget_kg * (1.0 + 1e-9));
@@ -103,8 +103,8 @@ case_file::Case short_verification(bool softening_check, double axial_gravity_m_
 // the same runs (same seed and settings): equal to the bit.
 TEST_CASE("the DEM verification checks its softening against contacts ten times stiffer", "[tasks]") {
   tasks::FillingRatiosOptions options;
-  const auto checked = tasks::run_filling_ratios(short_verification(true), options, tasks::silent_hooks(),
-                                                 tasks::local_executor());
+  const auto checked = tasks::run_filling_ratios(short_verification(true), options, base::silent_hooks(),
+                                                 base::local_executor());
   REQUIRE(checked.verification);
   const auto& v = *checked.verification;
   CHECK(v.softening_check == "two_softenings");
@@ -130,8 +130,8 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
   CHECK(j["verification"]["softening_check"]["kind"] == "two_softenings");
   CHECK(j["verification"]["designs"]["chosen"]["softening_check"]["stiffness_softening"] == Approx(1e-3));
 
-  const auto unchecked = tasks::run_filling_ratios(short_verification(false), options, tasks::silent_hooks(),
-                                                   tasks::local_executor());
+  const auto unchecked = tasks::run_filling_ratios(short_verification(false), options, base::silent_hooks(),
+                                                   base::local_executor());
   REQUIRE(unchecked.verification);
   CHECK(unchecked.verification->softening_check == "off");
   for (std::size_t k = 0; k < 2; ++k) {
@@ -149,7 +149,7 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
 TEST_CASE("under axial gravity the verification scores each design on its own modes", "[tasks]") {
   const case_file::Case c = short_verification(false, -9.80665);
   tasks::FillingRatiosOptions options;
-  const auto r = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  const auto r = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   REQUIRE(r.verification);
   bool warned = false;
   for (const auto& w : r.warnings) warned = warned || w.find("its own") != std::string::npos;
@@ -175,7 +175,7 @@ TEST_CASE("under axial gravity the verification scores each design on its own mo
 namespace {
 
 /// Records the notes a task gives.
-struct NoteHooks : tasks::RunHooks {
+struct NoteHooks : base::RunHooks {
   std::vector<std::string> notes;
   void note(const std::string& text) override { notes.push_back(text); }
 };
@@ -202,7 +202,7 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
   const auto c = short_calibration();
   tasks::FillingRatiosOptions options;
   options.calibration_cache = cache.path;
-  const auto first = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  const auto first = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   REQUIRE(first.calibration);
   const auto& calibration = *first.calibration;
   CHECK(calibration.beds.size() == 11);
@@ -222,15 +222,15 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
   // A verification decay too short to give the design's rate (NaN): the loop has nothing to
   // recalibrate with, runs nothing and keeps every bed (it once ran the beds with NaN damping).
   tasks::BedCalibration unchanged = calibration;
-  CHECK(tasks::recalibrate_in_design(c, first.problem, unchanged, {1, 3, 2}, NAN, 1e-3, tasks::silent_hooks(),
-                                     tasks::local_executor())
+  CHECK(tasks::recalibrate_in_design(c, first.problem, unchanged, {1, 3, 2}, NAN, 1e-3, base::silent_hooks(),
+                                     base::local_executor())
             .empty());
   CHECK(unchanged.runs == calibration.runs);
   for (std::size_t b = 0; b < calibration.beds.size(); ++b)
     CHECK(unchanged.beds[b].extra_damping_ratio == calibration.beds[b].extra_damping_ratio);
 
   // Again: every bed from the cache, the same fields, the same choice.
-  const auto second = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  const auto second = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   CHECK(second.calibration->runs == 0);
   for (std::size_t b = 0; b < calibration.beds.size(); ++b) {
     CHECK(second.calibration->beds[b].cached);
@@ -241,7 +241,7 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
   // A damaged file: that bed runs again (the same numbers: the same DEM), with a note.
   { std::ofstream(calibration.beds[4].file) << "{ not json"; }
   NoteHooks hooks;
-  const auto third = tasks::run_filling_ratios(c, options, hooks, tasks::local_executor());
+  const auto third = tasks::run_filling_ratios(c, options, hooks, base::local_executor());
   CHECK(third.calibration->runs == 1);
   CHECK_FALSE(third.calibration->beds[4].cached);
   // The same DEM run again: the same field (its provenance's time aside).
@@ -257,7 +257,7 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
 
   // --method formulas: the closed forms, no calibration.
   options.calibrated = false;
-  const auto closed_forms = tasks::run_filling_ratios(c, options, tasks::silent_hooks(), tasks::local_executor());
+  const auto closed_forms = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   CHECK_FALSE(closed_forms.calibration);
   CHECK(tasks::to_json(closed_forms)["method"] == "formulas");
 }
@@ -278,7 +278,7 @@ TEST_CASE("the design loop recalibrates the chosen design's beds and stops after
   tasks::FillingRatiosOptions options;
   options.calibration_cache = cache.path;
   NoteHooks hooks;
-  const auto r = tasks::run_filling_ratios(c, options, hooks, tasks::local_executor());
+  const auto r = tasks::run_filling_ratios(c, options, hooks, base::local_executor());
   REQUIRE(r.verification);
   CHECK_FALSE(r.verification->passed);
   REQUIRE_FALSE(r.rounds.empty());

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "tasks/executor_support.hpp"
 #include "../../tasks/src/job_codecs.hpp"
@@ -31,8 +31,8 @@ surrogate::FieldPoint point(std::size_t k) {
 // equal), so a sweep spread over processes equals the serial one.
 TEST_CASE("jobs run through their bytes equal the jobs run here", "[tasks]") {
   test::BytesExecutor elsewhere;
-  const auto remote = tasks::run_jobs<surrogate::FieldPoint>(elsewhere, 7, true, point);
-  const auto local = tasks::run_jobs<surrogate::FieldPoint>(tasks::local_executor(), 7, false, point);
+  const auto remote = base::run_jobs<surrogate::FieldPoint>(elsewhere, 7, true, point);
+  const auto local = base::run_jobs<surrogate::FieldPoint>(base::local_executor(), 7, false, point);
   CHECK(elsewhere.jobs_elsewhere == 7);
   REQUIRE(remote.size() == 7);
   for (std::size_t k = 0; k < 7; ++k) {
@@ -46,25 +46,25 @@ TEST_CASE("a job whose inputs differ in the process that runs it is refused", "[
   const auto job = [](std::size_t k) { return static_cast<double>(k); };
   const auto design = [](std::size_t k) { return 1000.0 + static_cast<double>(k); };
   test::BytesExecutor same;
-  CHECK(tasks::Jobs<double>(same, job, design)(3) == 3.0);
+  CHECK(base::Jobs<double>(same, job, design)(3) == 3.0);
   test::BytesExecutor other(true);
-  tasks::Jobs<double> jobs(other, job, design);
+  base::Jobs<double> jobs(other, job, design);
   CHECK_THROWS_WITH(jobs(3), Catch::Contains("set up differently"));
 }
 
 TEST_CASE("an exception in a concurrent job reaches the caller, the first in order", "[tasks]") {
-  CHECK_THROWS_WITH(tasks::for_each_concurrently(4, true,
+  CHECK_THROWS_WITH(base::for_each_concurrently(4, true,
                                                  [](std::size_t k) {
                                                    if (k >= 2) throw std::runtime_error("job " + std::to_string(k));
                                                  }),
                     "job 2");
   std::vector<int> ran(5, 0);
-  tasks::for_each_concurrently(5, false, [&](std::size_t k) { ran[k] = 1; });
+  base::for_each_concurrently(5, false, [&](std::size_t k) { ran[k] = 1; });
   CHECK(std::count(ran.begin(), ran.end(), 1) == 5);
 }
 
 TEST_CASE("two jobs run at once where two cores or two processes are", "[tasks]") {
   test::BytesExecutor two_processes;
-  CHECK(tasks::parallel_jobs(two_processes, 2) == (std::thread::hardware_concurrency() >= 2));
-  CHECK_FALSE(tasks::parallel_jobs(tasks::local_executor(), 1));
+  CHECK(base::parallel_jobs(two_processes, 2) == (std::thread::hardware_concurrency() >= 2));
+  CHECK_FALSE(base::parallel_jobs(base::local_executor(), 1));
 }

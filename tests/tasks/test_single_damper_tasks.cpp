@@ -11,8 +11,8 @@
 
 #include "cli/cli_support.hpp"
 #include "pdamp/case_file/case.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/run_errors.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
 #include "pdamp/tasks/damper_design.hpp"
@@ -86,7 +86,7 @@ TEST_CASE("a study of one damper refuses a case of several layers, naming /dampe
   try {
     (void)tasks::run_damper_design(c);
     FAIL("no error");
-  } catch (const strict_json::InputError& e) {
+  } catch (const base::InputError& e) {
     CHECK(e.pointer() == "/dampers");
     CHECK_THAT(e.rule(), Catch::Contains("one damper of one layer"));
   }
@@ -98,8 +98,8 @@ TEST_CASE("a study of one damper refuses a case of several layers, naming /dampe
 TEST_CASE("a formulas field is the closed form at every node, here or spread over processes", "[tasks]") {
   const auto& c = low_intensity();
   tasks::FieldOptions options;
-  const auto plan = tasks::plan_field(c, options, tasks::local_executor());
-  const auto here = tasks::run_field(c, plan, tasks::silent_hooks(), tasks::local_executor());
+  const auto plan = tasks::plan_field(c, options, base::local_executor());
+  const auto here = tasks::run_field(c, plan, base::silent_hooks(), base::local_executor());
   const auto& damper = c.dampers.front();
   const double h = damper.layers.front().clearance_m;
   REQUIRE(here.field.points.size() == plan.grid.size());
@@ -109,7 +109,7 @@ TEST_CASE("a formulas field is the closed form at every node, here or spread ove
     CHECK(here.field.points[k].eta_star == loss.eta_star);
   }
   test::BytesExecutor elsewhere;
-  const auto spread = tasks::run_field(c, plan, tasks::silent_hooks(), elsewhere);
+  const auto spread = tasks::run_field(c, plan, base::silent_hooks(), elsewhere);
   CHECK(elsewhere.jobs_elsewhere == static_cast<int>(plan.grid.size()));
   CHECK(spread.field.points == here.field.points);
   CHECK_FALSE(here.scattered_fit.has_value());  // a formulas field has no scattered state to fit
@@ -128,7 +128,7 @@ TEST_CASE("a DEM field approached from above accepts X_a on its grid and records
   const auto c = case_file::load_case(path.string());
   tasks::FieldOptions options;
   options.source = "dem";
-  const auto plan = tasks::plan_field(c, options, tasks::local_executor());
+  const auto plan = tasks::plan_field(c, options, base::local_executor());
   CHECK(plan.sweep.approach_amplitude_m == top);
   const auto at_top = surrogate::dem_point_options(c.dem.simulation, 3.6, top);
   CHECK(at_top.approach_amplitude_m == 0.0);  // from rest at X_a itself
@@ -142,8 +142,8 @@ TEST_CASE("a formulas sensitivity study's baseline row is the case's closed form
   const auto& c = low_intensity();
   tasks::SensitivityOptions options;
   options.source = "formulas";
-  const auto plan = tasks::plan_sensitivity(c, options, tasks::local_executor());
-  const auto r = tasks::run_sensitivity(c, plan, tasks::silent_hooks(), tasks::local_executor());
+  const auto plan = tasks::plan_sensitivity(c, options, base::local_executor());
+  const auto r = tasks::run_sensitivity(c, plan, base::silent_hooks(), base::local_executor());
   REQUIRE(r.rows.size() == plan.study.variants.size());
   CHECK(r.rows.front().parameter == "baseline");
   CHECK(r.rows.front().eta_star == r.rows.front().closed_form_eta_star);
@@ -154,17 +154,17 @@ TEST_CASE("a formulas sensitivity study's baseline row is the case's closed form
 namespace {
 
 /// Hooks that ask the run to stop at its first chance (as SIGINT would).
-struct StopAtOnce : tasks::RunHooks {
+struct StopAtOnce : base::RunHooks {
   int stop_requested() override { return SIGINT; }
 };
 /// Hooks that ask the run to stop once its first checkpoint is due (a signal in the transient).
-struct StopAtFirstCheckpoint : tasks::RunHooks {
+struct StopAtFirstCheckpoint : base::RunHooks {
   bool asked = false;
   bool checkpoint_due(double) override { return asked = true; }
   int stop_requested() override { return asked ? SIGINT : 0; }
 };
 /// Hooks that save a checkpoint at every chance and never stop.
-struct SaveAlways : tasks::RunHooks {
+struct SaveAlways : base::RunHooks {
   bool checkpoint_due(double) override { return true; }
 };
 
@@ -179,7 +179,7 @@ TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted r
   options.analysed_periods = 2;
   options.threads = 1;
   const auto plan = tasks::plan_dem(c, options);
-  const auto reference = tasks::run_dem(c, plan, {}, tasks::silent_hooks());
+  const auto reference = tasks::run_dem(c, plan, {}, base::silent_hooks());
   const test::TempDir dir("tasks_dem_checkpoint");
   const tasks::CheckpointFile file{dir.path / "dem.checkpoint", false};
   // Asked to stop while the bed settles: it stops at once, with no checkpoint to resume.
@@ -187,7 +187,7 @@ TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted r
   CHECK_THROWS_WITH(tasks::run_dem(c, plan, file, at_once), Catch::Contains("before its first checkpoint"));
   CHECK_FALSE(std::filesystem::exists(file.path));
   StopAtFirstCheckpoint stop;
-  CHECK_THROWS_AS(tasks::run_dem(c, plan, file, stop), strict_json::Interrupted);
+  CHECK_THROWS_AS(tasks::run_dem(c, plan, file, stop), base::Interrupted);
   REQUIRE(std::filesystem::exists(file.path));
   SaveAlways save;
   const auto resumed = tasks::run_dem(c, plan, {file.path, true}, save);
@@ -196,7 +196,7 @@ TEST_CASE("a DEM run stopped by its hooks and resumed equals the uninterrupted r
   CHECK(resumed.dem.series.force_n == reference.dem.series.force_n);
   // A checkpoint of another run (here: other periods) is refused naming the file.
   options.analysed_periods = 3;
-  CHECK_THROWS_AS(tasks::run_dem(c, tasks::plan_dem(c, options), {file.path, true}, save), strict_json::InputError);
+  CHECK_THROWS_AS(tasks::run_dem(c, tasks::plan_dem(c, options), {file.path, true}, save), base::InputError);
 }
 
 // Reference: the collect-and-collide orbit of a collected bed exists down to its saddle-node
@@ -218,9 +218,9 @@ TEST_CASE("a DEM run approached from above keeps the collect-and-collide orbit t
   const auto from_rest_case = case_file::load_case_document(document, "narrow_from_rest.json");
   document["dem"]["approach"] = {{"amplitude_m", 0.005}};
   const auto from_above_case = case_file::load_case_document(document, "narrow_from_above.json");
-  const auto from_rest = tasks::run_dem(from_rest_case, tasks::plan_dem(from_rest_case, options), {}, tasks::silent_hooks());
+  const auto from_rest = tasks::run_dem(from_rest_case, tasks::plan_dem(from_rest_case, options), {}, base::silent_hooks());
   const auto plan = tasks::plan_dem(from_above_case, options);
-  const auto from_above = tasks::run_dem(from_above_case, plan, {}, tasks::silent_hooks());
+  const auto from_above = tasks::run_dem(from_above_case, plan, {}, base::silent_hooks());
   CHECK(from_rest.dem.eta_star < 0.5);
   CHECK(from_above.dem.eta_star > 0.8);
   CHECK(from_above.dem.motion_mode == dem_reference::MotionMode::kRollingCollectAndCollide);
@@ -239,7 +239,7 @@ TEST_CASE("a DEM run approached from above keeps the collect-and-collide orbit t
   try {
     (void)tasks::plan_dem(case_file::load_case_document(document, "narrow_from_below.json"), options);
     FAIL("an approach from below the stroke was accepted");
-  } catch (const strict_json::InputError& e) {
+  } catch (const base::InputError& e) {
     CHECK_THAT(std::string(e.what()), Catch::Contains("/dem/approach/amplitude_m"));
     CHECK_THAT(std::string(e.what()), Catch::Contains("> amplitude_m"));
   }

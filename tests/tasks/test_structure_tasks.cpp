@@ -6,8 +6,8 @@
 
 #include "cli/cli_support.hpp"
 #include "pdamp/case_file/case.hpp"
-#include "pdamp/strict_json/input_error.hpp"
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/input_error.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/frf.hpp"
 #include "pdamp/tasks/modes.hpp"
@@ -37,7 +37,7 @@ TEST_CASE("modes: the containers lower every frequency, and the mass ratio is b^
 // containers (a lightly damped mode, ζ = 0.3%); 0.5% is two steps of the task's frequency grid.
 TEST_CASE("frf: the response without beds peaks at the first natural frequency with the containers", "[tasks]") {
   const auto c = case_file::load_case(case_path("beam_base_excited.json"));
-  const auto r = tasks::run_frf(c, {}, tasks::silent_hooks(), tasks::local_executor());
+  const auto r = tasks::run_frf(c, {}, base::silent_hooks(), base::local_executor());
   REQUIRE(r.harmonic.has_value());
   const auto& response = r.harmonic->response;
   REQUIRE_FALSE(response.linear_peaks.empty());
@@ -51,12 +51,12 @@ TEST_CASE("frf: the response without beds peaks at the first natural frequency w
 
 TEST_CASE("frf and decay refuse a case whose task is of another kind, naming /task", "[tasks]") {
   const auto decay_case = case_file::load_case(case_path("manipulator_link_decay.json"));
-  CHECK_THROWS_AS(tasks::run_frf(decay_case, {}, tasks::silent_hooks(), tasks::local_executor()), strict_json::InputError);
+  CHECK_THROWS_AS(tasks::run_frf(decay_case, {}, base::silent_hooks(), base::local_executor()), base::InputError);
   const auto frf_case = case_file::load_case(case_path("beam_base_excited.json"));
   try {
-    (void)tasks::run_decay(frf_case, {}, tasks::silent_hooks());
+    (void)tasks::run_decay(frf_case, {}, base::silent_hooks());
     FAIL("no error");
-  } catch (const strict_json::InputError& e) {
+  } catch (const base::InputError& e) {
     CHECK(e.pointer() == "/task");
   }
 }
@@ -66,7 +66,7 @@ TEST_CASE("frf and decay refuse a case whose task is of another kind, naming /ta
 // and each layer dissipated, to the integrator's accuracy (the shipped link closes to 5e-12).
 TEST_CASE("decay: the initial energy is the final energy plus what the structure and the layers dissipated", "[tasks]") {
   const auto c = case_file::load_case(case_path("manipulator_link_decay.json"));
-  const auto r = tasks::run_decay(c, {}, tasks::silent_hooks());
+  const auto r = tasks::run_decay(c, {}, base::silent_hooks());
   const auto& first = r.decay.samples.front();
   const auto& last = r.decay.samples.back();
   double dissipated = last.structural_dissipated_energy_j;
@@ -93,7 +93,7 @@ TEST_CASE("frf --method dem: the case's transient periods are honoured and each 
   o.dem.min_frequency_hz = 1.5;
   o.dem.max_frequency_hz = 1.7;
   o.dem.directions = {"up"};
-  const auto r = tasks::run_frf(c, o, tasks::silent_hooks(), tasks::local_executor());
+  const auto r = tasks::run_frf(c, o, base::silent_hooks(), base::local_executor());
   REQUIRE(r.stepped);
   CHECK(r.stepped->settling.min_transient_periods == 12);
   const auto& points = r.stepped->branches.at(0).points;
@@ -110,7 +110,7 @@ TEST_CASE("frf --method dem: the case's transient periods are honoured and each 
     std::size_t named = 0;
     for (const auto& w : r.warnings)
       if (w.find("not converged") != std::string::npos &&
-          w.find(strict_json::format_number(p.frequency_hz, 5) + " Hz") != std::string::npos)
+          w.find(base::format_number(p.frequency_hz, 5) + " Hz") != std::string::npos)
         ++named;
     CHECK(named == (p.converged ? 0u : 1u));
   }
@@ -134,8 +134,8 @@ TEST_CASE("frf --method dem: points that would fall on one frequency are refused
   o.dem.max_frequency_hz = 1.5 + 1e-6;
   bool refused = false;
   try {
-    tasks::run_frf(c, o, tasks::silent_hooks(), tasks::local_executor());
-  } catch (const strict_json::InputError& e) {
+    tasks::run_frf(c, o, base::silent_hooks(), base::local_executor());
+  } catch (const base::InputError& e) {
     refused = true;
     CHECK(e.file() == "--dem-points, --dem-min-frequency, --dem-max-frequency");
     CHECK(std::string(e.rule()).find("fall on one frequency") != std::string::npos);

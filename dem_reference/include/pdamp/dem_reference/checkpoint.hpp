@@ -95,7 +95,7 @@ struct DecodedCheckpoint {
   CheckpointHeader header;
   std::string payload;
 };
-/// Parses a checkpoint file's bytes (read from `file`). strict_json::InputError naming the
+/// Parses a checkpoint file's bytes (read from `file`). base::InputError naming the
 /// file, the header key and the rule: a missing magic line, malformed or incomplete header
 /// JSON, unknown keys, a payload of another length or hash (damaged or truncated).
 DecodedCheckpoint decode_checkpoint(std::string_view bytes, const std::string& file);

@@ -47,7 +47,7 @@ class DeferredSignals {
 /// The signal received during an output phase, or 0.
 int pending_interrupt();
 
-/// Throws strict_json::Interrupted when a signal arrived during the output phase.
+/// Throws base::Interrupted when a signal arrived during the output phase.
 void stop_if_interrupted();
 
 /// A test hook at a named point of a run's ending ("run-ended", "commit", "committed"):

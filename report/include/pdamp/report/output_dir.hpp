@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/number_text.hpp"
 
 namespace pdamp::report {
 
@@ -95,7 +95,7 @@ std::string gnuplot_string(const std::string& text);
 /// leading '.' or '-' is replaced, so a name cannot steer a path out of its folder.
 std::string safe_file_name(const std::string& name);
 
-/// Numbers in titles and labels (strict_json::format_number).
-using strict_json::format_number;
+/// Numbers in titles and labels (base::format_number).
+using base::format_number;
 
 }  // namespace pdamp::report

@@ -19,8 +19,8 @@
 #include "pdamp/case_file/filling_ratio_problem.hpp"
 #include "pdamp/surrogate/decay_field.hpp"
 #include "pdamp/surrogate/loss_model.hpp"
-#include "pdamp/tasks/executor.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/executor.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -64,7 +64,7 @@ std::filesystem::path default_calibration_cache();
 /// for a decay the DEM cannot run or a bed whose decay gives no field.
 BedCalibration calibrate_beds(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                               const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,
-                              RunHooks& hooks, Executor& executor);
+                              base::RunHooks& hooks, base::Executor& executor);
 
 /// The average damping ratio of a decay from its envelope: ln(e_first/e_last)/(2πf·Δt); NaN
 /// with fewer than two points or an envelope that is not positive.
@@ -81,8 +81,8 @@ double decay_damping_ratio(std::span<const double> time_s, std::span<const doubl
 /// design_damping_ratio that is not finite (a decay too short to give a rate).
 std::vector<std::string> recalibrate_in_design(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                                                BedCalibration& calibration, const std::vector<long>& slabs,
-                                               double design_damping_ratio, double design_threshold_m, RunHooks& hooks,
-                                               Executor& executor);
+                                               double design_damping_ratio, double design_threshold_m, base::RunHooks& hooks,
+                                               base::Executor& executor);
 
 /// The calibration's result keys (spec, cache folder, per bed: layer, slabs, key, cached, file,
 /// periods, stroke range, steps, wall time).

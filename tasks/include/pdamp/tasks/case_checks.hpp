@@ -4,15 +4,15 @@
 #pragma once
 
 #include "pdamp/case_file/case.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
-/// strict_json::InputError naming the file and key of the first check that fails. A
+/// base::InputError naming the file and key of the first check that fails. A
 /// format-2 case's structure is built as a run builds it (its modal model solved after the
 /// size checks), a decay's initial state must move a kept mode, and the cost of the case's
 /// DEM-in-the-loop decay (pdamp decay --method dem) is given to `hooks` as a note.
-void check_case(const case_file::Case& c, RunHooks& hooks = silent_hooks());
+void check_case(const case_file::Case& c, base::RunHooks& hooks = base::silent_hooks());
 
 /// InputError naming /task unless the case's task is of `kind` (with its settings), saying
 /// which keys such a task needs.

@@ -16,7 +16,7 @@ struct CheckpointFile {
 };
 
 /// The payload of `file.path` when its header has `expected`'s kind, case hash, model
-/// version and settings; strict_json::InputError naming the file and the key that differs
+/// version and settings; base::InputError naming the file and the key that differs
 /// (or "--resume" when there is no file), or the damage, otherwise.
 std::string read_checkpoint(const CheckpointFile& file, const dem_reference::CheckpointHeader& expected);
 /// `file.path` written atomically with `header` and `payload`.

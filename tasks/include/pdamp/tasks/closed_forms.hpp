@@ -74,7 +74,7 @@ LossStudy run_loss(const LossOptions& options);
 nlohmann::json to_json(const LossStudy& study);
 
 /// A closed form's result that holds a number that is not finite (a formula at the edge of
-/// its range) is a numerical failure: strict_json::NumericalError naming its JSON pointer.
+/// its range) is a numerical failure: base::NumericalError naming its JSON pointer.
 void require_finite(const nlohmann::json& result);
 
 /// The buffered-wall sizing's keys (layer_thickness_m, impact_velocity_m_s, ...).

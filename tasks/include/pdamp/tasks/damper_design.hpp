@@ -39,7 +39,7 @@ struct DamperDesignResult {
 
 /// The damper_design study of a case with one damper of one layer. A closed form that
 /// refuses the case's numbers, or a result that is not finite, is bad input of that case
-/// (strict_json::InputError naming the file), so `pdamp validate` catches what `pdamp run` would.
+/// (base::InputError naming the file), so `pdamp validate` catches what `pdamp run` would.
 DamperDesignResult run_damper_design(const case_file::Case& c);
 /// The result keys (task, case, model, clearance_m, optimum, sizing, operating_point, buffer);
 /// "warnings" and "outputs" are the caller's.

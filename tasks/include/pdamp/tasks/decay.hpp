@@ -19,7 +19,7 @@
 #include "pdamp/structure/sampled_decay.hpp"
 #include "pdamp/tasks/checkpoint.hpp"
 #include "pdamp/tasks/output_folder.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -48,17 +48,17 @@ struct DemDecay {
 /// task.settling_threshold (structure::sampled_settling). With a checkpoint file the run
 /// goes in segments of whole sample intervals (about 2 s of wall time each), saves its
 /// state when the hooks say a checkpoint is due, and when they ask to stop saves one and
-/// throws strict_json::Interrupted; with file.resume it continues from the file (bit for
+/// throws base::Interrupted; with file.resume it continues from the file (bit for
 /// bit the uninterrupted run). `containers`: the same dampers as the structure sees them
 /// (drive shapes and the static offset of the case's beds). Progress lines carry `label`;
 /// `duration_pointer` is named in the not-settled warning; `snapshots`: every bed's particles
 /// that many times, evenly over the decay (CosimulationResult::bed_snapshots, for ParaView).
 /// InputError for refused options,
-/// strict_json::NumericalError for a World that stops.
+/// base::NumericalError for a World that stops.
 DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal, std::vector<structure::Damper> containers,
                    const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
-                   const DemDecayCheckpoint& checkpoint, RunHooks& hooks, int snapshots = 0);
+                   const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots = 0);
 
 /// The cost of a DEM-in-the-loop run before it starts, computed without building its
 /// worlds: the coupled step, the steps, every bed's particles, and the memory of its worlds
@@ -90,7 +90,7 @@ CoupledRunEstimate estimate_coupled_decay(const case_file::Case& c, const struct
 CoupledRunEstimate check_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
                                          const std::vector<structure::CosimulationDamper>& dampers,
                                          const structure::CosimulationOptions& options,
-                                         const std::string& label, const std::string& duration_pointer, RunHooks& hooks);
+                                         const std::string& label, const std::string& duration_pointer, base::RunHooks& hooks);
 /// "N particles in B beds, S coupled steps of dt s = P particle-steps, about T s; memory about M".
 std::string estimate_text(const CoupledRunEstimate& estimate);
 
@@ -117,7 +117,7 @@ struct DecayResult {
   std::vector<std::string> warnings;
 };
 /// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
-DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, RunHooks& hooks);
+DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, base::RunHooks& hooks);
 /// The result keys (task, case, method, file, settling_time_s, damping_ratio, decay, ...).
 nlohmann::json to_json(const DecayResult& result, const OutputFolder& folder);
 /// The co-simulation's energy ledger (docs/cosimulation.md §4) as JSON.

@@ -12,12 +12,12 @@
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/tasks/checkpoint.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
 /// A DEM run's options and cost, checked before it starts (no job that cannot finish is
-/// started): every option in range (strict_json::InputError naming the case key), the time
+/// started): every option in range (base::InputError naming the case key), the time
 /// step below its bound, the memory within what is available. `damper`: the case's damper
 /// the options are of.
 dem_reference::RunEstimate check_dem_run(const case_file::Case& c, std::size_t damper,
@@ -38,7 +38,7 @@ inline constexpr double kMaxDemWallTime_s = 7.0 * 86400.0;
 /// InputError naming `pointer` of the case when `wall_time_s` exceeds kMaxDemWallTime_s and
 /// the hooks do not accept it; `what` names the run and `reduce` the keys that shorten it.
 void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
-                     const std::string& reduce, RunHooks& hooks);
+                     const std::string& reduce, base::RunHooks& hooks);
 /// The same with the acceptance given directly (a sweep's options carry it).
 void check_wall_time(const case_file::Case& c, double wall_time_s, const std::string& what, const std::string& pointer,
                      const std::string& reduce, bool accepted);
@@ -85,10 +85,10 @@ struct DemRunResult {
   std::vector<std::string> warnings;
 };
 /// Runs the plan: progress through `hooks`; with a checkpoint path, a checkpoint at period
-/// ends whenever the hooks say one is due, and strict_json::Interrupted (after saving one)
+/// ends whenever the hooks say one is due, and base::Interrupted (after saving one)
 /// when they ask to stop; with file.resume, from the saved state (bit for bit the
-/// uninterrupted run). A DEM that goes unstable or fails: strict_json::NumericalError.
-DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, RunHooks& hooks);
+/// uninterrupted run). A DEM that goes unstable or fails: base::NumericalError.
+DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks);
 
 /// The DEM's measures (eta_star, eta_star_stderr, apparent mass, energy, motion mode, run).
 nlohmann::json to_json(const dem_reference::DamperResult& result);

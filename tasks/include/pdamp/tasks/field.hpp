@@ -14,8 +14,8 @@
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/surrogate/scattered_fit.hpp"
 #include "pdamp/surrogate/sweep.hpp"
-#include "pdamp/tasks/executor.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/executor.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -49,7 +49,7 @@ struct FieldPlan {
 };
 /// Every check of the sweep: a grid, a stale or foreign results log, each DEM point's options
 /// and memory (InputError naming the case key). `executor` sets how many points run at once.
-FieldPlan plan_field(const case_file::Case& c, const FieldOptions& options, const Executor& executor);
+FieldPlan plan_field(const case_file::Case& c, const FieldOptions& options, const base::Executor& executor);
 
 struct FieldResult {
   std::string case_name;
@@ -63,7 +63,7 @@ struct FieldResult {
 };
 /// Runs the sweep: the points through `executor` (on a process that serves another:
 /// JobsServedElsewhere), progress through `hooks`.
-FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, RunHooks& hooks, Executor& executor);
+FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::RunHooks& hooks, base::Executor& executor);
 /// A test rig's CSV on the case's grid spacing and damper (docs/effective_fields.md).
 FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv);
 /// The shards' logs of one sweep joined into the field a single run gives; shards of another

@@ -18,9 +18,9 @@
 #include "pdamp/structure/free_decay.hpp"
 #include "pdamp/structure/sampled_decay.hpp"
 #include "pdamp/tasks/bed_calibration.hpp"
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 #include "pdamp/tasks/output_folder.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -150,8 +150,8 @@ std::vector<double> slabs_of(const optimizer::FillingDesign& design);
 /// The filling-ratio study of a case whose task is kind filling_ratios. The verification's
 /// two DEM decays are jobs of `executor` (on a process that serves another:
 /// JobsServedElsewhere); their progress and checkpoints go through `hooks`.
-FillingRatiosResult run_filling_ratios(const case_file::Case& c, const FillingRatiosOptions& options, RunHooks& hooks,
-                                       Executor& executor);
+FillingRatiosResult run_filling_ratios(const case_file::Case& c, const FillingRatiosOptions& options, base::RunHooks& hooks,
+                                       base::Executor& executor);
 /// The result keys (task, case, method, design, designs, solver, verification, ...).
 nlohmann::json to_json(const FillingRatiosResult& result);
 

@@ -15,9 +15,9 @@
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/dem_frequency_response.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 #include "pdamp/tasks/output_folder.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -89,7 +89,7 @@ struct FrfResult {
 
 /// The frf study of a case whose task is kind frf (InputError naming /task otherwise). On a
 /// process that serves another (an MPI worker) the stepped sine throws JobsServedElsewhere.
-FrfResult run_frf(const case_file::Case& c, const FrfOptions& options, RunHooks& hooks, Executor& executor);
+FrfResult run_frf(const case_file::Case& c, const FrfOptions& options, base::RunHooks& hooks, base::Executor& executor);
 /// The result keys (task, case, method, file, peaks, branches, frf or compare, ...); "warnings"
 /// and "outputs" are the caller's.
 nlohmann::json to_json(const FrfResult& result, const OutputFolder& folder);

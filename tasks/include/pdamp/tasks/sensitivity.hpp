@@ -12,8 +12,8 @@
 
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/surrogate/sweep.hpp"
-#include "pdamp/tasks/executor.hpp"
-#include "pdamp/tasks/run_hooks.hpp"
+#include "pdamp/base/executor.hpp"
+#include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
 
@@ -44,7 +44,7 @@ struct SensitivityPlan {
   surrogate::SweepOptions sweep;
   std::string estimate;  ///< dem: the runs still to do and their cost
 };
-SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOptions& options, const Executor& executor);
+SensitivityPlan plan_sensitivity(const case_file::Case& c, const SensitivityOptions& options, const base::Executor& executor);
 
 /// One variant's row (NaN where a value is not defined: the baseline's value, a failed run).
 struct SensitivityRow {
@@ -89,8 +89,8 @@ struct Tornado {
 /// The bars of `result`'s rows (the failed and missing ones left out).
 Tornado tornado(const SensitivityResult& result);
 
-SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, RunHooks& hooks,
-                                  Executor& executor);
+SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPlan& plan, base::RunHooks& hooks,
+                                  base::Executor& executor);
 /// The shards of one study joined into the rows a single run gives.
 SensitivityResult merge_sensitivity(const case_file::Case& c, const std::string& source,
                                     const std::vector<std::filesystem::path>& logs);

@@ -18,7 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace pdamp::tasks {
+namespace pdamp::base {
 
 /// Thrown on a process that served a task's jobs to another (an MPI worker rank): it has no
 /// result of its own and must write and print nothing; the command line ends it with
@@ -140,4 +140,4 @@ inline bool parallel_jobs(const Executor& executor, std::size_t count) {
   return count > 1 && executor.concurrency(std::thread::hardware_concurrency() >= 2 ? 2 : 1) > 1;
 }
 
-}  // namespace pdamp::tasks
+}  // namespace pdamp::base

@@ -1,5 +1,5 @@
 // Safe reading of users' input files and their errors (input_file.hpp, input_error.hpp).
-#include "pdamp/strict_json/input_file.hpp"
+#include "pdamp/base/input_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 namespace {
 
@@ -251,4 +251,4 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
   }
 }
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string_view>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// Writes `contents` to `path` atomically: readers see the old file or the new one, never a
 /// partial one. The temporary `<path>.tmp.<pid>` sits in the same folder (rename() stays on
@@ -38,4 +38,4 @@ void sync_parent_folder(const std::filesystem::path& path);
 /// process: the temporary is garbage left by a killed writer.
 bool names_a_dead_process(std::string_view pid_digits);
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

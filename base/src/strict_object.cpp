@@ -1,9 +1,9 @@
 // Strict reading of one JSON object (strict_object.hpp).
-#include "pdamp/strict_json/strict_object.hpp"
+#include "pdamp/base/strict_object.hpp"
 
 #include <cmath>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 void fail_at(const std::string& file, const std::string& pointer, const std::string& rule) {
   throw InputError(file, pointer.empty() ? "/" : pointer, rule);
@@ -81,4 +81,4 @@ void StrictObject::finish() const {
   }
 }
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -1,10 +1,10 @@
 // The number formatter of number_text.hpp.
-#include "pdamp/strict_json/number_text.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <cmath>
 #include <sstream>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 std::string format_number(double value, int significant) {
   if (std::isnan(value)) return "n/a";
@@ -14,4 +14,4 @@ std::string format_number(double value, int significant) {
   return out.str();
 }
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

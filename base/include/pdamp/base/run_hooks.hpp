@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-namespace pdamp::tasks {
+namespace pdamp::base {
 
 /// Where a long run stands.
 struct Progress {
@@ -38,7 +38,7 @@ class RunHooks {
   /// ago (or started that long ago) should save one at its next consistent point.
   virtual bool checkpoint_due(double /*seconds_since_checkpoint*/) { return false; }
   /// Nonzero (the signal number) when the runs should stop at their next consistent point,
-  /// save their checkpoint and throw strict_json::Interrupted; 0 to go on.
+  /// save their checkpoint and throw base::Interrupted; 0 to go on.
   virtual int stop_requested() { return 0; }
   /// Whether a run estimated to take longer than kMaxDemWallTime_s (a week) may start.
   virtual bool long_runs_accepted() { return false; }
@@ -50,4 +50,4 @@ inline RunHooks& silent_hooks() {
   return hooks;
 }
 
-}  // namespace pdamp::tasks
+}  // namespace pdamp::base

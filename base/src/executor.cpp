@@ -1,10 +1,10 @@
 // The local executor and the concurrency helper of executor.hpp.
-#include "pdamp/tasks/executor.hpp"
+#include "pdamp/base/executor.hpp"
 
 #include <algorithm>
 #include <atomic>
 
-namespace pdamp::tasks {
+namespace pdamp::base {
 
 namespace {
 
@@ -49,4 +49,4 @@ void for_each_concurrently(std::size_t count, bool parallel, const std::function
     if (e) std::rethrow_exception(e);
 }
 
-}  // namespace pdamp::tasks
+}  // namespace pdamp::base

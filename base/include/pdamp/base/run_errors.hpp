@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// A numerical failure detected at run time: a DEM that goes unstable, an eigenproblem or a
 /// solver that fails, a result that is not finite. Exit code 3. what() is "<what failed>"
@@ -34,4 +34,4 @@ class Interrupted : public std::runtime_error {
   int signal_number_;
 };
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

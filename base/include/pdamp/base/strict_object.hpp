@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// Throws InputError(file, pointer, rule); the pointer of the root is "/".
 [[noreturn]] void fail_at(const std::string& file, const std::string& pointer, const std::string& rule);
@@ -59,4 +59,4 @@ class StrictObject {
   std::set<std::string, std::less<>> allowed_;
 };
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -3,10 +3,10 @@
 
 #include <string>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// `value` with `significant` significant digits in the shortest of fixed and scientific
 /// notation (std::ostream's default floatfield), "n/a" for NaN.
 std::string format_number(double value, int significant = 6);
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -8,9 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pdamp/strict_json/input_error.hpp"
+#include "pdamp/base/input_error.hpp"
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// Largest input file read (256 MiB): far above any case, field or measured CSV, and
 /// small enough that a mistaken path (a disk image, /dev/zero) cannot exhaust memory.
@@ -42,4 +42,4 @@ bool valid_utf8(const std::string& text);
 /// input stays one line and is not cut at a NUL byte.
 std::string printable(const std::string& text);
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -1,5 +1,5 @@
 // Atomic replacement of files and fsynced writes (POSIX): output_file.hpp.
-#include "pdamp/strict_json/output_file.hpp"
+#include "pdamp/base/output_file.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 namespace {
 
@@ -108,4 +108,4 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
   remove_stale_temporaries(path);
 }
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base

@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-namespace pdamp::strict_json {
+namespace pdamp::base {
 
 /// A rule an input file breaks. what() is "<file>: <pointer>: <rule>" ("<file>: <rule>"
 /// when the pointer is empty, e.g. for a file that cannot be read), made printable on
@@ -28,4 +28,4 @@ class InputError : public std::invalid_argument {
 /// JSON pointer reference token for `key` (RFC 6901: "~" -> "~0", "/" -> "~1").
 std::string pointer_token(std::string_view key);
 
-}  // namespace pdamp::strict_json
+}  // namespace pdamp::base
