@@ -52,7 +52,7 @@ std::string design_row(const opt::FillingDesign& d, bool whole) {
 }
 
 std::string difference_text(const tasks::Agreement& a) {
-  return a.compared == "settled_only_one" ? std::string("only one settled")
+  return a.compared == tasks::Compared::kSettledOnlyOne ? std::string("only one settled")
                                           : "difference " + format_number(100.0 * a.relative_difference, 3) + " %";
 }
 
@@ -78,10 +78,10 @@ Rows verification_rows(const tasks::Verification& v) {
   rows.push_back({"verify ranking", std::string("chosen ahead of baseline: predicted ") +
                                         (v.predicted_chosen_ahead ? "yes" : "no") + ", DEM " +
                                         (v.dem_chosen_ahead ? "yes" : "no") + (v.ranking_passed ? ": pass" : ": FAIL")});
-  rows.push_back({"verify softening", v.softening_check == "two_softenings"
+  rows.push_back({"verify softening", v.softening_check == tasks::SofteningCheckKind::kTwoSoftenings
                                           ? std::string(v.softening_converged ? "converged" : "NOT CONVERGED") +
                                                 " (each design also ten times stiffer)"
-                                          : v.softening_check == "full_stiffness" ? "full stiffness" : "not checked"});
+                                          : v.softening_check == tasks::SofteningCheckKind::kFullStiffness ? "full stiffness" : "not checked"});
   rows.push_back({"verification", std::string(v.passed ? "PASS" : "FAIL") + " (tolerance " +
                                       format_number(100.0 * v.spec.tolerance_relative, 3) + " %, " +
                                       format_number(v.spec.duration_s, 4) + " s simulated each, " +
@@ -160,13 +160,13 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
     for (const auto& d : round.designs) {
       line += "; " + d.name + " (";
       for (std::size_t k = 0; k < d.slabs.size(); ++k) line += (k ? ", " : "") + format_number(d.slabs[k], 3);
-      line += ") " + (d.compared == "settled_only_one" ? std::string("only one settled")
+      line += ") " + (d.compared == tasks::Compared::kSettledOnlyOne ? std::string("only one settled")
                                                         : format_number(100.0 * d.relative_difference, 3) + " %");
     }
     if (!round.recalibrated.empty()) line += "; recalibrated " + std::to_string(round.recalibrated.size()) + " bed(s)";
     rows.push_back({"design loop round " + std::to_string(round.round), line});
   }
-  if (result.rounds.size() > 1) rows.push_back({"design loop", result.loop_outcome});
+  if (result.rounds.size() > 1) rows.push_back({"design loop", std::string(tasks::to_string(*result.loop_outcome))});
   const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report});
   remove_checkpoints(result.checkpoints);
   return code;

@@ -77,8 +77,8 @@ tasks::DemFrfOptions dem_frf_options(const ParsedArgs& args, const Case& c) {
   if (direction != "up" && direction != "down" && direction != "both")
     throw InputError("--dem-sweep", "", "'" + direction + "': must be up, down or both");
   o.directions.clear();
-  if (direction != "down") o.directions.push_back("up");
-  if (direction != "up") o.directions.push_back("down");
+  if (direction != "down") o.directions.push_back(st::SweepDirection::kUp);
+  if (direction != "up") o.directions.push_back(st::SweepDirection::kDown);
   const std::string signal = args.optional_text("--dem-signal").value_or("stepped");
   if (signal != "stepped" && signal != "linear") throw InputError("--dem-signal", "", "'" + signal + "': must be stepped or linear");
   o.linear_sweep = signal == "linear";
@@ -122,9 +122,9 @@ Rows stepped_rows(const tasks::SteppedSineFrf& s) {
   const auto& names = s.damper_names;
   for (const auto& branch : s.branches) {
     for (std::size_t d = 0; d < names.size(); ++d)
-      rows.push_back({"peak " + branch.sweep + " " + names[d], dem_peak_row(st::stepped_sine_peak(branch, d), branch.points.size())});
+      rows.push_back({"peak " + std::string(st::to_string(branch.sweep)) + " " + names[d], dem_peak_row(st::stepped_sine_peak(branch, d), branch.points.size())});
     for (const auto& p : branch.points)
-      rows.push_back({branch.sweep + " " + format_number(p.frequency_hz, 6) + " Hz",
+      rows.push_back({std::string(st::to_string(branch.sweep)) + " " + format_number(p.frequency_hz, 6) + " Hz",
                       "|out| = " + format_number(p.magnitude.front(), 4) +
                           (std::isfinite(p.standard_error) ? " +- " + format_number(p.standard_error, 2) : "") +
                           ", bed eta* " + format_number(p.bed_eta_star.front(), 3) + ", m_app/m_bed " +
@@ -145,7 +145,7 @@ Rows linear_rows(const tasks::LinearSweepFrf& l) {
     for (std::size_t d = 0; d < l.damper_names.size(); ++d) {
       const st::SweepPeak& sp = s.peaks[d];
       rows.push_back(
-          {"peak " + s.sweep + " " + l.damper_names[d],
+          {"peak " + std::string(st::to_string(s.sweep)) + " " + l.damper_names[d],
            sp.found() ? format_number(sp.peak.frequency_hz, 5) + " Hz, |out| = " + format_number(sp.peak.magnitude, 4) +
                             " +- " + format_number(sp.standard_error(), 2) + ", 0.9 band centre " +
                             optional_number(sp.peak.band_centre_hz, 5, "outside the band") +
@@ -153,7 +153,7 @@ Rows linear_rows(const tasks::LinearSweepFrf& l) {
                             format_number(sp.peak.damping_ratio, 3)
                       : "fewer than " + std::to_string(st::kSweepWindowCycles) + " cycles"});
     }
-    rows.push_back({s.sweep + " sweep", std::to_string(s.cycles.size()) + " cycles, energy error " +
+    rows.push_back({std::string(st::to_string(s.sweep)) + " sweep", std::to_string(s.cycles.size()) + " cycles, energy error " +
                                             format_number(s.energy_error, 2) + ", " + std::to_string(s.steps) +
                                             " steps of " + format_number(s.time_step_s, 3) + " s"});
   }
@@ -180,9 +180,9 @@ Rows compare_rows(const json& compare, const tasks::FrfResult& r) {
   };
   for (std::size_t k = 0; k < r.stepped->branches.size(); ++k) {
     const auto& branch = r.stepped->branches[k];
-    rows.push_back({"peak dem " + branch.sweep, dem_peak_row(st::stepped_sine_peak(branch), branch.points.size())});
-    row("peak formulas vs " + branch.sweep, compare["agreement"][k]["formulas"]);
-    row("peak field vs " + branch.sweep, compare["agreement"][k]["field"]);
+    rows.push_back({"peak dem " + std::string(st::to_string(branch.sweep)), dem_peak_row(st::stepped_sine_peak(branch), branch.points.size())});
+    row("peak formulas vs " + std::string(st::to_string(branch.sweep)), compare["agreement"][k]["formulas"]);
+    row("peak field vs " + std::string(st::to_string(branch.sweep)), compare["agreement"][k]["field"]);
   }
   return rows;
 }

@@ -203,7 +203,7 @@ Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
       << ",convergence_relative_drift,convergence_relative_spread\n";
   for (const auto& branch : s.branches)
     for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending) {
-      csv << p->sweep << ',' << p->frequency_hz;
+      csv << st::to_string(p->sweep) << ',' << p->frequency_hz;
       for (std::size_t d = 0; d < names.size(); ++d) csv << ',' << p->magnitude[d] << ',' << p->phase_deg[d];
       csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
           << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->bed_eta_star.front() << ','
@@ -226,7 +226,7 @@ Warnings linear_sweep_files(OutputDir& out, const tasks::FrfResult& r) {
   csv << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front()) << '\n';
   for (const auto& s : l.sweeps)
     for (const auto& cycle : s.cycles) {
-      csv << s.sweep << ',' << cycle.time_s << ',' << cycle.frequency_hz;
+      csv << st::to_string(s.sweep) << ',' << cycle.time_s << ',' << cycle.frequency_hz;
       for (std::size_t d = 0; d < names.size(); ++d)
         csv << ',' << cycle.site_amplitude_per_excitation[d] << ','
             << std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
@@ -241,7 +241,7 @@ Warnings compare_files(OutputDir& out, const tasks::FrfResult& r) {
   for (const auto& branch : r.stepped->branches)
     for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending)
       dem_points.push_back(
-          {p->frequency_hz, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, branch.sweep, p->converged});
+          {p->frequency_hz, p->magnitude.front(), std::isfinite(p->spread) ? p->spread : 0.0, std::string(st::to_string(branch.sweep)), p->converged});
   return write_frf_compare_files(out, r.harmonic->response, r.field ? &r.field->response : nullptr, dem_points,
                                  tasks::magnitude_label(r),
                                  r.case_name + (r.field ? ": formulas, field and DEM" : ": formulas and DEM (no field)"));

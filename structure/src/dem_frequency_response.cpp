@@ -8,6 +8,8 @@
 
 namespace pdamp::structure {
 
+std::string_view to_string(SweepDirection direction) { return direction == SweepDirection::kUp ? "up" : "down"; }
+
 CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling) {
   steady.transient_periods = std::max(settling.max_transient_periods, settling.min_transient_periods);
   steady.min_transient_periods = settling.min_transient_periods;
@@ -37,7 +39,7 @@ double stepped_sine_time_step(const ModalModel& model, const std::vector<Cosimul
 
 SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                                       CosimulationOptions options, const std::vector<double>& frequencies_hz,
-                                      const std::string& sweep, double time_step_s, const SteppedSineProgress& progress) {
+                                      SweepDirection sweep, double time_step_s, const SteppedSineProgress& progress) {
   SteppedSineBranch branch;
   branch.sweep = sweep;
   CosimulationState state;  // the bed, the modes and the drive's phase, carried over
@@ -134,7 +136,7 @@ SweepPeak sweep_peak(const std::vector<CosimulationSweepCycle>& cycles, std::siz
 }
 
 LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                  const CosimulationOptions& steady, const std::string& sweep, double start_hz,
+                                  const CosimulationOptions& steady, SweepDirection sweep, double start_hz,
                                   double end_hz, double rate_hz_s, const SteppedSineProgress& progress) {
   LinearSineSweep s;
   s.sweep = sweep;
@@ -158,7 +160,7 @@ LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<Cos
   const auto first = cosimulate(model, dampers, start, state, report(0));
   s.wall_time_s = first.wall_time_s;
   s.steps = first.steps;
-  for (const auto& w : first.warnings) s.warnings.push_back(sweep + " sweep: " + w);
+  for (const auto& w : first.warnings) s.warnings.push_back(std::string(to_string(sweep)) + " sweep: " + w);
   if (first.outcome != dem_reference::Outcome::kCompleted) {
     s.outcome = first.outcome;
     s.message = first.message;
@@ -167,7 +169,7 @@ LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<Cos
   s.start_transient_periods = first.steady_state.transient_periods;
   s.start_stable = first.steady_state.stable;
   const auto r = cosimulate(model, dampers, run, state, report(1));
-  for (const auto& w : r.warnings) s.warnings.push_back(sweep + " sweep: " + w);
+  for (const auto& w : r.warnings) s.warnings.push_back(std::string(to_string(sweep)) + " sweep: " + w);
   s.wall_time_s += r.wall_time_s;
   s.steps += r.steps;
   if (r.outcome != dem_reference::Outcome::kCompleted) {

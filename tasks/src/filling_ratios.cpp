@@ -23,6 +23,33 @@ using nlohmann::json;
 using base::format_number;
 using base::InputError;
 
+std::string_view to_string(Compared compared) {
+  switch (compared) {
+    case Compared::kObjective: return "objective";
+    case Compared::kEndEnvelope: return "end_envelope";
+    case Compared::kSettledOnlyOne: return "settled_only_one";
+  }
+  return "";
+}
+
+std::string_view to_string(SofteningCheckKind kind) {
+  switch (kind) {
+    case SofteningCheckKind::kOff: return "off";
+    case SofteningCheckKind::kFullStiffness: return "full_stiffness";
+    case SofteningCheckKind::kTwoSoftenings: return "two_softenings";
+  }
+  return "";
+}
+
+std::string_view to_string(LoopOutcome outcome) {
+  switch (outcome) {
+    case LoopOutcome::kAgreed: return "agreed";
+    case LoopOutcome::kRoundsExhausted: return "rounds_exhausted";
+    case LoopOutcome::kNothingToRecalibrate: return "nothing_to_recalibrate";
+  }
+  return "";
+}
+
 void to_json(json& j, const VerifiedDecay& v) {
   const auto& s = v.settling;
   j = json::array({v.time_s, v.site_displacement_m, s.envelope_time_s, s.envelope_m, s.sample_envelope_m, s.settling_time_s,
@@ -178,13 +205,13 @@ Agreement agreement(double objective, double end_envelope_m, double reference_ob
                     double reference_end_envelope_m, double tolerance) {
   Agreement out;
   if (std::isfinite(reference_objective) && std::isfinite(objective)) {
-    out.compared = "objective";
+    out.compared = Compared::kObjective;
     out.relative_difference = (objective - reference_objective) / reference_objective;
   } else if (!std::isfinite(reference_objective) && !std::isfinite(objective)) {
-    out.compared = "end_envelope";  // neither settled: how far each got
+    out.compared = Compared::kEndEnvelope;  // neither settled: how far each got
     out.relative_difference = (end_envelope_m - reference_end_envelope_m) / reference_end_envelope_m;
   } else {
-    out.compared = "settled_only_one";
+    out.compared = Compared::kSettledOnlyOne;
   }
   out.within = std::isfinite(out.relative_difference) && std::abs(out.relative_difference) <= tolerance;
   return out;
@@ -263,8 +290,10 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   v.settling_objective = settling_objective(p);
   const double stiffer = stiffer_softening(c, verify);
   const bool full_stiffness = at_full_stiffness(c, verify);
-  v.softening_check = !verify.softening_check ? "off" : full_stiffness ? "full_stiffness" : "two_softenings";
-  const std::size_t softenings = v.softening_check == "two_softenings" ? 2 : 1;
+  v.softening_check = !verify.softening_check ? SofteningCheckKind::kOff
+                      : full_stiffness         ? SofteningCheckKind::kFullStiffness
+                                               : SofteningCheckKind::kTwoSoftenings;
+  const std::size_t softenings = v.softening_check == SofteningCheckKind::kTwoSoftenings ? 2 : 1;
 
   // Job k: design k % 2 at softening k / 2 (the judged runs first).
   const std::pair<std::string, const opt::FillingDesign*> designs[] = {{"chosen", &r.chosen}, {"baseline", &r.baseline}};
@@ -367,7 +396,7 @@ json verification_json(const Verification& v) {
                  {"steps", d.dem.steps},
                  {"time_step_s", d.dem.time_step_s},
                  {"solve_time_s", d.dem.wall_time_s}}},
-        {"compared", d.agreement.compared},
+        {"compared", to_string(d.agreement.compared)},
         {"relative_difference", number_or_null(d.agreement.relative_difference)},
         {"passed", d.passed}};
     if (const auto& s = d.softening_check)
@@ -381,7 +410,7 @@ json verification_json(const Verification& v) {
                    {"steps", s->dem.steps},
                    {"time_step_s", s->dem.time_step_s},
                    {"solve_time_s", s->dem.wall_time_s}}},
-          {"compared", s->agreement.compared},
+          {"compared", to_string(s->agreement.compared)},
           {"relative_difference", number_or_null(s->agreement.relative_difference)},
           {"converged", s->agreement.within}};
   }
@@ -397,7 +426,7 @@ json verification_json(const Verification& v) {
               {"dem_stiffness_softening", v.dem_stiffness_softening},
               {"effective_stiffness_softening", v.dem_stiffness_softening * verify.stiffness_softening},
               {"require_ranking", verify.require_ranking},
-              {"softening_check", {{"kind", v.softening_check},
+              {"softening_check", {{"kind", to_string(v.softening_check)},
                                    {"rule", "each design again with contacts ten times stiffer (at most full stiffness); "
                                             "converged when the two DEM objectives agree within tolerance_relative"},
                                    {"converged", v.softening_converged}}},
@@ -451,7 +480,7 @@ json rounds_json(const std::vector<VerificationRound>& rounds) {
                          {"dem_objective", number_or_null(d.dem_objective)},
                          {"predicted_end_envelope_m", number_or_null(d.predicted_end_envelope_m)},
                          {"dem_end_envelope_m", number_or_null(d.dem_end_envelope_m)},
-                         {"compared", d.compared},
+                         {"compared", to_string(d.compared)},
                          {"relative_difference", number_or_null(d.relative_difference)},
                          {"passed", d.passed}};
     out.push_back({{"round", r.round},
@@ -540,11 +569,11 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
                                         out.checkpoints, runs);
       out.rounds.push_back(round_summary(round, *out.verification));
       if (out.verification->passed) {
-        out.loop_outcome = "agreed";
+        out.loop_outcome = LoopOutcome::kAgreed;
         break;
       }
       if (round >= rounds) {
-        out.loop_outcome = "rounds_exhausted";
+        out.loop_outcome = LoopOutcome::kRoundsExhausted;
         break;
       }
       // The chosen design's rate of decay down to its threshold: its ζ_eq when it settled,
@@ -559,7 +588,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
           recalibrate_in_design(c, out.problem, *out.calibration, whole_slabs(chosen.design), design_damping,
                                 chosen.dem.threshold_m, hooks, own_threads);
       if (out.rounds.back().recalibrated.empty()) {
-        out.loop_outcome = "nothing_to_recalibrate";
+        out.loop_outcome = LoopOutcome::kNothingToRecalibrate;
         break;
       }
       hooks.note("pdamp optimize: round " + std::to_string(round) + " of the design loop failed; recalibrated " +
@@ -581,7 +610,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
       if (d.softening_check && !d.softening_check->agreement.within)
         out.warnings.push_back("verify (" + d.name + "): the softening has not converged: ten times stiffer contacts " +
                                "change the DEM objective by " +
-                               (d.softening_check->agreement.compared == "settled_only_one"
+                               (d.softening_check->agreement.compared == Compared::kSettledOnlyOne
                                     ? std::string("settling in one run only")
                                     : format_number(100.0 * d.softening_check->agreement.relative_difference, 3) + " %") +
                                ": raise /task/verify/stiffness_softening towards 1");
@@ -649,7 +678,7 @@ json to_json(const FillingRatiosResult& res) {
   result["calibration"] = res.calibration ? to_json(*res.calibration) : json(nullptr);
   result["verification"] = res.verification ? verification_json(*res.verification) : json(nullptr);
   result["design_loop"] = res.rounds.empty() ? json(nullptr)
-                                             : json{{"rounds", rounds_json(res.rounds)}, {"outcome", res.loop_outcome}};
+                                             : json{{"rounds", rounds_json(res.rounds)}, {"outcome", to_string(*res.loop_outcome)}};
   return result;
 }
 

@@ -173,7 +173,7 @@ std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, co
   for (const auto& p : branch.points) {
     out.insert(out.end(), p.warnings.begin(), p.warnings.end());
     if (!p.converged) {
-      const std::string head = branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: not converged after " +
+      const std::string head = std::string(st::to_string(branch.sweep)) + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: not converged after " +
                                std::to_string(p.transient_periods) + " transient periods: ";
       const std::string tail = ": the point is marked unconverged and left out of the stable curve";
       if (p.window_periods < 2)
@@ -192,7 +192,8 @@ std::vector<std::string> branch_warnings(const st::SteppedSineBranch& branch, co
                       tail);
     }
     if (p.energy_error > 0.01)
-      out.push_back(branch.sweep + " sweep at " + format_number(p.frequency_hz, 5) + " Hz: the co-simulation's energy ledger "
+      out.push_back(std::string(st::to_string(branch.sweep)) + " sweep at " + format_number(p.frequency_hz, 5) +
+                    " Hz: the co-simulation's energy ledger "
                     "closes to " + format_number(p.energy_error, 3) + " only: a smaller /dem/time_step_s");
   }
   return out;
@@ -216,10 +217,11 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   }
   out.time_step_s = detail::call_dem(c, [&] { return st::stepped_sine_time_step(modal, dampers, options, out.frequencies_hz); });
   check_distinct_frequencies(out.frequencies_hz, out.time_step_s, o.points);
-  std::vector<std::pair<std::string, std::vector<double>>> directions;
-  for (const auto& d : o.directions)
-    directions.push_back({d, d == "up" ? out.frequencies_hz
-                                       : std::vector<double>(out.frequencies_hz.rbegin(), out.frequencies_hz.rend())});
+  std::vector<std::pair<st::SweepDirection, std::vector<double>>> directions;
+  for (const auto d : o.directions)
+    directions.push_back({d, d == st::SweepDirection::kUp
+                                 ? out.frequencies_hz
+                                 : std::vector<double>(out.frequencies_hz.rbegin(), out.frequencies_hz.rend())});
   out.parallel = base::parallel_jobs(executor, directions.size());
   {
     // At most max_transient_periods + analysed_periods a point (fewer once its transient
@@ -246,17 +248,18 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
       executor, directions.size(), out.parallel,
       [&](std::size_t k) {
         // Named references, not a structured binding: clang 14 cannot capture bindings in lambdas.
-        const std::string& sweep = directions.at(k).first;
+        const st::SweepDirection sweep = directions.at(k).first;
+        const std::string sweep_name(st::to_string(sweep));
         const std::vector<double>& frequencies = directions.at(k).second;
         const auto label = [&](std::size_t i) {
-          return "pdamp frf (dem) " + sweep + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
+          return "pdamp frf (dem) " + sweep_name + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
                  format_number(frequencies[i], 5) + " Hz";
         };
         // One progress line per direction: the point and its stage, with the share of the
         // sweep done for the ETA (a point's end time is an upper bound, so its share is capped).
         const auto report = [&](std::size_t i, const st::CosimulationProgress& p) {
           const double point_share = p.end_time_s > 0.0 ? std::min(1.0, p.simulated_time_s / p.end_time_s) : 0.0;
-          hooks.progress({"pdamp frf (dem) " + sweep,
+          hooks.progress({"pdamp frf (dem) " + sweep_name,
                           std::to_string(i + 1) + "/" + std::to_string(n) + " " + format_number(frequencies[i], 4) +
                               " Hz " + std::string(p.stage),
                           p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN,
@@ -323,20 +326,21 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
   out.parallel = o.directions.size() > 1 && std::thread::hardware_concurrency() >= 2;
   if (out.parallel)
     for (auto& d : dampers) d.world.threads = 1;
-  for (const auto& direction : o.directions) {  // every run's options checked before any starts
+  const auto up = [](st::SweepDirection d) { return d == st::SweepDirection::kUp; };
+  for (const auto direction : o.directions) {  // every run's options checked before any starts
     st::CosimulationOptions run = steady;
-    run.excitation.frequency_hz = direction == "up" ? o.min_frequency_hz : o.max_frequency_hz;
-    run.sweep_end_frequency_hz = direction == "up" ? o.max_frequency_hz : o.min_frequency_hz;
+    run.excitation.frequency_hz = up(direction) ? o.min_frequency_hz : o.max_frequency_hz;
+    run.sweep_end_frequency_hz = up(direction) ? o.max_frequency_hz : o.min_frequency_hz;
     run.duration_s = out.duration_s;
     detail::check_cosimulation(c, modal, dampers, run);
     detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, run); });
   }
   const auto started = std::chrono::steady_clock::now();
   base::for_each_concurrently(out.sweeps.size(), out.parallel, [&](std::size_t k) {
-    const std::string& direction = o.directions[k];
-    const double start = direction == "up" ? o.min_frequency_hz : o.max_frequency_hz;
-    const double end = direction == "up" ? o.max_frequency_hz : o.min_frequency_hz;
-    const std::string label = "pdamp frf (dem) linear " + direction;
+    const st::SweepDirection direction = o.directions[k];
+    const double start = up(direction) ? o.min_frequency_hz : o.max_frequency_hz;
+    const double end = up(direction) ? o.max_frequency_hz : o.min_frequency_hz;
+    const std::string label = "pdamp frf (dem) linear " + std::string(st::to_string(direction));
     const std::string labels[2] = {label + " start " + format_number(start, 5) + " Hz", label + " sweep"};
     auto s = detail::call_dem(c, [&] {
       return st::linear_sine_sweep(modal, dampers, steady, direction, start, end, out.rate_hz_s,
@@ -350,11 +354,11 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
       for (double m : cycle.site_amplitude_per_excitation)
         if (!std::isfinite(m)) throw NumericalError(label + ": a cycle's amplitude is not finite");
     if (!s.start_stable)
-      s.warnings.push_back(s.sweep + " sweep: the steady state at " + format_number(s.start_hz, 5) +
+      s.warnings.push_back(std::string(st::to_string(s.sweep)) + " sweep: the steady state at " + format_number(s.start_hz, 5) +
                            " Hz was not reached within " + std::to_string(settling.max_transient_periods) +
                            " periods: the sweep's first cycles may carry the transient");
     if (s.energy_error > 0.01)
-      s.warnings.push_back(s.sweep + " sweep: the co-simulation's energy ledger closes to " +
+      s.warnings.push_back(std::string(st::to_string(s.sweep)) + " sweep: the co-simulation's energy ledger closes to " +
                            format_number(s.energy_error, 3) + " only: a smaller /dem/time_step_s");
     out.sweeps[k] = std::move(s);
   });
@@ -379,7 +383,7 @@ json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<st
 json dem_peak_json(const std::string& output, const st::SteppedSineBranch& branch, const st::SteppedSinePeak& bp) {
   const st::SteppedSinePoint& top = *bp.ascending[bp.peak.index];
   return {{"output", output},
-          {"sweep", branch.sweep},
+          {"sweep", st::to_string(branch.sweep)},
           {"frequency_hz", bp.peak.frequency_hz},
           {"largest_point_frequency_hz", top.frequency_hz},
           {"magnitude", bp.peak.magnitude},
@@ -508,7 +512,7 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
         eta[names[d]] = number_or_null(p.bed_eta_star[d]);
         mass[names[d]] = number_or_null(p.bed_apparent_mass_fraction[d]);
       }
-      list.push_back({{"sweep", p.sweep}, {"frequency_hz", p.frequency_hz}, {"requested_frequency_hz", p.requested_frequency_hz},
+      list.push_back({{"sweep", st::to_string(p.sweep)}, {"frequency_hz", p.frequency_hz}, {"requested_frequency_hz", p.requested_frequency_hz},
                       {"magnitude", magnitude}, {"phase_deg", phase},
                       {"bed_eta_star", eta}, {"bed_apparent_mass_fraction", mass},
                       {"magnitude_spread", number_or_null(p.spread)},
@@ -524,7 +528,7 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
       "(q, dq/dt), the bed (particles and contacts) and the drive's phase; the bed is settled once, before a "
       "direction's first frequency";
   json sweeps = json::array();
-  for (const auto& b : s.branches) sweeps.push_back(b.sweep);
+  for (const auto& b : s.branches) sweeps.push_back(st::to_string(b.sweep));
   json frf = {{"file", folder.file("frf_dem.csv")},
               {"plot", folder.file("frf_dem.png")},
               {"method", "dem"},
@@ -572,7 +576,7 @@ json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFold
       const st::SweepPeak& sp = s.peaks[d];
       const auto value = [&](double v) { return sp.found() ? number_or_null(v) : json(nullptr); };
       peaks.push_back({{"output", names[d]},
-                       {"sweep", s.sweep},
+                       {"sweep", st::to_string(s.sweep)},
                        {"frequency_hz", value(sp.peak.frequency_hz)},
                        {"magnitude", value(sp.peak.magnitude)},
                        {"magnitude_standard_error", value(sp.standard_error())},
@@ -581,7 +585,7 @@ json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFold
                        {"band_centre_hz", value(sp.peak.band_centre_hz)},
                        {"damping_ratio", value(sp.peak.damping_ratio)}});
     }
-    runs.push_back({{"sweep", s.sweep}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
+    runs.push_back({{"sweep", st::to_string(s.sweep)}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
                     {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
                     {"start_transient_periods", s.start_transient_periods}, {"start_stable", s.start_stable},
                     {"energy_error", s.energy_error}, {"steps", s.steps}, {"time_step_s", s.time_step_s},
@@ -594,7 +598,7 @@ json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFold
         eta[names[d]] = number_or_null(cycle.bed_reduced_loss_factor[d]);
         mass[names[d]] = number_or_null(cycle.bed_apparent_mass_fraction[d]);
       }
-      list.push_back({{"sweep", s.sweep}, {"time_s", cycle.time_s}, {"frequency_hz", cycle.frequency_hz},
+      list.push_back({{"sweep", st::to_string(s.sweep)}, {"time_s", cycle.time_s}, {"frequency_hz", cycle.frequency_hz},
                       {"magnitude", magnitude}, {"phase_deg", phase}, {"bed_eta_star", eta},
                       {"bed_apparent_mass_fraction", mass}});
     }
@@ -636,7 +640,7 @@ json compare_result(const FrfResult& r, const OutputFolder& folder) {
   for (const auto& branch : r.stepped->branches) {
     const st::SteppedSinePeak bp = st::stepped_sine_peak(branch);
     for (const st::SteppedSinePoint* p : bp.ascending)
-      dem_list.push_back({{"sweep", branch.sweep}, {"frequency_hz", p->frequency_hz}, {"magnitude", p->magnitude.front()},
+      dem_list.push_back({{"sweep", st::to_string(branch.sweep)}, {"frequency_hz", p->frequency_hz}, {"magnitude", p->magnitude.front()},
                           {"magnitude_spread", number_or_null(p->spread)},
                           {"magnitude_standard_error", number_or_null(p->standard_error)},
                           {"energy_error", p->energy_error}, {"converged", p->converged}, {"stable", p->stable},
@@ -645,7 +649,7 @@ json compare_result(const FrfResult& r, const OutputFolder& folder) {
     dem_peaks.push_back(dem_peak_json(output, branch, bp));
     const json a_formulas = agreement_json(first_output_peak(f_response), bp.peak);
     const json a_field = r.field ? agreement_json(first_output_peak(r.field->response), bp.peak) : json(nullptr);
-    agreement.push_back({{"reference", "dem " + branch.sweep}, {"formulas", a_formulas}, {"field", a_field}});
+    agreement.push_back({{"reference", "dem " + std::string(st::to_string(branch.sweep))}, {"formulas", a_formulas}, {"field", a_field}});
   }
   const json f_peaks = peaks_json(f_response.peaks, names);
   const json field_peaks = r.field ? peaks_json(r.field->response.peaks, r.field->response.output_names) : json(nullptr);

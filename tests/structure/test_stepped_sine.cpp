@@ -57,7 +57,7 @@ SteppedSineBranch jump_branch(const SteadyStateSettling& settling) {
   const std::vector<double> f = {7.0, 8.8};
   const CosimulationOptions o = stepped_sine_options(base_drive(), settling);
   const double dt = stepped_sine_time_step(model, dampers, o, f);
-  return stepped_sine_branch(model, dampers, o, f, "up", dt, {});
+  return stepped_sine_branch(model, dampers, o, f, SweepDirection::kUp, dt, {});
 }
 
 }  // namespace

@@ -107,7 +107,7 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
                                                  base::local_executor());
   REQUIRE(checked.verification);
   const auto& v = *checked.verification;
-  CHECK(v.softening_check == "two_softenings");
+  CHECK(v.softening_check == tasks::SofteningCheckKind::kTwoSoftenings);
   bool converged = true;
   for (const auto& d : v.designs) {
     INFO(d.name);
@@ -118,7 +118,7 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
     CHECK(s.dem.time_step_s / d.dem.time_step_s == Approx(std::pow(10.0, -0.4)).epsilon(1e-6));
     CHECK(s.dem.steps > 2 * d.dem.steps);
     // 1 s does not settle: the envelopes at the end are compared.
-    REQUIRE(s.agreement.compared == "end_envelope");
+    REQUIRE(s.agreement.compared == tasks::Compared::kEndEnvelope);
     CHECK(s.agreement.relative_difference ==
           Approx((d.dem_end_envelope_m - s.dem_end_envelope_m) / s.dem_end_envelope_m).epsilon(1e-12));
     CHECK(s.agreement.within == (std::abs(s.agreement.relative_difference) <= v.spec.tolerance_relative));
@@ -133,7 +133,7 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
   const auto unchecked = tasks::run_filling_ratios(short_verification(false), options, base::silent_hooks(),
                                                    base::local_executor());
   REQUIRE(unchecked.verification);
-  CHECK(unchecked.verification->softening_check == "off");
+  CHECK(unchecked.verification->softening_check == tasks::SofteningCheckKind::kOff);
   for (std::size_t k = 0; k < 2; ++k) {
     const auto& d = unchecked.verification->designs[k];
     CHECK_FALSE(d.softening_check);
@@ -289,11 +289,11 @@ TEST_CASE("the design loop recalibrates the chosen design's beds and stops after
   if (layers < 2) {
     // A single bed is its own calibration: nothing to recalibrate, the loop ends.
     CHECK(r.rounds.size() == 1);
-    CHECK(r.loop_outcome == "nothing_to_recalibrate");
+    CHECK(r.loop_outcome == tasks::LoopOutcome::kNothingToRecalibrate);
     return;
   }
   REQUIRE(r.rounds.size() == 2);
-  CHECK(r.loop_outcome == "rounds_exhausted");
+  CHECK(r.loop_outcome == tasks::LoopOutcome::kRoundsExhausted);
   CHECK(first.recalibrated.size() == static_cast<std::size_t>(layers));
   CHECK(r.rounds.back().recalibrated.empty());
   // The chosen design's beds now carry the damping its other beds add; the others none.

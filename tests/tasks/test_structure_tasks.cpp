@@ -92,7 +92,7 @@ TEST_CASE("frf --method dem: the case's transient periods are honoured and each 
   o.dem.points = 2;
   o.dem.min_frequency_hz = 1.5;
   o.dem.max_frequency_hz = 1.7;
-  o.dem.directions = {"up"};
+  o.dem.directions = {structure::SweepDirection::kUp};
   const auto r = tasks::run_frf(c, o, base::silent_hooks(), base::local_executor());
   REQUIRE(r.stepped);
   CHECK(r.stepped->settling.min_transient_periods == 12);

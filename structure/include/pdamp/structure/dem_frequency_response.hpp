@@ -12,6 +12,11 @@
 
 namespace pdamp::structure {
 
+/// The direction a frequency response is swept in.
+enum class SweepDirection { kUp, kDown };
+/// "up", "down".
+std::string_view to_string(SweepDirection direction);
+
 /// Settling to a steady state at each frequency of a stepped sine (and at a linear sweep's
 /// start): the transient runs at least `min_transient_periods` and at most
 /// `max_transient_periods` periods, and ends once the first site's per-period amplitude has
@@ -42,7 +47,7 @@ std::vector<std::int64_t> stepped_sine_steps_per_period(const std::vector<double
 
 /// One frequency of a stepped sine.
 struct SteppedSinePoint {
-  std::string sweep;                   ///< "up" or "down"
+  SweepDirection sweep = SweepDirection::kUp;
   double frequency_hz = 0.0;           ///< as run (CosimulationSteadyState::frequency_hz)
   double requested_frequency_hz = 0.0;
   std::vector<double> magnitude, phase_deg;  ///< per damper: |ŷ_d| per unit excitation, arg ŷ_d in degrees
@@ -71,7 +76,7 @@ struct SteppedSinePoint {
 
 /// One direction of a stepped sine: its points in the order run.
 struct SteppedSineBranch {
-  std::string sweep;
+  SweepDirection sweep = SweepDirection::kUp;
   std::vector<SteppedSinePoint> points;
   double wall_time_s = 0.0;
   /// kCompleted, or the outcome of the point that stopped the branch (its `message` says
@@ -93,7 +98,7 @@ double stepped_sine_time_step(const ModalModel& model, const std::vector<Cosimul
 /// settled once, before the first. `options` from stepped_sine_options, validated.
 SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
                                       CosimulationOptions options, const std::vector<double>& frequencies_hz,
-                                      const std::string& sweep, double time_step_s, const SteppedSineProgress& progress);
+                                      SweepDirection sweep, double time_step_s, const SteppedSineProgress& progress);
 
 /// The points of a branch in ascending frequency and their resonance measures (sampled_peak)
 /// of one output; the standard errors are the first output's (its per-period amplitudes are
@@ -129,7 +134,7 @@ SweepPeak sweep_peak(const std::vector<CosimulationSweepCycle>& cycles, std::siz
 /// One direction of a linear sine sweep: the steady state at the start frequency, then the
 /// sweep to the end frequency continuing from it.
 struct LinearSineSweep {
-  std::string sweep;
+  SweepDirection sweep = SweepDirection::kUp;
   double start_hz = 0.0, end_hz = 0.0, rate_hz_s = 0.0, duration_s = 0.0;
   int start_transient_periods = 0;
   bool start_stable = false;
@@ -146,7 +151,7 @@ struct LinearSineSweep {
 /// on the sweep's step, then the sweep runs to `end_hz` at `rate_hz_s`. `progress` gets the
 /// start (index 0) and the sweep (index 1).
 LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                  const CosimulationOptions& steady, const std::string& sweep, double start_hz,
+                                  const CosimulationOptions& steady, SweepDirection sweep, double start_hz,
                                   double end_hz, double rate_hz_s, const SteppedSineProgress& progress);
 
 }  // namespace pdamp::structure

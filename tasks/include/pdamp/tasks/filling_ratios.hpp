@@ -52,10 +52,16 @@ struct VerifiedDecay {
   std::vector<std::string> warnings;
 };
 
+/// What an agreement compared: the objectives (both settled, or ½∫e² dt), the envelopes at
+/// the end (neither settled), or nothing (only one settled: they disagree).
+enum class Compared { kObjective, kEndEnvelope, kSettledOnlyOne };
+/// "objective", "end_envelope", "settled_only_one".
+std::string_view to_string(Compared compared);
+
 /// How one objective agrees with a reference: the objectives (settling time or ½∫e² dt),
 /// or, when neither settled, the envelopes at the end.
 struct Agreement {
-  std::string compared;              ///< "objective", "end_envelope" or "settled_only_one"
+  Compared compared = Compared::kSettledOnlyOne;
   double relative_difference = NAN;  ///< (value − reference)/reference
   bool within = false;               ///< |relative_difference| <= the tolerance
 };
@@ -88,6 +94,15 @@ struct DesignCheck {
   int particles = 0;
 };
 
+/// The verification's check of its softened contacts.
+enum class SofteningCheckKind {
+  kOff,            ///< VerifySpec::softening_check false
+  kFullStiffness,  ///< the judged runs are at full stiffness: nothing to check
+  kTwoSoftenings,  ///< each design also ran ten times stiffer
+};
+/// "off", "full_stiffness", "two_softenings".
+std::string_view to_string(SofteningCheckKind kind);
+
 struct Verification {
   case_file::VerifySpec spec;
   double dem_stiffness_softening = 1.0;  ///< the case's /dem softening (the runs use it times spec's)
@@ -96,9 +111,7 @@ struct Verification {
   bool predicted_chosen_ahead = false;
   bool dem_chosen_ahead = false;
   bool ranking_passed = false;
-  /// "two_softenings" (each design also ran ten times stiffer), "full_stiffness" (nothing to
-  /// check) or "off" (VerifySpec::softening_check false).
-  std::string softening_check = "off";
+  SofteningCheckKind softening_check = SofteningCheckKind::kOff;
   bool softening_converged = false;  ///< every design's check agreed (true at full stiffness)
   bool passed = false;
   double wall_time_s = 0.0;
@@ -119,7 +132,7 @@ struct VerificationRound {
     std::vector<double> slabs;
     double predicted_objective = NAN, dem_objective = NAN;  ///< NaN: not settled
     double predicted_end_envelope_m = NAN, dem_end_envelope_m = NAN;
-    std::string compared;
+    Compared compared = Compared::kSettledOnlyOne;
     double relative_difference = NAN;
     bool passed = false;
   };
@@ -130,6 +143,15 @@ struct VerificationRound {
   std::vector<std::string> recalibrated;
 };
 
+/// How the design loop ended.
+enum class LoopOutcome {
+  kAgreed,                ///< a round's verification passed
+  kRoundsExhausted,       ///< the last round allowed failed
+  kNothingToRecalibrate,  ///< a round failed and no bed of the chosen design could be recalibrated
+};
+/// "agreed", "rounds_exhausted", "nothing_to_recalibrate".
+std::string_view to_string(LoopOutcome outcome);
+
 struct FillingRatiosResult {
   std::string case_name;
   case_file::FillingRatioProblem problem;
@@ -139,7 +161,7 @@ struct FillingRatiosResult {
   DesignComparison comparison;
   std::optional<Verification> verification;  ///< of the last round
   std::vector<VerificationRound> rounds;     ///< every round of the design loop (one without calibration)
-  std::string loop_outcome;                  ///< "agreed", "rounds_exhausted", "nothing_to_recalibrate"
+  std::optional<LoopOutcome> loop_outcome;   ///< none without a verification
   std::vector<std::filesystem::path> checkpoints;  ///< the verification's files, to remove once its results are kept
   std::vector<std::string> warnings;
 };

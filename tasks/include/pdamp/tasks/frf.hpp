@@ -28,7 +28,8 @@ struct DemFrfOptions {
   int points = 9;                          ///< stepped sine: frequencies, linear over the band, [2, 1000]
   double min_frequency_hz = 0.0;           ///< the band, Hz (the task's by default), max > min > 0
   double max_frequency_hz = 0.0;
-  std::vector<std::string> directions{"up", "down"};  ///< "up", "down" (those asked for, up first)
+  /// The directions asked for, up first.
+  std::vector<structure::SweepDirection> directions{structure::SweepDirection::kUp, structure::SweepDirection::kDown};
   bool linear_sweep = false;               ///< a linear sine sweep instead of the stepped sine
   std::optional<double> sweep_rate_hz_s;   ///< linear sweep: default quasi_stationary_sweep_rate at the formulas' resonance
   structure::SteadyStateSettling settling; ///< each frequency's settling to its steady state
