@@ -52,7 +52,7 @@ formulas::LatticePacking packing_of(const CompartmentOptions& c, const Vec3& gra
 }
 
 /// Fraction of the radius the ball-lot tolerance may take at most: the time-step bound
-/// (world.cpp, from radius_m·(1 − radius_spread)) then errs by under 1%.
+/// (world_setup.cpp, from radius_m·(1 − radius_spread)) then errs by under 1%.
 constexpr double kMaxToleranceFraction = 0.01;
 
 /// Radius of one sphere of the group from one uniform draw u in [0, 1) (exactly one
