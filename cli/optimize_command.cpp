@@ -61,17 +61,17 @@ Rows verification_rows(const tasks::Verification& v) {
   const bool settling = v.settling_objective;
   for (const auto& d : v.designs) {
     const double pred = d.predicted_objective;
-    std::string line = settling ? "predicted " + seconds_or_not_settled(pred) + ", DEM " + seconds_or_not_settled(d.dem_objective)
-                                : "predicted " + format_number(pred, 4) + " m2 s, DEM " + format_number(d.dem_objective, 4) + " m2 s";
+    std::string line = settling ? "predicted " + seconds_or_not_settled(pred) + ", DEM " + seconds_or_not_settled(d.dem.objective)
+                                : "predicted " + format_number(pred, 4) + " m2 s, DEM " + format_number(d.dem.objective, 4) + " m2 s";
     line += "; end envelope predicted " + format_number(d.predicted_end_envelope_m * 1e3, 4) + " mm, DEM " +
-            format_number(d.dem_end_envelope_m * 1e3, 4) + " mm; energy error " + format_number(d.dem.energy_error, 2) +
+            format_number(d.dem.end_envelope_m * 1e3, 4) + " mm; energy error " + format_number(d.dem.energy_error, 2) +
             "; " +
             difference_text(d.agreement) + ": " + (d.agreement.within ? "pass" : "FAIL");
     rows.push_back({"verify " + d.name, line});
     if (const auto& s = d.softening_check)
       rows.push_back({"verify " + d.name + " stiffer",
                       "softening " + format_number(s->stiffness_softening, 3) + ": DEM " +
-                          (settling ? seconds_or_not_settled(s->dem_objective) : format_number(s->dem_objective, 4) + " m2 s") +
+                          (settling ? seconds_or_not_settled(s->dem.objective) : format_number(s->dem.objective, 4) + " m2 s") +
                           "; judged run " + difference_text(s->agreement) + ": " +
                           (s->agreement.within ? "converged" : "NOT CONVERGED")});
   }

@@ -63,6 +63,48 @@ std::string_view to_string(FillingObjective objective) {
   return objective == FillingObjective::kSettlingTime ? "settling_time" : "integral_square";
 }
 
+const base::Fields<LayerDesign>& LayerDesign::fields() {
+  using L = LayerDesign;
+  static const auto f =
+      base::Fields<L>()
+          .field("name", &L::name, "", "the layer")
+          .field("slabs", &L::slabs, "", "n_k, whole for integer designs", base::kNullable)
+          .field("particles", &L::particles, "", "spheres")
+          .field("filling_ratio", &L::filling_ratio, "1", "n k 2r/L of the settled bed", base::kNullable)
+          .field("volume_fraction", &L::volume_fraction, "1", "sphere volume over container volume (0: unknown)")
+          .field("clearance_m", &L::clearance_m, "m", "free length above the bed along the drive")
+          .field("bed_mass_kg", &L::bed_mass_kg, "kg", "particle mass");
+  return f;
+}
+
+std::vector<double> FillingDesign::slabs() const {
+  std::vector<double> n;
+  for (const auto& l : layers) n.push_back(l.slabs);
+  return n;
+}
+
+const base::Fields<FillingDesign>& FillingDesign::fields() {
+  using D = FillingDesign;
+  static const auto f =
+      base::Fields<D>()
+          .field("layers", &D::layers, "", "each layer's bed")
+          .derived("slabs", [](const D& d) { return d.slabs(); }, "", "n_k of each layer", base::kViewOnly)
+          .field("total_mass_kg", &D::total_mass_kg, "kg", "particle mass in all layers")
+          .field("total_slabs", &D::total_slabs, "", "slabs in all layers", base::kCodecOnly)
+          .field("feasible", &D::feasible, "", "within the mass budget and the slab limit")
+          .field("settled", &D::settled, "", "the decay settles within the duration")
+          .field("settling_time_s", &D::settling_time_s, "s", "time to settle (null: not settled)", base::kNullable)
+          .field("integral_square_m2_s", &D::integral_square_m2_s, "m2_s", "1/2 integral of e^2 dt (integral_square only)",
+                 base::kNullable)
+          .field("objective", &D::objective, "s or m2_s", "the minimised value");
+  return f;
+}
+
+const base::Fields<FillingDesign>& FillingDesign::neighbour_fields() {
+  static const auto f = fields().view({"slabs", "objective", "settling_time_s", "total_mass_kg"});
+  return f;
+}
+
 int LayerCandidate::max_slabs() const {
   if (!(slab_length_m > 0.0) || !(inner_length_m > 0.0) || spheres_per_lane < 1) return 0;
   const int rows = static_cast<int>(std::floor(inner_length_m / slab_length_m * (1.0 + kFitsTolerance)));

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/dem_reference/result_files.hpp"
 #include "pdamp/report/plots.hpp"
 #include "pdamp/report/structure_plots.hpp"
@@ -181,58 +182,42 @@ namespace {
 
 std::string csv_name(const std::string& name) { return safe_file_name(name); }
 
-/// A CSV cell: the number, or empty where it is not finite.
-std::string finite_or_empty(double v) {
-  if (!std::isfinite(v)) return "";
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
 Warnings stepped_sine_files(OutputDir& out, const tasks::FrfResult& r) {
   const auto& s = *r.stepped;
   const auto& names = s.damper_names;
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "sweep,frequency_hz";
-  for (const auto& d : names) csv << ",magnitude_" << csv_name(d) << ",phase_deg_" << csv_name(d);
-  csv << ",magnitude_spread_" << csv_name(names.front()) << ",magnitude_standard_error_" << csv_name(names.front())
-      << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front())
-      << ",energy_error,transient_periods,stable,steps,time_step_s,converged,periods,convergence_max_relative_change"
-      << ",convergence_relative_drift,convergence_relative_spread\n";
+  std::vector<std::string> outputs;
+  for (const auto& d : names) outputs.push_back(csv_name(d));
+  // Per damper its magnitude and phase; the first site's spread and its bed's measures.
+  const base::CsvTable<st::SteppedSinePoint> table(
+      {"sweep", "frequency_hz", {"magnitude", "phase_deg"},
+       base::CsvColumn("magnitude_spread").nan_as("0").named_for_first_output(),
+       base::CsvColumn("magnitude_standard_error").nan_as("0").named_for_first_output(),
+       base::CsvColumn("bed_eta_star").first_output_only(),
+       base::CsvColumn("bed_apparent_mass_fraction").first_output_only(), "energy_error", "transient_periods", "stable",
+       "steps", "time_step_s", "converged", "periods", base::CsvColumn("convergence/max_relative_change").nan_as(""),
+       base::CsvColumn("convergence/relative_drift").nan_as(""),
+       base::CsvColumn("convergence/relative_spread").nan_as("")},
+      outputs);
+  std::string csv = table.header() + "\n";
   for (const auto& branch : s.branches)
-    for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending) {
-      csv << st::to_string(p->sweep) << ',' << p->frequency_hz;
-      for (std::size_t d = 0; d < names.size(); ++d) csv << ',' << p->magnitude[d] << ',' << p->phase_deg[d];
-      csv << ',' << (std::isfinite(p->spread) ? p->spread : 0.0) << ','
-          << (std::isfinite(p->standard_error) ? p->standard_error : 0.0) << ',' << p->bed_eta_star.front() << ','
-          << p->bed_apparent_mass_fraction.front() << ',' << p->energy_error << ',' << p->transient_periods << ','
-          << (p->stable ? 1 : 0) << ',' << p->steps << ',' << p->time_step_s << ',' << (p->converged ? 1 : 0) << ','
-          << p->periods() << ',' << finite_or_empty(p->window_max_relative_change) << ','
-          << finite_or_empty(p->window_relative_drift) << ',' << finite_or_empty(p->window_relative_spread) << '\n';
-    }
-  out.add("frf_dem.csv", csv.str());
+    for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending) csv += table.row(*p) + "\n";
+  out.add("frf_dem.csv", csv);
   return write_frf_dem_plot(out, names, tasks::magnitude_label(r), r.case_name + ": stepped-sine DEM co-simulation");
 }
 
 Warnings linear_sweep_files(OutputDir& out, const tasks::FrfResult& r) {
   const auto& l = *r.linear;
   const auto& names = l.damper_names;
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "sweep,time_s,frequency_hz";
-  for (const auto& d : names) csv << ",magnitude_" << csv_name(d) << ",phase_deg_" << csv_name(d);
-  csv << ",bed_eta_star_" << csv_name(names.front()) << ",bed_apparent_mass_fraction_" << csv_name(names.front()) << '\n';
+  std::vector<std::string> outputs;
+  for (const auto& d : names) outputs.push_back(csv_name(d));
+  const base::CsvTable<st::CosimulationSweepCycle> table({"time_s", "frequency_hz", {"magnitude", "phase_deg"},
+                                                           base::CsvColumn("bed_eta_star").first_output_only(),
+                                                           base::CsvColumn("bed_apparent_mass_fraction").first_output_only()},
+                                                          outputs);
+  std::string csv = table.header("sweep") + "\n";
   for (const auto& s : l.sweeps)
-    for (const auto& cycle : s.cycles) {
-      csv << st::to_string(s.sweep) << ',' << cycle.time_s << ',' << cycle.frequency_hz;
-      for (std::size_t d = 0; d < names.size(); ++d)
-        csv << ',' << cycle.site_amplitude_per_excitation[d] << ','
-            << std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
-      csv << ',' << cycle.bed_reduced_loss_factor.front() << ',' << cycle.bed_apparent_mass_fraction.front() << '\n';
-    }
-  out.add("frf_dem_sweep.csv", csv.str());
+    for (const auto& cycle : s.cycles) csv += table.row(cycle, st::to_string(s.sweep)) + "\n";
+  out.add("frf_dem_sweep.csv", csv);
   return write_frf_dem_sweep_plot(out, names, tasks::magnitude_label(r), r.case_name + ": linear-sweep DEM co-simulation");
 }
 
@@ -312,18 +297,16 @@ namespace {
 /// designs.csv (one row per design and layer), decay_compare.csv and its plot.
 Warnings design_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
   const auto& r = res.optimum;
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "design,layer,slabs,particles,filling_ratio,volume_fraction,clearance_m,bed_mass_kg,settling_time_s,objective\n";
+  const base::CsvTable<opt::LayerDesign> layer_columns(
+      {"slabs", "particles", "filling_ratio", "volume_fraction", "clearance_m", "bed_mass_kg"});
+  const base::CsvTable<opt::FillingDesign> design_columns({base::CsvColumn("settling_time_s").nan_as("-1"), "objective"});
+  std::string csv = layer_columns.header("design,layer") + "," + design_columns.header() + "\n";
   const std::vector<std::pair<std::string, const opt::FillingDesign*>> designs = {
       {"chosen", &r.chosen},   {"relaxed", &r.relaxed}, {"baseline", &r.baseline},
       {"initial", &r.initial}, {"bare", &r.bare},       {"same_mass", &r.same_mass}};
   for (const auto& [name, d] : designs)
-    for (const auto& l : d->layers)
-      csv << name << ',' << l.name << ',' << l.slabs << ',' << l.particles << ',' << l.filling_ratio << ','
-          << l.volume_fraction << ',' << l.clearance_m << ',' << l.bed_mass_kg << ','
-          << (std::isfinite(d->settling_time_s) ? d->settling_time_s : -1.0) << ',' << d->objective << '\n';
-  out.add("designs.csv", csv.str());
+    for (const auto& l : d->layers) csv += layer_columns.row(l, name + "," + l.name) + "," + design_columns.row(*d) + "\n";
+  out.add("designs.csv", csv);
 
   const auto& runs = res.comparison.decays;
   std::ostringstream env;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -17,6 +18,29 @@
 #include "pdamp/structure/damper_coupling.hpp"
 
 namespace pdamp::structure {
+
+const base::Fields<CosimulationSweepCycle>& CosimulationSweepCycle::fields() {
+  using C = CosimulationSweepCycle;
+  static const auto f =
+      base::Fields<C>()
+          .field("time_s", &C::time_s, "s", "the cycle's middle")
+          .field("frequency_hz", &C::frequency_hz, "Hz", "the cycle's mean frequency")
+          .field("magnitude", &C::site_amplitude_per_excitation, "1 or m/N",
+                 "first-harmonic amplitude of each damper's site per unit excitation", base::kPerOutput)
+          .derived(
+              "phase_deg",
+              [](const C& c) {
+                std::vector<double> phase;
+                for (const auto& a : c.site_amplitudes_m) phase.push_back(std::arg(a) * 180.0 / std::numbers::pi);
+                return phase;
+              },
+              "deg", "phase of each damper site's first harmonic", base::kPerOutput)
+          .field("bed_eta_star", &C::bed_reduced_loss_factor, "1", "each bed's reduced loss factor in the cycle",
+                 base::kPerOutput | base::kNullable)
+          .field("bed_apparent_mass_fraction", &C::bed_apparent_mass_fraction, "1",
+                 "each bed's apparent mass over its mass in the cycle", base::kPerOutput | base::kNullable);
+  return f;
+}
 
 namespace {
 

@@ -10,6 +10,87 @@ namespace pdamp::structure {
 
 std::string_view to_string(SweepDirection direction) { return direction == SweepDirection::kUp ? "up" : "down"; }
 
+const base::Fields<SteppedSinePoint>& SteppedSinePoint::fields() {
+  using P = SteppedSinePoint;
+  static const auto f =
+      base::Fields<P>()
+          .field("sweep", &P::sweep, "", "the direction: up or down")
+          .field("frequency_hz", &P::frequency_hz, "Hz", "the frequency as run (whole steps per period)")
+          .field("requested_frequency_hz", &P::requested_frequency_hz, "Hz", "the frequency asked for")
+          .field("magnitude", &P::magnitude, "1 or m/N",
+                 "first-harmonic amplitude of each damper's site per unit excitation", base::kPerOutput)
+          .field("phase_deg", &P::phase_deg, "deg", "phase of each damper site's first harmonic", base::kPerOutput)
+          .field("bed_eta_star", &P::bed_eta_star, "1", "each bed's reduced loss factor in the loop",
+                 base::kPerOutput | base::kNullable)
+          .field("bed_apparent_mass_fraction", &P::bed_apparent_mass_fraction, "1",
+                 "each bed's apparent mass over its mass in the loop", base::kPerOutput | base::kNullable)
+          .field("magnitude_spread", &P::spread, "1 or m/N",
+                 "sample standard deviation of the analysed periods' first-site amplitude", base::kNullable)
+          .field("magnitude_standard_error", &P::standard_error, "1 or m/N",
+                 "the spread over the root of the analysed periods", base::kNullable)
+          .field("energy_error", &P::energy_error, "1", "relative error of the co-simulation's energy ledger")
+          .field("transient_periods", &P::transient_periods, "", "periods run before the analysed ones")
+          .field("analysed_periods", &P::analysed_periods, "", "periods analysed")
+          .derived("periods", [](const P& p) { return p.periods(); }, "", "periods run at this frequency")
+          .derived("first_magnitude", [](const P& p) { return p.magnitude.front(); }, "1 or m/N",
+                   "the first damper site's magnitude", base::kViewOnly)
+          .field("converged", &P::converged, "", "the transient converged before the analysed periods")
+          .field("stable", &P::stable, "", "= converged (the former name)")
+          .group("convergence", "the convergence window when the transient ended",
+                 base::Fields<P>()
+                     .field("window_periods", &P::window_periods, "", "periods in the window")
+                     .field("max_relative_change", &P::window_max_relative_change, "1",
+                            "largest period-to-period change of the first site's amplitude", base::kNullable)
+                     .field("relative_drift", &P::window_relative_drift, "1", "change across the window",
+                            base::kNullable)
+                     .field("relative_spread", &P::window_relative_spread, "1",
+                            "relative standard deviation over the window", base::kNullable)
+                     .field("period_magnitudes", &P::period_magnitudes, "1 or m/N",
+                            "first-site amplitude of every period run, per unit excitation"))
+          .field("steps", &P::steps, "", "integration steps")
+          .field("time_step_s", &P::time_step_s, "s", "the integration step")
+          .field("solve_time_s", &P::wall_time_s, "s", "wall time")
+          .field("warnings", &P::warnings, "", "the co-simulation's warnings", base::kCodecOnly);
+  return f;
+}
+
+const base::Fields<SteppedSinePoint>& SteppedSinePoint::summary_fields() {
+  static const auto f = fields().view({"sweep", "frequency_hz", "magnitude=first_magnitude", "magnitude_spread",
+                                       "magnitude_standard_error", "energy_error", "converged", "stable", "periods",
+                                       "convergence_max_relative_change=convergence/max_relative_change"});
+  return f;
+}
+
+const base::Fields<LinearSineSweep>& LinearSineSweep::fields() {
+  using S = LinearSineSweep;
+  static const auto f =
+      base::Fields<S>()
+          .field("sweep", &S::sweep, "", "the direction: up or down")
+          .field("start_hz", &S::start_hz, "Hz", "the frequency it starts from, at its steady state")
+          .field("end_hz", &S::end_hz, "Hz", "the frequency it ends at")
+          .field("rate_hz_per_s", &S::rate_hz_s, "Hz/s", "the sweep rate")
+          .field("duration_s", &S::duration_s, "s", "the sweep's duration")
+          .derived("cycles", [](const S& s) { return s.cycles.size(); }, "", "drive cycles analysed")
+          .field("start_transient_periods", &S::start_transient_periods, "", "periods to the steady state at the start")
+          .field("start_stable", &S::start_stable, "", "the steady state at the start was reached")
+          .field("energy_error", &S::energy_error, "1", "relative error of the co-simulation's energy ledger")
+          .field("steps", &S::steps, "", "integration steps")
+          .field("time_step_s", &S::time_step_s, "s", "the integration step")
+          .field("solve_time_s", &S::wall_time_s, "s", "wall time");
+  return f;
+}
+
+const base::Fields<SteppedSineBranch>& SteppedSineBranch::fields() {
+  using B = SteppedSineBranch;
+  static const auto f = base::Fields<B>()
+                            .field("sweep", &B::sweep, "", "the direction: up or down")
+                            .field("points", &B::points, "", "the points in the order run")
+                            .field("wall_time_s", &B::wall_time_s, "s", "wall time of the branch")
+                            .field("outcome", &B::outcome, "", "completed, or why the branch stopped")
+                            .field("message", &B::message, "", "what stopped the branch");
+  return f;
+}
+
 CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling) {
   steady.transient_periods = std::max(settling.max_transient_periods, settling.min_transient_periods);
   steady.min_transient_periods = settling.min_transient_periods;

@@ -10,6 +10,21 @@
 
 namespace pdamp::structure {
 
+const base::Fields<SampledSettling>& SampledSettling::fields() {
+  using S = SampledSettling;
+  static const auto f =
+      base::Fields<S>()
+          .field("envelope_time_s", &S::envelope_time_s, "s", "instant of each whole period's largest excursion")
+          .field("envelope_m", &S::envelope_m, "m", "each whole period's largest excursion about the offset")
+          .field("sample_envelope_m", &S::sample_envelope_m, "m", "the envelope at every sample")
+          .field("settling_time_s", &S::settling_time_s, "s", "when the envelope reached the threshold (null: not settled)",
+                 base::kNullable)
+          .field("frequency_hz", &S::frequency_hz, "Hz", "from the zero crossings up to settling", base::kNullable)
+          .field("damping_ratio", &S::damping_ratio, "1", "equivalent damping ratio from the decrement",
+                 base::kNullable);
+  return f;
+}
+
 SampledSettling sampled_settling(const std::vector<double>& t, const Eigen::VectorXd& y, double offset, double period_s,
                                  double initial_m, double threshold_m, double fallback_frequency_hz) {
   SampledSettling out;

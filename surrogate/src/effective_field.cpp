@@ -35,7 +35,7 @@ constexpr std::string_view kLabelUnit = "label";
 /// may round, but not enough to move a point onto another node.
 constexpr double kCoordinateTolerance = 1e-9;
 
-/// The table's columns after the two coordinates, in the order the writer uses.
+/// The table's columns after the two coordinates: FieldPoint::fields() in order.
 enum Column : int {
   kEtaStar,
   kEtaStarStderr,
@@ -46,13 +46,29 @@ enum Column : int {
   kStatus,
   kValueColumns
 };
-constexpr std::array<std::string_view, kValueColumns> kColumnNames = {
-    "eta_star", "eta_star_stderr", "e_diss_j", "apparent_mass_kg", "apparent_mass_fraction", "motion_mode", "status"};
-constexpr std::array<std::string_view, kValueColumns> kColumnUnits = {"1", "1", "J", "kg", "1", kLabelUnit, kLabelUnit};
+}  // namespace
+
+const base::Fields<FieldPoint>& FieldPoint::fields() {
+  static const auto f =
+      base::Fields<FieldPoint>()
+          .field("eta_star", &FieldPoint::eta_star, "1", "reduced loss factor eta* = E_diss/(1/2 m_bed |V*|^2)",
+                 base::kNullable)
+          .field("eta_star_stderr", &FieldPoint::eta_star_stderr, "1",
+                 "standard error of eta* (0 for the closed forms; null: not known)", base::kNullable)
+          .field("e_diss_j", &FieldPoint::e_diss_j, "J", "energy dissipated per cycle, Re(P)/Omega", base::kNullable)
+          .field("apparent_mass_kg", &FieldPoint::apparent_mass_kg, "kg",
+                 "apparent mass Im(F* conj V*)/(Omega |V*|^2) (null: not given)", base::kNullable)
+          .field("apparent_mass_fraction", &FieldPoint::apparent_mass_fraction, "1",
+                 "apparent mass over bed mass (null: not given)", base::kNullable)
+          .field("motion_mode", &FieldPoint::motion_mode, std::string(kLabelUnit),
+                 "motion-mode or regime label (empty: none)")
+          .field("status", &FieldPoint::status, std::string(kLabelUnit), "ok, missing or failed");
+  return f;
+}
+
+namespace {
 
 bool same_number(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
-
-json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
 bool is_iso8601_utc(const std::string& text) {
   // YYYY-MM-DDThh:mm:ssZ
@@ -66,10 +82,9 @@ bool is_iso8601_utc(const std::string& text) {
 }
 
 json row_of(const EffectiveField& field, std::size_t k) {
-  const FieldPoint& p = field.points[k];
-  return json::array({field.grid.coordinate0(k), field.grid.coordinate1(k), nullable(p.eta_star),
-                      nullable(p.eta_star_stderr), nullable(p.e_diss_j), nullable(p.apparent_mass_kg),
-                      nullable(p.apparent_mass_fraction), p.motion_mode, std::string(to_string(p.status))});
+  json row = json::array({field.grid.coordinate0(k), field.grid.coordinate1(k)});
+  for (auto& value : FieldPoint::fields().to_array(field.points[k])) row.push_back(std::move(value));
+  return row;
 }
 
 /// Metadata and columns (everything but the table) in the writer's key order.
@@ -94,9 +109,8 @@ nlohmann::ordered_json metadata_of(const EffectiveField& field) {
   for (const Axis* axis : {&field.grid.axis0, &field.grid.axis1}) {
     doc["columns"].push_back({{"name", to_string(axis->quantity)}, {"unit", unit_of(axis->quantity)}});
   }
-  for (int c = 0; c < kValueColumns; ++c) {
-    doc["columns"].push_back({{"name", kColumnNames[c]}, {"unit", kColumnUnits[c]}});
-  }
+  for (const auto& column : FieldPoint::fields().entries())
+    doc["columns"].push_back({{"name", column.name}, {"unit", column.unit}});
   return doc;
 }
 
@@ -186,8 +200,10 @@ TableLayout read_columns(const json& columns, const std::string& pointer, const 
   TableLayout layout;
   layout.names = {to_string(grid.axis0.quantity), to_string(grid.axis1.quantity)};
   layout.units = {unit_of(grid.axis0.quantity), unit_of(grid.axis1.quantity)};
-  layout.names.insert(layout.names.end(), kColumnNames.begin(), kColumnNames.end());
-  layout.units.insert(layout.units.end(), kColumnUnits.begin(), kColumnUnits.end());
+  for (const auto& column : FieldPoint::fields().entries()) {
+    layout.names.push_back(column.name);
+    layout.units.push_back(column.unit);
+  }
   constexpr std::size_t kAbsent = static_cast<std::size_t>(-1);
   layout.position.assign(layout.names.size(), kAbsent);
   for (std::size_t k = 0; k < columns.size(); ++k) {

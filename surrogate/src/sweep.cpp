@@ -46,8 +46,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-json nullable(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
 /// What a sweep visits, by index: a grid's nodes (their drives from the grid and the
 /// clearance) or a list of points (a sensitivity study's variants), and what identifies
 /// them in the results file's header.
@@ -95,16 +93,10 @@ std::vector<std::size_t> shard_nodes(std::size_t count, const SweepOptions& opti
 }
 
 std::string point_line(std::size_t index, const DrivePoint& drive, const FieldPoint& p, double wall_time_s) {
-  const json line = {{"index", index},
-                     {"drive", {{"frequency_hz", drive.frequency_hz}, {"amplitude_m", drive.amplitude_m}}},
-                     {"eta_star", nullable(p.eta_star)},
-                     {"eta_star_stderr", nullable(p.eta_star_stderr)},
-                     {"e_diss_j", nullable(p.e_diss_j)},
-                     {"apparent_mass_kg", nullable(p.apparent_mass_kg)},
-                     {"apparent_mass_fraction", nullable(p.apparent_mass_fraction)},
-                     {"motion_mode", p.motion_mode},
-                     {"status", to_string(p.status)},
-                     {"wall_time_s", wall_time_s}};
+  json line = base::to_json(p);
+  line["index"] = index;
+  line["drive"] = {{"frequency_hz", drive.frequency_hz}, {"amplitude_m", drive.amplitude_m}};
+  line["wall_time_s"] = wall_time_s;
   return line.dump() + "\n";
 }
 

@@ -1,7 +1,6 @@
 // pdamp field as a study (field.hpp).
 #include "pdamp/tasks/field.hpp"
 
-#include "job_codecs.hpp"
 #include "pdamp/base/input_error.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"

@@ -50,31 +50,181 @@ std::string_view to_string(LoopOutcome outcome) {
   return "";
 }
 
-void to_json(json& j, const VerifiedDecay& v) {
-  const auto& s = v.settling;
-  j = json::array({v.time_s, v.site_displacement_m, s.envelope_time_s, s.envelope_m, s.sample_envelope_m, s.settling_time_s,
-                   s.frequency_hz, s.damping_ratio, v.threshold_m, v.initial_envelope_m, v.energy_error, v.dem_dissipated_j,
-                   v.structural_dissipated_j, v.steps, v.time_step_s, v.wall_time_s, v.warnings});
+namespace {
+
+bool settled(const VerifiedDecay& v) { return std::isfinite(v.settling.settling_time_s); }
+
+}  // namespace
+
+const base::Fields<VerifiedDecay>& VerifiedDecay::fields() {
+  using V = VerifiedDecay;
+  static const auto f =
+      base::Fields<V>()
+          .derived("settled", settled, "", "the DEM decay reached the threshold within the record")
+          .derived("outcome", [](const V& v) { return std::string(settled(v) ? "settled" : "not_settled"); }, "",
+                   "settled or not_settled")
+          .derived("settling_time_s", [](const V& v) { return v.settling.settling_time_s; }, "s",
+                   "when the envelope reached the threshold (null: not settled)", base::kNullable)
+          .field("objective", &V::objective, "s or m2_s", "the DEM's settling time or 1/2 integral of e^2 dt",
+                 base::kNullable)
+          .field("end_envelope_m", &V::end_envelope_m, "m", "the envelope at the end of the record", base::kNullable)
+          .derived("damping_ratio", [](const V& v) { return v.settling.damping_ratio; }, "1",
+                   "equivalent damping ratio from the decrement down to the threshold", base::kNullable)
+          .field("threshold_m", &V::threshold_m, "m", "the settling threshold at the first damper's site")
+          .field("initial_envelope_m", &V::initial_envelope_m, "m", "the envelope the decay starts from")
+          .field("energy_error", &V::energy_error, "1", "relative error of the co-simulation's energy ledger")
+          .field("dem_dissipated_energy_j", &V::dem_dissipated_j, "J", "energy the beds dissipated")
+          .field("structural_dissipated_energy_j", &V::structural_dissipated_j, "J",
+                 "energy the structure's own damping dissipated")
+          .field("steps", &V::steps, "", "integration steps")
+          .field("time_step_s", &V::time_step_s, "s", "the integration step")
+          .field("solve_time_s", &V::wall_time_s, "s", "wall time")
+          .field("time_s", &V::time_s, "s", "the co-simulation's samples", base::kCodecOnly)
+          .field("site_displacement_m", &V::site_displacement_m, "m",
+                 "displacement about the static offset at the first damper's site, per sample", base::kCodecOnly)
+          .field("settling", &V::settling, "", "the envelope and its settling", base::kCodecOnly)
+          .field("warnings", &V::warnings, "", "the co-simulation's warnings", base::kCodecOnly);
+  return f;
 }
-void from_json(const json& j, VerifiedDecay& v) {
-  auto& s = v.settling;
-  j.at(0).get_to(v.time_s);
-  j.at(1).get_to(v.site_displacement_m);
-  j.at(2).get_to(s.envelope_time_s);
-  j.at(3).get_to(s.envelope_m);
-  j.at(4).get_to(s.sample_envelope_m);
-  j.at(5).get_to(s.settling_time_s);
-  j.at(6).get_to(s.frequency_hz);
-  j.at(7).get_to(s.damping_ratio);
-  j.at(8).get_to(v.threshold_m);
-  j.at(9).get_to(v.initial_envelope_m);
-  j.at(10).get_to(v.energy_error);
-  j.at(11).get_to(v.dem_dissipated_j);
-  j.at(12).get_to(v.structural_dissipated_j);
-  j.at(13).get_to(v.steps);
-  j.at(14).get_to(v.time_step_s);
-  j.at(15).get_to(v.wall_time_s);
-  j.at(16).get_to(v.warnings);
+
+const base::Fields<VerifiedDecay>& VerifiedDecay::summary_fields() {
+  static const auto f = fields().view(
+      {"settled", "settling_time_s", "objective", "end_envelope_m", "energy_error", "steps", "time_step_s", "solve_time_s"});
+  return f;
+}
+
+const base::Fields<SofteningCheck>& SofteningCheck::fields() {
+  using S = SofteningCheck;
+  static const auto f =
+      base::Fields<S>()
+          .field("stiffness_softening", &S::stiffness_softening, "1", "the stiffer run's verify softening")
+          .field("dem", &S::dem, VerifiedDecay::summary_fields(), "the DEM decay with contacts ten times stiffer")
+          .derived("compared", [](const S& s) { return s.agreement.compared; }, "",
+                   "objective, end_envelope or settled_only_one")
+          .derived("relative_difference", [](const S& s) { return s.agreement.relative_difference; }, "1",
+                   "(judged - stiffer)/stiffer", base::kNullable)
+          .derived("converged", [](const S& s) { return s.agreement.within; }, "",
+                   "the two agree within the tolerance");
+  return f;
+}
+
+const base::Fields<DesignCheck>& DesignCheck::fields() {
+  using D = DesignCheck;
+  static const auto f =
+      base::Fields<D>()
+          .derived("slabs", [](const D& d) { return d.design.slabs(); }, "", "the slabs of each layer")
+          .field("particles", &D::particles, "", "spheres in all layers")
+          .derived("bed_mass_kg", [](const D& d) { return d.design.total_mass_kg; }, "kg", "particle mass")
+          .group("predicted", "the prediction over the verification's duration",
+                 base::Fields<D>()
+                     .derived("settled", [](const D& d) { return d.predicted.settled; }, "",
+                              "the predicted decay settles within the duration")
+                     .derived("settling_time_s", [](const D& d) { return d.predicted.settling_time_s; }, "s",
+                              "predicted settling time (null: not settled)", base::kNullable)
+                     .field("objective", &D::predicted_objective, "s or m2_s", "the predicted objective",
+                            base::kNullable)
+                     .field("end_envelope_m", &D::predicted_end_envelope_m, "m",
+                            "the predicted envelope at the end", base::kNullable))
+          .field("dem", &D::dem, "", "the DEM-in-the-loop decay")
+          .derived("compared", [](const D& d) { return d.agreement.compared; }, "",
+                   "objective, end_envelope or settled_only_one")
+          .derived("relative_difference", [](const D& d) { return d.agreement.relative_difference; }, "1",
+                   "(DEM - predicted)/predicted", base::kNullable)
+          .field("passed", &D::passed, "", "within the tolerance, and the softening check's if run")
+          .field("softening_check", &D::softening_check, "", "the same decay ten times stiffer", base::kOmitEmpty);
+  return f;
+}
+
+const base::Fields<Verification>& Verification::fields() {
+  using V = Verification;
+  static const auto f =
+      base::Fields<V>()
+          .derived("method", [](const V&) { return std::string("dem"); }, "", "the judge: the DEM in the loop")
+          .derived("what",
+                   [](const V&) {
+                     return std::string(
+                         "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
+                         "optimiser's modal model, from the task's initial state, against the prediction (the "
+                         "optimiser's bed models) over the same time");
+                   },
+                   "", "what was run")
+          .derived("objective",
+                   [](const V& v) { return std::string(v.settling_objective ? "settling_time" : "integral_square"); },
+                   "", "settling_time or integral_square")
+          .derived("duration_s", [](const V& v) { return v.spec.duration_s; }, "s", "each DEM decay's duration")
+          .derived("tolerance_relative", [](const V& v) { return v.spec.tolerance_relative; }, "1",
+                   "the largest relative difference that passes")
+          .derived("stiffness_softening", [](const V& v) { return v.spec.stiffness_softening; }, "1",
+                   "the verification's softening, on top of the case's")
+          .field("dem_stiffness_softening", &V::dem_stiffness_softening, "1", "the case's /dem softening")
+          .derived("effective_stiffness_softening",
+                   [](const V& v) { return v.dem_stiffness_softening * v.spec.stiffness_softening; }, "1",
+                   "the softening the judged runs ran at")
+          .derived("require_ranking", [](const V& v) { return v.spec.require_ranking; }, "",
+                   "the DEM must rank the chosen design ahead")
+          .group("softening_check", "the check that the softening has converged",
+                 base::Fields<V>()
+                     .field("kind", &V::softening_check, "", "two_softenings, full_stiffness or off")
+                     .derived("rule",
+                              [](const V&) {
+                                return std::string(
+                                    "each design again with contacts ten times stiffer (at most full stiffness); "
+                                    "converged when the two DEM objectives agree within tolerance_relative");
+                              },
+                              "", "the rule")
+                     .field("converged", &V::softening_converged, "", "every design's check agreed"))
+          .derived("designs",
+                   [](const V& v) {
+                     json designs = json::object();
+                     for (const auto& d : v.designs) designs[d.name] = base::to_json(d);
+                     return designs;
+                   },
+                   "", "each design's check, by name (chosen, baseline)")
+          .group("ranking", "the designs' order",
+                 base::Fields<V>()
+                     .field("predicted_chosen_ahead", &V::predicted_chosen_ahead, "",
+                            "the prediction ranks the chosen design ahead")
+                     .field("dem_chosen_ahead", &V::dem_chosen_ahead, "", "the DEM ranks the chosen design ahead")
+                     .field("passed", &V::ranking_passed, "", "= dem_chosen_ahead"))
+          .field("passed", &V::passed, "", "every design passed, and the ranking when required")
+          .field("wall_time_s", &V::wall_time_s, "s", "wall time of the verification")
+          .field("mpi", &V::mpi, "", "how the decays spread over processes", base::kOmitEmpty);
+  return f;
+}
+
+const base::Fields<VerificationRound::Design>& VerificationRound::Design::fields() {
+  using D = VerificationRound::Design;
+  static const auto f =
+      base::Fields<D>()
+          .field("slabs", &D::slabs, "", "the slabs of each layer")
+          .field("predicted_objective", &D::predicted_objective, "s or m2_s", "the predicted objective",
+                 base::kNullable)
+          .field("dem_objective", &D::dem_objective, "s or m2_s", "the DEM's objective", base::kNullable)
+          .field("predicted_end_envelope_m", &D::predicted_end_envelope_m, "m", "the predicted envelope at the end",
+                 base::kNullable)
+          .field("dem_end_envelope_m", &D::dem_end_envelope_m, "m", "the DEM's envelope at the end", base::kNullable)
+          .field("compared", &D::compared, "", "objective, end_envelope or settled_only_one")
+          .field("relative_difference", &D::relative_difference, "1", "(DEM - predicted)/predicted", base::kNullable)
+          .field("passed", &D::passed, "", "within the tolerance");
+  return f;
+}
+
+const base::Fields<VerificationRound>& VerificationRound::fields() {
+  using R = VerificationRound;
+  static const auto f =
+      base::Fields<R>()
+          .field("round", &R::round, "", "1, 2, ...")
+          .derived("designs",
+                   [](const R& r) {
+                     json designs = json::object();
+                     for (const auto& d : r.designs) designs[d.name] = base::to_json(d);
+                     return designs;
+                   },
+                   "", "each design verified, by name")
+          .field("ranking_passed", &R::ranking_passed, "", "the DEM ranks the chosen design ahead")
+          .field("passed", &R::passed, "", "the round's verification passed")
+          .field("recalibrated", &R::recalibrated, "", "the beds recalibrated after it (empty: the loop ended)");
+  return f;
 }
 
 namespace {
@@ -124,7 +274,7 @@ std::vector<long> whole_slabs(const opt::FillingDesign& design) {
 /// asked to verify a design checks that its own optimisation chose the same.
 double design_fingerprint(const opt::FillingDesign& design) {
   double fingerprint = 0.0, place = 1.0;
-  for (const double n : slabs_of(design)) fingerprint += n * place, place *= 1000.0;
+  for (const double n : design.slabs()) fingerprint += n * place, place *= 1000.0;
   return fingerprint;
 }
 
@@ -138,7 +288,7 @@ DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const 
   checkpoint.file = {o.checkpoint_dir / ("verify_" + name + suffix + ".checkpoint"), o.resume};
   checkpoint.kind = "verify_" + name + suffix;
   std::ostringstream design_text;
-  for (double n : slabs_of(design)) design_text << ' ' << n;
+  for (double n : design.slabs()) design_text << ' ' << n;
   design_text << "; softening " << softening;
   checkpoint.settings = "design" + design_text.str();
   // A design that completed before the interruption left no checkpoint: it runs again.
@@ -235,15 +385,15 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   out.name = name;
   out.design = design;
   for (const auto& l : design.layers) out.particles += static_cast<int>(std::lround(l.particles));
-  const std::vector<double> slabs = slabs_of(design);
+  const std::vector<double> slabs = design.slabs();
   opt::FillingRatioOptions options = p.options;
   options.decay.duration_s = verify.duration_s;
   options.decay.initial_modal_amplitudes = modes.initial_modal_displacements.cwiseAbs();  // released from rest
   out.predicted = opt::evaluate_filling_design(modes.modal, options, slabs);
   out.predicted_objective = settling_objective(p) ? out.predicted.settling_time_s : out.predicted.integral_square_m2_s;
   out.dem = std::move(dem);
-  out.dem_end_envelope_m = end_envelope(out.dem);
-  out.dem_objective = dem_objective(p, out.dem);
+  out.dem.end_envelope_m = end_envelope(out.dem);
+  out.dem.objective = dem_objective(p, out.dem);
 
   // The prediction at the DEM's instants (its envelope for the plot and the end value).
   st::FreeDecayOptions at_samples = options.decay;
@@ -257,14 +407,14 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
   for (const auto& s : curve.samples) out.predicted_envelope_m.push_back(s.threshold_measure_m);
   out.predicted_end_envelope_m = out.predicted_envelope_m.empty() ? NAN : out.predicted_envelope_m.back();
 
-  out.agreement = agreement(out.dem_objective, out.dem_end_envelope_m, out.predicted_objective,
+  out.agreement = agreement(out.dem.objective, out.dem.end_envelope_m, out.predicted_objective,
                             out.predicted_end_envelope_m, verify.tolerance_relative);
   out.passed = out.agreement.within;
   if (stiffer) {
-    stiffer->dem_objective = dem_objective(p, stiffer->dem);
-    stiffer->dem_end_envelope_m = end_envelope(stiffer->dem);
-    stiffer->agreement = agreement(out.dem_objective, out.dem_end_envelope_m, stiffer->dem_objective,
-                                   stiffer->dem_end_envelope_m, verify.tolerance_relative);
+    stiffer->dem.objective = dem_objective(p, stiffer->dem);
+    stiffer->dem.end_envelope_m = end_envelope(stiffer->dem);
+    stiffer->agreement = agreement(out.dem.objective, out.dem.end_envelope_m, stiffer->dem.objective,
+                                   stiffer->dem.end_envelope_m, verify.tolerance_relative);
     out.passed = out.passed && stiffer->agreement.within;
     out.softening_check = std::move(stiffer);
   }
@@ -309,7 +459,7 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   }
   const auto run_key = [&](std::size_t k) {
     std::ostringstream key;
-    for (const double n : slabs_of(*designs[k % 2].second)) key << n << ' ';
+    for (const double n : designs[k % 2].second->slabs()) key << n << ' ';
     key << "softening " << softening_of(k);
     return key.str();
   };
@@ -345,99 +495,11 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   const DesignCheck& b = v.designs[1];
   v.predicted_chosen_ahead = ahead(a.predicted_objective, a.predicted_end_envelope_m, b.predicted_objective,
                                    b.predicted_end_envelope_m);
-  v.dem_chosen_ahead = ahead(a.dem_objective, a.dem_end_envelope_m, b.dem_objective, b.dem_end_envelope_m);
+  v.dem_chosen_ahead = ahead(a.dem.objective, a.dem.end_envelope_m, b.dem.objective, b.dem.end_envelope_m);
   v.ranking_passed = v.dem_chosen_ahead;
   v.passed = a.passed && b.passed && (!verify.require_ranking || v.ranking_passed);
   v.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return v;
-}
-
-json design_json(const opt::FillingDesign& d) {
-  json layers = json::array();
-  for (const auto& l : d.layers)
-    layers.push_back({{"name", l.name},
-                      {"slabs", number_or_null(l.slabs)},
-                      {"particles", l.particles},
-                      {"filling_ratio", number_or_null(l.filling_ratio)},
-                      {"volume_fraction", l.volume_fraction},
-                      {"clearance_m", l.clearance_m},
-                      {"bed_mass_kg", l.bed_mass_kg}});
-  return {{"layers", layers},
-          {"total_mass_kg", d.total_mass_kg},
-          {"feasible", d.feasible},
-          {"settled", d.settled},
-          {"settling_time_s", number_or_null(d.settling_time_s)},
-          {"integral_square_m2_s", number_or_null(d.integral_square_m2_s)},
-          {"objective", d.objective}};
-}
-
-json verification_json(const Verification& v) {
-  json designs = json::object();
-  for (const auto& d : v.designs) {
-    designs[d.name] = {
-        {"slabs", slabs_of(d.design)},
-        {"particles", d.particles},
-        {"bed_mass_kg", d.design.total_mass_kg},
-        {"predicted", {{"settled", d.predicted.settled},
-                       {"settling_time_s", number_or_null(d.predicted.settling_time_s)},
-                       {"objective", number_or_null(d.predicted_objective)},
-                       {"end_envelope_m", number_or_null(d.predicted_end_envelope_m)}}},
-        {"dem", {{"settled", std::isfinite(d.dem.settling.settling_time_s)},
-                 {"outcome", std::isfinite(d.dem.settling.settling_time_s) ? "settled" : "not_settled"},
-                 {"settling_time_s", number_or_null(d.dem.settling.settling_time_s)},
-                 {"objective", number_or_null(d.dem_objective)},
-                 {"end_envelope_m", number_or_null(d.dem_end_envelope_m)},
-                 {"damping_ratio", number_or_null(d.dem.settling.damping_ratio)},
-                 {"threshold_m", d.dem.threshold_m},
-                 {"initial_envelope_m", d.dem.initial_envelope_m},
-                 {"energy_error", d.dem.energy_error},
-                 {"dem_dissipated_energy_j", d.dem.dem_dissipated_j},
-                 {"structural_dissipated_energy_j", d.dem.structural_dissipated_j},
-                 {"steps", d.dem.steps},
-                 {"time_step_s", d.dem.time_step_s},
-                 {"solve_time_s", d.dem.wall_time_s}}},
-        {"compared", to_string(d.agreement.compared)},
-        {"relative_difference", number_or_null(d.agreement.relative_difference)},
-        {"passed", d.passed}};
-    if (const auto& s = d.softening_check)
-      designs[d.name]["softening_check"] = {
-          {"stiffness_softening", s->stiffness_softening},
-          {"dem", {{"settled", std::isfinite(s->dem.settling.settling_time_s)},
-                   {"settling_time_s", number_or_null(s->dem.settling.settling_time_s)},
-                   {"objective", number_or_null(s->dem_objective)},
-                   {"end_envelope_m", number_or_null(s->dem_end_envelope_m)},
-                   {"energy_error", s->dem.energy_error},
-                   {"steps", s->dem.steps},
-                   {"time_step_s", s->dem.time_step_s},
-                   {"solve_time_s", s->dem.wall_time_s}}},
-          {"compared", to_string(s->agreement.compared)},
-          {"relative_difference", number_or_null(s->agreement.relative_difference)},
-          {"converged", s->agreement.within}};
-  }
-  const auto& verify = v.spec;
-  json out = {{"method", "dem"},
-              {"what", "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
-                       "optimiser's modal model, from the task's initial state, against the prediction (the optimiser's bed models) over "
-                       "the same time"},
-              {"objective", v.settling_objective ? "settling_time" : "integral_square"},
-              {"duration_s", verify.duration_s},
-              {"tolerance_relative", verify.tolerance_relative},
-              {"stiffness_softening", verify.stiffness_softening},
-              {"dem_stiffness_softening", v.dem_stiffness_softening},
-              {"effective_stiffness_softening", v.dem_stiffness_softening * verify.stiffness_softening},
-              {"require_ranking", verify.require_ranking},
-              {"softening_check", {{"kind", to_string(v.softening_check)},
-                                   {"rule", "each design again with contacts ten times stiffer (at most full stiffness); "
-                                            "converged when the two DEM objectives agree within tolerance_relative"},
-                                   {"converged", v.softening_converged}}},
-              {"designs", designs},
-              {"ranking", {{"predicted_chosen_ahead", v.predicted_chosen_ahead},
-                           {"dem_chosen_ahead", v.dem_chosen_ahead},
-                           {"passed", v.ranking_passed}}},
-              {"passed", v.passed},
-              {"wall_time_s", v.wall_time_s}};
-  if (!v.mpi.is_null()) out["mpi"] = v.mpi;
-  return out;
 }
 
 /// The closed-form envelopes of the chosen, baseline and starting designs and of the
@@ -447,7 +509,7 @@ DesignComparison compare_designs(const case_file::FillingRatioProblem& p, const 
   decay.sample_times_s = st::uniform_sample_times(decay.duration_s, kComparisonSamples);
   DesignComparison out;
   for (const auto* d : {&r.chosen, &r.baseline, &r.initial, &r.bare}) {
-    std::vector<st::Damper> dampers = {opt::filling_damper(p.options, slabs_of(*d))};
+    std::vector<st::Damper> dampers = {opt::filling_damper(p.options, d->slabs())};
     dampers.insert(dampers.end(), p.options.fixed_dampers.begin(), p.options.fixed_dampers.end());
     out.decays.push_back(st::free_decay(p.modal, dampers, decay));
   }
@@ -462,43 +524,15 @@ VerificationRound round_summary(int round, const Verification& v) {
   VerificationRound out;
   out.round = round;
   for (const auto& d : v.designs)
-    out.designs.push_back({d.name, slabs_of(d.design), d.predicted_objective, d.dem_objective,
-                           d.predicted_end_envelope_m, d.dem_end_envelope_m, d.agreement.compared,
+    out.designs.push_back({d.name, d.design.slabs(), d.predicted_objective, d.dem.objective,
+                           d.predicted_end_envelope_m, d.dem.end_envelope_m, d.agreement.compared,
                            d.agreement.relative_difference, d.passed});
   out.ranking_passed = v.ranking_passed;
   out.passed = v.passed;
   return out;
 }
 
-json rounds_json(const std::vector<VerificationRound>& rounds) {
-  json out = json::array();
-  for (const auto& r : rounds) {
-    json designs = json::object();
-    for (const auto& d : r.designs)
-      designs[d.name] = {{"slabs", d.slabs},
-                         {"predicted_objective", number_or_null(d.predicted_objective)},
-                         {"dem_objective", number_or_null(d.dem_objective)},
-                         {"predicted_end_envelope_m", number_or_null(d.predicted_end_envelope_m)},
-                         {"dem_end_envelope_m", number_or_null(d.dem_end_envelope_m)},
-                         {"compared", to_string(d.compared)},
-                         {"relative_difference", number_or_null(d.relative_difference)},
-                         {"passed", d.passed}};
-    out.push_back({{"round", r.round},
-                   {"designs", designs},
-                   {"ranking_passed", r.ranking_passed},
-                   {"passed", r.passed},
-                   {"recalibrated", r.recalibrated}});
-  }
-  return out;
-}
-
 }  // namespace
-
-std::vector<double> slabs_of(const opt::FillingDesign& d) {
-  std::vector<double> n;
-  for (const auto& l : d.layers) n.push_back(l.slabs);
-  return n;
-}
 
 FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions& o, base::RunHooks& hooks, base::Executor& executor) {
   const case_file::FillingRatiosTask& task = *c.task.filling_ratios;
@@ -633,9 +667,7 @@ json to_json(const FillingRatiosResult& res) {
   const auto& r = res.optimum;
   const auto& p = res.problem;
   json neighbours = json::array();
-  for (const auto& d : r.neighbours)
-    neighbours.push_back({{"slabs", slabs_of(d)}, {"objective", d.objective}, {"settling_time_s", number_or_null(d.settling_time_s)},
-                          {"total_mass_kg", d.total_mass_kg}});
+  for (const auto& d : r.neighbours) neighbours.push_back(opt::FillingDesign::neighbour_fields().to_json(d));
   const auto& s = r.summary;
   const std::string unit = p.options.objective == opt::FillingObjective::kSettlingTime ? "s" : "m2_s";
   json result = {
@@ -646,13 +678,13 @@ json to_json(const FillingRatiosResult& res) {
       {"mass_budget_kg", res.mass_budget_kg},
       {"objective", {{"kind", std::string(opt::to_string(p.options.objective))}, {"unit", unit},
                      {"value", r.chosen.objective}}},
-      {"design", design_json(r.chosen)},
-      {"designs", {{"chosen", design_json(r.chosen)},
-                   {"relaxed", design_json(r.relaxed)},
-                   {"baseline", design_json(r.baseline)},
-                   {"initial", design_json(r.initial)},
-                   {"bare", design_json(r.bare)},
-                   {"same_mass", design_json(r.same_mass)}}},
+      {"design", base::to_json(r.chosen)},
+      {"designs", {{"chosen", base::to_json(r.chosen)},
+                   {"relaxed", base::to_json(r.relaxed)},
+                   {"baseline", base::to_json(r.baseline)},
+                   {"initial", base::to_json(r.initial)},
+                   {"bare", base::to_json(r.bare)},
+                   {"same_mass", base::to_json(r.same_mass)}}},
       {"references", {{"baseline", "the best single layer of the case's containers within the budget"},
                       {"bare", "the structure with the damper's containers empty"},
                       {"same_mass", "the chosen design's particle mass in one compartment at its own best clearance"}}},
@@ -676,9 +708,9 @@ json to_json(const FillingRatiosResult& res) {
       {"decay_evaluations", r.decay_evaluations},
       {"solve_time_s", r.solve_time_s}};
   result["calibration"] = res.calibration ? to_json(*res.calibration) : json(nullptr);
-  result["verification"] = res.verification ? verification_json(*res.verification) : json(nullptr);
+  result["verification"] = res.verification ? base::to_json(*res.verification) : json(nullptr);
   result["design_loop"] = res.rounds.empty() ? json(nullptr)
-                                             : json{{"rounds", rounds_json(res.rounds)}, {"outcome", to_string(*res.loop_outcome)}};
+                                             : json{{"rounds", base::to_json(res.rounds)}, {"outcome", to_string(*res.loop_outcome)}};
   return result;
 }
 

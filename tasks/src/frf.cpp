@@ -8,7 +8,6 @@
 #include <map>
 #include <numbers>
 
-#include "job_codecs.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/tasks/case_checks.hpp"
@@ -130,12 +129,12 @@ HarmonicFrf compared_response(const Case& c, detail::Setup& setup) {
 /// steady state, the case's DEM settings; the excitation checked (InputError naming /task/excitation).
 st::CosimulationOptions dem_frf_options(const Case& c, const st::ModalModel& modal, const st::SteadyStateSettling& settling) {
   const auto& task = *c.task.frf;
-  const bool base = base_excitation(c);
+  const bool base_motion = base_excitation(c);
   st::CosimulationOptions options;
-  options.excitation.kind = base ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
+  options.excitation.kind = base_motion ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
   options.excitation.direction = {task.direction[0], task.direction[1]};
-  options.excitation.amplitude = base ? task.base_amplitude_m : task.force_amplitude_n;
-  options.excitation.point = base ? std::string() : task.force_point;
+  options.excitation.amplitude = base_motion ? task.base_amplitude_m : task.force_amplitude_n;
+  options.excitation.point = base_motion ? std::string() : task.force_point;
   options.analysed_periods = c.dem.simulation.analysed_periods;
   options.bed_settling_time_s = c.dem.simulation.settling_time_s;
   task_excitation(c, modal);  // the excitation's own checks first
@@ -368,60 +367,62 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
   return out;
 }
 
-json peaks_json(const std::vector<st::ResponsePeak>& peaks, const std::vector<std::string>& names) {
-  json out = json::array();
-  for (const auto& p : peaks)
-    out.push_back({{"output", p.output < names.size() ? names[p.output] : std::to_string(p.output)},
-                   {"frequency_hz", p.frequency_hz},
-                   {"magnitude", p.magnitude},
-                   {"damping_ratio", number_or_null(p.damping_ratio)},
-                   {"band_centre_hz", number_or_null(p.band_centre_hz)}});
+/// A branch's resonance of output `output` named `name`.
+DemPeak dem_peak(const std::string& name, const st::SteppedSineBranch& branch, const st::SteppedSinePeak& bp) {
+  const st::SteppedSinePoint& top = *bp.ascending[bp.peak.index];
+  DemPeak out;
+  out.output = name;
+  out.sweep = branch.sweep;
+  out.frequency_hz = bp.peak.frequency_hz;
+  out.largest_point_frequency_hz = top.frequency_hz;
+  out.magnitude = bp.peak.magnitude;
+  if (bp.output == 0) out.magnitude_standard_error = top.standard_error;
+  out.band_low_hz = bp.peak.band.low_hz;
+  out.band_high_hz = bp.peak.band.high_hz;
+  out.band_centre_hz = bp.peak.band_centre_hz;
+  out.indistinguishable_low_hz = bp.peak.indistinguishable_low_hz;
+  out.indistinguishable_high_hz = bp.peak.indistinguishable_high_hz;
+  out.damping_ratio = bp.peak.damping_ratio;
   return out;
 }
 
-/// A branch's resonance measures of one output as JSON (sampled_response.hpp).
-json dem_peak_json(const std::string& output, const st::SteppedSineBranch& branch, const st::SteppedSinePeak& bp) {
-  const st::SteppedSinePoint& top = *bp.ascending[bp.peak.index];
-  return {{"output", output},
-          {"sweep", st::to_string(branch.sweep)},
-          {"frequency_hz", bp.peak.frequency_hz},
-          {"largest_point_frequency_hz", top.frequency_hz},
-          {"magnitude", bp.peak.magnitude},
-          {"magnitude_standard_error", bp.output == 0 ? number_or_null(top.standard_error) : json(nullptr)},
-          {"band_low_hz", number_or_null(bp.peak.band.low_hz)},
-          {"band_high_hz", number_or_null(bp.peak.band.high_hz)},
-          {"band_centre_hz", number_or_null(bp.peak.band_centre_hz)},
-          {"indistinguishable_low_hz", bp.peak.indistinguishable_low_hz},
-          {"indistinguishable_high_hz", bp.peak.indistinguishable_high_hz},
-          {"damping_ratio", number_or_null(bp.peak.damping_ratio)}};
+/// A linear sweep's resonance of output `output` named `name` (NaN where none was found).
+DemPeak sweep_peak(const std::string& name, const st::LinearSineSweep& s, std::size_t output) {
+  const st::SweepPeak& sp = s.peaks[output];
+  DemPeak out;
+  out.output = name;
+  out.sweep = s.sweep;
+  if (!sp.found()) return out;
+  out.frequency_hz = sp.peak.frequency_hz;
+  out.magnitude = sp.peak.magnitude;
+  out.magnitude_standard_error = sp.standard_error();
+  out.band_low_hz = sp.peak.band.low_hz;
+  out.band_high_hz = sp.peak.band.high_hz;
+  out.band_centre_hz = sp.peak.band_centre_hz;
+  out.damping_ratio = sp.peak.damping_ratio;
+  return out;
 }
 
-/// Relative differences of a method's largest first-output peak from a DEM branch's, for
-/// the peak (argmax) frequency, the 0.9 band's centre and the magnitude.
-json agreement_json(const st::ResponsePeak* peak, const st::SampledPeak& dem) {
-  if (!peak) return nullptr;
-  const auto relative = [](double a, double b) { return number_or_null((a - b) / b); };
-  return {{"frequency_hz", peak->frequency_hz},
-          {"band_centre_hz", number_or_null(peak->band_centre_hz)},
-          {"magnitude", peak->magnitude},
-          {"frequency_relative_difference", relative(peak->frequency_hz, dem.frequency_hz)},
-          {"band_centre_relative_difference", relative(peak->band_centre_hz, dem.band_centre_hz)},
-          {"magnitude_relative_difference", relative(peak->magnitude, dem.magnitude)},
-          {"damping_ratio", number_or_null(peak->damping_ratio)},
-          {"dem_damping_ratio", number_or_null(dem.damping_ratio)},
-          {"frequency_within_dem_indistinguishable",
-           peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz}};
-}
-
-json names_json(const std::vector<std::string>& names) {
-  json n = json::array();
-  for (const auto& name : names) n.push_back(name);
-  return n;
+/// How a method's largest first-output peak agrees with a DEM branch's (none without a peak).
+std::optional<PeakAgreement> peak_agreement(const st::ResponsePeak* peak, const st::SampledPeak& dem) {
+  if (!peak) return std::nullopt;
+  PeakAgreement a;
+  a.frequency_hz = peak->frequency_hz;
+  a.band_centre_hz = peak->band_centre_hz;
+  a.magnitude = peak->magnitude;
+  a.frequency_relative_difference = (peak->frequency_hz - dem.frequency_hz) / dem.frequency_hz;
+  a.band_centre_relative_difference = (peak->band_centre_hz - dem.band_centre_hz) / dem.band_centre_hz;
+  a.magnitude_relative_difference = (peak->magnitude - dem.magnitude) / dem.magnitude;
+  a.damping_ratio = peak->damping_ratio;
+  a.dem_damping_ratio = dem.damping_ratio;
+  a.frequency_within_dem_indistinguishable =
+      peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz;
+  return a;
 }
 
 json harmonic_result(const FrfResult& r, const HarmonicFrf& h, const OutputFolder& folder) {
   const auto& response = h.response;
-  const bool base = r.base_excitation;
+  const bool base_motion = r.base_excitation;
   std::size_t held = 0;
   for (const auto& p : response.points)
     if (!p.held_at_jump.empty()) ++held;
@@ -452,21 +453,21 @@ json harmonic_result(const FrfResult& r, const HarmonicFrf& h, const OutputFolde
     if (e.kind == st::BranchEnd::Kind::kFold) j["other_branch"] = e.other_branch_id;
     jumps.push_back(std::move(j));
   }
-  const json peaks = peaks_json(response.peaks, response.output_names);
+  const json peaks = base::to_json(peak_summaries(response.peaks, response.output_names));
   json frf = {{"file", folder.file("frf.csv")},
               {"branches_file", folder.file("frf_branches.csv")},
               {"plot", folder.file("frf.png")},
               {"method", case_file::to_string(h.method)},
               {"outputs", response.output_names},
-              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude)"
+              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude)"
                                  : "receptance |X/F| in m/N"},
-              {"excitation", base ? "base" : "force"},
+              {"excitation", base_motion ? "base" : "force"},
               {"frequencies", {{"min_hz", response.points.front().frequency_hz},
                                {"max_hz", response.points.back().frequency_hz},
                                {"points", response.points.size()},
                                {"spacing", h.spacing == surrogate::AxisSpacing::kLog ? "log" : "linear"}}},
               {"peaks", peaks},
-              {"linear_peaks", peaks_json(response.linear_peaks, response.output_names)},
+              {"linear_peaks", base::to_json(peak_summaries(response.linear_peaks, response.output_names))},
               {"jumps", jumps},
               {"branches", branches},
               {"held_at_jump_points", held},
@@ -489,39 +490,14 @@ const char* const kConvergenceRule =
     "amplitude and its change across the window are at most stable_tolerance of the window's mean; otherwise after "
     "max_transient_periods, and the point is converged = false";
 
-/// A point's convergence window (SteppedSinePoint::window_*) and its per-period magnitudes.
-json convergence_json(const st::SteppedSinePoint& p) {
-  return {{"window_periods", p.window_periods},
-          {"max_relative_change", number_or_null(p.window_max_relative_change)},
-          {"relative_drift", number_or_null(p.window_relative_drift)},
-          {"relative_spread", number_or_null(p.window_relative_spread)},
-          {"period_magnitudes", p.period_magnitudes}};
-}
-
 json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFolder& folder) {
-  const bool base = r.base_excitation;
+  const bool base_motion = r.base_excitation;
   const auto& names = s.damper_names;
   json peaks = json::array(), list = json::array();
   for (const auto& branch : s.branches) {
     for (std::size_t d = 0; d < names.size(); ++d)
-      peaks.push_back(dem_peak_json(names[d], branch, st::stepped_sine_peak(branch, d)));
-    for (const auto& p : branch.points) {
-      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
-      for (std::size_t d = 0; d < names.size(); ++d) {
-        magnitude[names[d]] = p.magnitude[d], phase[names[d]] = p.phase_deg[d];
-        eta[names[d]] = number_or_null(p.bed_eta_star[d]);
-        mass[names[d]] = number_or_null(p.bed_apparent_mass_fraction[d]);
-      }
-      list.push_back({{"sweep", st::to_string(p.sweep)}, {"frequency_hz", p.frequency_hz}, {"requested_frequency_hz", p.requested_frequency_hz},
-                      {"magnitude", magnitude}, {"phase_deg", phase},
-                      {"bed_eta_star", eta}, {"bed_apparent_mass_fraction", mass},
-                      {"magnitude_spread", number_or_null(p.spread)},
-                      {"magnitude_standard_error", number_or_null(p.standard_error)}, {"energy_error", p.energy_error},
-                      {"transient_periods", p.transient_periods}, {"analysed_periods", p.analysed_periods},
-                      {"periods", p.periods()}, {"converged", p.converged}, {"stable", p.stable},
-                      {"convergence", convergence_json(p)}, {"steps", p.steps},
-                      {"time_step_s", p.time_step_s}, {"solve_time_s", p.wall_time_s}});
-    }
+      peaks.push_back(base::to_json(dem_peak(names[d], branch, st::stepped_sine_peak(branch, d))));
+    for (const auto& p : branch.points) list.push_back(base::to_json(p, &names));
   }
   const std::string bed_state =
       "each direction (up, down) continues from frequency to frequency with the previous one's final state: modes "
@@ -532,10 +508,10 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
   json frf = {{"file", folder.file("frf_dem.csv")},
               {"plot", folder.file("frf_dem.png")},
               {"method", "dem"},
-              {"outputs", names_json(names)},
-              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic"
+              {"outputs", names},
+              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic"
                                  : "receptance |X/F| in m/N, first harmonic"},
-              {"excitation", base ? "base" : "force"},
+              {"excitation", base_motion ? "base" : "force"},
               {"frequencies", {{"min_hz", s.frequencies_hz.front()}, {"max_hz", s.frequencies_hz.back()},
                                {"points", s.frequencies_hz.size()}, {"spacing", "linear"}}},
               {"points", list},
@@ -568,50 +544,27 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
 }
 
 json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFolder& folder) {
-  const bool base = r.base_excitation;
+  const bool base_motion = r.base_excitation;
   const auto& names = l.damper_names;
   json peaks = json::array(), list = json::array(), runs = json::array();
   for (const auto& s : l.sweeps) {
-    for (std::size_t d = 0; d < names.size(); ++d) {
-      const st::SweepPeak& sp = s.peaks[d];
-      const auto value = [&](double v) { return sp.found() ? number_or_null(v) : json(nullptr); };
-      peaks.push_back({{"output", names[d]},
-                       {"sweep", st::to_string(s.sweep)},
-                       {"frequency_hz", value(sp.peak.frequency_hz)},
-                       {"magnitude", value(sp.peak.magnitude)},
-                       {"magnitude_standard_error", value(sp.standard_error())},
-                       {"band_low_hz", value(sp.peak.band.low_hz)},
-                       {"band_high_hz", value(sp.peak.band.high_hz)},
-                       {"band_centre_hz", value(sp.peak.band_centre_hz)},
-                       {"damping_ratio", value(sp.peak.damping_ratio)}});
-    }
-    runs.push_back({{"sweep", st::to_string(s.sweep)}, {"start_hz", s.start_hz}, {"end_hz", s.end_hz}, {"rate_hz_per_s", s.rate_hz_s},
-                    {"duration_s", s.duration_s}, {"cycles", s.cycles.size()},
-                    {"start_transient_periods", s.start_transient_periods}, {"start_stable", s.start_stable},
-                    {"energy_error", s.energy_error}, {"steps", s.steps}, {"time_step_s", s.time_step_s},
-                    {"solve_time_s", s.wall_time_s}});
+    for (std::size_t d = 0; d < names.size(); ++d) peaks.push_back(DemPeak::sweep_fields().to_json(sweep_peak(names[d], s, d)));
+    runs.push_back(base::to_json(s));
     for (const auto& cycle : s.cycles) {
-      json magnitude = json::object(), phase = json::object(), eta = json::object(), mass = json::object();
-      for (std::size_t d = 0; d < names.size(); ++d) {
-        magnitude[names[d]] = cycle.site_amplitude_per_excitation[d];
-        phase[names[d]] = std::arg(cycle.site_amplitudes_m[d]) * 180.0 / std::numbers::pi;
-        eta[names[d]] = number_or_null(cycle.bed_reduced_loss_factor[d]);
-        mass[names[d]] = number_or_null(cycle.bed_apparent_mass_fraction[d]);
-      }
-      list.push_back({{"sweep", st::to_string(s.sweep)}, {"time_s", cycle.time_s}, {"frequency_hz", cycle.frequency_hz},
-                      {"magnitude", magnitude}, {"phase_deg", phase}, {"bed_eta_star", eta},
-                      {"bed_apparent_mass_fraction", mass}});
+      json point = base::to_json(cycle, &names);
+      point["sweep"] = st::to_string(s.sweep);
+      list.push_back(std::move(point));
     }
   }
   json frf = {{"file", folder.file("frf_dem_sweep.csv")},
               {"plot", folder.file("frf_dem_sweep.png")},
               {"method", "dem"},
               {"signal", "linear_sweep"},
-              {"outputs", names_json(names)},
-              {"magnitude", base ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic "
+              {"outputs", names},
+              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic "
                                    "of each drive cycle"
                                  : "receptance |X/F| in m/N, first harmonic of each drive cycle"},
-              {"excitation", base ? "base" : "force"},
+              {"excitation", base_motion ? "base" : "force"},
               {"rate_hz_per_s", l.rate_hz_s},
               {"rate_basis", l.rate_basis},
               {"quasi_stationary_ratio_default", 100.0},
@@ -636,30 +589,22 @@ json compare_result(const FrfResult& r, const OutputFolder& folder) {
   const auto& f_response = r.harmonic->response;
   const std::vector<std::string>& names = f_response.output_names;
   const std::string output = names.empty() ? std::string() : names.front();
-  json dem_list = json::array(), dem_peaks = json::array(), agreement = json::array();
+  json dem_list = json::array(), dem_peaks = json::array();
   for (const auto& branch : r.stepped->branches) {
     const st::SteppedSinePeak bp = st::stepped_sine_peak(branch);
-    for (const st::SteppedSinePoint* p : bp.ascending)
-      dem_list.push_back({{"sweep", st::to_string(branch.sweep)}, {"frequency_hz", p->frequency_hz}, {"magnitude", p->magnitude.front()},
-                          {"magnitude_spread", number_or_null(p->spread)},
-                          {"magnitude_standard_error", number_or_null(p->standard_error)},
-                          {"energy_error", p->energy_error}, {"converged", p->converged}, {"stable", p->stable},
-                          {"periods", p->periods()},
-                          {"convergence_max_relative_change", number_or_null(p->window_max_relative_change)}});
-    dem_peaks.push_back(dem_peak_json(output, branch, bp));
-    const json a_formulas = agreement_json(first_output_peak(f_response), bp.peak);
-    const json a_field = r.field ? agreement_json(first_output_peak(r.field->response), bp.peak) : json(nullptr);
-    agreement.push_back({{"reference", "dem " + std::string(st::to_string(branch.sweep))}, {"formulas", a_formulas}, {"field", a_field}});
+    for (const st::SteppedSinePoint* p : bp.ascending) dem_list.push_back(st::SteppedSinePoint::summary_fields().to_json(*p));
+    dem_peaks.push_back(base::to_json(dem_peak(output, branch, bp)));
   }
-  const json f_peaks = peaks_json(f_response.peaks, names);
-  const json field_peaks = r.field ? peaks_json(r.field->response.peaks, r.field->response.output_names) : json(nullptr);
+  const json f_peaks = base::to_json(peak_summaries(f_response.peaks, names));
+  const json field_peaks =
+      r.field ? base::to_json(peak_summaries(r.field->response.peaks, r.field->response.output_names)) : json(nullptr);
   json compare = {
       {"output", output},
       {"formulas", {{"peaks", f_peaks}}},
       {"field", r.field ? json{{"peaks", field_peaks}} : json(nullptr)},
       {"dem", {{"peaks", dem_peaks}, {"points", dem_list}, {"bed_carried_over", true}, {"peak_note", kDemPeakNote}}},
       {"agreement_definition", "(method - dem) / dem of the largest peak of the first output, per DEM sweep direction"},
-      {"agreement", agreement},
+      {"agreement", base::to_json(r.agreement)},
       {"file", folder.file("frf_compare.csv")},
       {"plot", folder.file("frf_compare.png")},
       {"dem_solve_time_s", r.stepped->solve_time_s}};
@@ -672,6 +617,88 @@ json compare_result(const FrfResult& r, const OutputFolder& folder) {
 }
 
 }  // namespace
+
+const base::Fields<PeakSummary>& PeakSummary::fields() {
+  using P = PeakSummary;
+  static const auto f =
+      base::Fields<P>()
+          .field("output", &P::output, "", "the output (a damper's site or a named point)")
+          .field("frequency_hz", &P::frequency_hz, "Hz", "parabola through the largest point and its neighbours")
+          .field("magnitude", &P::magnitude, "1 or m/N", "the largest point's magnitude")
+          .field("damping_ratio", &P::damping_ratio, "1", "half-power width (f2 - f1)/(2 f) (null: a side is missing)",
+                 base::kNullable)
+          .field("band_centre_hz", &P::band_centre_hz, "Hz", "centre of the band at >= 0.9 of the peak",
+                 base::kNullable);
+  return f;
+}
+
+std::vector<PeakSummary> peak_summaries(const std::vector<st::ResponsePeak>& peaks, const std::vector<std::string>& names) {
+  std::vector<PeakSummary> out;
+  for (const auto& p : peaks)
+    out.push_back({p.output < names.size() ? names[p.output] : std::to_string(p.output), p.frequency_hz, p.magnitude,
+                   p.damping_ratio, p.band_centre_hz});
+  return out;
+}
+
+const base::Fields<DemPeak>& DemPeak::fields() {
+  using P = DemPeak;
+  static const auto f =
+      base::Fields<P>()
+          .field("output", &P::output, "", "the damper whose site this is")
+          .field("sweep", &P::sweep, "", "the direction: up or down")
+          .field("frequency_hz", &P::frequency_hz, "Hz", "vertex of the parabola through the largest point and its neighbours",
+                 base::kNullable)
+          .field("largest_point_frequency_hz", &P::largest_point_frequency_hz, "Hz", "the largest point's frequency")
+          .field("magnitude", &P::magnitude, "1 or m/N", "the largest point's magnitude", base::kNullable)
+          .field("magnitude_standard_error", &P::magnitude_standard_error, "1 or m/N",
+                 "its standard error (the first output's only)", base::kNullable)
+          .field("band_low_hz", &P::band_low_hz, "Hz", "low edge of the band at >= 0.9 of the peak", base::kNullable)
+          .field("band_high_hz", &P::band_high_hz, "Hz", "high edge of that band", base::kNullable)
+          .field("band_centre_hz", &P::band_centre_hz, "Hz", "its centre", base::kNullable)
+          .field("indistinguishable_low_hz", &P::indistinguishable_low_hz, "Hz",
+                 "lowest point within two standard errors of the largest")
+          .field("indistinguishable_high_hz", &P::indistinguishable_high_hz, "Hz",
+                 "highest point within two standard errors of the largest")
+          .field("damping_ratio", &P::damping_ratio, "1", "half-power width between the points", base::kNullable);
+  return f;
+}
+
+const base::Fields<DemPeak>& DemPeak::sweep_fields() {
+  static const auto f = fields().view({"output", "sweep", "frequency_hz", "magnitude", "magnitude_standard_error",
+                                       "band_low_hz", "band_high_hz", "band_centre_hz", "damping_ratio"});
+  return f;
+}
+
+const base::Fields<PeakAgreement>& PeakAgreement::fields() {
+  using A = PeakAgreement;
+  static const auto f =
+      base::Fields<A>()
+          .field("frequency_hz", &A::frequency_hz, "Hz", "the method's peak frequency")
+          .field("band_centre_hz", &A::band_centre_hz, "Hz", "the method's 0.9 band centre", base::kNullable)
+          .field("magnitude", &A::magnitude, "1 or m/N", "the method's peak magnitude")
+          .field("frequency_relative_difference", &A::frequency_relative_difference, "1", "(method - dem)/dem",
+                 base::kNullable)
+          .field("band_centre_relative_difference", &A::band_centre_relative_difference, "1", "(method - dem)/dem",
+                 base::kNullable)
+          .field("magnitude_relative_difference", &A::magnitude_relative_difference, "1", "(method - dem)/dem",
+                 base::kNullable)
+          .field("damping_ratio", &A::damping_ratio, "1", "the method's half-power damping ratio", base::kNullable)
+          .field("dem_damping_ratio", &A::dem_damping_ratio, "1", "the DEM's", base::kNullable)
+          .field("frequency_within_dem_indistinguishable", &A::frequency_within_dem_indistinguishable, "",
+                 "the method's peak lies among the DEM points that cannot be told from the largest");
+  return f;
+}
+
+const base::Fields<BranchAgreement>& BranchAgreement::fields() {
+  using B = BranchAgreement;
+  static const auto f =
+      base::Fields<B>()
+          .derived("reference", [](const B& b) { return "dem " + std::string(st::to_string(b.sweep)); }, "",
+                   "the DEM direction compared with")
+          .field("formulas", &B::formulas, "", "the closed forms' agreement (null: no peak)")
+          .field("field", &B::field, "", "the effective fields' agreement (null: no field)");
+  return f;
+}
 
 const st::ResponsePeak* first_output_peak(const st::FrequencyResponse& r) {
   const st::ResponsePeak* best = nullptr;
@@ -740,6 +767,11 @@ FrfResult run_frf(const Case& c, const FrfOptions& options, base::RunHooks& hook
       warnings.add(dem.warnings.list(), "dem: ");
       if (out.stepped->branches.empty() || out.stepped->branches.front().points.empty())
         throw NumericalError("pdamp frf --compare: the DEM sweep returned no points");
+      for (const auto& branch : out.stepped->branches) {
+        const st::SampledPeak dem = st::stepped_sine_peak(branch).peak;
+        out.agreement.push_back({branch.sweep, peak_agreement(first_output_peak(out.harmonic->response), dem),
+                                 out.field ? peak_agreement(first_output_peak(out.field->response), dem) : std::nullopt});
+      }
       out.warnings = warnings.list();
       break;
     }

@@ -5,7 +5,6 @@
 
 #include <cmath>
 
-#include "job_codecs.hpp"
 #include "pdamp/base/input_error.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/surrogate/dem_evaluator.hpp"

@@ -86,11 +86,6 @@ Enumerated enumerate(const st::ModalModel& model, const opt::FillingRatioOptions
   return best;
 }
 
-std::vector<double> slabs_of(const opt::FillingDesign& d) {
-  std::vector<double> n;
-  for (const auto& l : d.layers) n.push_back(l.slabs);
-  return n;
-}
 
 }  // namespace
 
@@ -125,7 +120,7 @@ TEST_CASE("the chosen integer design of two and three layers is the best of an e
     const auto reference = enumerate(model, o);
     INFO("layers " << lengths.size() << ", enumeration of " << reference.points << " points, relaxed objective "
                    << result.relaxed.objective << ", chosen " << result.chosen.objective);
-    CHECK(slabs_of(result.chosen) == reference.slabs);
+    CHECK(result.chosen.slabs() == reference.slabs);
     CHECK(result.chosen.objective == Approx(reference.objective).epsilon(1e-12));
     CHECK(result.neighbours_feasible >= 1);
     CHECK(result.neighbours_feasible <= result.neighbours_total);
@@ -146,7 +141,7 @@ TEST_CASE("NLopt and the Ipopt hybrid choose the same integer design", "[optimiz
   const auto a = opt::optimize_filling_ratios(model, o, nlopt);
   const auto b = opt::optimize_filling_ratios(model, o, ipopt);
   INFO("nlopt: " << a.summary.brief_report() << "\nipopt: " << b.summary.brief_report());
-  CHECK(slabs_of(a.chosen) == slabs_of(b.chosen));
+  CHECK(a.chosen.slabs() == b.chosen.slabs());
   CHECK(a.summary.backend == opt::Backend::kNlopt);
   CHECK(b.summary.backend == opt::Backend::kIpopt);
 }
@@ -205,10 +200,10 @@ TEST_CASE("with calibrated beds every whole-slab design is evaluated on its own 
                                              o.model, o.layers[k].clearance_m(n), options));
   const auto result = opt::optimize_filling_ratios(model, o);
   const auto reference = enumerate(model, o);
-  CHECK(slabs_of(result.chosen) == reference.slabs);
+  CHECK(result.chosen.slabs() == reference.slabs);
   CHECK(result.chosen.objective == reference.objective);
   CHECK(result.neighbours_feasible == reference.points);
-  CHECK(slabs_of(result.relaxed) == reference.slabs);
+  CHECK(result.relaxed.slabs() == reference.slabs);
   // The damper of a design carries the calibrated bed itself.
   const auto damper = opt::filling_damper(o, std::vector<double>{2.0, 0.0, 1.0});
   REQUIRE(damper.layers.size() == 2);

@@ -30,7 +30,7 @@ TEST_CASE("filling ratios: the chosen design is within the budget and its decay 
   const auto& chosen = r.optimum.chosen;
   CHECK(chosen.total_mass_kg <= r.mass_budget_kg * (1.0 + 1e-9));
   for (const auto& l : chosen.layers) CHECK(l.slabs == std::round(l.slabs));
-  const auto again = optimizer::evaluate_filling_design(r.problem.modal, r.problem.options, tasks::slabs_of(chosen));
+  const auto again = optimizer::evaluate_filling_design(r.problem.modal, r.problem.options, chosen.slabs());
   CHECK(again.objective == chosen.objective);
   REQUIRE(r.comparison.decays.size() == 4);  // chosen, baseline, initial, without particles
   CHECK(r.comparison.decays[0].settling_time_s == Approx(chosen.settling_time_s).epsilon(1e-6));
@@ -120,7 +120,7 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
     // 1 s does not settle: the envelopes at the end are compared.
     REQUIRE(s.agreement.compared == tasks::Compared::kEndEnvelope);
     CHECK(s.agreement.relative_difference ==
-          Approx((d.dem_end_envelope_m - s.dem_end_envelope_m) / s.dem_end_envelope_m).epsilon(1e-12));
+          Approx((d.dem.end_envelope_m - s.dem.end_envelope_m) / s.dem.end_envelope_m).epsilon(1e-12));
     CHECK(s.agreement.within == (std::abs(s.agreement.relative_difference) <= v.spec.tolerance_relative));
     CHECK(d.passed == (d.agreement.within && s.agreement.within));
     converged = converged && s.agreement.within;
@@ -167,7 +167,7 @@ TEST_CASE("under axial gravity the verification scores each design on its own mo
     own.decay.duration_s = r.verification->spec.duration_s;
     own.decay.initial_modal_amplitudes =
         case_file::initial_modal_amplitudes(dc, setup, c.task.filling_ratios->decay).cwiseAbs();
-    const auto expected = optimizer::evaluate_filling_design(setup.modal, own, tasks::slabs_of(d.design));
+    const auto expected = optimizer::evaluate_filling_design(setup.modal, own, d.design.slabs());
     CHECK(d.predicted.objective == expected.objective);
   }
 }
@@ -216,7 +216,7 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
   }
   CHECK(tasks::to_json(first)["method"] == "calibrated");
   const auto again = optimizer::evaluate_filling_design(first.problem.modal, first.problem.options,
-                                                        tasks::slabs_of(first.optimum.chosen));
+                                                        first.optimum.chosen.slabs());
   CHECK(again.objective == first.optimum.chosen.objective);
 
   // A verification decay too short to give the design's rate (NaN): the loop has nothing to
@@ -236,7 +236,7 @@ TEST_CASE("calibrated beds: one DEM decay per candidate bed, cached and resumed 
     CHECK(second.calibration->beds[b].cached);
     CHECK(second.calibration->beds[b].field == calibration.beds[b].field);
   }
-  CHECK(tasks::slabs_of(second.optimum.chosen) == tasks::slabs_of(first.optimum.chosen));
+  CHECK(second.optimum.chosen.slabs() == first.optimum.chosen.slabs());
 
   // A damaged file: that bed runs again (the same numbers: the same DEM), with a note.
   { std::ofstream(calibration.beds[4].file) << "{ not json"; }

@@ -8,7 +8,6 @@
 #include "pdamp/base/executor.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "tasks/executor_support.hpp"
-#include "../../tasks/src/job_codecs.hpp"
 
 using namespace pdamp;
 

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/optimizer/summary.hpp"
@@ -95,6 +96,7 @@ struct LayerDesign {
   double clearance_m = 0.0;       ///< h = L − n·k·2r, m
   double bed_mass_kg = 0.0;       ///< m = n·spheres_per_slab·m_sphere, kg
   double particles = 0.0;         ///< n·spheres_per_slab
+  static const base::Fields<LayerDesign>& fields();
 };
 
 struct FillingDesign {
@@ -106,6 +108,10 @@ struct FillingDesign {
   double settling_time_s = 0.0;   ///< NaN when not settled within the duration
   double integral_square_m2_s = 0.0;  ///< ½∫e² dt, m²·s (kIntegralSquare only; else NaN)
   double objective = 0.0;         ///< the minimised value (s or m²·s)
+  std::vector<double> slabs() const;  ///< n_k of each layer
+  static const base::Fields<FillingDesign>& fields();
+  /// A rounded neighbour's summary: slabs, objective, settling time, mass.
+  static const base::Fields<FillingDesign>& neighbour_fields();
 };
 
 struct FillingRatioResult {

@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/container_motion.hpp"
 #include "pdamp/dem_reference/summary.hpp"
@@ -199,6 +200,8 @@ struct CosimulationSweepCycle {
   std::vector<std::complex<double>> bed_force_amplitudes_n;
   std::vector<double> bed_reduced_loss_factor;
   std::vector<double> bed_apparent_mass_fraction;
+  /// A cycle of a result (its per-damper values keyed by the dampers' names).
+  static const base::Fields<CosimulationSweepCycle>& fields();
 };
 
 /// Energy over the coupled run in one inertial frame, J (docs/cosimulation.md §4).

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/sampled_response.hpp"
 
@@ -72,6 +73,10 @@ struct SteppedSinePoint {
   std::int64_t steps = 0;
   double time_step_s = 0.0, wall_time_s = 0.0;
   std::vector<std::string> warnings;  ///< the co-simulation's
+  /// A point of a result (its per-damper values keyed by the dampers' names) and of a job.
+  static const base::Fields<SteppedSinePoint>& fields();
+  /// A point compared with the other methods: the first site's magnitude and convergence.
+  static const base::Fields<SteppedSinePoint>& summary_fields();
 };
 
 /// One direction of a stepped sine: its points in the order run.
@@ -83,6 +88,7 @@ struct SteppedSineBranch {
   /// why; the points before it are kept).
   dem_reference::Outcome outcome = dem_reference::Outcome::kCompleted;
   std::string message;
+  static const base::Fields<SteppedSineBranch>& fields();
 };
 
 /// Progress of point `index` of a branch.
@@ -145,6 +151,8 @@ struct LinearSineSweep {
   std::vector<SweepPeak> peaks;  ///< per output
   dem_reference::Outcome outcome = dem_reference::Outcome::kCompleted;  ///< as SteppedSineBranch
   std::string message;
+  /// The run's summary in a result (its cycles are points of their own).
+  static const base::Fields<LinearSineSweep>& fields();
 };
 
 /// Runs one direction: `steady` (stepped_sine_options) settles the structure at `start_hz`

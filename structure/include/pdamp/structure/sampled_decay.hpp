@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/structure/modal_model.hpp"
 #include "pdamp/surrogate/decay_field.hpp"
 
@@ -20,6 +21,7 @@ struct SampledSettling {
   double settling_time_s = NAN;                     ///< s; NaN: not settled within the record
   double frequency_hz = NAN;  ///< from the zero crossings of y − y_s up to settling (or the whole record)
   double damping_ratio = NAN; ///< ζ_eq = δ/√(4π² + δ²), δ = ln(initial/threshold)/(f t_s); NaN if not settled
+  static const base::Fields<SampledSettling>& fields();
 };
 
 /// The envelope is the largest |y − offset| over each whole period `period_s` (placed at

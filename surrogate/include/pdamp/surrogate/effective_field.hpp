@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/surrogate/grid.hpp"
 
 namespace pdamp::surrogate {
@@ -40,6 +41,8 @@ struct FieldPoint {
   std::string motion_mode;                   ///< motion-mode or regime label, free text ("" if none)
   PointStatus status = PointStatus::kMissing;
   bool operator==(const FieldPoint& other) const;  ///< NaN equals NaN here (same "not given")
+  /// The value columns of a field file, a sweep's log line and a job's result.
+  static const base::Fields<FieldPoint>& fields();
 };
 
 /// Who made a field, from what, when.

@@ -19,6 +19,7 @@
 #include "pdamp/structure/sampled_decay.hpp"
 #include "pdamp/tasks/bed_calibration.hpp"
 #include "pdamp/base/executor.hpp"
+#include "pdamp/base/record.hpp"
 #include "pdamp/tasks/output_folder.hpp"
 #include "pdamp/base/run_hooks.hpp"
 
@@ -50,6 +51,12 @@ struct VerifiedDecay {
   std::int64_t steps = 0;
   double time_step_s = 0.0, wall_time_s = 0.0;
   std::vector<std::string> warnings;
+  double objective = NAN;       ///< settling time (NaN: not settled) or ½∫e² dt, as the task's objective
+  double end_envelope_m = NAN;  ///< the envelope at the end of the record, m
+  /// A design check's "dem" (a job's result in full).
+  static const base::Fields<VerifiedDecay>& fields();
+  /// The softening check's shorter "dem".
+  static const base::Fields<VerifiedDecay>& summary_fields();
 };
 
 /// What an agreement compared: the objectives (both settled, or ½∫e² dt), the envelopes at
@@ -71,9 +78,8 @@ struct Agreement {
 struct SofteningCheck {
   double stiffness_softening = NAN;  ///< the stiffer run's verify softening (10x, at most full)
   VerifiedDecay dem;
-  double dem_objective = NAN;
-  double dem_end_envelope_m = NAN;
   Agreement agreement;               ///< the judged run against the stiffer one
+  static const base::Fields<SofteningCheck>& fields();
 };
 
 /// One design checked by the DEM: the prediction over the verification's duration and the
@@ -86,12 +92,11 @@ struct DesignCheck {
   double predicted_end_envelope_m = NAN;
   std::vector<double> predicted_envelope_m;  ///< at the DEM's sample times
   VerifiedDecay dem;
-  double dem_objective = NAN;     ///< settling time (NaN: not settled) or ½∫e² dt
-  double dem_end_envelope_m = NAN;
   Agreement agreement;            ///< the DEM against the prediction
   bool passed = false;            ///< agreement.within, and the softening check's if run
   std::optional<SofteningCheck> softening_check;
   int particles = 0;
+  static const base::Fields<DesignCheck>& fields();
 };
 
 /// The verification's check of its softened contacts.
@@ -116,6 +121,7 @@ struct Verification {
   bool passed = false;
   double wall_time_s = 0.0;
   nlohmann::json mpi;  ///< how the two decays spread over processes, or null
+  static const base::Fields<Verification>& fields();
 };
 
 /// The closed-form envelopes of the chosen, baseline and starting designs on one time grid
@@ -135,12 +141,14 @@ struct VerificationRound {
     Compared compared = Compared::kSettledOnlyOne;
     double relative_difference = NAN;
     bool passed = false;
+    static const base::Fields<Design>& fields();
   };
   std::vector<Design> designs;
   bool ranking_passed = false;
   bool passed = false;
   /// The beds recalibrated after this round (empty: the loop ended here).
   std::vector<std::string> recalibrated;
+  static const base::Fields<VerificationRound>& fields();
 };
 
 /// How the design loop ended.
@@ -165,9 +173,6 @@ struct FillingRatiosResult {
   std::vector<std::filesystem::path> checkpoints;  ///< the verification's files, to remove once its results are kept
   std::vector<std::string> warnings;
 };
-
-/// The slabs of a design, one per layer.
-std::vector<double> slabs_of(const optimizer::FillingDesign& design);
 
 /// The filling-ratio study of a case whose task is kind filling_ratios. The verification's
 /// two DEM decays are jobs of `executor` (on a process that serves another:

@@ -16,6 +16,7 @@
 #include "pdamp/structure/dem_frequency_response.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
 #include "pdamp/base/executor.hpp"
+#include "pdamp/base/record.hpp"
 #include "pdamp/tasks/output_folder.hpp"
 #include "pdamp/base/run_hooks.hpp"
 
@@ -74,6 +75,49 @@ struct LinearSweepFrf {
   double solve_time_s = 0.0;
 };
 
+/// A response's peak of one output, as a result shows it.
+struct PeakSummary {
+  std::string output;  ///< the output's name
+  double frequency_hz = NAN, magnitude = NAN, damping_ratio = NAN, band_centre_hz = NAN;
+  static const base::Fields<PeakSummary>& fields();
+};
+/// The peaks of `response` (`peaks` or `linear_peaks`) with their outputs' names.
+std::vector<PeakSummary> peak_summaries(const std::vector<structure::ResponsePeak>& peaks,
+                                        const std::vector<std::string>& output_names);
+
+/// A DEM direction's resonance of one output (structure::SampledPeak), NaN where not found.
+struct DemPeak {
+  std::string output;
+  structure::SweepDirection sweep = structure::SweepDirection::kUp;
+  double frequency_hz = NAN, largest_point_frequency_hz = NAN, magnitude = NAN;
+  double magnitude_standard_error = NAN;  ///< the first output's (its per-period amplitudes are recorded)
+  double band_low_hz = NAN, band_high_hz = NAN, band_centre_hz = NAN;
+  double indistinguishable_low_hz = NAN, indistinguishable_high_hz = NAN;
+  double damping_ratio = NAN;
+  static const base::Fields<DemPeak>& fields();
+  /// A linear sweep's peak (no single largest point, no indistinguishable range).
+  static const base::Fields<DemPeak>& sweep_fields();
+};
+
+/// How a method's largest peak of the first output agrees with a DEM direction's.
+struct PeakAgreement {
+  double frequency_hz = NAN, band_centre_hz = NAN, magnitude = NAN;
+  /// (method − dem)/dem of the peak (argmax) frequency, the 0.9 band's centre and the magnitude.
+  double frequency_relative_difference = NAN, band_centre_relative_difference = NAN, magnitude_relative_difference = NAN;
+  double damping_ratio = NAN, dem_damping_ratio = NAN;
+  /// The method's peak frequency lies among the DEM points that cannot be told from the largest.
+  bool frequency_within_dem_indistinguishable = false;
+  static const base::Fields<PeakAgreement>& fields();
+};
+
+/// --compare: the formulas' and the field's agreement with one DEM direction (none: the
+/// method has no peak of the first output, or no field).
+struct BranchAgreement {
+  structure::SweepDirection sweep = structure::SweepDirection::kUp;
+  std::optional<PeakAgreement> formulas, field;
+  static const base::Fields<BranchAgreement>& fields();
+};
+
 struct FrfResult {
   std::string case_name;
   FrfMethod method = FrfMethod::kFormulas;
@@ -85,6 +129,7 @@ struct FrfResult {
   /// kDem: the structure without particles (the containers empty; linear, so the harmonic
   /// balance is exact) over the task's band, for the plots.
   std::optional<structure::FrequencyResponse> without_beds;
+  std::vector<BranchAgreement> agreement;  ///< kCompare: per DEM direction
   std::vector<std::string> warnings;
 };
 
