@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -16,19 +15,15 @@
 
 #include "pdamp/case_file/case_error.hpp"
 #include "pdamp/case_file/ranges.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/base/strict_object.hpp"
 
 namespace pdamp::case_file::detail {
 
 using nlohmann::json;
 
-/// A number for messages, with enough digits to tell 0.1000001 from 0.1.
-inline std::string number_text(double value) {
-  std::ostringstream out;
-  out.precision(10);
-  out << value;
-  return out.str();
-}
+/// Significant digits of numbers in messages: enough to tell 0.1000001 from 0.1.
+inline constexpr int kMessageDigits = 10;
 
 inline std::string json_type_name(const json& value) { return value.type_name(); }
 
@@ -126,10 +121,7 @@ class ObjectReader {
       value = item.get<double>();
     }
     if (!range.contains(value)) {
-      std::ostringstream out;
-      out.precision(10);  // 0.1000001 is not 0.1
-      out << "= " << value << ": " << range.text() << unit;
-      fail(key, out.str());
+      fail(key, "= " + base::format_number(value, kMessageDigits) + ": " + range.text() + unit);
     }
     resolved_[key] = value;
     return value;
@@ -158,12 +150,15 @@ class ObjectReader {
       const bool whole = item.is_number_integer() ||
                          (item.is_number_float() && std::isfinite(item.get<double>()) &&
                           item.get<double>() == std::floor(item.get<double>()));
-      if (!whole) fail(key, "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "], got " +
-                                (item.is_number() ? number_text(item.get<double>()) : json_type_name(item)));
+      if (!whole)
+        fail(key,
+             "must be a whole number in [" + std::to_string(min) + ", " + std::to_string(max) + "], got " +
+                 (item.is_number() ? base::format_number(item.get<double>(), kMessageDigits) : json_type_name(item)));
       const double wide = item.is_number_unsigned() ? static_cast<double>(item.get<unsigned long long>())
                                                     : item.get<double>();
       if (wide < min || wide > max)
-        fail(key, "= " + number_text(wide) + ": must be in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+        fail(key, "= " + base::format_number(wide, kMessageDigits) + ": must be in [" + std::to_string(min) + ", " +
+                      std::to_string(max) + "]");
       value = static_cast<int>(wide);
     }
     resolved_[key] = value;
@@ -211,10 +206,8 @@ class ObjectReader {
         if (!item[i].is_number()) fail(key + "/" + std::to_string(i), "must be a number" + unit);
         value[i] = item[i].get<double>();
         if (!range.contains(value[i])) {
-          std::ostringstream out;
-          out.precision(10);  // 0.1000001 is not 0.1
-          out << "= " << value[i] << ": " << range.text() << unit;
-          fail(key + "/" + std::to_string(i), out.str());
+          fail(key + "/" + std::to_string(i),
+               "= " + base::format_number(value[i], kMessageDigits) + ": " + range.text() + unit);
         }
       }
     }

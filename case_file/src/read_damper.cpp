@@ -213,7 +213,9 @@ PlaneVector read_plane_direction(ObjectReader& r, const std::string& key, std::o
     v = *fallback;
   }
   const double norm = std::hypot(v[0], v[1]);
-  if (!(norm > 1e-9)) r.fail(key, "= [" + number_text(v[0]) + ", " + number_text(v[1]) + "]: must be a non-zero direction");
+  if (!(norm > 1e-9))
+    r.fail(key, "= [" + base::format_number(v[0], kMessageDigits) + ", " + base::format_number(v[1], kMessageDigits) +
+                    "]: must be a non-zero direction");
   v = {v[0] / norm, v[1] / norm};
   r.resolved()[key] = v;
   return v;

@@ -133,15 +133,18 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
     const double length = layer.container.inner_length(damper.drive_axis);
     if (length < 4.0 * layer.particle_radius_m * (1.0 - 1e-9))
       throw CaseError(r.file(), at + "/container/inner_size_m",
-                      "= " + number_text(length) + " m along the drive: task kind filling_ratios needs room for two "
-                      "slabs of 2r = " + number_text(2.0 * layer.particle_radius_m) + " m (one slab and its travel)");
+                      "= " + base::format_number(length, kMessageDigits) +
+                          " m along the drive: task kind filling_ratios needs room for two "
+                          "slabs of 2r = " +
+                          base::format_number(2.0 * layer.particle_radius_m, kMessageDigits) +
+                          " m (one slab and its travel)");
     const int per_slab = spheres_per_slab(layer, damper.drive_axis);
     t.spheres_per_slab.push_back(per_slab);
     t.spheres_per_lane.push_back(layer.bed.spheres_per_lane);
     if ((static_cast<int>(std::floor(length / (2.0 * layer.particle_radius_m) * (1.0 + 1e-9))) - 1) /
             layer.bed.spheres_per_lane < 1)
       throw CaseError(r.file(), at + "/container/inner_size_m",
-                      "= " + number_text(length) + " m along the drive: a slab stacked " +
+                      "= " + base::format_number(length, kMessageDigits) + " m along the drive: a slab stacked " +
                           std::to_string(layer.bed.spheres_per_lane) +
                           " high settles into as many rows of 2r on the base; task kind filling_ratios needs room "
                           "for them and one row of travel");
@@ -149,8 +152,9 @@ FillingRatiosTask read_filling_ratios(ObjectReader& r, const Case& c) {
     lightest_slab_kg = k == 0 ? slab_kg : std::min(lightest_slab_kg, slab_kg);
   }
   if (t.mass_budget_kg < lightest_slab_kg * (1.0 - 1e-9))
-    r.fail("mass_budget_kg", "= " + number_text(t.mass_budget_kg) + ": must be >= the lightest whole slab of a layer, " +
-                                 number_text(lightest_slab_kg) + " kg");
+    r.fail("mass_budget_kg", "= " + base::format_number(t.mass_budget_kg, kMessageDigits) +
+                                 ": must be >= the lightest whole slab of a layer, " +
+                                 base::format_number(lightest_slab_kg, kMessageDigits) + " kg");
   t.decay = read_decay(r, c);
   r.object("verify", false, [&](ObjectReader& v) { t.verify = read_verify(v, t.decay); });
   r.object("calibration", false, [&](ObjectReader& b) {

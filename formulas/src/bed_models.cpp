@@ -3,7 +3,6 @@
 // nested bed as a Coulomb block (§3.3).
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -11,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/one_dimensional.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 
 namespace pdamp::formulas {
@@ -20,24 +21,12 @@ constexpr double kTwoPi = 2.0 * kPi;
 /// R = √(π²+4) and α = atan(2/π) of the plastic orbit (e_b = 0), as collect_and_collide.cpp has them.
 constexpr double kOnsetRadius = 3.724191778237173;
 
-std::string format(double value) {
-  char buffer[32];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::general, 6).ptr;
-  return std::string(buffer, end);
-}
+using base::require;
+using base::require_positive;
 
-void require(bool ok, const char* name, double value, const char* rule) {
-  if (!ok) throw std::invalid_argument(std::string(name) + " = " + format(value) + ": must be " + rule);
-}
-void require_positive(const char* name, double value) {
-  require(value > 0.0 && std::isfinite(value), name, value, "> 0 and finite");
-}
-void require_inertia_factor(double inertia_factor) {
-  require(inertia_factor >= 0.0 && inertia_factor <= 1.0, "inertia_factor", inertia_factor, "in [0, 1]");
-}
+void require_inertia_factor(double inertia_factor) { base::require_in("inertia_factor", inertia_factor, 0.0, 1.0); }
 void require_bed_restitution(double bed_restitution) {
-  require(bed_restitution >= 0.0 && bed_restitution <= kMaxBedRestitution, "bed_restitution", bed_restitution,
-          "in [0, 0.9]");
+  base::require_in("bed_restitution", bed_restitution, 0.0, kMaxBedRestitution);
 }
 
 // ---- Impact map ------------------------------------------------------------------------
@@ -330,26 +319,11 @@ BedRestitutionFit fit_bed_restitution(double inertia_factor, double clearance_m,
   };
   // Golden section on [0, e_max]: the misfit is a sum of two squares of monotone functions of
   // e_b (the onset falls, the peak rises), unimodal there.
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double lo = 0.0, hi = kMaxBedRestitution;
-  double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
-  double f1 = misfit(m1), f2 = misfit(m2);
-  for (int k = 0; k < 200 && hi - lo > 1e-13; ++k) {
-    if (f1 <= f2) {
-      hi = m2;
-      m2 = m1;
-      f2 = f1;
-      m1 = hi - g * (hi - lo);
-      f1 = misfit(m1);
-    } else {
-      lo = m1;
-      m1 = m2;
-      f1 = f2;
-      m2 = lo + g * (hi - lo);
-      f2 = misfit(m2);
-    }
-  }
-  double best = 0.5 * (lo + hi);
+  base::GoldenSectionOptions search;
+  search.max_iterations = 200;
+  search.min_width = 1e-13;
+  search.ties_keep_lower = true;
+  double best = base::golden_section(misfit, 0.0, kMaxBedRestitution, search).middle();
   for (const double end : {0.0, kMaxBedRestitution})
     if (misfit(end) < misfit(best)) best = end;
   fit.bed_restitution = best;

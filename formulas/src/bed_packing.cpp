@@ -1,10 +1,12 @@
 // Collected simple-cubic bed in a box or cylinder: sphere centres and the clearance h.
 #include "pdamp/formulas/bed_packing.hpp"
 
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -23,18 +25,13 @@ constexpr double kMaxSlabSites = 1e7;
 /// may land a few ulps below n·2r and must still hold n sites.
 constexpr double kFitTolerance = 1e-9;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using base::format_number;
+using base::positive_finite;
+using base::violation;
 
 std::string field(const std::string& prefix, const std::string& name) {
   return prefix.empty() ? name : prefix + "." + name;
 }
-
-bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
 
 bool is_axis(int axis) { return axis >= 0 && axis <= 2; }
 
@@ -176,8 +173,8 @@ std::vector<Vec3> cylinder_sites_block(double r, double disk_radius_m, const Cro
     for (const double b : pb) {
       if (!inside_disk(a, b, r, disk_radius_m)) {
         reject("lattice_counts give " + std::to_string(n_a) + " x " + std::to_string(n_b) +
-               " sites across the cylinder for radius_m = " + number(r) +
-               ": they do not fit in inner_radius_m = " + number(disk_radius_m));
+               " sites across the cylinder for radius_m = " + format_number(r, 12) +
+               ": they do not fit in inner_radius_m = " + format_number(disk_radius_m, 12));
       }
       sites.push_back(site(cs, a, b));
     }
@@ -189,8 +186,7 @@ std::vector<std::string> packing_problems(const Container& container, int count,
                                           const LatticePacking& packing) {
   std::vector<std::string> problems = container.validate("container");
   if (count < 1) problems.push_back("count = " + std::to_string(count) + ": must be >= 1");
-  if (!positive_finite(radius_m))
-    problems.push_back("radius_m = " + number(radius_m) + ": must be > 0 and finite");
+  if (!positive_finite(radius_m)) problems.push_back(violation("radius_m", radius_m, "> 0 and finite"));
   if (!is_axis(packing.drive_axis)) {
     problems.push_back("packing.drive_axis = " + std::to_string(packing.drive_axis) + ": must be 0, 1 or 2");
   }
@@ -205,11 +201,11 @@ std::vector<std::string> packing_problems(const Container& container, int count,
     if (sign != -1 && sign != 1)
       problems.push_back("packing.gravity sign = " + std::to_string(sign) + ": must be -1 or +1");
   }
-  if (!std::isfinite(packing.lane_gap_m) || packing.lane_gap_m < 0.0) {
-    problems.push_back("packing.lane_gap_m = " + number(packing.lane_gap_m) + ": must be >= 0 and finite");
-  }
+  if (!base::non_negative_finite(packing.lane_gap_m))
+    problems.push_back(violation("packing.lane_gap_m", packing.lane_gap_m, ">= 0 and finite"));
   if ((packing.lane_gap_m != 0.0 || packing.lane_gap_auto) && container.shape != ContainerShape::kBox) {
-    problems.push_back("packing.lane_gap_m = " + (packing.lane_gap_auto ? std::string("auto") : number(packing.lane_gap_m)) +
+    problems.push_back("packing.lane_gap_m = " +
+                       (packing.lane_gap_auto ? std::string("auto") : format_number(packing.lane_gap_m, 12)) +
                        ": lane gaps are supported in a box only (must be 0 for a cylinder)");
   }
   if (packing.lattice_counts) {
@@ -237,8 +233,7 @@ double Container::inner_length(int axis) const {
 std::vector<std::string> Container::validate(const std::string& prefix) const {
   std::vector<std::string> problems;
   const auto positive = [&](double value, const std::string& name) {
-    if (!positive_finite(value))
-      problems.push_back(field(prefix, name) + " = " + number(value) + ": must be > 0 and finite");
+    if (!positive_finite(value)) problems.push_back(violation(field(prefix, name), value, "> 0 and finite"));
   };
   switch (shape) {
     case ContainerShape::kBox:
@@ -319,9 +314,9 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
   // the caller must give the counts.
   const auto refuse_huge = [&](double per_slab) {
     if (per_slab > kMaxSlabSites)
-      reject("the cross-section normal to axis " + std::to_string(drive) + " holds about " + number(per_slab) +
-             " lattice sites of radius_m = " + number(r) + " (more than " + number(kMaxSlabSites) +
-             "): give lattice_counts (the lanes the bed really has)");
+      reject("the cross-section normal to axis " + std::to_string(drive) + " holds about " +
+             format_number(per_slab, 12) + " lattice sites of radius_m = " + format_number(r, 12) + " (more than " +
+             format_number(kMaxSlabSites, 12) + "): give lattice_counts (the lanes the bed really has)");
   };
   std::vector<Vec3> sites;
   if (packing.lattice_counts) {
@@ -335,9 +330,9 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
     const auto check_fit = [&](int axis) {
       const double inner = container.inner_length(axis);
       if (n[axis] * 2.0 * r > inner * (1.0 + kFitTolerance)) {
-        reject("lattice_counts " + counts_text(n) + " with radius_m = " + number(r) + ": " +
-               std::to_string(n[axis]) + " sites need " + number(n[axis] * 2.0 * r) + " m along axis " +
-               std::to_string(axis) + ", the inner length is " + number(inner) + " m");
+        reject("lattice_counts " + counts_text(n) + " with radius_m = " + format_number(r, 12) + ": " +
+               std::to_string(n[axis]) + " sites need " + format_number(n[axis] * 2.0 * r, 12) + " m along axis " +
+               std::to_string(axis) + ", the inner length is " + format_number(inner, 12) + " m");
       }
     };
     check_fit(drive);
@@ -351,9 +346,10 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
         const double gap = lane_gap(packing, cs, axis, inner, n[axis], r);
         const double width = n[axis] * 2.0 * r + (n[axis] - 1) * gap;
         if (width > inner * (1.0 + kFitTolerance)) {
-          reject("lattice_counts " + counts_text(n) + " with radius_m = " + number(r) + " and lane_gap_m = " +
-                 number(gap) + ": " + std::to_string(n[axis]) + " lanes need " + number(width) +
-                 " m along axis " + std::to_string(axis) + ", the inner length is " + number(inner) + " m");
+          reject("lattice_counts " + counts_text(n) + " with radius_m = " + format_number(r, 12) +
+                 " and lane_gap_m = " + format_number(gap, 12) + ": " + std::to_string(n[axis]) + " lanes need " +
+                 format_number(width, 12) + " m along axis " + std::to_string(axis) + ", the inner length is " +
+                 format_number(inner, 12) + " m");
         }
       }
       sites = box_sites(container, r, cs, n[cs.axis_a], n[cs.axis_b], packing);
@@ -372,9 +368,9 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
     sites = box_sites(container, r, cs, lanes(cs.axis_a), lanes(cs.axis_b), packing);
   }
   if (sites.empty()) {
-    reject("no sphere of radius_m = " + number(r) + " fits in the cross-section normal to axis " +
-           std::to_string(drive) + " (inner lengths " + number(container.inner_length(cs.axis_a)) + " and " +
-           number(container.inner_length(cs.axis_b)) + " m)");
+    reject("no sphere of radius_m = " + format_number(r, 12) + " fits in the cross-section normal to axis " +
+           std::to_string(drive) + " (inner lengths " + format_number(container.inner_length(cs.axis_a), 12) + " and " +
+           format_number(container.inner_length(cs.axis_b), 12) + " m)");
   }
 
   // Lowest first (height against gravity), then by position: a strict, deterministic
@@ -392,10 +388,10 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
   bed.bed_extent_m = bed.slabs * 2.0 * r;
   bed.clearance_m = length - bed.bed_extent_m;
   if (!(bed.clearance_m > 0.0)) {
-    reject("count = " + std::to_string(count) + " spheres of radius_m = " + number(r) + " fill " +
+    reject("count = " + std::to_string(count) + " spheres of radius_m = " + format_number(r, 12) + " fill " +
            std::to_string(bed.slabs) + " slabs of " + std::to_string(per_slab) + " sites, extent " +
-           number(bed.bed_extent_m) + " m along axis " + std::to_string(drive) + " of inner length " +
-           number(length) + " m: clearance_m = " + number(bed.clearance_m) + " must be > 0");
+           format_number(bed.bed_extent_m, 12) + " m along axis " + std::to_string(drive) + " of inner length " +
+           format_number(length, 12) + " m: clearance_m = " + format_number(bed.clearance_m, 12) + " must be > 0");
   }
 
   bed.centres_m.reserve(static_cast<std::size_t>(count));

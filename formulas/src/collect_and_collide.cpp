@@ -1,8 +1,10 @@
 // Closed-form collect-and-collide models: ideal orbits, optimum strokes, η* with validity warnings.
 #include "pdamp/formulas/collect_and_collide.hpp"
 
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
+
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -39,27 +41,9 @@ constexpr double kLastStep = 1e-8;
 /// difference already loses about 3 bits).
 constexpr double kSeriesLimit = 1.0;
 
-/// Six significant digits; std::to_chars keeps the warning path cheap.
-std::string format(double value) {
-  char buffer[32];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, value,
-                                 std::chars_format::general, 6).ptr;
-  return std::string(buffer, end);
-}
-
-void require_positive(const char* name, double value) {
-  if (!(value > 0.0 && std::isfinite(value))) {
-    throw std::invalid_argument(std::string(name) + " = " + format(value) +
-                                ": must be > 0 and finite");
-  }
-}
-
-void require_non_negative(const char* name, double value) {
-  if (!(value >= 0.0 && std::isfinite(value))) {
-    throw std::invalid_argument(std::string(name) + " = " + format(value) +
-                                ": must be >= 0 and finite");
-  }
-}
+using base::format_number;
+using base::require_non_negative;
+using base::require_positive;
 
 void require_valid(const ModelOptions& options) {
   const std::vector<std::string> problems = options.validate();
@@ -157,7 +141,7 @@ IdealOrbit orbit_of(double inertia_factor, double clearance_m, double stroke_m) 
 
 void append_range_rule(std::vector<std::string>& problems, const std::string& name, double value,
                        bool ok, const char* rule) {
-  if (!ok) problems.push_back(name + " = " + format(value) + ": must be " + rule);
+  if (!ok) problems.push_back(base::violation(name, value, rule));
 }
 
 }  // namespace
@@ -244,7 +228,7 @@ std::vector<std::string> ModelOptions::validate() const {
 double impact_phase(double clearance_over_stroke) {
   const double r = clearance_over_stroke;
   if (!(r >= 0.0 && r <= kPi)) {
-    throw std::domain_error("impact_phase: clearance_over_stroke = " + format(r) +
+    throw std::domain_error("impact_phase: clearance_over_stroke = " + format_number(r, 6) +
                             ": must be in [0, pi]");
   }
   if (r == 0.0) return 0.0;
@@ -289,20 +273,14 @@ double impact_phase(double clearance_over_stroke) {
 }
 
 IdealOrbit ideal_orbit(double inertia_factor, double clearance_m, double stroke_m) {
-  if (!(inertia_factor >= 0.0 && inertia_factor <= 1.0)) {
-    throw std::invalid_argument("inertia_factor = " + format(inertia_factor) +
-                                ": must be in [0, 1]");
-  }
+  base::require_in("inertia_factor", inertia_factor, 0.0, 1.0);
   require_positive("clearance_m", clearance_m);
   require_positive("stroke_m", stroke_m);
   return orbit_of(inertia_factor, clearance_m, stroke_m);
 }
 
 double rolling_no_slip_friction(double inertia_factor, double intensity) {
-  if (!(inertia_factor > 0.0 && inertia_factor <= 1.0)) {
-    throw std::invalid_argument("inertia_factor = " + format(inertia_factor) +
-                                ": must be in (0, 1]");
-  }
+  base::require(inertia_factor > 0.0 && inertia_factor <= 1.0, "inertia_factor", inertia_factor, "in (0, 1]");
   require_non_negative("intensity", intensity);
   return inertia_factor * intensity / (1.0 + inertia_factor);
 }
@@ -376,17 +354,17 @@ void common_warnings(const LossResult& result, double clearance_m, double stroke
   if (options.gravity_along_drive) {
     warn([&] { return std::string(
         "gravity along the drive is not in the ideal models (docs/theory.md section 2): it moves "
-        "the onset and lowers the peak, so eta* = " + format(result.eta_star) +
+        "the onset and lowers the peak, so eta* = " + format_number(result.eta_star, 6) +
         " is an optimistic estimate"); });
   }
   if (stroke_m > kMaxStrokeOverClearance * clearance_m) {
     warn([&] {
       const std::string impact =
           std::isfinite(result.impact_phase_rad)
-              ? " (impact " + format(result.impact_phase_rad) + " rad after detachment)"
+              ? " (impact " + format_number(result.impact_phase_rad, 6) + " rad after detachment)"
               : std::string();
-      return std::string("stroke/clearance X/h = " + format(stroke_m / clearance_m) +
-                         " > " + format(kMaxStrokeOverClearance) +
+      return std::string("stroke/clearance X/h = " + format_number(stroke_m / clearance_m, 6) +
+                         " > " + format_number(kMaxStrokeOverClearance, 6) +
                          ": the bed barely separates from the wall" + impact +
                          ", where the one-block model is outside its range");
     });
@@ -418,9 +396,9 @@ void rebounding_loss(LossResult& result, double inertia_factor, double clearance
   result.impact_phase_rad = kNaN;
   if (stroke_m > kMaxTailStrokeOverClearance * clearance_m) {
     warn([&] { return std::string(
-        "rebounding bed (bed_restitution = " + format(e_b) + ") at X/h = " + format(stroke_m / clearance_m) +
-        ": above its peak eta* = eta*_pk X_pk/X = " + format(result.eta_star) + " is what the DEM of rebounding "
-        "layers shows up to X/h = " + format(kMaxTailStrokeOverClearance) + " (docs/theory.md section 3.1); "
+        "rebounding bed (bed_restitution = " + format_number(e_b, 6) + ") at X/h = " + format_number(stroke_m / clearance_m, 6) +
+        ": above its peak eta* = eta*_pk X_pk/X = " + format_number(result.eta_star, 6) + " is what the DEM of rebounding "
+        "layers shows up to X/h = " + format_number(kMaxTailStrokeOverClearance, 6) + " (docs/theory.md section 3.1); "
         "beyond it is extrapolated"); });
   }
 }
@@ -444,21 +422,21 @@ void coulomb_loss(LossResult& result, double clearance_m, double stroke_m, const
   result.eta_star = block.eta_star;
   if (block.regime == MotionRegime::kSliding) {
     warn([&] { return std::string(
-        "nested bed at Gamma = " + format(result.intensity) + " > mu = " + format(mu) + ": the Coulomb block slides "
-        "(eta* = " + format(result.eta_star) + "), an estimate: the DEM of a nested bed (docs/theory.md section 3.3) "
+        "nested bed at Gamma = " + format_number(result.intensity, 6) + " > mu = " + format_number(mu, 6) + ": the Coulomb block slides "
+        "(eta* = " + format_number(result.eta_star, 6) + "), an estimate: the DEM of a nested bed (docs/theory.md section 3.3) "
         "gives 0.24-0.26 at Gamma = 3 mu where the block gives 0.15-0.31, and is still held at Gamma = 1.5 mu for "
         "mu = 0.1 where the block gives 0.23: check with pdamp dem"); });
   } else if (mu > kMaxHeldNestedFriction) {
     warn([&] { return std::string(
-        "nested bed held by its base (eta* = 0) up to Gamma = mu = " + format(mu) + ": the DEM holds a nested bed "
-        "so only at low friction (mu <= " + format(kMaxHeldNestedFriction) + "); at mu = 0.35 and 0.5 it moved from "
+        "nested bed held by its base (eta* = 0) up to Gamma = mu = " + format_number(mu, 6) + ": the DEM holds a nested bed "
+        "so only at low friction (mu <= " + format_number(kMaxHeldNestedFriction, 6) + "); at mu = 0.35 and 0.5 it moved from "
         "Gamma = 0.28 and 0.1 with eta* = 0.3-0.75 (docs/theory.md section 3.3), so eta* = 0 at Gamma = " +
-        format(result.intensity) + " may be far too low: check with pdamp dem"); });
+        format_number(result.intensity, 6) + " may be far too low: check with pdamp dem"); });
   }
   if (block.outside_domain) {
     warn([&] { return std::string(
-        "Coulomb block at Gamma = " + format(result.intensity) + ", X/h = " + format(stroke_m / clearance_m) +
-        ": its slide (" + format(block.slide_over_stroke * stroke_m) + " m per half cycle) neither stays inside the "
+        "Coulomb block at Gamma = " + format_number(result.intensity, 6) + ", X/h = " + format_number(stroke_m / clearance_m, 6) +
+        ": its slide (" + format_number(block.slide_over_stroke * stroke_m, 6) + " m per half cycle) neither stays inside the "
         "clearance nor runs from wall to wall before the drive reverses; eta* is that of the slide without walls"); });
   }
 }
@@ -521,8 +499,8 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
     result.eta_star = c * impact_map_reduced_loss_factor(c * stroke_m / clearance_m);
     if (explicit_family) {
       warn([&] { return std::string(
-          std::string(family_name) + " model at stroke X = " + format(stroke_m) +
-          " m below its onset X_onset = " + format(onset_m) + " m (s = " + format(s) +
+          std::string(family_name) + " model at stroke X = " + format_number(stroke_m, 6) +
+          " m below its onset X_onset = " + format_number(onset_m, 6) + " m (s = " + format_number(s, 6) +
           "): the collect-and-collide orbit does not exist there, so eta* comes from the plastic block's "
           "impact map"); });
     }
@@ -534,8 +512,8 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
     result.eta_star = fit.jump_fraction * eta_onset * std::pow(s, fit.exponent);
     if (explicit_family) {
       warn([&] { return std::string(
-          std::string(family_name) + " model at stroke X = " + format(stroke_m) +
-          " m below its onset X_onset = " + format(onset_m) + " m (s = " + format(s) +
+          std::string(family_name) + " model at stroke X = " + format_number(stroke_m, 6) +
+          " m below its onset X_onset = " + format_number(onset_m, 6) + " m (s = " + format_number(s, 6) +
           "): the collect-and-collide orbit does not exist there, so eta* comes from the "
           "scattered-state fit"); });
     }
@@ -546,18 +524,18 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
         std::string quality;
         if (fit.points > 0)
           quality = " (fitted on " + std::to_string(fit.points) + " points, reduced chi^2 = " +
-                    format(fit.reduced_chi_squared) + ", jump_fraction = " + format(fit.jump_fraction) + " +- " +
-                    format(fit.jump_fraction_stderr) + ")";
-        return std::string("scattered-state fit evaluated at s = X/X_onset = " + format(s) +
-                           ", outside the range it was fitted on [" + format(fit.s_min) + ", " +
-                           format(fit.s_max) + "]: extrapolated" + quality);
+                    format_number(fit.reduced_chi_squared, 6) + ", jump_fraction = " + format_number(fit.jump_fraction, 6) + " +- " +
+                    format_number(fit.jump_fraction_stderr, 6) + ")";
+        return std::string("scattered-state fit evaluated at s = X/X_onset = " + format_number(s, 6) +
+                           ", outside the range it was fitted on [" + format_number(fit.s_min, 6) + ", " +
+                           format_number(fit.s_max, 6) + "]: extrapolated" + quality);
       });
     }
     if (fit.provisional) {
       warn([&] { return std::string(
-          "scattered-state fit is provisional (jump_fraction = " + format(fit.jump_fraction) +
-          ", exponent = " + format(fit.exponent) + ", source: " + fit.source +
-          "): the scattered-state eta* = " + format(result.eta_star) +
+          "scattered-state fit is provisional (jump_fraction = " + format_number(fit.jump_fraction, 6) +
+          ", exponent = " + format_number(fit.exponent, 6) + ", source: " + fit.source +
+          "): the scattered-state eta* = " + format_number(result.eta_star, 6) +
           " is a placeholder until the fit is made on DEM points"); });
     }
   }
@@ -567,24 +545,24 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
                               "fly rather than roll (the bouncing model describes that)"); });
   } else if (model == DamperModel::kRolling && !rolls) {
     warn([&] { return std::string(
-        "rolling model at intensity Gamma = " + format(result.intensity) + ": rolling without slip needs a base "
-        "friction mu >= kappa Gamma/(1+kappa) = " + format(rolling_no_slip_friction(inertia_factor, result.intensity)) +
-        ", more than mu = " + format(options.base_friction) + ", so the spheres slide (auto then moves toward "
+        "rolling model at intensity Gamma = " + format_number(result.intensity, 6) + ": rolling without slip needs a base "
+        "friction mu >= kappa Gamma/(1+kappa) = " + format_number(rolling_no_slip_friction(inertia_factor, result.intensity), 6) +
+        ", more than mu = " + format_number(options.base_friction, 6) + ", so the spheres slide (auto then moves toward "
         "free flight)"); });
   }
   if (model == DamperModel::kBouncing && rolls) {
     warn([&] { return std::string(
-        "bouncing model at intensity Gamma = " + format(result.intensity) + " <= " + format(slip) +
-        ": the base friction mu = " + format(options.base_friction) + " keeps the spheres rolling there, and "
+        "bouncing model at intensity Gamma = " + format_number(result.intensity, 6) + " <= " + format_number(slip, 6) +
+        ": the base friction mu = " + format_number(options.base_friction, 6) + " keeps the spheres rolling there, and "
         "the rolling model describes a bed rolling on its base"); });
   }
   if (!explicit_family && options.gravity_across_drive && !rolls &&
       result.intensity < kFreeFlightFrictionRatio * options.base_friction) {
     warn([&] { return std::string(
-        "auto at intensity Gamma = " + format(result.intensity) + ": the spheres slide on the base (rolling holds up "
-        "to Gamma = " + format(slip) + " with mu = " + format(options.base_friction) + "), and friction still takes " +
-        format(100.0 * options.base_friction / result.intensity) + "% of the drive's acceleration: eta* = " +
-        format(result.eta_star) + " uses the relative acceleration 1 - mu/Gamma (kappa_eff = " + format(inertia_factor) +
+        "auto at intensity Gamma = " + format_number(result.intensity, 6) + ": the spheres slide on the base (rolling holds up "
+        "to Gamma = " + format_number(slip, 6) + " with mu = " + format_number(options.base_friction, 6) + "), and friction still takes " +
+        format_number(100.0 * options.base_friction / result.intensity, 6) + "% of the drive's acceleration: eta* = " +
+        format_number(result.eta_star, 6) + " uses the relative acceleration 1 - mu/Gamma (kappa_eff = " + format_number(inertia_factor, 6) +
         "), between rolling and free flight, an approximation: check with pdamp dem"); });
   }
   if (result.model_used == DamperModel::kBouncing && options.gravity_across_drive && stroke_m < clearance_m &&
@@ -594,24 +572,24 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
     // from X = 0.45 h to 0.8 h, where the orbit gives ~1. No closed form says when the
     // bed is thrown off its base instead, so the whole range X < h is flagged.
     warn([&] { return std::string(
-        "bouncing model with gravity across the drive at X/h = " + format(stroke_m / clearance_m) +
+        "bouncing model with gravity across the drive at X/h = " + format_number(stroke_m / clearance_m, 6) +
         " < 1: the bed can stay nearly at rest on the base while the container moves around it (the decoupled "
         "state; the shipped cylinder case with gravity gives eta* ~ 0.02 from 0.45 h to 0.8 h), so eta* = " +
-        format(result.eta_star) + " holds only if the bed is thrown off its base: check with pdamp dem"); });
+        format_number(result.eta_star, 6) + " holds only if the bed is thrown off its base: check with pdamp dem"); });
   }
   if (explicit_family && options.nested_bed && options.gravity_across_drive) {
     warn([&] { return std::string(
         std::string(to_string(model)) + " model for a nested bed (spheres resting on two or more others cannot "
         "rotate, docs/theory.md section 3.3): the bed does not roll but is held by its base up to Gamma = mu = " +
-        format(options.base_friction) + " (Gamma = " + format(result.intensity) +
+        format_number(options.base_friction, 6) + " (Gamma = " + format_number(result.intensity, 6) +
         " here) and then slides; the auto model takes that Coulomb block"); });
   }
   if (options.bed_restitution > 0.0 && std::isfinite(options.particle_restitution) &&
       options.bed_restitution > bed_restitution_bound(options.particle_restitution, inertia_factor)) {
     warn([&] { return std::string(
-        "bed_restitution e_b = " + format(options.bed_restitution) + " exceeds what one sphere can give, eps/"
-        "(1+kappa) = " + format(bed_restitution_bound(options.particle_restitution, inertia_factor)) + " for eps = " +
-        format(options.particle_restitution) + " and kappa = " + format(inertia_factor) +
+        "bed_restitution e_b = " + format_number(options.bed_restitution, 6) + " exceeds what one sphere can give, eps/"
+        "(1+kappa) = " + format_number(bed_restitution_bound(options.particle_restitution, inertia_factor), 6) + " for eps = " +
+        format_number(options.particle_restitution, 6) + " and kappa = " + format_number(inertia_factor, 6) +
         " (docs/theory.md section 3.1): a bed rebounds less than its front sphere, so the onset and peak are placed "
         "too low"); });
   }

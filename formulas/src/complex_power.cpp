@@ -1,5 +1,6 @@
 // Complex power P = ½F*·conj(V*) from sampled force and velocity: period folding and an FFTW r2c transform.
 #include "pdamp/formulas/complex_power.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 
 #include <fftw3.h>
@@ -10,7 +11,6 @@
 #include <limits>
 #include <mutex>
 #include <new>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -29,12 +29,7 @@ constexpr double kWindowTolerance = 1e-9;
 /// harmonics) and m_app, η* would be noise.
 constexpr double kZeroVelocityFraction = 1e-12;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using base::format_number;
 
 [[noreturn]] void reject(const std::string& what) { throw std::invalid_argument("complex_power: " + what); }
 
@@ -144,7 +139,7 @@ FundamentalAmplitude fundamental(std::span<const double> signal, const char* nam
   if (!finite) {
     for (std::size_t i = 0; i < signal.size(); ++i) {
       if (!std::isfinite(signal[i])) {
-        reject(std::string(name) + "[" + std::to_string(i) + "] = " + number(signal[i]) +
+        reject(std::string(name) + "[" + std::to_string(i) + "] = " + format_number(signal[i], 12) +
                ": samples must be finite");
       }
     }
@@ -173,7 +168,7 @@ void finish_measures(ComplexPower& result, double frequency_hz) {
 
 double ComplexPower::reduced_loss_factor(double bed_mass_kg) const {
   if (!(bed_mass_kg > 0.0) || !std::isfinite(bed_mass_kg)) {
-    throw std::invalid_argument("reduced_loss_factor: bed_mass_kg = " + number(bed_mass_kg) +
+    throw std::invalid_argument("reduced_loss_factor: bed_mass_kg = " + format_number(bed_mass_kg, 12) +
                                 ": must be > 0 and finite");
   }
   return e_diss_j / (0.5 * bed_mass_kg * std::norm(velocity_amplitude));
@@ -189,9 +184,9 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
     reject("force has " + std::to_string(force_n.size()) + " samples, velocity " +
            std::to_string(velocity_m_s.size()) + ": lengths must be equal");
   }
-  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) reject("dt_s = " + number(dt_s) + ": must be > 0 and finite");
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) reject("dt_s = " + format_number(dt_s, 12) + ": must be > 0 and finite");
   if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
-    reject("frequency_hz = " + number(frequency_hz) + ": must be > 0 and finite");
+    reject("frequency_hz = " + format_number(frequency_hz, 12) + ": must be > 0 and finite");
   }
   if (force_n.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
     reject("N = " + std::to_string(force_n.size()) + " samples: at most " +
@@ -202,17 +197,17 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
   const double period_over_dt = 1.0 / (frequency_hz * dt_s);
   const double nearest = std::round(period_over_dt);
   if (std::abs(period_over_dt - nearest) > kWindowTolerance * period_over_dt) {
-    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) +
-           ": T/dt = " + number(period_over_dt) + " must be an integer (within 1e-9 relative)");
+    reject("dt_s = " + format_number(dt_s, 12) + ", frequency_hz = " + format_number(frequency_hz, 12) +
+           ": T/dt = " + format_number(period_over_dt, 12) + " must be an integer (within 1e-9 relative)");
   }
   // Below 3 samples per period Ω sits at or above Nyquist, where (2/N)·X[k] is not
   // the amplitude (at M = 2 a sine of any amplitude samples to zero).
   if (nearest < 3.0) {
-    reject("dt_s = " + number(dt_s) + ", frequency_hz = " + number(frequency_hz) +
-           ": T/dt = " + number(nearest) + " samples per period, must be >= 3");
+    reject("dt_s = " + format_number(dt_s, 12) + ", frequency_hz = " + format_number(frequency_hz, 12) +
+           ": T/dt = " + format_number(nearest, 12) + " samples per period, must be >= 3");
   }
   if (nearest > static_cast<double>(n) || n % static_cast<int>(nearest) != 0) {
-    reject("N = " + std::to_string(n) + " samples, T/dt = " + number(nearest) +
+    reject("N = " + std::to_string(n) + " samples, T/dt = " + format_number(nearest, 12) +
            ": N must be a positive multiple of T/dt (a whole number of periods)");
   }
   const int samples_per_period = static_cast<int>(nearest);
@@ -230,9 +225,10 @@ ComplexPower complex_power(std::span<const double> force_n, std::span<const doub
 
   const double v_norm = std::norm(result.velocity_amplitude);
   if (!(std::sqrt(v_norm) > kZeroVelocityFraction * velocity.max_abs_average)) {
-    reject("|V*| = " + number(std::sqrt(v_norm)) + " m/s with max|v| = " + number(velocity.max_abs_average) +
+    reject("|V*| = " + format_number(std::sqrt(v_norm), 12) +
+           " m/s with max|v| = " + format_number(velocity.max_abs_average, 12) +
            " m/s over the period-averaged velocity: it has no component at the drive frequency " +
-           number(frequency_hz) + " Hz, so m_app and eta* are undefined");
+           format_number(frequency_hz, 12) + " Hz, so m_app and eta* are undefined");
   }
 
   finish_measures(result, frequency_hz);
@@ -298,7 +294,7 @@ void DriveBinAccumulator::clear() {
 
 ComplexPower DriveBinAccumulator::result(double frequency_hz) const {
   if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
-    reject("frequency_hz = " + number(frequency_hz) + ": must be > 0 and finite");
+    reject("frequency_hz = " + format_number(frequency_hz, 12) + ": must be > 0 and finite");
   }
   if (samples_ <= 0 || samples_ % steps_per_period_ != 0) {
     reject("N = " + std::to_string(samples_) + " samples, T/dt = " + std::to_string(steps_per_period_) +
@@ -313,8 +309,8 @@ ComplexPower DriveBinAccumulator::result(double frequency_hz) const {
   result.velocity_amplitude = scale * velocity_sum_;
   const double v_abs = std::abs(result.velocity_amplitude);
   if (!(v_abs > kZeroVelocityFraction * max_abs_velocity_)) {
-    reject("|V*| = " + number(v_abs) + " m/s with max|v| = " + number(max_abs_velocity_) +
-           " m/s: the velocity has no component at the drive frequency " + number(frequency_hz) +
+    reject("|V*| = " + format_number(v_abs, 12) + " m/s with max|v| = " + format_number(max_abs_velocity_, 12) +
+           " m/s: the velocity has no component at the drive frequency " + format_number(frequency_hz, 12) +
            " Hz, so m_app and eta* are undefined");
   }
   finish_measures(result, frequency_hz);

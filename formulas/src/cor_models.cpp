@@ -1,9 +1,11 @@
 // Coefficient-of-restitution models, impact CSV, NLopt fits and the Hertz damping calibration.
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/base/run_errors.hpp"
-#include "pdamp/formulas/root_finding.hpp"
-#include "pdamp/formulas/csv_text.hpp"
-#include "pdamp/formulas/input_file.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/csv_text.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/one_dimensional.hpp"
 
 #include <nlopt.hpp>
 
@@ -24,12 +26,13 @@ namespace {
 
 using std::numbers::pi;
 
-std::string format_number(double value) {
-  std::ostringstream out;
-  out.precision(9);
-  out << value;
-  return out.str();
-}
+using base::format_number;
+using base::printable;
+using base::read_input_file;
+using base::require_non_negative;
+using base::require_positive;
+using base::split_csv_line;
+using base::trim_blanks;
 
 // "[i]" (written with a stream: GCC 12 gives a false -Wrestrict on "[" + to_string(i)).
 std::string bracketed(std::size_t index) {
@@ -38,24 +41,8 @@ std::string bracketed(std::size_t index) {
   return out.str();
 }
 
-void require_positive(const char* name, double value) {
-  if (!(std::isfinite(value) && value > 0.0)) {
-    throw std::invalid_argument(std::string(name) + " = " + format_number(value) +
-                                ": must be finite and > 0");
-  }
-}
-
 void require_restitution(const std::string& name, double value) {
-  if (!(value > 0.0 && value <= 1.0)) {
-    throw std::invalid_argument(name + " = " + format_number(value) + ": must be in (0, 1]");
-  }
-}
-
-void require_speed(double impact_speed_m_s) {
-  if (!(std::isfinite(impact_speed_m_s) && impact_speed_m_s >= 0.0)) {
-    throw std::invalid_argument("impact_speed_m_s = " + format_number(impact_speed_m_s) +
-                                ": must be finite and >= 0");
-  }
+  base::require(value > 0.0 && value <= 1.0, name, value, "in (0, 1]");
 }
 
 // ---------------------------------------------------------------------------
@@ -146,10 +133,10 @@ class ConstantRestitution final : public RestitutionModel {
  public:
   explicit ConstantRestitution(double restitution) : restitution_(restitution) {}
   double restitution(double impact_speed_m_s) const override {
-    require_speed(impact_speed_m_s);
+    require_non_negative("impact_speed_m_s", impact_speed_m_s);
     return restitution_;
   }
-  std::string describe() const override { return "constant " + format_number(restitution_); }
+  std::string describe() const override { return "constant " + format_number(restitution_, 9); }
 
  private:
   double restitution_;
@@ -160,12 +147,12 @@ class LinearRestitution final : public RestitutionModel {
   LinearRestitution(double intercept, double slope_s_per_m)
       : intercept_(intercept), slope_s_per_m_(slope_s_per_m) {}
   double restitution(double impact_speed_m_s) const override {
-    require_speed(impact_speed_m_s);
+    require_non_negative("impact_speed_m_s", impact_speed_m_s);
     return std::clamp(intercept_ - slope_s_per_m_ * impact_speed_m_s, kMinLinearRestitution, 1.0);
   }
   std::string describe() const override {
-    return "linear " + format_number(intercept_) + " - " + format_number(slope_s_per_m_) +
-           " s/m * v, clamped to [" + format_number(kMinLinearRestitution) + ", 1]";
+    return "linear " + format_number(intercept_, 9) + " - " + format_number(slope_s_per_m_, 9) +
+           " s/m * v, clamped to [" + format_number(kMinLinearRestitution, 9) + ", 1]";
   }
 
  private:
@@ -178,12 +165,12 @@ class TabulatedRestitution final : public RestitutionModel {
   TabulatedRestitution(std::vector<double> speeds_m_s, std::vector<double> values)
       : curve_(std::move(speeds_m_s), std::move(values)) {}
   double restitution(double impact_speed_m_s) const override {
-    require_speed(impact_speed_m_s);
+    require_non_negative("impact_speed_m_s", impact_speed_m_s);
     return curve_(impact_speed_m_s);
   }
   std::string describe() const override {
     return "tabulated (monotone cubic), " + std::to_string(curve_.size()) + " points over v in [" +
-           format_number(curve_.first_x()) + ", " + format_number(curve_.last_x()) + "] m/s";
+           format_number(curve_.first_x(), 9) + ", " + format_number(curve_.last_x(), 9) + "] m/s";
   }
 
  private:
@@ -213,14 +200,13 @@ class ThorntonRestitution final : public RestitutionModel {
   ThorntonRestitution(double limiting_pressure_pa, double yield_speed_m_s)
       : limiting_pressure_pa_(limiting_pressure_pa), yield_speed_m_s_(yield_speed_m_s) {}
   double restitution(double impact_speed_m_s) const override {
-    require_speed(impact_speed_m_s);
+    require_non_negative("impact_speed_m_s", impact_speed_m_s);
     if (impact_speed_m_s <= yield_speed_m_s_) return 1.0;
     return thornton_restitution_ratio(yield_speed_m_s_ / impact_speed_m_s);
   }
   std::string describe() const override {
-    return "Thornton (1997) elastic-perfectly-plastic, p_y = " +
-           format_number(limiting_pressure_pa_) + " Pa, v_y = " + format_number(yield_speed_m_s_) +
-           " m/s";
+    return "Thornton (1997) elastic-perfectly-plastic, p_y = " + format_number(limiting_pressure_pa_, 9) +
+           " Pa, v_y = " + format_number(yield_speed_m_s_, 9) + " m/s";
   }
 
  private:
@@ -289,10 +275,7 @@ void validate_impact_data(const ImpactData& data) {
   if (data.speed_m_s.empty()) throw std::invalid_argument("impact data: no points: need >= 1");
   for (std::size_t i = 0; i < data.speed_m_s.size(); ++i) {
     const double speed = data.speed_m_s[i];
-    if (!(std::isfinite(speed) && speed >= 0.0)) {
-      throw std::invalid_argument("impact data: speed_m_s[" + std::to_string(i) +
-                                  "] = " + format_number(speed) + ": must be finite and >= 0");
-    }
+    require_non_negative("impact data: speed_m_s[" + std::to_string(i) + "]", speed);
     require_restitution("impact data: restitution[" + std::to_string(i) + "]", data.restitution[i]);
   }
 }
@@ -343,9 +326,8 @@ std::vector<double> fit_linear(const ImpactData& data) {
   const auto [min_speed, max_speed] =
       std::minmax_element(data.speed_m_s.begin(), data.speed_m_s.end());
   if (!(*max_speed > *min_speed)) {
-    throw std::invalid_argument("impact data: all " + std::to_string(data.speed_m_s.size()) +
-                                " speeds equal " + format_number(*min_speed) +
-                                " m/s: the linear law needs >= 2 distinct speeds");
+    throw std::invalid_argument("impact data: all " + std::to_string(data.speed_m_s.size()) + " speeds equal " +
+                                format_number(*min_speed, 9) + " m/s: the linear law needs >= 2 distinct speeds");
   }
   const double top_speed = *max_speed;
   NloptCallback objective{[&](const std::vector<double>& x, std::vector<double>& gradient) {
@@ -595,9 +577,8 @@ double integrate_restitution(double damping, double tolerance) {
     }
     return -end.v;
   }
-  throw base::NumericalError("realised_restitution: no end of contact after " +
-                           std::to_string(kMaxSteps) + " steps at damping " +
-                           format_number(damping));
+  throw base::NumericalError("realised_restitution: no end of contact after " + std::to_string(kMaxSteps) +
+                             " steps at damping " + format_number(damping, 9));
 }
 
 // Tolerances of the two uses: the accurate public solve (|ε error| ~1e-11) and the
@@ -616,10 +597,7 @@ std::unique_ptr<RestitutionModel> make_constant_restitution(double restitution) 
 
 std::unique_ptr<RestitutionModel> make_linear_restitution(double intercept, double slope_s_per_m) {
   require_restitution("intercept", intercept);
-  if (!std::isfinite(slope_s_per_m)) {
-    throw std::invalid_argument("slope_s_per_m = " + format_number(slope_s_per_m) +
-                                ": must be finite");
-  }
+  base::require(std::isfinite(slope_s_per_m), "slope_s_per_m", slope_s_per_m, "finite");
   return std::make_unique<LinearRestitution>(intercept, slope_s_per_m);
 }
 
@@ -636,15 +614,11 @@ std::unique_ptr<RestitutionModel> make_tabulated_restitution(std::span<const dou
   }
   for (std::size_t i = 0; i < speeds_m_s.size(); ++i) {
     const std::string index = bracketed(i);
-    if (!(std::isfinite(speeds_m_s[i]) && speeds_m_s[i] >= 0.0)) {
-      throw std::invalid_argument("restitution table: speeds_m_s" + index + " = " +
-                                  format_number(speeds_m_s[i]) + ": must be finite and >= 0");
-    }
+    require_non_negative("restitution table: speeds_m_s" + index, speeds_m_s[i]);
     if (i > 0 && !(speeds_m_s[i] > speeds_m_s[i - 1])) {
-      throw std::invalid_argument(
-          "restitution table: speeds_m_s" + index + " = " + format_number(speeds_m_s[i]) +
-          ": must be > speeds_m_s[" + std::to_string(i - 1) +
-          "] = " + format_number(speeds_m_s[i - 1]) + " (strictly increasing)");
+      throw std::invalid_argument("restitution table: speeds_m_s" + index + " = " + format_number(speeds_m_s[i], 9) +
+                                  ": must be > speeds_m_s[" + std::to_string(i - 1) +
+                                  "] = " + format_number(speeds_m_s[i - 1], 9) + " (strictly increasing)");
     }
     require_restitution("restitution table: values" + index, values[i]);
   }
@@ -748,12 +722,10 @@ ImpactData read_impact_csv(const std::string& path) {
     const double speed = parse(speed_column, kSpeedColumn);
     const double restitution = parse(restitution_column, kRestitutionColumn);
     if (speed < 0.0) {
-      throw std::invalid_argument(where + "impact_speed_m_s = " + format_number(speed) +
-                                  ": must be >= 0");
+      throw std::invalid_argument(where + "impact_speed_m_s = " + format_number(speed, 9) + ": must be >= 0");
     }
     if (!(restitution > 0.0 && restitution <= 1.0)) {
-      throw std::invalid_argument(where + "restitution = " + format_number(restitution) +
-                                  ": must be in (0, 1]");
+      throw std::invalid_argument(where + "restitution = " + format_number(restitution, 9) + ": must be in (0, 1]");
     }
     data.speed_m_s.push_back(speed);
     data.restitution.push_back(restitution);
@@ -794,18 +766,12 @@ RestitutionFit fit_restitution(const ImpactData& data, RestitutionLaw law,
 }
 
 double realised_restitution(double damping_coefficient) {
-  if (!(damping_coefficient >= 0.0 && damping_coefficient <= kMaxDampingCoefficient)) {
-    throw std::invalid_argument("damping_coefficient = " + format_number(damping_coefficient) +
-                                ": must be in [0, " + format_number(kMaxDampingCoefficient) + "]");
-  }
+  base::require_in("damping_coefficient", damping_coefficient, 0.0, kMaxDampingCoefficient);
   return integrate_restitution(damping_coefficient, kAccurateTolerance);
 }
 
 double damping_for_restitution(double restitution) {
-  if (!(restitution >= kMinCalibratedRestitution && restitution <= 1.0)) {
-    throw std::invalid_argument("restitution = " + format_number(restitution) + ": must be in [" +
-                                format_number(kMinCalibratedRestitution) + ", 1]");
-  }
+  base::require_in("restitution", restitution, kMinCalibratedRestitution, 1.0);
   if (restitution == 1.0) return 0.0;
   // Solve ln ε(γ) = ln ε_target in u = ln(1 + γ): ln ε is nearly linear in u
   // (slope −π/√5 at γ = 0, tending to −2 as ε ≈ 1.25/γ² for large γ), so the
@@ -819,9 +785,8 @@ double damping_for_restitution(double restitution) {
   double hi = std::min(-target / 1.3, max_u), f_hi = residual(hi);
   while (f_hi > 0.0) {
     if (hi == max_u) {
-      throw base::NumericalError("damping_for_restitution: restitution " +
-                               format_number(restitution) + " not reached at damping " +
-                               format_number(kMaxDampingCoefficient));
+      throw base::NumericalError("damping_for_restitution: restitution " + format_number(restitution, 9) +
+                                 " not reached at damping " + format_number(kMaxDampingCoefficient, 9));
     }
     lo = hi;
     f_lo = f_hi;
@@ -830,7 +795,7 @@ double damping_for_restitution(double restitution) {
   }
   // |Δ ln ε| < 1e-10 gives |Δε| < 1e-10: inside the 1e-9 promise with the
   // integrator's own ~1e-11 error.
-  const double u = illinois_root(residual, lo, f_lo, hi, f_hi, 1e-10, 1e-15, 200);
+  const double u = base::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-10, 1e-15, 200);
   return std::expm1(u);
 }
 
@@ -851,9 +816,9 @@ DampingTable::DampingTable() : damping_(kPoints) {
     log_restitution[j] = std::log(integrate_restitution(gamma, kTableTolerance));
   }
   if (!(log_restitution.front() < std::log(kMinRestitution))) {
-    throw base::NumericalError(
-        "DampingTable: realised restitution at damping " + format_number(kMaxDamping) + " is " +
-        format_number(std::exp(log_restitution.front())) + ", not below the table's lower end");
+    throw base::NumericalError("DampingTable: realised restitution at damping " + format_number(kMaxDamping, 9) +
+                               " is " + format_number(std::exp(log_restitution.front()), 9) +
+                               ", not below the table's lower end");
   }
   const MonotoneCubic inverse(std::move(log_restitution), std::move(damping));
   for (int i = 0; i < kPoints; ++i) {
@@ -864,8 +829,9 @@ DampingTable::DampingTable() : damping_(kPoints) {
 }
 
 void DampingTable::throw_out_of_range(double restitution) {
-  throw std::invalid_argument("DampingTable: restitution = " + format_number(restitution) +
-                              ": must be in [" + format_number(kMinRestitution) + ", 1]");
+  throw std::invalid_argument("DampingTable: " +
+                              base::violation("restitution", restitution,
+                                              "in [" + format_number(kMinRestitution, base::kCheckDigits) + ", 1]"));
 }
 
 }  // namespace pdamp::formulas

@@ -2,10 +2,11 @@
 #include "pdamp/formulas/hertz_impact.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"  // kPi, kStandardGravity
 #include "pdamp/formulas/layered_contact.hpp"
 
@@ -20,18 +21,13 @@ constexpr double kIntensityMismatch = 1e-6;          // relative X-Γ disagreeme
 // solution is already 1.3-1.45x stiffer than Hertz for nu = 0.3-0.5 (docs).
 constexpr double kMaxHalfSpaceContactOverThickness = 0.3;
 
-std::string number(double value, int digits = 12) {
-  std::ostringstream out;
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
+using base::format_number;
+using base::positive_finite;
+using base::violation;
 
 std::string field(const std::string& prefix, const char* name) {
   return prefix.empty() ? std::string(name) : prefix + "." + name;
 }
-
-bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
 
 bool valid(const Material& m) {
   return positive_finite(m.density_kg_m3) && positive_finite(m.youngs_modulus_pa) && m.poisson_ratio >= 0.0 &&
@@ -48,23 +44,16 @@ void require_valid(const Material& m, const char* function, const char* name) {
   if (!valid(m)) throw std::invalid_argument(std::string(function) + ": " + joined(m.validate(name)));
 }
 
-void require_positive(double value, const char* function, const char* name) {
-  if (!positive_finite(value)) {
-    throw std::invalid_argument(std::string(function) + ": " + name + " = " + number(value) +
-                                ": must be > 0 and finite");
-  }
-}
-
 /// (1 − ν²)/E: the compliance of one body in 1/E*.
 double compliance(const Material& m) {
   return (1.0 - m.poisson_ratio * m.poisson_ratio) / m.youngs_modulus_pa;
 }
 
 void require_valid(const HertzContact& c, double speed, const char* function) {
-  require_positive(speed, function, "impact_speed_m_s");
-  require_positive(c.effective_modulus_pa, function, "effective_modulus_pa");
-  require_positive(c.effective_radius_m, function, "effective_radius_m");
-  require_positive(c.effective_mass_kg, function, "effective_mass_kg");
+  base::require_positive("impact_speed_m_s", speed, function);
+  base::require_positive("effective_modulus_pa", c.effective_modulus_pa, function);
+  base::require_positive("effective_radius_m", c.effective_radius_m, function);
+  base::require_positive("effective_mass_kg", c.effective_mass_kg, function);
 }
 
 /// I = ∫₀¹ (1 − x^{5/2})^{-1/2} dx = (2/5)·B(2/5, 1/2) (substitute u = x^{5/2}).
@@ -78,20 +67,17 @@ double half_contact_integral() {
 std::vector<std::string> Material::validate(const std::string& prefix) const {
   std::vector<std::string> problems;
   if (!positive_finite(density_kg_m3)) {
-    problems.push_back(field(prefix, "density_kg_m3") + " = " + number(density_kg_m3) +
-                       ": must be > 0 and finite");
+    problems.push_back(violation(field(prefix, "density_kg_m3"), density_kg_m3, "> 0 and finite"));
   }
   if (!positive_finite(youngs_modulus_pa)) {
-    problems.push_back(field(prefix, "youngs_modulus_pa") + " = " + number(youngs_modulus_pa) +
-                       ": must be > 0 and finite");
+    problems.push_back(violation(field(prefix, "youngs_modulus_pa"), youngs_modulus_pa, "> 0 and finite"));
   }
   // ν = 0.5 (incompressible: rubbers, polyurethane) is allowed. Hertz (E* = E/(1−ν²)),
   // Mindlin's G* and the Rayleigh time stay finite there; only the constrained modulus
   // of a thin bonded layer diverges, and the layered law (layered_contact.hpp) takes
   // that limit.
   if (!(poisson_ratio >= 0.0 && poisson_ratio <= 0.5)) {
-    problems.push_back(field(prefix, "poisson_ratio") + " = " + number(poisson_ratio) +
-                       ": must be in [0, 0.5]");
+    problems.push_back(violation(field(prefix, "poisson_ratio"), poisson_ratio, "in [0, 0.5]"));
   }
   return problems;
 }
@@ -115,10 +101,10 @@ double HertzContact::force(double overlap_m) const {
 HertzContact sphere_sphere_contact(double radius1_m, double mass1_kg, const Material& m1, double radius2_m,
                                    double mass2_kg, const Material& m2) {
   constexpr const char* kFunction = "sphere_sphere_contact";
-  require_positive(radius1_m, kFunction, "radius1_m");
-  require_positive(mass1_kg, kFunction, "mass1_kg");
-  require_positive(radius2_m, kFunction, "radius2_m");
-  require_positive(mass2_kg, kFunction, "mass2_kg");
+  base::require_positive("radius1_m", radius1_m, kFunction);
+  base::require_positive("mass1_kg", mass1_kg, kFunction);
+  base::require_positive("radius2_m", radius2_m, kFunction);
+  base::require_positive("mass2_kg", mass2_kg, kFunction);
   require_valid(m1, kFunction, "m1");
   require_valid(m2, kFunction, "m2");
   HertzContact contact;
@@ -131,8 +117,8 @@ HertzContact sphere_sphere_contact(double radius1_m, double mass1_kg, const Mate
 HertzContact sphere_wall_contact(double radius_m, double mass_kg, const Material& sphere,
                                  const Material& wall) {
   constexpr const char* kFunction = "sphere_wall_contact";
-  require_positive(radius_m, kFunction, "radius_m");
-  require_positive(mass_kg, kFunction, "mass_kg");
+  base::require_positive("radius_m", radius_m, kFunction);
+  base::require_positive("mass_kg", mass_kg, kFunction);
   require_valid(sphere, kFunction, "sphere");
   require_valid(wall, kFunction, "wall");
   return {1.0 / (compliance(sphere) + compliance(wall)), radius_m, mass_kg};
@@ -140,8 +126,8 @@ HertzContact sphere_wall_contact(double radius_m, double mass_kg, const Material
 
 HertzContact sphere_rigid_wall_contact(double radius_m, double mass_kg, const Material& sphere) {
   constexpr const char* kFunction = "sphere_rigid_wall_contact";
-  require_positive(radius_m, kFunction, "radius_m");
-  require_positive(mass_kg, kFunction, "mass_kg");
+  base::require_positive("radius_m", radius_m, kFunction);
+  base::require_positive("mass_kg", mass_kg, kFunction);
   require_valid(sphere, kFunction, "sphere");
   return {1.0 / compliance(sphere), radius_m, mass_kg};
 }
@@ -165,13 +151,10 @@ double contact_time_coefficient() { return 2.0 * std::pow(15.0 / 16.0, 0.4) * ha
 std::vector<std::string> BufferDesignInput::validate() const {
   std::vector<std::string> problems;
   const auto positive = [&](double value, const char* name) {
-    if (!positive_finite(value))
-      problems.push_back(std::string(name) + " = " + number(value) + ": must be > 0 and finite");
+    if (!positive_finite(value)) problems.push_back(violation(name, value, "> 0 and finite"));
   };
   const auto non_negative = [&](double value, const char* name) {
-    if (!(value >= 0.0 && std::isfinite(value))) {
-      problems.push_back(std::string(name) + " = " + number(value) + ": must be >= 0 and finite");
-    }
+    if (!base::non_negative_finite(value)) problems.push_back(violation(name, value, ">= 0 and finite"));
   };
   positive(frequency_hz, "frequency_hz");
   non_negative(amplitude_m, "amplitude_m");
@@ -183,14 +166,13 @@ std::vector<std::string> BufferDesignInput::validate() const {
   }
   positive(particle_radius_m, "particle_radius_m");
   if (!(particles_per_contact >= 1.0 && std::isfinite(particles_per_contact))) {
-    problems.push_back("particles_per_contact = " + number(particles_per_contact) +
-                       ": must be >= 1 and finite");
+    problems.push_back(violation("particles_per_contact", particles_per_contact, ">= 1 and finite"));
   }
   for (auto& line : particle.validate("particle")) problems.push_back(std::move(line));
   for (auto& line : layer.validate("layer")) problems.push_back(std::move(line));
   // ε_a = 1 is full compression; a strain above it would put the sphere through the layer.
   if (!(allowable_strain > 0.0 && allowable_strain <= 1.0)) {
-    problems.push_back("allowable_strain = " + number(allowable_strain) + ": must be in (0, 1]");
+    problems.push_back(violation("allowable_strain", allowable_strain, "in (0, 1]"));
   }
   if (model != BufferModel::kLayered && model != BufferModel::kHalfSpace) {
     problems.push_back("model = " + std::to_string(static_cast<int>(model)) + ": must be layered or half_space");
@@ -268,107 +250,105 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
 
   auto& said = design.assumptions;
   if (input.impact_velocity_m_s > 0.0) {
-    said.push_back("Impact speed v = " + number(v, 4) +
-                   " m/s as given (not derived from the design stroke).");
+    said.push_back("Impact speed v = " + format_number(v, 4) + " m/s as given (not derived from the design stroke).");
   } else {
     const std::string origin = input.amplitude_m > 0.0
-                                   ? "the design stroke X = " + number(stroke, 4) + " m"
-                                   : "the design stroke X = Gamma*g/Omega^2 = " + number(stroke, 4) +
-                                         " m (Gamma = " + number(input.intensity, 4) + ")";
-    said.push_back(
-        "Impact speed v = 2*X*Omega = " + number(v, 4) + " m/s from " + origin + " at f = " + number(f, 4) +
-        " Hz: at the bouncing optimum the bed leaves one wall at the peak container velocity V = X*Omega "
-        "and meets the other wall moving at -V (docs/theory.md, section 2).");
+                                   ? "the design stroke X = " + format_number(stroke, 4) + " m"
+                                   : "the design stroke X = Gamma*g/Omega^2 = " + format_number(stroke, 4) +
+                                         " m (Gamma = " + format_number(input.intensity, 4) + ")";
+    said.push_back("Impact speed v = 2*X*Omega = " + format_number(v, 4) + " m/s from " + origin +
+                   " at f = " + format_number(f, 4) +
+                   " Hz: at the bouncing optimum the bed leaves one wall at the peak container velocity V = X*Omega "
+                   "and meets the other wall moving at -V (docs/theory.md, section 2).");
   }
   if (input.particles_per_contact == 1.0) {
-    said.push_back("One sphere (r = " + number(r, 4) + " m, m = " + number(particle_mass, 4) +
+    said.push_back("One sphere (r = " + format_number(r, 4) + " m, m = " + format_number(particle_mass, 4) +
                    " kg) hits the layer alone: particles_per_contact = 1.");
   } else {
-    said.push_back("The bed's mass is shared over its front row: each front-row sphere (r = " + number(r, 4) +
-                   " m) hits the layer carrying " + number(input.particles_per_contact, 4) +
-                   " spheres, m* = " + number(design.effective_mass_kg, 4) +
+    said.push_back("The bed's mass is shared over its front row: each front-row sphere (r = " + format_number(r, 4) +
+                   " m) hits the layer carrying " + format_number(input.particles_per_contact, 4) +
+                   " spheres, m* = " + format_number(design.effective_mass_kg, 4) +
                    " kg, as a rigid column (no wave travel or rebound inside the bed).");
   }
   const bool half_space = input.model == BufferModel::kHalfSpace;
   said.push_back(
       "The wall behind the layer is rigid and driven (no wall mass in m*); the layer is bonded to the wall "
       "and the sphere's contact with the layer is frictionless; E* = " +
-      number(contact.effective_modulus_pa, 4) + " Pa from both materials.");
-  said.push_back(
-      "Layer modulus E = " + number(input.layer.youngs_modulus_pa, 4) +
-      " Pa (nu = " + number(input.layer.poisson_ratio, 3) +
-      ") is taken at the design frequency and temperature: polymers are rate- and temperature-dependent "
-      "(viscoelastic), and the contact law is elastic, so the layer's own loss is not in this sizing.");
+      format_number(contact.effective_modulus_pa, 4) + " Pa from both materials.");
+  said.push_back("Layer modulus E = " + format_number(input.layer.youngs_modulus_pa, 4) +
+                 " Pa (nu = " + format_number(input.layer.poisson_ratio, 3) +
+                 ") is taken at the design frequency and temperature: polymers are rate- and temperature-dependent "
+                 "(viscoelastic), and the contact law is elastic, so the layer's own loss is not in this sizing.");
   if (half_space) {
     said.push_back(
         "Model half_space (the source study's sizing): Hertz treats the layer as a half-space, valid while "
         "the contact radius a = sqrt(r*delta) is small against the thickness; here a = " +
-        number(a, 4) + " m is " + number(a / thickness, 3) + " times the thickness " + number(thickness, 4) +
+        format_number(a, 4) + " m is " + format_number(a / thickness, 3) + " times the thickness " +
+        format_number(thickness, 4) +
         " m. Under the layered law (bonded layer) the design impact compresses this layer to only " +
-        number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
+        format_number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
     said.push_back(
         "The thickness equals the Hertz delta_max so the design impact just compresses the layer fully "
         "(strain 1 under the sphere's tip): a first sizing beyond linear elasticity, to be checked in the "
         "DEM. The allowable strain (" +
-        number(input.allowable_strain, 4) + ") is not used by this rule (model layered sizes to it).");
+        format_number(input.allowable_strain, 4) + ") is not used by this rule (model layered sizes to it).");
   } else {
     const double strain = design.allowable_strain;
     said.push_back(
         "Model layered: sphere on an elastic layer of thickness t bonded to the rigid wall (exact linear "
         "elasticity for any a/t, Hertz for a/t -> 0, thin-layer limits for a/t >> 1; "
         "docs/hertz_and_buffer.md). The thickness t = " +
-        number(thickness, 4) + " m is the one whose tip strain at the design impact is the allowable strain " +
-        number(strain, 4) + " (delta_max = " + number(design.max_penetration_m, 4) +
+        format_number(thickness, 4) + " m is the one whose tip strain at the design impact is the allowable strain " +
+        format_number(strain, 4) + " (delta_max = " + format_number(design.max_penetration_m, 4) +
         " m, the compression under the sphere's tip over the thickness): 1/2 m* v^2 = integral_0^(eps_a t) "
         "F(delta; t) ddelta. The half-space sizing would give " +
-        number(half_space_thickness, 4) + " m, which this impact compresses to only " +
-        number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
+        format_number(half_space_thickness, 4) + " m, which this impact compresses to only " +
+        format_number(design.layered_compression_of_half_space_design, 3) + " of its thickness.");
     said.push_back(
-        "At the design impact the contact radius is a = " + number(a, 4) + " m, a/t = " + number(a / thickness, 3) +
-        "; a tip strain of " + number(strain, 3) +
+        "At the design impact the contact radius is a = " + format_number(a, 4) +
+        " m, a/t = " + format_number(a / thickness, 3) + "; a tip strain of " + format_number(strain, 3) +
         (strain >= 1.0 ? " (full compression: the layer bottoms out) is far beyond linear elasticity"
                        : " is beyond the small strains of linear elasticity") +
         " (and the paraboloid needs a << r): a sizing estimate, to be checked in the DEM with the layered law.");
   }
   auto& warn = design.warnings;
   if (design.contact_time_over_period > kMaxContactTimeOverPeriod) {
-    warn.push_back(
-        "contact time " + number(design.contact_time_s, 4) + " s is " +
-        number(design.contact_time_over_period, 3) +
-        " of the period (> 0.1): the impact is not short against the period, so it is not an impact "
-        "and the collect-and-collide timing does not hold");
+    warn.push_back("contact time " + format_number(design.contact_time_s, 4) + " s is " +
+                   format_number(design.contact_time_over_period, 3) +
+                   " of the period (> 0.1): the impact is not short against the period, so it is not an impact "
+                   "and the collect-and-collide timing does not hold");
   }
   if (half_space && a > kMaxHalfSpaceContactOverThickness * thickness) {
-    warn.push_back(
-        "half-space sizing: contact radius a = " + number(a, 4) + " m is " + number(a / thickness, 3) +
-        " times the layer thickness " + number(thickness, 4) +
-        " m (> 0.3): the layer is thin, not the half-space Hertz assumes; bonded to the rigid wall it is "
-        "stiffer, and the design impact compresses it to only " +
-        number(design.layered_compression_of_half_space_design, 3) + " of its thickness (model layered)");
+    warn.push_back("half-space sizing: contact radius a = " + format_number(a, 4) + " m is " +
+                   format_number(a / thickness, 3) + " times the layer thickness " + format_number(thickness, 4) +
+                   " m (> 0.3): the layer is thin, not the half-space Hertz assumes; bonded to the rigid wall it is "
+                   "stiffer, and the design impact compresses it to only " +
+                   format_number(design.layered_compression_of_half_space_design, 3) +
+                   " of its thickness (model layered)");
   }
   // χ = √(r δ_max)/t at the design impact (√(r/t) at full compression).
   const double chi = std::sqrt(r * design.max_penetration_m) / thickness;
   if (!half_space && chi > LayeredContact::kMaxTabulatedOverlapParameter) {
-    warn.push_back("layered law: sqrt(r*delta_max)/t = " + number(chi, 3) + " exceeds the tabulated " +
-                   "exact solution (" + number(LayeredContact::kMaxTabulatedOverlapParameter, 3) +
+    warn.push_back("layered law: sqrt(r*delta_max)/t = " + format_number(chi, 3) + " exceeds the tabulated " +
+                   "exact solution (" + format_number(LayeredContact::kMaxTabulatedOverlapParameter, 3) +
                    "): the force continues as the table's end power law (thin-layer regime)");
   }
   if (a > kMaxContactRadiusOverRadius * r) {
-    warn.push_back("contact radius a = " + number(a, 4) + " m is " + number(a / r, 3) +
-                   " of the particle radius " + number(r, 4) +
+    warn.push_back("contact radius a = " + format_number(a, 4) + " m is " + format_number(a / r, 3) +
+                   " of the particle radius " + format_number(r, 4) +
                    " m (> 0.2): the contact law needs a << r (small strain, paraboloidal sphere)");
   }
   if (input.impact_velocity_m_s == 0.0 && intensity < 1.0) {
-    warn.push_back("design intensity Gamma = " + number(intensity, 3) +
+    warn.push_back("design intensity Gamma = " + format_number(intensity, 3) +
                    " < 1: the bed rolls rather than flies (docs/theory.md, section 3), so the bouncing impact "
                    "speed 2*X*Omega "
                    "overestimates the impact");
   }
   if (input.amplitude_m > 0.0 && input.intensity > 0.0 &&
       std::abs(input.intensity - intensity) > kIntensityMismatch * intensity) {
-    warn.push_back("intensity = " + number(input.intensity, 6) +
-                   " disagrees with amplitude_m = " + number(input.amplitude_m, 6) +
-                   " m (Gamma = " + number(intensity, 6) + "): the amplitude is used");
+    warn.push_back("intensity = " + format_number(input.intensity, 6) +
+                   " disagrees with amplitude_m = " + format_number(input.amplitude_m, 6) +
+                   " m (Gamma = " + format_number(intensity, 6) + "): the amplitude is used");
   }
   return design;
 }

@@ -1,7 +1,9 @@
 // Sphere on an elastic layer bonded to a rigid wall: kernel, thin-layer limits, exact Nyström solution, table.
 #include "pdamp/formulas/layered_contact.hpp"
 #include "pdamp/base/run_errors.hpp"
-#include "pdamp/formulas/root_finding.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/one_dimensional.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -9,7 +11,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,18 +20,10 @@
 namespace pdamp::formulas {
 namespace {
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
+using base::positive_finite;
+using base::require;
+using base::require_positive;
 
-void require(bool ok, const char* function, const char* name, double value, const char* rule) {
-  if (!ok) throw std::invalid_argument(std::string(function) + ": " + name + " = " + number(value) + ": " + rule);
-}
-
-bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
 bool layer_poisson_ok(double nu) { return nu >= 0.0 && nu <= 0.5; }
 
 /// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n from Tricomi's guess), n >= 2.
@@ -222,10 +215,9 @@ double bonded_layer_kernel_complement(double u, double nu) {
 
 ThinLayerModuli thin_layer_moduli(double youngs_modulus_pa, double nu, double thickness_m) {
   constexpr const char* kFunction = "thin_layer_moduli";
-  require(positive_finite(youngs_modulus_pa), kFunction, "youngs_modulus_pa", youngs_modulus_pa,
-          "must be > 0 and finite");
-  require(layer_poisson_ok(nu), kFunction, "poisson_ratio", nu, "must be in [0, 0.5]");
-  require(positive_finite(thickness_m), kFunction, "thickness_m", thickness_m, "must be > 0 and finite");
+  require_positive("youngs_modulus_pa", youngs_modulus_pa, kFunction);
+  require(layer_poisson_ok(nu), "poisson_ratio", nu, "in [0, 0.5]", kFunction);
+  require_positive("thickness_m", thickness_m, kFunction);
   const double kappa = 3.0 - 4.0 * nu;
   const double plane = youngs_modulus_pa / (1.0 - nu * nu);
   ThinLayerModuli m;
@@ -244,8 +236,8 @@ ThinLayerModuli thin_layer_moduli(double youngs_modulus_pa, double nu, double th
 
 ThinLayerPoint thin_layer_indentation(double a, double radius, double modulus, double nu, double t) {
   constexpr const char* kFunction = "thin_layer_indentation";
-  require(positive_finite(a), kFunction, "contact_radius_m", a, "must be > 0 and finite");
-  require(positive_finite(radius), kFunction, "sphere_radius_m", radius, "must be > 0 and finite");
+  require_positive("contact_radius_m", a, kFunction);
+  require_positive("sphere_radius_m", radius, kFunction);
   const ThinLayerModuli m = thin_layer_moduli(modulus, nu, t);
   ThinLayerPoint out;
   if (m.spreading_length_m == 0.0) {
@@ -298,16 +290,16 @@ ThinLayerPoint thin_layer_indentation(double a, double radius, double modulus, d
 
 double foundation_force(double overlap, double radius, double modulus, double nu, double t) {
   const ThinLayerModuli m = thin_layer_moduli(modulus, nu, t);
-  require(positive_finite(radius), "foundation_force", "sphere_radius_m", radius, "must be > 0 and finite");
+  require_positive("sphere_radius_m", radius, "foundation_force");
   if (!(overlap > 0.0)) return 0.0;
   return kPi * m.constrained_modulus_pa * radius * overlap * overlap / t;
 }
 
 double incompressible_thin_layer_force(double overlap, double radius, double modulus, double t) {
   constexpr const char* kFunction = "incompressible_thin_layer_force";
-  require(positive_finite(radius), kFunction, "sphere_radius_m", radius, "must be > 0 and finite");
-  require(positive_finite(modulus), kFunction, "youngs_modulus_pa", modulus, "must be > 0 and finite");
-  require(positive_finite(t), kFunction, "thickness_m", t, "must be > 0 and finite");
+  require_positive("sphere_radius_m", radius, kFunction);
+  require_positive("youngs_modulus_pa", modulus, kFunction);
+  require_positive("thickness_m", t, kFunction);
   if (!(overlap > 0.0)) return 0.0;
   return 2.0 * kPi / 3.0 * modulus * radius * radius * overlap * overlap * overlap / (t * t * t);
 }
@@ -323,11 +315,10 @@ double dimitriadis_force_ratio(double chi, double nu) {
 
 LayerIndentation solve_layer_indentation(double lambda, double nu, double layer_share, int nodes) {
   constexpr const char* kFunction = "solve_layer_indentation";
-  require(lambda >= 0.0 && lambda <= 200.0, kFunction, "contact_radius_over_thickness", lambda,
-          "must be in [0, 200]");
-  require(layer_poisson_ok(nu), kFunction, "poisson_ratio", nu, "must be in [0, 0.5]");
-  require(layer_share > 0.0 && layer_share <= 1.0, kFunction, "layer_share", layer_share, "must be in (0, 1]");
-  require(nodes >= 0 && nodes <= 4000, kFunction, "nodes", nodes, "must be in [0, 4000]");
+  require(lambda >= 0.0 && lambda <= 200.0, "contact_radius_over_thickness", lambda, "in [0, 200]", kFunction);
+  require(layer_poisson_ok(nu), "poisson_ratio", nu, "in [0, 0.5]", kFunction);
+  require(layer_share > 0.0 && layer_share <= 1.0, "layer_share", layer_share, "in (0, 1]", kFunction);
+  require(nodes >= 0 && nodes <= 4000, "nodes", nodes, "in [0, 4000]", kFunction);
   const KernelTransform h(nu, layer_share, 2.0 * lambda + 1.0);
   return nystrom(h, lambda, nodes > 0 ? nodes : default_nodes(lambda));
 }
@@ -364,7 +355,7 @@ std::shared_ptr<const LayeredContact::Table> build_table(double nu, double share
     lam[i] = lambda;
     if (i > 0 && !(chi[i] > chi[i - 1])) {
       throw base::NumericalError("LayeredContact: overlap parameter not increasing with a/t at a/t = " +
-                               number(lambda));
+                                 base::format_number(lambda, 12));
     }
   }
   if (!(chi.back() > LayeredContact::kMaxTabulatedOverlapParameter)) {
@@ -448,17 +439,13 @@ std::shared_ptr<const LayeredContact::Table> shared_table(double nu, double shar
 LayeredContact::LayeredContact(double effective_radius_m, double layer_modulus_pa, double layer_poisson_ratio,
                                double sphere_modulus_pa, double sphere_poisson_ratio, double thickness_m) {
   constexpr const char* kFunction = "LayeredContact";
-  require(positive_finite(effective_radius_m), kFunction, "effective_radius_m", effective_radius_m,
-          "must be > 0 and finite");
-  require(positive_finite(layer_modulus_pa), kFunction, "layer_modulus_pa", layer_modulus_pa,
-          "must be > 0 and finite");
-  require(layer_poisson_ok(layer_poisson_ratio), kFunction, "layer_poisson_ratio", layer_poisson_ratio,
-          "must be in [0, 0.5]");
-  require(sphere_modulus_pa > 0.0, kFunction, "sphere_modulus_pa", sphere_modulus_pa,
-          "must be > 0 (+inf: rigid)");
-  require(sphere_poisson_ratio >= 0.0 && sphere_poisson_ratio < 0.5, kFunction, "sphere_poisson_ratio",
-          sphere_poisson_ratio, "must be in [0, 0.5)");
-  require(positive_finite(thickness_m), kFunction, "thickness_m", thickness_m, "must be > 0 and finite");
+  require_positive("effective_radius_m", effective_radius_m, kFunction);
+  require_positive("layer_modulus_pa", layer_modulus_pa, kFunction);
+  require(layer_poisson_ok(layer_poisson_ratio), "layer_poisson_ratio", layer_poisson_ratio, "in [0, 0.5]", kFunction);
+  require(sphere_modulus_pa > 0.0, "sphere_modulus_pa", sphere_modulus_pa, "> 0 (+inf: rigid)", kFunction);
+  require(sphere_poisson_ratio >= 0.0 && sphere_poisson_ratio < 0.5, "sphere_poisson_ratio", sphere_poisson_ratio,
+          "in [0, 0.5)", kFunction);
+  require_positive("thickness_m", thickness_m, kFunction);
   radius_ = effective_radius_m;
   thickness_ = thickness_m;
   const double layer_compliance = (1.0 - layer_poisson_ratio * layer_poisson_ratio) / layer_modulus_pa;
@@ -472,7 +459,7 @@ LayeredContact::LayeredContact(double effective_radius_m, double layer_modulus_p
 }
 
 LayeredContact::LayeredContact(const LayeredContact& materials, double thickness_m) : LayeredContact(materials) {
-  require(positive_finite(thickness_m), "LayeredContact", "thickness_m", thickness_m, "must be > 0 and finite");
+  require_positive("thickness_m", thickness_m, "LayeredContact");
   thickness_ = thickness_m;
 }
 
@@ -566,8 +553,8 @@ double LayeredContact::contact_radius(double overlap) const {
 
 LayeredImpact layered_impact(const LayeredContact& contact, double mass, double speed) {
   constexpr const char* kFunction = "layered_impact";
-  require(positive_finite(mass), kFunction, "effective_mass_kg", mass, "must be > 0 and finite");
-  require(positive_finite(speed), kFunction, "impact_speed_m_s", speed, "must be > 0 and finite");
+  require_positive("effective_mass_kg", mass, kFunction);
+  require_positive("impact_speed_m_s", speed, kFunction);
   const double kinetic = 0.5 * mass * speed * speed;
   // δ_max: U is increasing; bracket from the Hertz value (the layer is stiffer, so δ_max
   // is smaller), then bisection on ln δ to double precision.
@@ -649,9 +636,9 @@ double realised_restitution(const LayeredContact& contact, double mass, double s
 
 double layered_realised_restitution(const LayeredContact& contact, double mass, double speed, double damping) {
   constexpr const char* kFunction = "layered_realised_restitution";
-  require(positive_finite(mass), kFunction, "effective_mass_kg", mass, "must be > 0 and finite");
-  require(positive_finite(speed), kFunction, "impact_speed_m_s", speed, "must be > 0 and finite");
-  require(damping >= 0.0 && damping <= 100.0, kFunction, "damping_coefficient", damping, "must be in [0, 100]");
+  require_positive("effective_mass_kg", mass, kFunction);
+  require_positive("impact_speed_m_s", speed, kFunction);
+  require(damping >= 0.0 && damping <= 100.0, "damping_coefficient", damping, "in [0, 100]", kFunction);
   // Step: the elastic contact time over 20000 (RK4, the force's δ^{1/4}-type start costs
   // an O(h^{5/4}) local error in the first steps only: ε converged to ~1e-6, docs).
   return realised_restitution(contact, mass, speed, damping, 20000);
@@ -659,8 +646,8 @@ double layered_realised_restitution(const LayeredContact& contact, double mass, 
 
 double layered_damping_for_restitution(const LayeredContact& contact, double mass, double speed,
                                        double restitution) {
-  require(restitution >= 1e-3 && restitution <= 1.0, "layered_damping_for_restitution", "restitution",
-          restitution, "must be in [0.001, 1]");
+  require(restitution >= 1e-3 && restitution <= 1.0, "restitution", restitution, "in [0.001, 1]",
+          "layered_damping_for_restitution");
   if (restitution == 1.0) return 0.0;
   // ln ε(γ) is nearly linear in u = ln(1 + γ) (as for Hertz, cor_models.cpp): bisection
   // on u with the Illinois update.
@@ -670,7 +657,7 @@ double layered_damping_for_restitution(const LayeredContact& contact, double mas
   };
   double lo = 0.0, f_lo = -target, hi = std::log1p(100.0), f_hi = residual(hi);
   if (f_hi > 0.0) throw base::NumericalError("layered_damping_for_restitution: not reached at damping 100");
-  const double u = illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
+  const double u = base::illinois_root(residual, lo, f_lo, hi, f_hi, 1e-7, 1e-12, 100);
   return std::min(std::expm1(u), 100.0);
 }
 

@@ -13,6 +13,7 @@
 #include "pdamp/optimizer/solve.hpp"
 #include "pdamp/structure/harmonic_balance.hpp"
 #include "pdamp/surrogate/loss_model.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
@@ -61,7 +62,7 @@ std::string_view to_string(ClearanceObjective objective) {
 std::vector<std::string> ClearanceOnStructureOptions::validate() const {
   std::vector<std::string> problems;
   const auto rule = [&](const char* field, double value, bool holds, const char* text) {
-    if (!holds) problems.push_back(std::string(field) + " = " + detail::format_number(value) + ": must be " + text);
+    if (!holds) problems.push_back(std::string(field) + " = " + base::format_number(value, 10) + ": must be " + text);
   };
   if (site.empty()) problems.emplace_back("site: must name a point of the model");
   if (!is_unit(drive_direction)) problems.emplace_back("drive_direction: must be a unit vector");
@@ -201,7 +202,7 @@ ClearanceResponse clearance_response(const st::ModalModel& model, const Clearanc
   }
   if (r.peak_transmissibility < 0.0) {
     throw base::NumericalError("clearance-on-structure: no stable or held response in the frequency band at h = " +
-                             detail::format_number(clearance_m) + " m");
+                               base::format_number(clearance_m, 10) + " m");
   }
   return r;
 }
@@ -216,7 +217,7 @@ ClearanceOnStructureResult size_clearance_on_structure(const st::ModalModel& mod
   const double upper = options.clearance_max_m.value_or(result.estimate.clearance_m * 3.0);
   if (!(upper > lower)) {
     throw std::invalid_argument("invalid clearance-on-structure options:\n  clearance range [" +
-                                detail::format_number(lower) + ", " + detail::format_number(upper) +
+                                base::format_number(lower, 10) + ", " + base::format_number(upper, 10) +
                                 "] m is empty");
   }
   Problem problem;

@@ -1,6 +1,8 @@
 // Private: point evaluation, forward differences and the incumbent for the back ends.
 #include "evaluator.hpp"
 
+#include "pdamp/base/number_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -26,12 +28,13 @@ double checked(double value, const std::string& what, std::span<const double> x)
 }  // namespace
 
 std::string format_point(std::span<const double> x) {
-  std::ostringstream out;
-  out.precision(10);
-  out << '(';
-  for (std::size_t j = 0; j < x.size(); ++j) out << (j ? ", " : "") << x[j];
-  out << ')';
-  return out.str();
+  std::string text = "(";
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    if (j) text += ", ";
+    text += base::format_number(x[j], 10);
+  }
+  text += ')';
+  return text;
 }
 
 Evaluator::Evaluator(const Problem& problem, double constraint_tolerance)

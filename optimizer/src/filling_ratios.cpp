@@ -2,6 +2,8 @@
 #include "pdamp/optimizer/filling_ratios.hpp"
 
 #include "pdamp/structure/sampled_decay.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/one_dimensional.hpp"
 #include "pdamp/base/run_errors.hpp"
 
 #include <algorithm>
@@ -9,7 +11,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 
 #include "pdamp/optimizer/solve.hpp"
@@ -27,12 +28,7 @@ constexpr int kMaxLayers = 10;
 constexpr std::size_t kSingleCompartmentScan = 41;
 constexpr int kSingleCompartmentRefinements = 20;
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(10);
-  out << value;
-  return out.str();
-}
+using base::format_number;
 
 double clock_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -124,20 +120,20 @@ std::vector<std::string> FillingRatioOptions::validate() const {
     for (std::size_t j = 0; j < k; ++j)
       if (layers[j].name == l.name) problems.push_back(at + "name = " + l.name + ": must be unique");
     if (!(l.inner_length_m > 0.0 && std::isfinite(l.inner_length_m)))
-      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must be > 0 and finite");
+      problems.push_back(at + "inner_length_m = " + format_number(l.inner_length_m, 10) + ": must be > 0 and finite");
     if (!(l.slab_length_m > 0.0 && std::isfinite(l.slab_length_m)))
-      problems.push_back(at + "slab_length_m = " + number(l.slab_length_m) + ": must be > 0 and finite");
+      problems.push_back(at + "slab_length_m = " + format_number(l.slab_length_m, 10) + ": must be > 0 and finite");
     else if (l.spheres_per_lane >= 1 && l.max_slabs() < 1)
-      problems.push_back(at + "inner_length_m = " + number(l.inner_length_m) + ": must hold the " +
+      problems.push_back(at + "inner_length_m = " + format_number(l.inner_length_m, 10) + ": must hold the " +
                          std::to_string(l.spheres_per_lane) + " settled row(s) of one slab and one row of travel, " +
-                         number(l.slab_length_m) + " m each");
+                         format_number(l.slab_length_m, 10) + " m each");
     if (l.spheres_per_slab < 1)
       problems.push_back(at + "spheres_per_slab = " + std::to_string(l.spheres_per_slab) + ": must be >= 1");
     if (l.spheres_per_lane < 1 || l.spheres_per_lane > std::max(l.spheres_per_slab, 1))
       problems.push_back(at + "spheres_per_lane = " + std::to_string(l.spheres_per_lane) +
                          ": must be in [1, spheres_per_slab]");
     if (!(l.sphere_mass_kg > 0.0 && std::isfinite(l.sphere_mass_kg)))
-      problems.push_back(at + "sphere_mass_kg = " + number(l.sphere_mass_kg) + ": must be > 0 and finite");
+      problems.push_back(at + "sphere_mass_kg = " + format_number(l.sphere_mass_kg, 10) + ": must be > 0 and finite");
     if (!(l.cross_section_m2 >= 0.0 && std::isfinite(l.cross_section_m2)) ||
         !(l.sphere_volume_m3 >= 0.0 && std::isfinite(l.sphere_volume_m3)))
       problems.push_back(at + "cross_section_m2, sphere_volume_m3: must be >= 0 and finite");
@@ -147,10 +143,10 @@ std::vector<std::string> FillingRatioOptions::validate() const {
     if (l.spheres_per_slab >= 1 && l.sphere_mass_kg > 0.0) lightest = std::min(lightest, l.slab_mass_kg());
   }
   if (!(mass_budget_kg >= 0.0 && std::isfinite(mass_budget_kg)))
-    problems.push_back("mass_budget_kg = " + number(mass_budget_kg) + ": must be >= 0 and finite");
+    problems.push_back("mass_budget_kg = " + format_number(mass_budget_kg, 10) + ": must be >= 0 and finite");
   else if (mass_budget_kg > 0.0 && std::isfinite(lightest) && mass_budget_kg < lightest * (1.0 - 1e-9))
-    problems.push_back("mass_budget_kg = " + number(mass_budget_kg) + ": must be >= the lightest slab, " +
-                       number(lightest) + " kg (no layer could hold a whole slab)");
+    problems.push_back("mass_budget_kg = " + format_number(mass_budget_kg, 10) + ": must be >= the lightest slab, " +
+                       format_number(lightest, 10) + " kg (no layer could hold a whole slab)");
   if (max_total_slabs < 0) problems.push_back("max_total_slabs = " + std::to_string(max_total_slabs) + ": must be >= 0");
   if (mass_budget_kg == 0.0 && max_total_slabs == 0)
     problems.push_back("mass_budget_kg = 0 and max_total_slabs = 0: give at least one constraint");
@@ -175,7 +171,7 @@ std::vector<std::string> FillingRatioOptions::validate() const {
                          " whole-slab designs to enumerate");
   }
   if (!(decay.duration_s > 0.0 && std::isfinite(decay.duration_s)))
-    problems.push_back("decay.duration_s = " + number(decay.duration_s) + ": must be > 0 and finite");
+    problems.push_back("decay.duration_s = " + format_number(decay.duration_s, 10) + ": must be > 0 and finite");
   return problems;
 }
 
@@ -189,8 +185,8 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
     const auto& l = options.layers[k];
     const double n = slabs[k];
     if (!(n >= 0.0 && n <= l.max_slabs()))
-      throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + number(n) + ": must be in [0, " +
-                                  std::to_string(l.max_slabs()) + "]");
+      throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + format_number(n, 10) +
+                                  ": must be in [0, " + std::to_string(l.max_slabs()) + "]");
     if (n <= kEmptyLayerSlabs) continue;
     structure::DamperLayer layer;
     layer.name = l.name;
@@ -200,7 +196,7 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
           std::make_shared<surrogate::ClosedFormLossModel>(options.model, l.clearance_m(n), options.model_options);
     } else {
       if (std::abs(n - std::round(n)) > kWholeTolerance)
-        throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + number(n) +
+        throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + format_number(n, 10) +
                                     ": calibrated beds exist for whole slabs only");
       layer.loss_model = options.bed_models[k][static_cast<std::size_t>(std::lround(n))];
     }
@@ -315,16 +311,19 @@ FillingDesign best_single_compartment(const structure::ModalModel& model, const 
     auto d = at(h[k]);
     if (d.objective < best.objective) best = std::move(d), best_k = k;
   }
-  double a = std::log(h[best_k == 0 ? 0 : best_k - 1]), b = std::log(h[std::min(best_k + 1, h.size() - 1)]);
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  for (int i = 0; i < kSingleCompartmentRefinements && b - a > 1e-6; ++i) {
-    const double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a);
-    auto d1 = at(std::exp(x1)), d2 = at(std::exp(x2));
-    if (d1.objective < best.objective) best = d1;
-    if (d2.objective < best.objective) best = d2;
-    if (d1.objective < d2.objective) b = x2;
-    else a = x1;
-  }
+  // Both inner points are evaluated afresh at every step (two evaluations a step), in ln h.
+  base::GoldenSectionOptions search;
+  search.max_iterations = kSingleCompartmentRefinements;
+  search.min_width = 1e-6;
+  search.reuse_inner_point = false;
+  base::golden_section(
+      [&](double log_h) {
+        auto d = at(std::exp(log_h));
+        const double objective = d.objective;
+        if (objective < best.objective) best = std::move(d);
+        return objective;
+      },
+      std::log(h[best_k == 0 ? 0 : best_k - 1]), std::log(h[std::min(best_k + 1, h.size() - 1)]), search);
   return best;
 }
 
@@ -461,8 +460,9 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
   out.same_mass = best_single_compartment(model, options, out.chosen, out.decay_evaluations);
   if (out.baseline_evaluations > 0 && out.baseline.objective < out.chosen.objective)
     out.warnings.push_back("the best single-layer design (" + out.baseline_layer + ", objective " +
-                           number(out.baseline.objective) + ") beats the chosen multi-layer design (objective " +
-                           number(out.chosen.objective) +
+                           format_number(out.baseline.objective, 10) +
+                           ") beats the chosen multi-layer design (objective " +
+                           format_number(out.chosen.objective, 10) +
                            "): the relaxed optimum is a local one; raise the global stage's evaluations");
   if (!out.chosen.settled && options.objective == FillingObjective::kSettlingTime)
     out.warnings.push_back("the chosen design does not settle within the duration: lengthen it");

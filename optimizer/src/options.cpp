@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "pdamp/base/number_text.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
@@ -33,7 +34,7 @@ std::string_view to_string(NloptLocalAlgorithm algorithm) {
 std::vector<std::string> Options::validate() const {
   std::vector<std::string> problems;
   const auto rule = [&](const char* field, double value, bool holds, const char* text) {
-    if (!holds) problems.push_back(std::string(field) + " = " + detail::format_number(value) + ": must be " + text);
+    if (!holds) problems.push_back(std::string(field) + " = " + base::format_number(value, 10) + ": must be " + text);
   };
   rule("max_evaluations", max_evaluations, max_evaluations >= 2, ">= 2");
   if (global_stage) {

@@ -9,9 +9,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/optimizer/solve.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/beam.hpp"
+#include "validation.hpp"
 
 namespace pdamp::optimizer {
 
@@ -33,19 +35,8 @@ std::string free_site_name(const st::BeamModel& beam) {
   return name;
 }
 
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(10);
-  out << value;
-  return out.str();
-}
-
-void throw_if_invalid(const std::vector<std::string>& problems, const std::string& what) {
-  if (problems.empty()) return;
-  std::string text = "invalid " + what + ":";
-  for (const auto& p : problems) text += "\n  " + p;
-  throw std::invalid_argument(text);
-}
+using base::format_number;
+using detail::throw_if_invalid;
 
 double objective_of(const std::vector<ModeAtSite>& modes, const PlacementOptions& options) {
   if (options.objective == PlacementObjective::kWorstMode) {
@@ -80,19 +71,21 @@ std::vector<std::string> PlacementOptions::validate() const {
         problems.push_back(at + "mode = " + std::to_string(t.mode) + ": must differ from targets[" + std::to_string(i) +
                            "].mode");
     if (!(t.weight >= 0.0 && std::isfinite(t.weight)))
-      problems.push_back(at + "weight = " + number(t.weight) + ": must be >= 0 and finite");
+      problems.push_back(at + "weight = " + format_number(t.weight, 10) + ": must be >= 0 and finite");
     weights += t.weight;
     if (t.reference_point.empty()) problems.push_back(at + "reference_point: must name a point");
     if (!(t.reference_amplitude_m > 0.0 && std::isfinite(t.reference_amplitude_m)))
-      problems.push_back(at + "reference_amplitude_m = " + number(t.reference_amplitude_m) + ": must be > 0 and finite");
+      problems.push_back(at + "reference_amplitude_m = " + format_number(t.reference_amplitude_m, 10) +
+                         ": must be > 0 and finite");
   }
   if (objective == PlacementObjective::kWeightedMean && !targets.empty() && !(weights > 0.0))
     problems.push_back("targets: the weights sum to 0: at least one must be > 0");
   if (damper.layers.empty()) problems.push_back("damper.layers: the placed damper must hold at least one layer");
   if (!(rotation_warning_fraction > 0.0 && rotation_warning_fraction <= 10.0))
-    problems.push_back("rotation_warning_fraction = " + number(rotation_warning_fraction) + ": must be in (0, 10]");
+    problems.push_back("rotation_warning_fraction = " + format_number(rotation_warning_fraction, 10) +
+                       ": must be in (0, 10]");
   if (!(frequency_tolerance > 0.0 && frequency_tolerance <= 1e-3))
-    problems.push_back("frequency_tolerance = " + number(frequency_tolerance) + ": must be in (0, 1e-3]");
+    problems.push_back("frequency_tolerance = " + format_number(frequency_tolerance, 10) + ": must be in (0, 1e-3]");
   return problems;
 }
 
@@ -102,11 +95,11 @@ std::vector<std::string> BeamPlacement::validate() const {
   if (mode_count < 1) problems.push_back("mode_count = " + std::to_string(mode_count) + ": must be >= 1");
   for (auto& p : damping.validate()) problems.push_back("damping." + p);
   if (!(carried_mass_kg >= 0.0 && std::isfinite(carried_mass_kg)))
-    problems.push_back("carried_mass_kg = " + number(carried_mass_kg) + ": must be >= 0 and finite");
+    problems.push_back("carried_mass_kg = " + format_number(carried_mass_kg, 10) + ": must be >= 0 and finite");
   const double length = problems.empty() ? beam.length_m() : 0.0;
   if (!(min_position_m >= 0.0 && min_position_m < max_position_m && max_position_m <= length * (1.0 + 1e-12)))
-    problems.push_back("positions [" + number(min_position_m) + ", " + number(max_position_m) +
-                       "] m: must satisfy 0 <= min < max <= the beam's length " + number(length) + " m");
+    problems.push_back("positions [" + format_number(min_position_m, 10) + ", " + format_number(max_position_m, 10) +
+                       "] m: must satisfy 0 <= min < max <= the beam's length " + format_number(length, 10) + " m");
   if (scan_positions < 3 || scan_positions > 100000)
     problems.push_back("scan_positions = " + std::to_string(scan_positions) + ": must be in [3, 100000]");
   return problems;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "evaluator.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
@@ -27,17 +28,17 @@ void validate_variable(const Variable& variable, std::size_t index, std::set<std
   if (std::isnan(variable.lower)) report("lower = nan: must be a number");
   if (std::isnan(variable.upper)) report("upper = nan: must be a number");
   if (variable.lower > variable.upper) {
-    report("lower = " + detail::format_number(variable.lower) + " > upper = " +
-           detail::format_number(variable.upper) + ": must have lower <= upper");
+    report("lower = " + base::format_number(variable.lower, 10) +
+           " > upper = " + base::format_number(variable.upper, 10) + ": must have lower <= upper");
   }
   if (variable.lower == std::numeric_limits<double>::infinity() ||
       variable.upper == -std::numeric_limits<double>::infinity()) {
-    report("bounds [" + detail::format_number(variable.lower) + ", " + detail::format_number(variable.upper) +
+    report("bounds [" + base::format_number(variable.lower, 10) + ", " + base::format_number(variable.upper, 10) +
            "]: must contain a finite value");
   }
   if (!std::isfinite(variable.initial) || variable.initial < variable.lower || variable.initial > variable.upper) {
-    report("initial = " + detail::format_number(variable.initial) + ": must be finite and in [lower, upper] = [" +
-           detail::format_number(variable.lower) + ", " + detail::format_number(variable.upper) + "]");
+    report("initial = " + base::format_number(variable.initial, 10) + ": must be finite and in [lower, upper] = [" +
+           base::format_number(variable.lower, 10) + ", " + base::format_number(variable.upper, 10) + "]");
   }
 }
 
@@ -84,8 +85,8 @@ GradientCheck check_gradients(const Problem& problem, std::span<const double> x)
   for (std::size_t j = 0; j < x.size(); ++j) {
     const Variable& variable = problem.variables[j];
     if (!(x[j] >= variable.lower && x[j] <= variable.upper)) {
-      throw std::invalid_argument("check_gradients: variable '" + variable.name + "' = " +
-                                  detail::format_number(x[j]) + ": must be in [lower, upper]");
+      throw std::invalid_argument("check_gradients: variable '" + variable.name +
+                                  "' = " + base::format_number(x[j], 10) + ": must be in [lower, upper]");
     }
   }
   // Differences of the same problem with its analytic gradients removed.

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "pdamp/optimizer/solve.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
@@ -118,7 +119,7 @@ Problem sizing_problem(const std::shared_ptr<const SizingModel>& model, double c
 std::vector<std::string> RobustSizingOptions::validate() const {
   std::vector<std::string> problems;
   const auto rule = [&](const char* field, double value, bool holds, const char* text) {
-    if (!holds) problems.push_back(std::string(field) + " = " + detail::format_number(value) + ": must be " + text);
+    if (!holds) problems.push_back(std::string(field) + " = " + base::format_number(value, 10) + ": must be " + text);
   };
   if (model == fm::DamperModel::kScattered) {
     problems.emplace_back("model = scattered: must be rolling, bouncing or auto (no orbit to size)");

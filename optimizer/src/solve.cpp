@@ -7,6 +7,7 @@
 
 #include "evaluator.hpp"
 #include "stages.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
@@ -16,8 +17,8 @@ std::vector<std::string> global_stage_violations(const Problem& problem) {
   std::vector<std::string> problems;
   for (const Variable& variable : problem.variables) {
     if (!std::isfinite(variable.lower) || !std::isfinite(variable.upper)) {
-      problems.push_back("variable '" + variable.name + "': bounds [" + detail::format_number(variable.lower) +
-                         ", " + detail::format_number(variable.upper) +
+      problems.push_back("variable '" + variable.name + "': bounds [" + base::format_number(variable.lower, 10) + ", " +
+                         base::format_number(variable.upper, 10) +
                          "]: must be finite for the global stage (or set global_stage = false)");
     }
   }
@@ -46,8 +47,8 @@ std::string infeasibility_message(const Problem& problem, const detail::Incumben
   }
   return "constraint '" + problem.constraints[worst].name +
          "' cannot be met within the bounds: the least violating of " + std::to_string(evaluations) +
-         " points evaluated has c = " + detail::format_number(best.values.constraints[worst]) +
-         " > constraint_tolerance = " + detail::format_number(options.constraint_tolerance) +
+         " points evaluated has c = " + base::format_number(best.values.constraints[worst], 10) +
+         " > constraint_tolerance = " + base::format_number(options.constraint_tolerance, 10) +
          " at x = " + detail::format_point(best.x);
 }
 

@@ -1,20 +1,12 @@
-// Private: the formatting and throwing shared by the validate() functions.
+// Private: the throwing shared by the validate() functions (their numbers are
+// base::format_number's, with 10 significant digits).
 #pragma once
 
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace pdamp::optimizer::detail {
-
-/// Shortest round-trip-ish text of a number for messages ("0.05", "nan", "inf").
-inline std::string format_number(double value) {
-  std::ostringstream out;
-  out.precision(10);
-  out << value;
-  return out.str();
-}
 
 /// Throws std::invalid_argument listing every violation, one a line, after
 /// "invalid <what>:"; does nothing when violations is empty.

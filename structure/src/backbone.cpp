@@ -2,6 +2,7 @@
 // damper amplitude.
 #include "pdamp/structure/backbone.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include "single_mode.hpp"
 
@@ -15,7 +16,7 @@ namespace pdamp::structure {
 namespace {
 using detail::kTwoPi;
 
-using detail::number;
+using base::format_number;
 }  // namespace
 
 std::vector<std::string> BackboneOptions::validate() const {
@@ -24,10 +25,10 @@ std::vector<std::string> BackboneOptions::validate() const {
   if (damper_amplitudes_m.empty()) problems.push_back("damper_amplitudes_m: must hold at least one amplitude");
   for (std::size_t k = 0; k < damper_amplitudes_m.size(); ++k)
     if (!(damper_amplitudes_m[k] > 0.0 && std::isfinite(damper_amplitudes_m[k])))
-      problems.push_back("damper_amplitudes_m[" + std::to_string(k) + "] = " + number(damper_amplitudes_m[k]) +
-                         ": must be > 0 and finite");
+      problems.push_back("damper_amplitudes_m[" + std::to_string(k) +
+                         "] = " + format_number(damper_amplitudes_m[k], 12) + ": must be > 0 and finite");
   if (!(frequency_tolerance > 0.0 && frequency_tolerance <= 1e-3))
-    problems.push_back("frequency_tolerance = " + number(frequency_tolerance) + ": must be in (0, 1e-3]");
+    problems.push_back("frequency_tolerance = " + format_number(frequency_tolerance, 12) + ": must be in (0, 1e-3]");
   if (max_iterations < 1) problems.push_back("max_iterations = " + std::to_string(max_iterations) + ": must be >= 1");
   for (auto& p : coupling.validate()) problems.push_back("coupling." + p);
   return problems;
@@ -70,7 +71,8 @@ SingleMode single_mode(const CoupledModel& coupled, int mode, double modal_ampli
     }
     if (!(mass > 0.0))
       throw std::invalid_argument("backbone: the effective modal mass of mode " + std::to_string(mode) + " is " +
-                                  number(mass) + " kg at modal amplitude " + number(modal_amplitude) +
+                                  format_number(mass, 12) + " kg at modal amplitude " +
+                                  format_number(modal_amplitude, 12) +
                                   " (negative apparent mass of the beds exceeds the structure's)");
     const double next = std::sqrt(stiffness / mass);
     const bool done = std::abs(next - omega) <= frequency_tolerance * omega;

@@ -3,7 +3,8 @@
 // Model, conventions and limits: docs/structures.md, "Beam models".
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/base/run_errors.hpp"
-#include "numbers.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -39,7 +40,9 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 /// Local DOFs of the bending part (w1, θ1, w2, θ2) inside an element's (u1, w1, θ1, u2, w2, θ2).
 constexpr std::array<int, 4> kBendingDofs{1, 2, 4, 5};
 
-using detail::number;
+using base::format_number;
+using base::non_negative_finite;
+using base::positive_finite;
 
 std::string joined(const std::vector<std::string>& lines) {
   std::string text;
@@ -51,18 +54,16 @@ void throw_if_any(const std::vector<std::string>& problems, const std::string& c
   if (!problems.empty()) throw std::invalid_argument(base::printable(context + ": " + joined(problems)));
 }
 
-bool positive_finite(double x) { return x > 0.0 && std::isfinite(x); }
-bool non_negative_finite(double x) { return x >= 0.0 && std::isfinite(x); }
 bool within(double x, double lo, double hi) { return std::isfinite(x) && x >= lo && x <= hi; }
 /// "must be in [lo, hi] unit".
 std::string interval(double lo, double hi, const std::string& unit) {
-  return "must be in [" + number(lo) + ", " + number(hi) + "] " + unit;
+  return "must be in [" + format_number(lo, 12) + ", " + format_number(hi, 12) + "] " + unit;
 }
 
 /// Adds "<field> = <value>: <rule>" unless `ok`.
 void require(std::vector<std::string>& problems, bool ok, const std::string& field, double value,
              const std::string& rule) {
-  if (!ok) problems.push_back(field + " = " + number(value) + ": " + rule);
+  if (!ok) problems.push_back(field + " = " + format_number(value, 12) + ": " + rule);
 }
 
 void section_problems(const Section& s, const std::string& at, std::vector<std::string>& problems) {
@@ -87,7 +88,7 @@ void section_problems(const Section& s, const std::string& at, std::vector<std::
   const double half_size = 0.5 * (rectangle ? std::min(s.width_m, s.depth_m) : s.diameter_m);
   require(problems, s.wall_thickness_m >= beam_limits::kMinSectionSize_m && s.wall_thickness_m < half_size,
           at + "wall_thickness_m", s.wall_thickness_m,
-          "must be in [" + number(beam_limits::kMinSectionSize_m) + ", " + number(half_size) +
+          "must be in [" + format_number(beam_limits::kMinSectionSize_m, 12) + ", " + format_number(half_size, 12) +
               ") m (half the smallest outer size)");
 }
 
@@ -116,7 +117,7 @@ struct Mesh {
   Eigen::Index node_at(double x) const {
     const auto it = std::lower_bound(node_x_m.begin(), node_x_m.end(), x - merge_tolerance_m);
     if (it == node_x_m.end() || std::abs(*it - x) > merge_tolerance_m) {
-      throw std::logic_error("beam mesh: no node at x = " + number(x) + " m");
+      throw std::logic_error("beam mesh: no node at x = " + format_number(x, 12) + " m");
     }
     return it - node_x_m.begin();
   }
@@ -437,9 +438,10 @@ FreeVibration free_vibration(const Assembly& a) {
     throw std::invalid_argument(
         a.has_geometric_stiffness
             ? "beam model: the axial compression from gravity exceeds the buckling load (lowest ω² = " +
-                  number(lambda[0]) + " rad²/s²): the beam is unstable"
-            : "beam model: an elastic mode has ω² = " + number(lambda[rigid]) +
-                  " rad²/s² <= 0 (stiffnesses too disparate to resolve; soften the stiff parts or stiffen the soft ones)");
+                  format_number(lambda[0], 12) + " rad²/s²): the beam is unstable"
+            : "beam model: an elastic mode has ω² = " + format_number(lambda[rigid], 12) +
+                  " rad²/s² <= 0 (stiffnesses too disparate to resolve; soften the stiff parts or stiffen the soft "
+                  "ones)");
   }
   FreeVibration result;
   const Eigen::Index elastic = lambda.size() - rigid;
@@ -550,7 +552,7 @@ std::vector<std::string> BeamModel::validate() const {
                        std::to_string(beam_limits::kMaxElements) + " (the modal eigenproblem is dense: O(n^3) work)");
   const double length = length_m();
   const double tolerance = kMergeFraction * length;
-  const std::string position_rule = "must be in [0, " + number(length) + "] m (on the beam)";
+  const std::string position_rule = "must be in [0, " + format_number(length, 12) + "] m (on the beam)";
   const auto on_beam = [&](double x) { return std::isfinite(x) && x >= -tolerance && x <= length + tolerance; };
 
   bool axial_anchor = false;
@@ -691,8 +693,8 @@ PointModeShape beam_point_shape(const BeamModel& beam, const ModalModel& modal, 
                                 " DOFs: pass the modal model of this beam");
   const double length = beam.length_m();
   if (!std::isfinite(position_m) || position_m < -kMergeFraction * length || position_m > (1.0 + kMergeFraction) * length)
-    throw std::invalid_argument("beam point shape: position_m = " + number(position_m) + ": must be in [0, " +
-                                number(length) + "] m");
+    throw std::invalid_argument("beam point shape: position_m = " + format_number(position_m, 12) +
+                                ": must be in [0, " + format_number(length, 12) + "] m");
   const auto [element, xi] = mesh.element_at(std::clamp(position_m, 0.0, length));
   const HermiteAt h = hermite(xi, element->length_m);
   const Eigen::Index first = kDofsPerNode * element->first_node;
@@ -722,8 +724,8 @@ Eigen::VectorXd static_deflection_modal_amplitudes(const BeamModel& beam, const 
   }
   const double length = beam.length_m();
   if (!std::isfinite(position_m) || position_m < -kMergeFraction * length || position_m > (1.0 + kMergeFraction) * length) {
-    throw std::invalid_argument("static deflection: position_m = " + number(position_m) + ": must be in [0, " +
-                                number(length) + "] m");
+    throw std::invalid_argument("static deflection: position_m = " + format_number(position_m, 12) +
+                                ": must be in [0, " + format_number(length, 12) + "] m");
   }
   if (!force_n.allFinite() || !std::isfinite(moment_n_m)) {
     throw std::invalid_argument("static deflection: force and moment must be finite");

@@ -6,12 +6,13 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <initializer_list>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 
 #include "cosimulation_plan.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
 #include "pdamp/structure/cosimulation_run.hpp"
@@ -45,15 +46,15 @@ const base::Fields<CosimulationSweepCycle>& CosimulationSweepCycle::fields() {
 namespace {
 
 namespace dem = pdamp::dem_reference;
+using base::format_number;
 using detail::energy_terms;
 using detail::harmonic;
 using detail::join;
 using detail::kTwoPi;
 using detail::ledger_error;
-using detail::number;
 using detail::plan_step;
-using detail::Prepared;
 using detail::prepare;
+using detail::Prepared;
 using detail::start_vector;
 using detail::StepPlan;
 using detail::sweeping;
@@ -70,19 +71,19 @@ const PointModeShape* find_point(const ModalModel& model, const std::string& nam
 
 double norm3(const dem::Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 double dot3(const dem::Vec3& a, const dem::Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-// Streams rather than string concatenation: GCC 12 flags "(" + std::string with a false -Wrestrict.
-std::string vec3(const dem::Vec3& v) {
-  std::ostringstream out;
-  out.precision(12);
-  out << '(' << v[0] << ", " << v[1] << ", " << v[2] << ')';
-  return out.str();
+/// "(x, y, ...)", 12 significant digits each. Appended piece by piece: GCC 12 flags
+/// "(" + std::string with a false -Wrestrict.
+std::string coordinates(std::initializer_list<double> values) {
+  std::string text = "(";
+  for (const double value : values) {
+    if (text.size() > 1) text += ", ";
+    text += format_number(value, 12);
+  }
+  text += ')';
+  return text;
 }
-std::string vec2(const Eigen::Vector2d& v) {
-  std::ostringstream out;
-  out.precision(12);
-  out << '(' << v.x() << ", " << v.y() << ')';
-  return out.str();
-}
+std::string vec3(const dem::Vec3& v) { return coordinates({v[0], v[1], v[2]}); }
+std::string vec2(const Eigen::Vector2d& v) { return coordinates({v.x(), v.y()}); }
 
 }  // namespace
 
@@ -149,9 +150,9 @@ std::vector<std::string> CosimulationDamper::validate(const ModalModel& model) c
   if (!(std::abs(drive_direction.norm() - 1.0) <= kUnitTolerance))
     problems.push_back("drive_direction = " + vec2(drive_direction) + ": must be a unit vector");
   if (!(container_mass_kg >= 0.0 && std::isfinite(container_mass_kg)))
-    problems.push_back("container_mass_kg = " + number(container_mass_kg) + ": must be >= 0 and finite");
+    problems.push_back("container_mass_kg = " + format_number(container_mass_kg, 12) + ": must be >= 0 and finite");
   if (!(container_rotary_inertia_kg_m2 >= 0.0 && std::isfinite(container_rotary_inertia_kg_m2)))
-    problems.push_back("container_rotary_inertia_kg_m2 = " + number(container_rotary_inertia_kg_m2) +
+    problems.push_back("container_rotary_inertia_kg_m2 = " + format_number(container_rotary_inertia_kg_m2, 12) +
                        ": must be >= 0 and finite");
   const bool drive_unit = std::abs(norm3(container_drive_axis) - 1.0) <= kUnitTolerance;
   const bool rotation_unit = std::abs(norm3(container_rotation_axis) - 1.0) <= kUnitTolerance;
@@ -174,9 +175,11 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
     if (!(std::abs(e.direction.norm() - 1.0) <= kUnitTolerance))
       p.push_back(at + "excitation.direction = " + vec2(e.direction) + ": must be a unit vector");
     if (!(e.amplitude > 0.0 && std::isfinite(e.amplitude)))
-      p.push_back(at + "excitation.amplitude = " + number(e.amplitude) + ": must be > 0 and finite (m or N)");
+      p.push_back(at + "excitation.amplitude = " + format_number(e.amplitude, 12) +
+                  ": must be > 0 and finite (m or N)");
     if (!(e.frequency_hz >= dem::limits::kMinFrequency_hz && e.frequency_hz <= dem::limits::kMaxFrequency_hz))
-      p.push_back(at + "excitation.frequency_hz = " + number(e.frequency_hz) + ": must be in [0.01, 10000] Hz");
+      p.push_back(at + "excitation.frequency_hz = " + format_number(e.frequency_hz, 12) +
+                  ": must be in [0.01, 10000] Hz");
     if (e.kind == CosimulationExcitationKind::kPointForce && !find_point(model, e.point))
       p.push_back(at + "excitation.point = \"" + e.point + "\": must name a point of the modal model");
     if (e.kind == CosimulationExcitationKind::kBaseTranslation && model.base_participation.cols() != 2)
@@ -189,20 +192,22 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
       p.push_back(at + "min_transient_periods = " + std::to_string(min_transient_periods) + ": must be in [0, transient_periods = " +
                   std::to_string(transient_periods) + "]");
     if (settle_until_stable && !(stable_tolerance > 0.0 && stable_tolerance < 1.0))
-      p.push_back(at + "stable_tolerance = " + number(stable_tolerance) + ": must be in (0, 1)");
+      p.push_back(at + "stable_tolerance = " + format_number(stable_tolerance, 12) + ": must be in (0, 1)");
     if (sweep_end_frequency_hz != 0.0) {
       if (!(sweep_end_frequency_hz >= dem::limits::kMinFrequency_hz &&
             sweep_end_frequency_hz <= dem::limits::kMaxFrequency_hz))
-        p.push_back(at + "sweep_end_frequency_hz = " + number(sweep_end_frequency_hz) +
+        p.push_back(at + "sweep_end_frequency_hz = " + format_number(sweep_end_frequency_hz, 12) +
                     ": must be 0 (one frequency) or in [0.01, 10000] Hz (a linear sweep)");
       if (!(duration_s > 0.0 && std::isfinite(duration_s)))
-        p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a linear sweep");
+        p.push_back(at + "duration_s = " + format_number(duration_s, 12) +
+                    ": must be > 0 and finite for a linear sweep");
     }
   } else {
     if (!(duration_s > 0.0 && std::isfinite(duration_s)))
-      p.push_back(at + "duration_s = " + number(duration_s) + ": must be > 0 and finite for a free decay");
+      p.push_back(at + "duration_s = " + format_number(duration_s, 12) + ": must be > 0 and finite for a free decay");
     if (sweep_end_frequency_hz != 0.0)
-      p.push_back(at + "sweep_end_frequency_hz = " + number(sweep_end_frequency_hz) + ": must be 0 for a free decay");
+      p.push_back(at + "sweep_end_frequency_hz = " + format_number(sweep_end_frequency_hz, 12) +
+                  ": must be 0 for a free decay");
   }
   const auto check_initial = [&](const Eigen::VectorXd& v, const std::string& name) {
     if (v.size() != 0 && v.size() != modes)
@@ -217,16 +222,20 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
       !(initial_modal_velocities.size() && initial_modal_velocities.cwiseAbs().maxCoeff() > 0))
     p.push_back(at + "initial_modal_displacements, initial_modal_velocities: a free decay needs a non-zero start");
   if (!(bed_settling_time_s == -1.0 || (bed_settling_time_s >= 0.0 && bed_settling_time_s <= 100.0)))
-    p.push_back(at + "bed_settling_time_s = " + number(bed_settling_time_s) + ": must be -1 (automatic) or in [0, 100] s");
+    p.push_back(at + "bed_settling_time_s = " + format_number(bed_settling_time_s, 12) +
+                ": must be -1 (automatic) or in [0, 100] s");
   if (!(sample_interval_s >= 0.0 && std::isfinite(sample_interval_s)))
-    p.push_back(at + "sample_interval_s = " + number(sample_interval_s) + ": must be >= 0 and finite (0 = automatic)");
+    p.push_back(at + "sample_interval_s = " + format_number(sample_interval_s, 12) +
+                ": must be >= 0 and finite (0 = automatic)");
   if (!(peak_site_speed_m_s >= 0.0 && peak_site_speed_m_s <= dem::limits::kMaxImpactSpeed_m_s))
-    p.push_back(at + "peak_site_speed_m_s = " + number(peak_site_speed_m_s) + ": must be in [0, 1000] m/s (0 = automatic)");
+    p.push_back(at + "peak_site_speed_m_s = " + format_number(peak_site_speed_m_s, 12) +
+                ": must be in [0, 1000] m/s (0 = automatic)");
   if (!(time_step_s == 0.0 ||
         (time_step_s >= dem::limits::kMinTimeStep_s && time_step_s <= dem::limits::kMaxTimeStep_s)))
-    p.push_back(at + "time_step_s = " + number(time_step_s) + ": must be 0 (automatic) or in [1e-10, 1e-3] s");
+    p.push_back(at + "time_step_s = " + format_number(time_step_s, 12) +
+                ": must be 0 (automatic) or in [1e-10, 1e-3] s");
   if (!(progress_interval_s > 0.0 && std::isfinite(progress_interval_s)))
-    p.push_back(at + "progress_interval_s = " + number(progress_interval_s) + ": must be > 0 and finite");
+    p.push_back(at + "progress_interval_s = " + format_number(progress_interval_s, 12) + ": must be > 0 and finite");
   if (snapshots < 0 || snapshots > dem::limits::kMaxSnapshots)
     p.push_back(at + "snapshots = " + std::to_string(snapshots) + ": must be in [0, " +
                 std::to_string(dem::limits::kMaxSnapshots) + "]");
@@ -247,7 +256,8 @@ void validate_inputs(const ModalModel& model, const std::vector<CosimulationDamp
     if (!(continuation && line.find("a free decay needs a non-zero start") != std::string::npos))
       problems.push_back(std::move(line));
   if (!std::isfinite(options.excitation_phase_rad))
-    problems.push_back("cosimulation.excitation_phase_rad = " + number(options.excitation_phase_rad) + ": must be finite");
+    problems.push_back("cosimulation.excitation_phase_rad = " + format_number(options.excitation_phase_rad, 12) +
+                       ": must be finite");
   if (!problems.empty()) throw std::invalid_argument(join(problems));
 }
 
@@ -266,13 +276,15 @@ void validate_state(const ModalModel& model, const std::vector<CosimulationDampe
   if (state.modal_displacements.size() != model.mode_count() || state.modal_velocities.size() != model.mode_count())
     p.push_back(at + "modal state has " + std::to_string(state.modal_displacements.size()) + " entries, the model " +
                 std::to_string(model.mode_count()) + " modes");
-  if (!(state.time_step_s > 0.0)) p.push_back(at + "time_step_s = " + number(state.time_step_s) + ": must be > 0");
+  if (!(state.time_step_s > 0.0))
+    p.push_back(at + "time_step_s = " + format_number(state.time_step_s, 12) + ": must be > 0");
   if (options.initial_modal_displacements.size() || options.initial_modal_velocities.size())
     p.push_back("cosimulation.initial_modal_displacements, initial_modal_velocities: must be empty when continuing a "
                 "state (the run starts from the state's q, dq/dt)");
   if (options.time_step_s != 0.0 && std::abs(options.time_step_s - state.time_step_s) > 1e-12 * state.time_step_s)
-    p.push_back("cosimulation.time_step_s = " + number(options.time_step_s) + ": must be 0 or the state's step " +
-                number(state.time_step_s) + " s when continuing (the worlds keep their step)");
+    p.push_back("cosimulation.time_step_s = " + format_number(options.time_step_s, 12) +
+                ": must be 0 or the state's step " + format_number(state.time_step_s, 12) +
+                " s when continuing (the worlds keep their step)");
   const auto& a = state.excitation;
   const auto& b = options.excitation;
   if (a.kind != b.kind) {
@@ -283,8 +295,8 @@ void validate_state(const ModalModel& model, const std::vector<CosimulationDampe
       p.push_back("cosimulation.excitation.direction = " + vec2(b.direction) + ": must be the state's " +
                   vec2(a.direction) + " when continuing");
     if (std::abs(a.amplitude - b.amplitude) > 1e-12 * std::abs(a.amplitude))
-      p.push_back("cosimulation.excitation.amplitude = " + number(b.amplitude) + ": must be the state's " +
-                  number(a.amplitude) + " when continuing (only the frequency may change)");
+      p.push_back("cosimulation.excitation.amplitude = " + format_number(b.amplitude, 12) + ": must be the state's " +
+                  format_number(a.amplitude, 12) + " when continuing (only the frequency may change)");
     if (a.point != b.point)
       p.push_back("cosimulation.excitation.point = \"" + b.point + "\": must be the state's \"" + a.point +
                   "\" when continuing");
@@ -330,8 +342,8 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
     if (dampers[d].rotation) {
       P.R.col(static_cast<Eigen::Index>(d)) = rot.transpose();
     } else if (rot.cwiseAbs().maxCoeff() > 0.0) {
-      P.warnings.push_back("damper " + dampers[d].name + ": the site rotates (max |θ_j| = " +
-                           number(rot.cwiseAbs().maxCoeff()) +
+      P.warnings.push_back("damper " + dampers[d].name +
+                           ": the site rotates (max |θ_j| = " + format_number(rot.cwiseAbs().maxCoeff(), 12) +
                            " rad per unit q) but rotation = false: the container only translates");
     }
   }
@@ -435,16 +447,17 @@ StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dam
     }
     if (options.time_step_s > 0.0) {
       if (options.time_step_s > dt)
-        throw std::invalid_argument("cosimulation.time_step_s = " + number(options.time_step_s) +
-                                    ": must be <= the worlds' automatic bound " + number(dt) + " s");
+        throw std::invalid_argument("cosimulation.time_step_s = " + format_number(options.time_step_s, 12) +
+                                    ": must be <= the worlds' automatic bound " + format_number(dt, 12) + " s");
       dt = options.time_step_s;
     } else {
       dt = std::min(dt, kStructureStepTarget / omega_max);
     }
   }
   if (omega_max * dt > kStructureStepLimit)
-    throw std::invalid_argument("cosimulation.time_step_s = " + number(dt) + ": the highest mode (" +
-                                number(omega_max / kTwoPi) + " Hz) needs ω·dt <= 0.2 for the modal Verlet step");
+    throw std::invalid_argument("cosimulation.time_step_s = " + format_number(dt, 12) + ": the highest mode (" +
+                                format_number(omega_max / kTwoPi, 12) +
+                                " Hz) needs ω·dt <= 0.2 for the modal Verlet step");
   return plan;
 }
 

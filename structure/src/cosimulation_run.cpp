@@ -12,6 +12,7 @@
 
 #include "cosimulation_plan.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
 
 namespace pdamp::structure {
@@ -19,8 +20,8 @@ namespace pdamp::structure {
 namespace {
 
 namespace dem = pdamp::dem_reference;
+using base::format_number;
 using detail::kTwoPi;
-using detail::number;
 using Clock = std::chrono::steady_clock;
 
 /// The progress clock is read every this many steps.
@@ -530,15 +531,15 @@ void Cosimulation::Impl::plan(const ModalModel& model, const CosimulationState* 
     if (periodic_) {
       steps_per_period_ = std::max<std::int64_t>(1, std::llround(1.0 / (exc.frequency_hz * dt_)));
       if (steps_per_period_ < 8)
-        throw std::invalid_argument("cosimulation.excitation.frequency_hz = " + number(exc.frequency_hz) +
-                                    ": a period of the state's step " + number(dt_) + " s is only " +
+        throw std::invalid_argument("cosimulation.excitation.frequency_hz = " + format_number(exc.frequency_hz, 12) +
+                                    ": a period of the state's step " + format_number(dt_, 12) + " s is only " +
                                     std::to_string(steps_per_period_) + " steps (at least 8)");
       const double whole = 1.0 / (static_cast<double>(steps_per_period_) * dt_);
       if (std::abs(whole - exc.frequency_hz) > 1e-12 * exc.frequency_hz) f_run_ = whole;
       if (std::abs(whole - exc.frequency_hz) > detail::kFrequencyChangeWarning * exc.frequency_hz)
-        warnings_.push_back("frequency " + number(exc.frequency_hz) + " Hz run as " + number(whole) + " Hz: " +
-                            std::to_string(steps_per_period_) + " whole steps of the carried-over step " + number(dt_) +
-                            " s per period");
+        warnings_.push_back("frequency " + format_number(exc.frequency_hz, 12) + " Hz run as " +
+                            format_number(whole, 12) + " Hz: " + std::to_string(steps_per_period_) +
+                            " whole steps of the carried-over step " + format_number(dt_, 12) + " s per period");
     }
   }
   modal_ = detail::prepare(model, dampers_, options_, f_run_, q_start, v_start);
@@ -549,12 +550,13 @@ void Cosimulation::Impl::plan(const ModalModel& model, const CosimulationState* 
     automatic.time_step_s = 0.0;
     const detail::StepPlan own = detail::plan_step(modal_, dampers_, automatic, f_plan_);
     if (dt_ > own.dt * (1.0 + detail::kCarriedStepMargin))
-      warnings_.push_back("the carried-over step " + number(dt_) + " s is above the automatic step " + number(own.dt) +
-                          " s" + (is_harmonic_ ? " at " + number(f_plan_) + " Hz" : std::string()) +
+      warnings_.push_back("the carried-over step " + format_number(dt_, 12) + " s is above the automatic step " +
+                          format_number(own.dt, 12) + " s" +
+                          (is_harmonic_ ? " at " + format_number(f_plan_, 12) + " Hz" : std::string()) +
                           ": contacts are resolved more coarsely (plan the sweep's step with "
                           "cosimulation_time_step at its most demanding frequency)");
     if (modal_.w.maxCoeff() * dt_ > detail::kStructureStepLimit)
-      throw std::invalid_argument("cosimulation state: time_step_s = " + number(dt_) +
+      throw std::invalid_argument("cosimulation state: time_step_s = " + format_number(dt_, 12) +
                                   ": the highest mode needs ω·dt <= 0.2");
   } else {
     detail::StepPlan plan = detail::plan_step(modal_, dampers_, options_, f_plan_);
@@ -562,8 +564,9 @@ void Cosimulation::Impl::plan(const ModalModel& model, const CosimulationState* 
     steps_per_period_ = is_sweep_ ? 0 : plan.steps_per_period;
     if (restored_) {
       if (state->time_step_s != dt_)
-        throw std::invalid_argument("cosimulation checkpoint: time_step_s = " + number(state->time_step_s) +
-                                    ": this run's step is " + number(dt_) + " s (a checkpoint of other settings)");
+        throw std::invalid_argument("cosimulation checkpoint: time_step_s = " + format_number(state->time_step_s, 12) +
+                                    ": this run's step is " + format_number(dt_, 12) +
+                                    " s (a checkpoint of other settings)");
       warnings_ = earlier->warnings;
     } else {
       for (auto& wline : plan.warnings) warnings_.push_back(std::move(wline));
@@ -853,7 +856,8 @@ inline bool Cosimulation::Impl::step_beds() {
     const dem::ContainerLoad& load = worlds[d].step(s);
     if (worlds[d].status().outcome != dem::Outcome::kCompleted) {
       outcome_ = worlds[d].status().outcome;
-      message_ = "damper " + dampers_[d].name + " at t = " + number(t_next_) + " s: " + worlds[d].status().message;
+      message_ =
+          "damper " + dampers_[d].name + " at t = " + format_number(t_next_, 12) + " s: " + worlds[d].status().message;
     }
     read_load(d, load);
   }

@@ -2,6 +2,7 @@
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,7 @@ using detail::kTwoPi;
 /// A drive direction is a unit vector to this relative tolerance (inputs from JSON carry ~1e-9).
 constexpr double kUnitTolerance = 1e-6;
 
-using detail::number;
+using base::format_number;
 
 /// The named point's shapes, or nullptr (ModalModel::point throws; the coupling collects problems).
 const PointModeShape* find_point(const ModalModel& model, const std::string& name) {
@@ -38,14 +39,14 @@ std::vector<std::string> coupling_model_problems(const ModalModel& model) {
     problems.push_back("modal_model.modal_masses_kg: must have one entry per mode (" + std::to_string(modes) + ")");
   for (Eigen::Index j = 0; j < modes; ++j) {
     if (!(model.natural_frequencies_hz[j] > 0.0 && std::isfinite(model.natural_frequencies_hz[j])))
-      problems.push_back("modal_model.natural_frequencies_hz[" + std::to_string(j) + "] = " +
-                         number(model.natural_frequencies_hz[j]) + ": must be > 0 and finite");
+      problems.push_back("modal_model.natural_frequencies_hz[" + std::to_string(j) +
+                         "] = " + format_number(model.natural_frequencies_hz[j], 12) + ": must be > 0 and finite");
     if (j < model.damping_ratios.size() && !(model.damping_ratios[j] >= 0.0 && std::isfinite(model.damping_ratios[j])))
-      problems.push_back("modal_model.damping_ratios[" + std::to_string(j) + "] = " + number(model.damping_ratios[j]) +
-                         ": must be >= 0 and finite");
+      problems.push_back("modal_model.damping_ratios[" + std::to_string(j) +
+                         "] = " + format_number(model.damping_ratios[j], 12) + ": must be >= 0 and finite");
     if (j < model.modal_masses_kg.size() && !(model.modal_masses_kg[j] > 0.0 && std::isfinite(model.modal_masses_kg[j])))
-      problems.push_back("modal_model.modal_masses_kg[" + std::to_string(j) + "] = " +
-                         number(model.modal_masses_kg[j]) + ": must be > 0 and finite");
+      problems.push_back("modal_model.modal_masses_kg[" + std::to_string(j) +
+                         "] = " + format_number(model.modal_masses_kg[j], 12) + ": must be > 0 and finite");
   }
   for (const auto& p : model.points)
     if (p.translation.rows() != 2 || p.translation.cols() != modes)
@@ -63,17 +64,18 @@ std::vector<std::string> Damper::validate(const ModalModel& model) const {
   if (!find_point(model, point)) problems.push_back("point = \"" + point + "\": must name a point of the modal model");
   const double norm = drive_direction.norm();
   if (!(std::abs(norm - 1.0) <= kUnitTolerance))
-    problems.push_back("drive_direction = (" + number(drive_direction.x()) + ", " + number(drive_direction.y()) +
-                       "): must be a unit vector");
+    problems.push_back("drive_direction = (" + format_number(drive_direction.x(), 12) + ", " +
+                       format_number(drive_direction.y(), 12) + "): must be a unit vector");
   if (!(container_mass_kg >= 0.0 && std::isfinite(container_mass_kg)))
-    problems.push_back("container_mass_kg = " + number(container_mass_kg) + ": must be >= 0 and finite");
+    problems.push_back("container_mass_kg = " + format_number(container_mass_kg, 12) + ": must be >= 0 and finite");
   if (!(container_rotary_inertia_kg_m2 >= 0.0 && std::isfinite(container_rotary_inertia_kg_m2)))
-    problems.push_back("container_rotary_inertia_kg_m2 = " + number(container_rotary_inertia_kg_m2) +
+    problems.push_back("container_rotary_inertia_kg_m2 = " + format_number(container_rotary_inertia_kg_m2, 12) +
                        ": must be >= 0 and finite");
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const std::string prefix = "layers[" + std::to_string(l) + "].";
     if (!(layers[l].bed_mass_kg > 0.0 && std::isfinite(layers[l].bed_mass_kg)))
-      problems.push_back(prefix + "bed_mass_kg = " + number(layers[l].bed_mass_kg) + ": must be > 0 and finite");
+      problems.push_back(prefix + "bed_mass_kg = " + format_number(layers[l].bed_mass_kg, 12) +
+                         ": must be > 0 and finite");
     if (!layers[l].loss_model) problems.push_back(prefix + "loss_model: must be set");
   }
   return problems;
@@ -115,7 +117,8 @@ std::vector<std::string> rotation_warnings(const ModalModel& model, const std::v
 
 std::vector<std::string> CouplingOptions::validate() const {
   if (std::isfinite(apparent_mass_fraction_if_missing)) return {};
-  return {"apparent_mass_fraction_if_missing = " + number(apparent_mass_fraction_if_missing) + ": must be finite"};
+  return {"apparent_mass_fraction_if_missing = " + format_number(apparent_mass_fraction_if_missing, 12) +
+          ": must be finite"};
 }
 
 LayerImpedance layer_impedance(const DamperLayer& layer, double frequency_hz, double stroke_m,

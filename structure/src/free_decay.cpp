@@ -1,6 +1,7 @@
 // Free decay by slowly varying amplitude: RK4 on the modal envelopes and the energies.
 #include "pdamp/structure/free_decay.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,7 +24,7 @@ constexpr int kSettlingBisections = 60;
 /// Closest approach in ln a to a jump before a step crosses it (~40 graded steps from 0.05).
 constexpr double kJumpApproach = 1e-12;
 
-using detail::number;
+using base::format_number;
 
 const PointModeShape& point_of(const ModalModel& model, const std::string& name) {
   for (const auto& p : model.points)
@@ -121,24 +122,25 @@ std::vector<std::string> FreeDecayOptions::validate(Eigen::Index modes) const {
            !(initial_modal_amplitudes.maxCoeff() > 0.0))
     problems.push_back("initial_modal_amplitudes: must be >= 0 and finite, not all 0");
   if (!(duration_s > 0.0 && std::isfinite(duration_s)))
-    problems.push_back("duration_s = " + number(duration_s) + ": must be > 0 and finite");
+    problems.push_back("duration_s = " + format_number(duration_s, 12) + ": must be > 0 and finite");
   for (std::size_t k = 0; k < sample_times_s.size(); ++k)
     if (!(sample_times_s[k] >= 0.0 && sample_times_s[k] <= duration_s) ||
         (k > 0 && !(sample_times_s[k] >= sample_times_s[k - 1])))
-      problems.push_back("sample_times_s[" + std::to_string(k) + "] = " + number(sample_times_s[k]) +
+      problems.push_back("sample_times_s[" + std::to_string(k) + "] = " + format_number(sample_times_s[k], 12) +
                          ": must be ascending in [0, duration_s]");
   if (!(std::abs(threshold_direction.norm() - 1.0) <= 1e-6))
     problems.push_back("threshold_direction: must be a unit vector");
   if (!(threshold_m >= 0.0 && std::isfinite(threshold_m)))
-    problems.push_back("threshold_m = " + number(threshold_m) + ": must be >= 0 and finite");
+    problems.push_back("threshold_m = " + format_number(threshold_m, 12) + ": must be >= 0 and finite");
   if (!(threshold_fraction > 0.0 && threshold_fraction < 1.0))
-    problems.push_back("threshold_fraction = " + number(threshold_fraction) + ": must be in (0, 1)");
+    problems.push_back("threshold_fraction = " + format_number(threshold_fraction, 12) + ": must be in (0, 1)");
   if (!(step_log_change > 0.0 && step_log_change <= 0.2))
-    problems.push_back("step_log_change = " + number(step_log_change) + ": must be in (0, 0.2]");
+    problems.push_back("step_log_change = " + format_number(step_log_change, 12) + ": must be in (0, 0.2]");
   if (!(max_step_s >= 0.0 && std::isfinite(max_step_s)))
-    problems.push_back("max_step_s = " + number(max_step_s) + ": must be >= 0 and finite");
+    problems.push_back("max_step_s = " + format_number(max_step_s, 12) + ": must be >= 0 and finite");
   if (!(second_mode_warning_fraction > 0.0 && second_mode_warning_fraction < 1.0))
-    problems.push_back("second_mode_warning_fraction = " + number(second_mode_warning_fraction) + ": must be in (0, 1)");
+    problems.push_back("second_mode_warning_fraction = " + format_number(second_mode_warning_fraction, 12) +
+                       ": must be in (0, 1)");
   for (auto& p : coupling.validate()) problems.push_back("coupling." + p);
   return problems;
 }
@@ -219,9 +221,9 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
       const double total = share.sum(), top = share.maxCoeff(&largest);
       const double second = total - top;
       if (total > 0.0 && second > options.second_mode_warning_fraction * total) {
-        result.warnings.push_back("at t = " + number(t) + " s modes other than mode " + std::to_string(largest) +
-                                  " carry " + number(100.0 * second / total) + "% of damper " +
-                                  dampers[static_cast<std::size_t>(d)].name +
+        result.warnings.push_back("at t = " + format_number(t, 12) + " s modes other than mode " +
+                                  std::to_string(largest) + " carry " + format_number(100.0 * second / total, 12) +
+                                  "% of damper " + dampers[static_cast<std::size_t>(d)].name +
                                   "'s amplitude: single-mode averaging misjudges eta* there");
         warned_second_mode = true;
         return;

@@ -11,9 +11,10 @@
 // a D-dimensional problem whatever the number of modes.
 #include "pdamp/structure/harmonic_balance.hpp"
 
-#include "pdamp/formulas/root_finding.hpp"
+#include "pdamp/base/one_dimensional.hpp"
 #include "pdamp/structure/sampled_response.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -45,7 +46,7 @@ const PointModeShape& point_of(const ModalModel& model, const std::string& name)
   throw std::invalid_argument("harmonic_balance: point \"" + name + "\" is not a point of the modal model");
 }
 
-using detail::number;
+using base::format_number;
 
 /// The linear structure with empty containers at one frequency, and the loop closure.
 class FrequencyOperator {
@@ -237,11 +238,11 @@ class FrequencyOperator {
 };
 
 /// Root of a continuous residual with f(lo) and f(hi) of opposite signs, in ln X: the
-/// Illinois regula falsi (formulas::IllinoisBracket) with a bisection step where the secant
+/// Illinois regula falsi (base::IllinoisBracket) with a bisection step where the secant
 /// leaves the bracket; stops at a bracket narrower than the relative tolerance.
 template <class Residual>
 double illinois_log_root(Residual&& residual, double lo, double f_lo, double hi, double f_hi, double tolerance) {
-  formulas::IllinoisBracket bracket{std::log(lo), f_lo, std::log(hi), f_hi};
+  base::IllinoisBracket bracket{std::log(lo), f_lo, std::log(hi), f_hi};
   for (int iteration = 0; iteration < 200 && bracket.hi - bracket.lo > tolerance; ++iteration) {
     double x = bracket.secant();
     if (!(x > bracket.lo && x < bracket.hi)) x = 0.5 * (bracket.lo + bracket.hi);
@@ -284,32 +285,18 @@ struct ScanSettings {
   double tolerance;
 };
 
-/// Golden-section search for the maximum of sign·residual on [lo, hi] in ln X (0.618⁶⁰ ≈
-/// 3e-13 of the bracket); returns the value and its abscissa.
+/// Golden-section search (base::golden_section) for the maximum of sign·residual on
+/// [lo, hi] in ln X, kRefineIterations steps (0.618⁶⁰ ≈ 3e-13 of the bracket); returns the
+/// value and its abscissa.
 template <class Residual>
 double golden_maximum(Residual&& residual, double lo, double hi, double sign, double& at) {
-  auto score = [&](double u) { return sign * residual(std::exp(u)); };
-  constexpr double kGolden = 0.61803398874989485;
-  double a = std::log(lo), b = std::log(hi);
-  double c = b - kGolden * (b - a), d = a + kGolden * (b - a);
-  double fc = score(c), fd = score(d);
-  for (int iteration = 0; iteration < kRefineIterations; ++iteration) {
-    if (fc > fd) {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - kGolden * (b - a);
-      fc = score(c);
-    } else {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + kGolden * (b - a);
-      fd = score(d);
-    }
-  }
-  at = std::exp(0.5 * (a + b));
-  return std::max(fc, fd);
+  base::GoldenSectionOptions search;
+  search.maximum = true;
+  search.max_iterations = kRefineIterations;
+  const base::GoldenSection s =
+      base::golden_section([&](double u) { return sign * residual(std::exp(u)); }, std::log(lo), std::log(hi), search);
+  at = std::exp(s.middle());
+  return std::max(s.f1, s.f2);
 }
 
 /// Scan workspace, reused across frequencies (no allocation once grown).
@@ -680,10 +667,10 @@ std::string_view to_string(Stability stability) {
 std::vector<std::string> Excitation::validate(const ModalModel& model) const {
   std::vector<std::string> problems;
   if (!(std::abs(direction.norm() - 1.0) <= 1e-6))
-    problems.push_back("excitation.direction = (" + number(direction.x()) + ", " + number(direction.y()) +
-                       "): must be a unit vector");
+    problems.push_back("excitation.direction = (" + format_number(direction.x(), 12) + ", " +
+                       format_number(direction.y(), 12) + "): must be a unit vector");
   if (!(amplitude > 0.0 && std::isfinite(amplitude)))
-    problems.push_back("excitation.amplitude = " + number(amplitude) + ": must be > 0 and finite");
+    problems.push_back("excitation.amplitude = " + format_number(amplitude, 12) + ": must be > 0 and finite");
   if (kind == Kind::kBaseTranslation && model.base_participation.cols() != 2)
     problems.push_back("excitation.kind = base: the modal model has no base participation (Gamma)");
   if (kind == Kind::kPointForce) {
@@ -699,26 +686,27 @@ std::vector<std::string> HarmonicBalanceOptions::validate() const {
   if (frequencies_hz.empty()) problems.push_back("frequencies_hz: must hold at least one frequency");
   for (std::size_t k = 0; k < frequencies_hz.size(); ++k) {
     if (!(frequencies_hz[k] > 0.0 && std::isfinite(frequencies_hz[k])))
-      problems.push_back("frequencies_hz[" + std::to_string(k) + "] = " + number(frequencies_hz[k]) +
+      problems.push_back("frequencies_hz[" + std::to_string(k) + "] = " + format_number(frequencies_hz[k], 12) +
                          ": must be > 0 and finite");
     else if (k > 0 && !(frequencies_hz[k] > frequencies_hz[k - 1]))
-      problems.push_back("frequencies_hz[" + std::to_string(k) + "] = " + number(frequencies_hz[k]) +
+      problems.push_back("frequencies_hz[" + std::to_string(k) + "] = " + format_number(frequencies_hz[k], 12) +
                          ": must be > frequencies_hz[" + std::to_string(k - 1) + "]");
   }
   if (!(stroke_min_m >= 0.0 && std::isfinite(stroke_min_m)))
-    problems.push_back("stroke_min_m = " + number(stroke_min_m) + ": must be >= 0 and finite (0 = auto)");
+    problems.push_back("stroke_min_m = " + format_number(stroke_min_m, 12) + ": must be >= 0 and finite (0 = auto)");
   if (!(stroke_max_m >= 0.0 && std::isfinite(stroke_max_m)))
-    problems.push_back("stroke_max_m = " + number(stroke_max_m) + ": must be >= 0 and finite (0 = auto)");
+    problems.push_back("stroke_max_m = " + format_number(stroke_max_m, 12) + ": must be >= 0 and finite (0 = auto)");
   if (stroke_min_m > 0.0 && stroke_max_m > 0.0 && !(stroke_max_m > stroke_min_m))
-    problems.push_back("stroke_max_m = " + number(stroke_max_m) + ": must be > stroke_min_m = " + number(stroke_min_m));
+    problems.push_back("stroke_max_m = " + format_number(stroke_max_m, 12) +
+                       ": must be > stroke_min_m = " + format_number(stroke_min_m, 12));
   if (scan_points_per_decade < 4)
     problems.push_back("scan_points_per_decade = " + std::to_string(scan_points_per_decade) + ": must be >= 4");
   if (!(stroke_tolerance > 0.0 && stroke_tolerance <= 1e-3))
-    problems.push_back("stroke_tolerance = " + number(stroke_tolerance) + ": must be in (0, 1e-3]");
+    problems.push_back("stroke_tolerance = " + format_number(stroke_tolerance, 12) + ": must be in (0, 1e-3]");
   if (max_newton_iterations < 1)
     problems.push_back("max_newton_iterations = " + std::to_string(max_newton_iterations) + ": must be >= 1");
   if (!(fixed_point_relaxation > 0.0 && fixed_point_relaxation <= 1.0))
-    problems.push_back("fixed_point_relaxation = " + number(fixed_point_relaxation) + ": must be in (0, 1]");
+    problems.push_back("fixed_point_relaxation = " + format_number(fixed_point_relaxation, 12) + ": must be in (0, 1]");
   for (auto& p : coupling.validate()) problems.push_back("coupling." + p);
   return problems;
 }

@@ -1,6 +1,6 @@
 // Strict JSON import and export of modal data: every error names the JSON pointer and rule.
 #include "pdamp/structure/imported_modal_data.hpp"
-#include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -17,7 +17,7 @@ namespace {
 
 using nlohmann::json;
 
-using detail::number;
+using base::format_number;
 
 using base::pointer_token;
 
@@ -56,7 +56,8 @@ double finite_number(const json& value, const std::string& at, Range range, std:
   const double x = value.get<double>();
   if (!std::isfinite(x)) throw ModalDataError(at, "must be a finite number" + in_unit);
   if (!(x >= range.min && x <= range.max))
-    throw ModalDataError(at, number(x) + " must be in [" + number(range.min) + ", " + number(range.max) + "]" + in_unit);
+    throw ModalDataError(at, format_number(x, 12) + " must be in [" + format_number(range.min, 12) + ", " +
+                                 format_number(range.max, 12) + "]" + in_unit);
   return x;
 }
 
@@ -124,8 +125,8 @@ ModalModel modal_model_from_json(const json& document) {
   for (Eigen::Index j = 1; j < modes; ++j) {
     if (model.natural_frequencies_hz[j] < model.natural_frequencies_hz[j - 1]) {
       throw ModalDataError("/frequencies_hz/" + std::to_string(j),
-                           number(model.natural_frequencies_hz[j]) + " must be >= the previous frequency " +
-                               number(model.natural_frequencies_hz[j - 1]) + " Hz (ascending order)");
+                           format_number(model.natural_frequencies_hz[j], 12) + " must be >= the previous frequency " +
+                               format_number(model.natural_frequencies_hz[j - 1], 12) + " Hz (ascending order)");
     }
   }
 

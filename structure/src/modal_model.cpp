@@ -1,6 +1,7 @@
 // ModalModel: look-up of named points and validation of the modal data (sizes, ranges).
 #include "pdamp/structure/modal_model.hpp"
 #include "numbers.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <cmath>
 #include <set>
@@ -12,7 +13,7 @@
 namespace pdamp::structure {
 namespace {
 
-using detail::number;
+using base::format_number;
 
 /// "<field> has N <what>, must have M (one per mode)" if the sizes differ.
 void check_count(std::vector<std::string>& problems, const std::string& field, Eigen::Index count,
@@ -29,7 +30,7 @@ void check_finite(std::vector<std::string>& problems, const std::string& field, 
     for (Eigen::Index row = 0; row < values.rows(); ++row) {
       if (!std::isfinite(values(row, col))) {
         problems.push_back(field + "/" + std::to_string(row) + "/" + std::to_string(col) + " = " +
-                           number(values(row, col)) + ": must be finite");
+                           format_number(values(row, col), 12) + ": must be finite");
         return;  // one line per field: a NaN matrix would otherwise flood the report
       }
     }
@@ -55,7 +56,7 @@ std::vector<std::string> ModalModel::validate() const {
 
   for (Eigen::Index j = 0; j < modes; ++j) {
     const double f = natural_frequencies_hz[j];
-    const std::string field = "natural_frequencies_hz/" + std::to_string(j) + " = " + number(f);
+    const std::string field = "natural_frequencies_hz/" + std::to_string(j) + " = " + format_number(f, 12);
     if (!(f > 0.0) || !std::isfinite(f)) {
       problems.push_back(field + ": must be > 0 Hz and finite");
     } else if (j > 0 && f < natural_frequencies_hz[j - 1]) {
@@ -66,7 +67,7 @@ std::vector<std::string> ModalModel::validate() const {
   check_count(problems, "damping_ratios", damping_ratios.size(), modes, "entries");
   for (Eigen::Index j = 0; j < damping_ratios.size(); ++j) {
     if (!(damping_ratios[j] >= 0.0) || !std::isfinite(damping_ratios[j])) {
-      problems.push_back("damping_ratios/" + std::to_string(j) + " = " + number(damping_ratios[j]) +
+      problems.push_back("damping_ratios/" + std::to_string(j) + " = " + format_number(damping_ratios[j], 12) +
                          ": must be >= 0 and finite");
     }
   }
@@ -74,7 +75,7 @@ std::vector<std::string> ModalModel::validate() const {
   check_count(problems, "modal_masses_kg", modal_masses_kg.size(), modes, "entries");
   for (Eigen::Index j = 0; j < modal_masses_kg.size(); ++j) {
     if (!(modal_masses_kg[j] > 0.0) || !std::isfinite(modal_masses_kg[j])) {
-      problems.push_back("modal_masses_kg/" + std::to_string(j) + " = " + number(modal_masses_kg[j]) +
+      problems.push_back("modal_masses_kg/" + std::to_string(j) + " = " + format_number(modal_masses_kg[j], 12) +
                          ": must be > 0 kg and finite");
     }
   }

@@ -1,5 +1,7 @@
 // Effective-field data, provenance stamps, and the strict JSON field file format.
 #include "pdamp/surrogate/effective_field.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <algorithm>
 #include <array>
@@ -21,8 +23,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 using nlohmann::json;
 
 namespace {
@@ -155,8 +157,8 @@ Axis read_axis(const json& value, const std::string& pointer, const std::string&
     axis.values.push_back(object.number_value(values[k], at, true, unit_of(axis.quantity)));
     if (k > 0 && !(axis.values[k] > axis.values[k - 1])) {
       base::fail_at(file, at,
-                      number(axis.values[k]) + " must be > the previous node " + number(axis.values[k - 1]) +
-                          " (axis values strictly increasing)");
+                    format_number(axis.values[k], 12) + " must be > the previous node " +
+                        format_number(axis.values[k - 1], 12) + " (axis values strictly increasing)");
     }
   }
   object.finish();
@@ -243,8 +245,8 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
     if (!v.is_number() || !std::isfinite(v.get<double>())) {
       const std::string unit = layout.units[c] == "1" ? "" : " (in " + std::string(layout.units[c]) + ")";
       base::fail_at(file, cell_at(c),
-                      "must be a finite number" + unit + ", got " +
-                          (v.is_number() ? number(v.get<double>()) : std::string(v.type_name())));
+                    "must be a finite number" + unit + ", got " +
+                        (v.is_number() ? format_number(v.get<double>(), 12) : std::string(v.type_name())));
     }
     const double x = v.get<double>();
     if (positive && !(x > 0.0)) base::fail_at(file, cell_at(c), "must be > 0");
@@ -264,9 +266,9 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
     const double x = finite(c, true);
     if (std::abs(x - nodes[c]) > kCoordinateTolerance * nodes[c]) {
       base::fail_at(file, cell_at(c),
-                      std::string(layout.names[c]) + " = " + number(x) + " does not match the axis node " +
-                          number(nodes[c]) + " (rows in storage order, row i0*n1 + i1 = " + std::to_string(k / n1) +
-                          "*" + std::to_string(n1) + " + " + std::to_string(k % n1) + ")");
+                    std::string(layout.names[c]) + " = " + format_number(x, 12) + " does not match the axis node " +
+                        format_number(nodes[c], 12) + " (rows in storage order, row i0*n1 + i1 = " +
+                        std::to_string(k / n1) + "*" + std::to_string(n1) + " + " + std::to_string(k % n1) + ")");
     }
   }
   constexpr std::size_t kFirstValue = 2;
@@ -309,11 +311,11 @@ FieldPoint read_row(const json& row, const std::string& at, std::size_t k, const
 
 std::string field_value_problem(double eta_star, double apparent_mass_fraction) {
   if (!std::isnan(eta_star) && !(eta_star >= kMinEtaStar && eta_star <= kMaxEtaStar))
-    return "eta_star = " + number(eta_star) + ": must be in [" + number(kMinEtaStar) + ", " + number(kMaxEtaStar) +
-           "] (docs/effective_fields.md, file format)";
+    return "eta_star = " + format_number(eta_star, 12) + ": must be in [" + format_number(kMinEtaStar, 12) + ", " +
+           format_number(kMaxEtaStar, 12) + "] (docs/effective_fields.md, file format)";
   if (!std::isnan(apparent_mass_fraction) && !(std::abs(apparent_mass_fraction) <= kMaxApparentMassFraction))
-    return "apparent_mass_fraction = " + number(apparent_mass_fraction) + ": must be in [" +
-           number(-kMaxApparentMassFraction) + ", " + number(kMaxApparentMassFraction) + "]";
+    return "apparent_mass_fraction = " + format_number(apparent_mass_fraction, 12) + ": must be in [" +
+           format_number(-kMaxApparentMassFraction, 12) + ", " + format_number(kMaxApparentMassFraction, 12) + "]";
   return "";
 }
 
@@ -387,10 +389,10 @@ std::string case_hash(const json& case_json) {
 std::vector<std::string> EffectiveField::validate() const {
   std::vector<std::string> problems = grid.validate();
   if (!positive_finite(clearance_m)) {
-    problems.push_back("clearance_m = " + number(clearance_m) + ": must be > 0 and finite");
+    problems.push_back("clearance_m = " + format_number(clearance_m, 12) + ": must be > 0 and finite");
   }
   if (!positive_finite(bed_mass_kg)) {
-    problems.push_back("bed_mass_kg = " + number(bed_mass_kg) + ": must be > 0 and finite");
+    problems.push_back("bed_mass_kg = " + format_number(bed_mass_kg, 12) + ": must be > 0 and finite");
   }
   if (provenance.model_version < 0) {
     problems.push_back("provenance.model_version = " + std::to_string(provenance.model_version) + ": must be >= 0");
@@ -411,24 +413,26 @@ std::vector<std::string> EffectiveField::validate() const {
     const std::string at = "points[" + std::to_string(k) + "]";
     const bool ok = p.status == PointStatus::kOk;
     if (ok && !std::isfinite(p.eta_star)) {
-      problems.push_back(at + ".eta_star = " + number(p.eta_star) + ": must be finite for status ok");
+      problems.push_back(at + ".eta_star = " + format_number(p.eta_star, 12) + ": must be finite for status ok");
     }
     if (ok && !std::isfinite(p.e_diss_j)) {
-      problems.push_back(at + ".e_diss_j = " + number(p.e_diss_j) + ": must be finite for status ok");
+      problems.push_back(at + ".e_diss_j = " + format_number(p.e_diss_j, 12) + ": must be finite for status ok");
     }
     if (!ok && !std::isnan(p.eta_star)) {
-      problems.push_back(at + ".eta_star = " + number(p.eta_star) + ": must be NaN (no value) for status " +
+      problems.push_back(at + ".eta_star = " + format_number(p.eta_star, 12) + ": must be NaN (no value) for status " +
                          std::string(to_string(p.status)));
     }
     if (const std::string problem = field_value_problem(p.eta_star, p.apparent_mass_fraction); !problem.empty())
       problems.push_back(at + "." + problem);
     if (!std::isnan(p.eta_star_stderr) && !(p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr))) {
-      problems.push_back(at + ".eta_star_stderr = " + number(p.eta_star_stderr) + ": must be >= 0 and finite, or NaN");
+      problems.push_back(at + ".eta_star_stderr = " + format_number(p.eta_star_stderr, 12) +
+                         ": must be >= 0 and finite, or NaN");
     }
     for (const auto& [name, value] :
          {std::pair{".e_diss_j", p.e_diss_j}, std::pair{".apparent_mass_kg", p.apparent_mass_kg},
           std::pair{".apparent_mass_fraction", p.apparent_mass_fraction}}) {
-      if (std::isinf(value)) problems.push_back(at + name + " = " + number(value) + ": must be finite or NaN");
+      if (std::isinf(value))
+        problems.push_back(at + name + " = " + format_number(value, 12) + ": must be finite or NaN");
     }
   }
   return problems;

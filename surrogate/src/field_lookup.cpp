@@ -1,5 +1,7 @@
 // Lookup of an effective field by drive frequency and stroke, with normalised rescaling.
 #include "pdamp/surrogate/field_lookup.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,8 +11,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 
 namespace {
 
@@ -30,8 +32,8 @@ double column_of(const FieldPoint& p, FieldColumn column) {
 }
 
 std::string axis_range_text(const Axis& axis) {
-  return std::string(to_string(axis.quantity)) + " range [" + number(axis.values.front()) + ", " +
-         number(axis.values.back()) + "]";
+  return std::string(to_string(axis.quantity)) + " range [" + format_number(axis.values.front(), 12) + ", " +
+         format_number(axis.values.back(), 12) + "]";
 }
 
 /// The field's grid once field and options are known to be valid (std::invalid_argument otherwise).
@@ -53,7 +55,8 @@ std::vector<double> column_values(const EffectiveField& field, FieldColumn colum
 std::vector<std::string> LookupOptions::validate() const {
   std::vector<std::string> problems;
   if (!(clearance_m >= 0.0 && std::isfinite(clearance_m))) {
-    problems.push_back("clearance_m = " + number(clearance_m) + ": must be >= 0 and finite (0 = the field's own)");
+    problems.push_back("clearance_m = " + format_number(clearance_m, 12) +
+                       ": must be >= 0 and finite (0 = the field's own)");
   }
   return problems;
 }
@@ -90,16 +93,16 @@ FieldLookup::Mapped FieldLookup::map(double frequency_hz, double amplitude_m) co
 
 LookupResult FieldLookup::evaluate(double frequency_hz, double amplitude_m) const {
   if (!positive_finite(frequency_hz) || !positive_finite(amplitude_m)) [[unlikely]] {
-    throw std::invalid_argument("field lookup at frequency_hz = " + number(frequency_hz) +
-                                ", amplitude_m = " + number(amplitude_m) + ": both must be > 0 and finite");
+    throw std::invalid_argument("field lookup at frequency_hz = " + format_number(frequency_hz, 12) +
+                                ", amplitude_m = " + format_number(amplitude_m, 12) + ": both must be > 0 and finite");
   }
   const Mapped m = map(frequency_hz, amplitude_m);
   BilinearInterpolator::Result r;
   try {
     r = interpolator_.evaluate(m.x0, m.x1);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("field lookup at frequency_hz = " + number(frequency_hz) +
-                                ", amplitude_m = " + number(amplitude_m) + ": " + e.what());
+    throw std::invalid_argument("field lookup at frequency_hz = " + format_number(frequency_hz, 12) +
+                                ", amplitude_m = " + format_number(amplitude_m, 12) + ": " + e.what());
   }
   if (std::isnan(r.value)) [[unlikely]] {
     missing_point(frequency_hz, amplitude_m);
@@ -123,10 +126,11 @@ void FieldLookup::missing_point(double frequency_hz, double amplitude_m) const {
   const std::size_t k = nearest_point(frequency_hz, amplitude_m);
   const bool no_value_in_column = column_ != FieldColumn::kEtaStar && status_[k] == PointStatus::kOk;
   throw std::invalid_argument(
-      "field lookup at frequency_hz = " + number(frequency_hz) + ", amplitude_m = " + number(amplitude_m) +
+      "field lookup at frequency_hz = " + format_number(frequency_hz, 12) +
+      ", amplitude_m = " + format_number(amplitude_m, 12) +
       ": the grid cell around this point holds a point without a value (nearest node " +
-      std::string(to_string(grid.axis0.quantity)) + " = " + number(grid.coordinate0(k)) + ", " +
-      std::string(to_string(grid.axis1.quantity)) + " = " + number(grid.coordinate1(k)) + ", status " +
+      std::string(to_string(grid.axis0.quantity)) + " = " + format_number(grid.coordinate0(k), 12) + ", " +
+      std::string(to_string(grid.axis1.quantity)) + " = " + format_number(grid.coordinate1(k), 12) + ", status " +
       std::string(to_string(status_[k])) + (no_value_in_column ? ", column not given by the field's source" : "") +
       "); the field cannot answer here: compute the missing points or stay away from them");
 }
@@ -141,8 +145,8 @@ std::vector<std::string> FieldLookup::describe(std::uint8_t warnings) const {
     }
   }
   if ((warnings & kRescaledClearance) != 0) {
-    lines.push_back("field made for clearance " + number(field_clearance_m_) + " m used for clearance " +
-                    number(clearance_m_) +
+    lines.push_back("field made for clearance " + format_number(field_clearance_m_, 12) + " m used for clearance " +
+                    format_number(clearance_m_, 12) +
                     " m at equal intensity and stroke/clearance: valid only where eta* depends on those two "
                     "alone (docs/effective_fields.md, normalised lookup)");
   }

@@ -11,16 +11,16 @@
 
 namespace pdamp::surrogate::detail {
 
-/// The path as it appears in messages: formulas::printable(path), so a name holding a
+/// The path as it appears in messages: base::printable(path), so a name holding a
 /// newline or a control byte still gives a one-line message.
 std::string file_label(const std::filesystem::path& path);
 
-/// The whole file as bytes, through formulas::read_input_file: a directory, FIFO,
+/// The whole file as bytes, through base::read_input_file: a directory, FIFO,
 /// socket or device, a missing file or one above 256 MiB throws std::invalid_argument
 /// "<path>: <reason>" at once (a FIFO never blocks the reader).
 std::string read_text_file(const std::filesystem::path& path);
 
-/// read_text_file + formulas::parse_json_document: std::invalid_argument
+/// read_text_file + base::parse_json_document: std::invalid_argument
 /// "<path>: malformed JSON: ..." or "<path>: <pointer>: duplicate key".
 nlohmann::json read_json_file(const std::filesystem::path& path);
 

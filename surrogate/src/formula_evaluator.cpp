@@ -2,6 +2,8 @@
 #include <string>
 #include <vector>
 
+#include "pdamp/base/checks.hpp"
+
 #include "pdamp/surrogate/sweep.hpp"  // declares formula_evaluator next to run_sweep
 #include "text_util.hpp"
 
@@ -10,12 +12,10 @@ namespace pdamp::surrogate {
 PointEvaluator formula_evaluator(formulas::DamperModel model, double clearance_m, double bed_mass_kg,
                                  const formulas::ModelOptions& options) {
   std::vector<std::string> problems = options.validate();
-  if (!detail::positive_finite(clearance_m)) {
-    problems.push_back("clearance_m = " + detail::number(clearance_m) + ": must be > 0 and finite");
-  }
-  if (!detail::positive_finite(bed_mass_kg)) {
-    problems.push_back("bed_mass_kg = " + detail::number(bed_mass_kg) + ": must be > 0 and finite");
-  }
+  if (!base::positive_finite(clearance_m))
+    problems.push_back(base::violation("clearance_m", clearance_m, "> 0 and finite"));
+  if (!base::positive_finite(bed_mass_kg))
+    problems.push_back(base::violation("bed_mass_kg", bed_mass_kg, "> 0 and finite"));
   detail::throw_if_any(problems, "formula evaluator");
   return [model, clearance_m, bed_mass_kg, options](double frequency_hz, double amplitude_m) {
     const auto loss = formulas::reduced_loss_factor(model, clearance_m, amplitude_m, frequency_hz, options);

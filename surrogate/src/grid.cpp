@@ -1,5 +1,7 @@
 // Axes and grids of effective fields: names, units, node generation and validation.
 #include "pdamp/surrogate/grid.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,8 +11,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 
 namespace {
 
@@ -67,18 +69,21 @@ std::string_view to_string(GridAxes axes) {
 
 std::vector<std::string> AxisRange::validate(const std::string& prefix) const {
   std::vector<std::string> problems;
-  if (!positive_finite(min)) problems.push_back(prefix + ".min = " + number(min) + ": must be > 0 and finite");
+  if (!positive_finite(min))
+    problems.push_back(prefix + ".min = " + format_number(min, 12) + ": must be > 0 and finite");
   if (!std::isfinite(max) || max < min) {
-    problems.push_back(prefix + ".max = " + number(max) + ": must be finite and >= min = " + number(min));
+    problems.push_back(prefix + ".max = " + format_number(max, 12) +
+                       ": must be finite and >= min = " + format_number(min, 12));
   }
   if (count < 1 || count > kMaxAxisCount) {
     problems.push_back(prefix + ".count = " + std::to_string(count) + ": must be in [1, " +
                        std::to_string(kMaxAxisCount) + "]");
   } else if (count == 1 && max != min) {
-    problems.push_back(prefix + ".count = 1: needs max == min (got min = " + number(min) + ", max = " + number(max) +
-                       ")");
+    problems.push_back(prefix + ".count = 1: needs max == min (got min = " + format_number(min, 12) +
+                       ", max = " + format_number(max, 12) + ")");
   } else if (count > 1 && !(max > min)) {
-    problems.push_back(prefix + ".max = " + number(max) + ": must be > min = " + number(min) + " when count > 1");
+    problems.push_back(prefix + ".max = " + format_number(max, 12) + ": must be > min = " + format_number(min, 12) +
+                       " when count > 1");
   }
   return problems;
 }
@@ -104,12 +109,12 @@ std::vector<std::string> Axis::validate(const std::string& prefix) const {
   std::vector<std::string> problems;
   if (values.empty()) problems.push_back(prefix + ".values: must hold at least one node");
   for (std::size_t k = 0; k < values.size(); ++k) {
-    const std::string at = prefix + ".values[" + std::to_string(k) + "] = " + number(values[k]);
+    const std::string at = prefix + ".values[" + std::to_string(k) + "] = " + format_number(values[k], 12);
     if (!positive_finite(values[k])) {
       problems.push_back(at + ": must be > 0 and finite");
     } else if (k > 0 && !(values[k] > values[k - 1])) {
-      problems.push_back(at + ": must be > values[" + std::to_string(k - 1) + "] = " + number(values[k - 1]) +
-                         " (strictly increasing)");
+      problems.push_back(at + ": must be > values[" + std::to_string(k - 1) +
+                         "] = " + format_number(values[k - 1], 12) + " (strictly increasing)");
     }
   }
   return problems;
@@ -160,7 +165,7 @@ DrivePoint drive_point(const Grid& grid, std::size_t k, double clearance_m) {
   const double c1 = grid.coordinate1(k);
   if (grid.axes() == GridAxes::kFrequencyAmplitude) return {c0, c1};
   if (!positive_finite(clearance_m)) {
-    throw std::invalid_argument("clearance_m = " + number(clearance_m) +
+    throw std::invalid_argument("clearance_m = " + format_number(clearance_m, 12) +
                                 ": must be > 0 and finite to turn (intensity, stroke_over_clearance) into a drive");
   }
   // Γ = XΩ²/g  =>  Ω = √(Γg/X).

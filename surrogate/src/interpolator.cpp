@@ -1,5 +1,6 @@
 // Bilinear interpolation over a Grid: cell location, weights, derivatives, range policy.
 #include "pdamp/surrogate/interpolator.hpp"
+#include "pdamp/base/number_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,7 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
+using base::format_number;
 
 namespace {
 
@@ -90,9 +91,9 @@ double BilinearInterpolator::outside(const AxisLookup& axis, double x, double t)
   const std::string name(to_string(axis.quantity));
   if (std::isnan(x)) throw std::invalid_argument(name + " = nan: must be a number");
   if (policy_ == OutOfRangePolicy::kError) {
-    throw std::invalid_argument(name + " = " + number(x) + ": outside the field's axis [" +
-                                number(axis.log ? std::exp(axis.t_min) : axis.t_min) + ", " +
-                                number(axis.log ? std::exp(axis.t_max) : axis.t_max) +
+    throw std::invalid_argument(name + " = " + format_number(x, 12) + ": outside the field's axis [" +
+                                format_number(axis.log ? std::exp(axis.t_min) : axis.t_min, 12) + ", " +
+                                format_number(axis.log ? std::exp(axis.t_max) : axis.t_max, 12) +
                                 "] (out-of-range policy \"error\")");
   }
   // Below the axis includes x <= 0 on a log axis, where ln x is NaN or −inf.

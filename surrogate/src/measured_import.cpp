@@ -1,7 +1,9 @@
 // CSV import of measured effective fields: column checks, number parsing, full-grid check.
 #include "pdamp/surrogate/measured_import.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 
-#include "pdamp/formulas/csv_text.hpp"
+#include "pdamp/base/csv_text.hpp"
 #include "pdamp/base/input_file.hpp"
 
 #include <algorithm>
@@ -20,8 +22,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 
 namespace {
 
@@ -73,9 +75,9 @@ class CsvReader {
 std::vector<std::string> MeasuredImportOptions::validate() const {
   std::vector<std::string> problems;
   if (!positive_finite(clearance_m))
-    problems.push_back("clearance_m = " + number(clearance_m) + ": must be > 0 and finite");
+    problems.push_back("clearance_m = " + format_number(clearance_m, 12) + ": must be > 0 and finite");
   if (!positive_finite(bed_mass_kg))
-    problems.push_back("bed_mass_kg = " + number(bed_mass_kg) + ": must be > 0 and finite");
+    problems.push_back("bed_mass_kg = " + format_number(bed_mass_kg, 12) + ": must be > 0 and finite");
   if (model_version < 0) problems.push_back("model_version = " + std::to_string(model_version) + ": must be >= 0");
   return problems;
 }
@@ -98,7 +100,7 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
   std::size_t begin = 0;
   while (begin <= text.size()) {
     const std::size_t end = std::min(text.find('\n', begin), text.size());
-    const std::string_view line = formulas::trim_blanks(text.substr(begin, end - begin));
+    const std::string_view line = base::trim_blanks(text.substr(begin, end - begin));
     begin = end + 1;
     ++line_number;
     // A NUL byte means a binary file (a spreadsheet's native format, a UTF-16 export):
@@ -111,7 +113,7 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
                       "\"");
     }
     if (line.empty() || line.front() == '#') continue;
-    const auto cells = formulas::split_csv_line(line);
+    const auto cells = base::split_csv_line(line);
     if (!have_header) {
       have_header = true;
       header_cells = cells.size();
@@ -149,11 +151,13 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     // cannot drive outside them, and a value there is a unit or column mistake.
     namespace lim = dem_reference::limits;
     if (!(row.frequency_hz >= lim::kMinFrequency_hz && row.frequency_hz <= lim::kMaxFrequency_hz))
-      reader.fail(line_number, kNames[kFrequency], number(row.frequency_hz) + ": must be in [" + number(lim::kMinFrequency_hz) +
-                                                      ", " + number(lim::kMaxFrequency_hz) + "] (in Hz)");
+      reader.fail(line_number, kNames[kFrequency],
+                  format_number(row.frequency_hz, 12) + ": must be in [" + format_number(lim::kMinFrequency_hz, 12) +
+                      ", " + format_number(lim::kMaxFrequency_hz, 12) + "] (in Hz)");
     if (!(row.amplitude_m >= kMinAmplitude_m && row.amplitude_m <= lim::kMaxAmplitude_m))
-      reader.fail(line_number, kNames[kAmplitude], number(row.amplitude_m) + ": must be in [" + number(kMinAmplitude_m) +
-                                                      ", " + number(lim::kMaxAmplitude_m) + "] (in m)");
+      reader.fail(line_number, kNames[kAmplitude],
+                  format_number(row.amplitude_m, 12) + ": must be in [" + format_number(kMinAmplitude_m, 12) + ", " +
+                      format_number(lim::kMaxAmplitude_m, 12) + "] (in m)");
     FieldPoint& p = row.point;
     p.eta_star = reader.parse_number(cell(kEta), line_number, kNames[kEta]);
     // η* = E_diss/(½ m_bed V²) with E_diss = Re(P)/Ω the mean power the container puts
@@ -165,18 +169,19 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     // above, at kMaxEtaStar: a value beyond is a unit or column mistake (a percentage,
     // E_diss in the η* column), not a damper.
     if (!(p.eta_star >= 0.0 && p.eta_star <= kMaxEtaStar))
-      reader.fail(line_number, kNames[kEta], number(p.eta_star) + ": must be in [0, " + number(kMaxEtaStar) +
-                                                 "] (>= 0: a passive damper dissipates)");
+      reader.fail(line_number, kNames[kEta],
+                  format_number(p.eta_star, 12) + ": must be in [0, " + format_number(kMaxEtaStar, 12) +
+                      "] (>= 0: a passive damper dissipates)");
     p.eta_star_stderr = optional_number(kStderr);
     if (p.eta_star_stderr < 0.0)
-      reader.fail(line_number, kNames[kStderr], number(p.eta_star_stderr) + ": must be >= 0");
+      reader.fail(line_number, kNames[kStderr], format_number(p.eta_star_stderr, 12) + ": must be >= 0");
     p.apparent_mass_kg = optional_number(kApparentMass);
     // m_app of a particle bed lies between about 0 (bed detached) and m_bed (locked to
     // the container); m_app < 0 would be a spring-like reaction (−k/Ω²,
     // docs/complex_power.md) that a bed far below its contact frequencies does not
     // show, so it is taken as a sign error of the rig.
     if (p.apparent_mass_kg < 0.0)
-      reader.fail(line_number, kNames[kApparentMass], number(p.apparent_mass_kg) + ": must be >= 0 (in kg)");
+      reader.fail(line_number, kNames[kApparentMass], format_number(p.apparent_mass_kg, 12) + ": must be >= 0 (in kg)");
     p.apparent_mass_fraction = p.apparent_mass_kg / options.bed_mass_kg;  // NaN stays NaN
     p.motion_mode = std::string(cell(kMotionMode));
     if (detail::has_control_byte(p.motion_mode)) {
@@ -216,8 +221,9 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     const std::size_t k = field.grid.index(i0, i1);
     if (line_of[k] != 0) {
       reader.fail(row.line, "",
-                  "frequency_hz = " + number(row.frequency_hz) + ", amplitude_m = " + number(row.amplitude_m) +
-                      " repeats line " + std::to_string(line_of[k]) + " (each grid point once)");
+                  "frequency_hz = " + format_number(row.frequency_hz, 12) +
+                      ", amplitude_m = " + format_number(row.amplitude_m, 12) + " repeats line " +
+                      std::to_string(line_of[k]) + " (each grid point once)");
     }
     line_of[k] = row.line;
     field.points[k] = std::move(row.point);
@@ -226,8 +232,9 @@ EffectiveField measured_field_from_csv(std::string_view text, const std::string&
     if (line_of[k] == 0) {
       reader.fail(line_number, "",
                   "the rows do not form a full grid: " + std::to_string(n0) + " frequencies x " + std::to_string(n1) +
-                      " amplitudes need " + std::to_string(n0 * n1) + " rows, and frequency_hz = " +
-                      number(field.grid.coordinate0(k)) + ", amplitude_m = " + number(field.grid.coordinate1(k)) +
+                      " amplitudes need " + std::to_string(n0 * n1) +
+                      " rows, and frequency_hz = " + format_number(field.grid.coordinate0(k), 12) +
+                      ", amplitude_m = " + format_number(field.grid.coordinate1(k), 12) +
                       " has none (values must repeat exactly across rows)");
     }
   }

@@ -1,5 +1,7 @@
 // Scattered-state law: samples below the onset, weighted least squares (NLopt), coefficient file.
 #include "pdamp/surrogate/scattered_fit.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 
 #include <algorithm>
@@ -15,8 +17,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 using nlohmann::json;
 
 namespace {
@@ -90,15 +92,18 @@ void check_samples(std::span<const ScatteredSample> samples) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const auto& x = samples[k];
     const std::string at = "scattered fit: sample " + std::to_string(k);
-    if (!(x.s > 0.0 && x.s < 1.0)) throw std::invalid_argument(at + ": s = " + number(x.s) + ": must be in (0, 1)");
+    if (!(x.s > 0.0 && x.s < 1.0))
+      throw std::invalid_argument(at + ": s = " + format_number(x.s, 12) + ": must be in (0, 1)");
     if (!std::isfinite(x.eta_star))
-      throw std::invalid_argument(at + ": eta_star = " + number(x.eta_star) + ": must be finite");
+      throw std::invalid_argument(at + ": eta_star = " + format_number(x.eta_star, 12) + ": must be finite");
     if (!positive_finite(x.eta_star_stderr)) {
-      throw std::invalid_argument(at + " (s = " + number(x.s) + "): eta_star_stderr = " + number(x.eta_star_stderr) +
+      throw std::invalid_argument(at + " (s = " + format_number(x.s, 12) +
+                                  "): eta_star_stderr = " + format_number(x.eta_star_stderr, 12) +
                                   ": must be > 0 and finite (the fit weights by 1/stderr^2)");
     }
     if (!positive_finite(x.eta_star_onset)) {
-      throw std::invalid_argument(at + ": eta_star_onset = " + number(x.eta_star_onset) + ": must be > 0 and finite");
+      throw std::invalid_argument(at + ": eta_star_onset = " + format_number(x.eta_star_onset, 12) +
+                                  ": must be > 0 and finite");
     }
   }
 }
@@ -227,14 +232,15 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
     const json* value = root.optional(key);
     if (value == nullptr || value->is_null()) return kNaN;
     const double x = root.number_value(*value, root.pointer(key), false);
-    if (x < 0.0) root.fail(key, number(x) + ": must be >= 0 or null");
+    if (x < 0.0) root.fail(key, format_number(x, 12) + ": must be >= 0 or null");
     return x;
   };
   result.fit.jump_fraction_stderr = optional_stderr("jump_fraction_stderr");
   result.fit.exponent_stderr = optional_stderr("exponent_stderr");
   root.finish();
   if (!(result.fit.s_max >= result.fit.s_min && result.fit.s_max <= 1.0)) {
-    root.fail("s_max", number(result.fit.s_max) + ": must be in [s_min, 1] = [" + number(result.fit.s_min) + ", 1]");
+    root.fail("s_max", format_number(result.fit.s_max, 12) + ": must be in [s_min, 1] = [" +
+                           format_number(result.fit.s_min, 12) + ", 1]");
   }
   // Range rules, each reported at its key.
   const std::vector<std::string> problems = result.fit.validate();
@@ -243,7 +249,8 @@ ScatteredFitResult read_scattered_fit(const std::filesystem::path& path) {
     const std::string key = line.substr(0, line.find_first_of(" ="));
     root.fail(key, line);
   }
-  if (result.fit.reduced_chi_squared < 0.0) root.fail("residual", number(result.fit.reduced_chi_squared) + ": must be >= 0");
+  if (result.fit.reduced_chi_squared < 0.0)
+    root.fail("residual", format_number(result.fit.reduced_chi_squared, 12) + ": must be >= 0");
   return result;
 }
 

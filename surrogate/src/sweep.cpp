@@ -1,5 +1,8 @@
 // Parallel, resumable sweeps over a grid or a list of points with a JSON-lines results file.
 #include "pdamp/surrogate/sweep.hpp"
+#include "pdamp/base/checks.hpp"
+#include "pdamp/base/executor.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 
 #include <fcntl.h>
@@ -20,7 +23,6 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include "field_format.hpp"
 #include "file_io.hpp"
@@ -30,8 +32,8 @@
 
 namespace pdamp::surrogate {
 
-using detail::number;
-using detail::positive_finite;
+using base::format_number;
+using base::positive_finite;
 using nlohmann::json;
 
 namespace {
@@ -102,8 +104,8 @@ std::string point_line(std::size_t index, const DrivePoint& drive, const FieldPo
 
 /// Makes an evaluator's point storable: status ok or failed, derived columns filled in.
 FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptions& options) {
-  const std::string where =
-      "evaluator at frequency_hz = " + number(drive.frequency_hz) + ", amplitude_m = " + number(drive.amplitude_m);
+  const std::string where = "evaluator at frequency_hz = " + format_number(drive.frequency_hz, 12) +
+                            ", amplitude_m = " + format_number(drive.amplitude_m, 12);
   if (p.status == PointStatus::kMissing) {
     throw base::NumericalError(where + ": returned status \"missing\"; return \"ok\" or \"failed\"");
   }
@@ -112,7 +114,7 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
     return p;
   }
   if (!std::isfinite(p.eta_star))
-    throw base::NumericalError(where + ": returned status \"ok\" with eta_star = " + number(p.eta_star));
+    throw base::NumericalError(where + ": returned status \"ok\" with eta_star = " + format_number(p.eta_star, 12));
   if (std::isnan(p.e_diss_j)) {
     const double velocity = 2.0 * formulas::kPi * drive.frequency_hz * drive.amplitude_m;  // |V*| = XΩ
     p.e_diss_j = p.eta_star * 0.5 * options.bed_mass_kg * velocity * velocity;
@@ -122,8 +124,8 @@ FieldPoint checked_point(FieldPoint p, const DrivePoint& drive, const SweepOptio
   }
   if (!std::isfinite(p.e_diss_j) || std::isinf(p.apparent_mass_kg) || std::isinf(p.apparent_mass_fraction) ||
       !(std::isnan(p.eta_star_stderr) || (p.eta_star_stderr >= 0.0 && std::isfinite(p.eta_star_stderr)))) {
-    throw base::NumericalError(where + ": returned non-finite values (e_diss_j = " + number(p.e_diss_j) +
-                             ", eta_star_stderr = " + number(p.eta_star_stderr) + ")");
+    throw base::NumericalError(where + ": returned non-finite values (e_diss_j = " + format_number(p.e_diss_j, 12) +
+                               ", eta_star_stderr = " + format_number(p.eta_star_stderr, 12) + ")");
   }
   return p;
 }
@@ -256,8 +258,9 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       if (std::abs(f - node.frequency_hz) > kDriveTolerance * node.frequency_hz ||
           std::abs(x - node.amplitude_m) > kDriveTolerance * node.amplitude_m) {
         std::ostringstream what;  // a stream: GCC 12 flags "(" + std::string with a false -Wrestrict
-        what << "(" << number(f) << " Hz, " << number(x) << " m) is not " << nodes.noun << " " << k << " ("
-             << number(node.frequency_hz) << " Hz, " << number(node.amplitude_m) << " m)";
+        what << "(" << format_number(f, 12) << " Hz, " << format_number(x, 12) << " m) is not " << nodes.noun << " "
+             << k << " (" << format_number(node.frequency_hz, 12) << " Hz, " << format_number(node.amplitude_m, 12)
+             << " m)";
         object.fail("drive", what.str());
       }
       auto nullable_number = [&](std::string_view key) {
@@ -267,7 +270,8 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
       FieldPoint p;
       p.eta_star = nullable_number("eta_star");
       p.eta_star_stderr = nullable_number("eta_star_stderr");
-      if (p.eta_star_stderr < 0.0) object.fail("eta_star_stderr", number(p.eta_star_stderr) + ": must be >= 0 or null");
+      if (p.eta_star_stderr < 0.0)
+        object.fail("eta_star_stderr", format_number(p.eta_star_stderr, 12) + ": must be >= 0 or null");
       p.e_diss_j = nullable_number("e_diss_j");
       p.apparent_mass_kg = nullable_number("apparent_mass_kg");
       p.apparent_mass_fraction = nullable_number("apparent_mass_fraction");
@@ -286,7 +290,7 @@ SavedPoints read_saved_points(const std::string& text, const std::string& file_n
         object.fail("eta_star", "null: an ok point needs eta_star and e_diss_j");
       }
       const double wall_time_s = object.number("wall_time_s", false, "s");
-      if (wall_time_s < 0.0) object.fail("wall_time_s", number(wall_time_s) + ": must be >= 0 (in s)");
+      if (wall_time_s < 0.0) object.fail("wall_time_s", format_number(wall_time_s, 12) + ": must be >= 0 (in s)");
       object.finish();
       points[k] = std::move(p);
       done[k] = true;
@@ -323,9 +327,9 @@ std::vector<std::string> SweepOptions::validate() const {
   std::vector<std::string> problems;
   if (model_version < 0) problems.push_back("model_version = " + std::to_string(model_version) + ": must be >= 0");
   if (!positive_finite(clearance_m))
-    problems.push_back("clearance_m = " + number(clearance_m) + ": must be > 0 and finite");
+    problems.push_back("clearance_m = " + format_number(clearance_m, 12) + ": must be > 0 and finite");
   if (!positive_finite(bed_mass_kg))
-    problems.push_back("bed_mass_kg = " + number(bed_mass_kg) + ": must be > 0 and finite");
+    problems.push_back("bed_mass_kg = " + format_number(bed_mass_kg, 12) + ": must be > 0 and finite");
   if (threads < 1 || threads > kMaxThreads) {
     problems.push_back("threads = " + std::to_string(threads) + ": must be in [1, " + std::to_string(kMaxThreads) +
                        "]");
@@ -345,10 +349,10 @@ std::vector<std::string> SweepPoints::validate() const {
   if (drives.empty()) problems.push_back("drives: must hold at least one point");
   for (std::size_t k = 0; k < drives.size(); ++k) {
     if (!positive_finite(drives[k].frequency_hz))
-      problems.push_back("drives[" + std::to_string(k) + "].frequency_hz = " + number(drives[k].frequency_hz) +
-                         ": must be > 0 and finite");
+      problems.push_back("drives[" + std::to_string(k) +
+                         "].frequency_hz = " + format_number(drives[k].frequency_hz, 12) + ": must be > 0 and finite");
     if (!positive_finite(drives[k].amplitude_m))
-      problems.push_back("drives[" + std::to_string(k) + "].amplitude_m = " + number(drives[k].amplitude_m) +
+      problems.push_back("drives[" + std::to_string(k) + "].amplitude_m = " + format_number(drives[k].amplitude_m, 12) +
                          ": must be > 0 and finite");
   }
   return problems;
@@ -392,7 +396,6 @@ PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, 
   std::mutex mutex;  // guards points, the file, the counters, the progress callback and `error`
   std::exception_ptr error;
   std::atomic<bool> stop{false};
-  std::atomic<std::size_t> next{0};
   std::size_t computed = 0;
   auto report_progress = [&] {
     if (!options.progress) return;
@@ -408,25 +411,23 @@ PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, 
     if (!error) error = e;
     stop = true;
   };
-  auto worker = [&] {
-    while (!stop) {
-      const std::size_t slot = next++;
-      if (slot >= pending.size()) return;
-      const std::size_t k = pending[slot];
-      try {
-        const DrivePoint drive = all.drive(k);
-        const auto point_start = Clock::now();
-        FieldPoint p = checked_point(evaluator(k, drive), drive, options);
-        const double wall_time_s = seconds_since(point_start);
-        std::lock_guard lock(mutex);
-        if (file) file->append(point_line(k, drive, p, wall_time_s));
-        points[k] = std::move(p);
-        ++computed;
-        report_progress();
-      } catch (...) {
-        fail(std::current_exception());
-        return;
-      }
+  // Pending point `slot`, unless a point failed or the progress callback threw: then no
+  // further point starts (those written so far stay in the results file for a resume).
+  auto compute = [&](std::size_t slot) {
+    if (stop) return;
+    const std::size_t k = pending[slot];
+    try {
+      const DrivePoint drive = all.drive(k);
+      const auto point_start = Clock::now();
+      FieldPoint p = checked_point(evaluator(k, drive), drive, options);
+      const double wall_time_s = seconds_since(point_start);
+      std::lock_guard lock(mutex);
+      if (file) file->append(point_line(k, drive, p, wall_time_s));
+      points[k] = std::move(p);
+      ++computed;
+      report_progress();
+    } catch (...) {
+      fail(std::current_exception());
     }
   };
 
@@ -435,13 +436,10 @@ PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, 
   } catch (...) {
     fail(std::current_exception());
   }
+  // Each thread takes the next pending point in order; one thread (or one point): this one.
+  // compute() catches every error, so the first to fail is rethrown here, after all end.
   const std::size_t workers = std::min<std::size_t>(static_cast<std::size_t>(options.threads), pending.size());
-  if (workers <= 1) {
-    worker();
-  } else {
-    std::vector<std::jthread> threads;
-    for (std::size_t t = 0; t < workers; ++t) threads.emplace_back(worker);
-  }
+  base::for_each_concurrently(pending.size(), workers > 1, compute, workers);
   if (error) std::rethrow_exception(error);
 
   PointSweepResult result;

@@ -1,24 +1,13 @@
-// Private text helpers of the surrogate module: numbers and rule lists in messages.
+// Private text helpers of the surrogate module: labels and rule lists in messages (numbers
+// are base::format_number's, with 12 significant digits to tell close values apart).
 #pragma once
 
-#include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace pdamp::surrogate::detail {
-
-/// A double as text with enough digits to tell close values apart.
-inline std::string number(double value, int digits = 12) {
-  std::ostringstream out;
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
-
-inline bool positive_finite(double value) { return value > 0.0 && std::isfinite(value); }
 
 /// True if `text` holds a control byte (below 0x20, or DEL): a label (motion mode, fit
 /// source) is printed in tables and one-line messages, where such a byte breaks the

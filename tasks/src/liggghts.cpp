@@ -21,8 +21,9 @@ namespace pdamp::tasks {
 
 namespace fm = formulas;
 namespace dr = dem_reference;
-using nlohmann::json;
+using base::format_number;
 using base::InputError;
+using nlohmann::json;
 
 namespace {
 
@@ -30,13 +31,8 @@ constexpr const char* kRecordFormat = "pdamp_liggghts_export";
 constexpr int kRecordFormatVersion = 1;
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
-/// A number as LIGGGHTS reads it back to the last bit (17 significant digits, C locale).
-std::string num(double value) {
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out << std::setprecision(17) << value;
-  return out.str();
-}
+/// Numbers in the deck: 17 significant digits, which LIGGGHTS reads back to the last bit.
+constexpr int kDeckDigits = 17;
 
 /// FNV-1a over the deck's files: the export's identity, written into the title line of
 /// every output file, so that an import never reads the output of an earlier deck.
@@ -156,24 +152,26 @@ int mantle_segments(double cylinder_radius_m, double smallest_particle_radius_m)
 std::string readme_text(const json& r, bool cylinder) {
   std::ostringstream out;
   out << "LIGGGHTS deck of pdamp dem's run of case '" << r["case"].get<std::string>() << "'\n"
-      << "written by pdamp " << r["pdamp_version"].get<std::string>() << " (export " << r["export_id"].get<std::string>()
-      << "); docs/liggghts.md of pdamp explains every command.\n\n"
-      << "The run: " << r["particles"].get<int>() << " spheres (" << base::format_number(r["bed_mass_kg"].get<double>(), 4)
+      << "written by pdamp " << r["pdamp_version"].get<std::string>() << " (export "
+      << r["export_id"].get<std::string>() << "); docs/liggghts.md of pdamp explains every command.\n\n"
+      << "The run: " << r["particles"].get<int>() << " spheres (" << format_number(r["bed_mass_kg"].get<double>(), 4)
       << " kg) settle for " << r["settling_steps"].get<long long>() << " steps with the container at rest, then the\n"
-      << "container moves as x = X sin(2 pi f t) along " << r["drive_axis"].get<std::string>() << ", X = "
-      << base::format_number(r["amplitude_m"].get<double>()) << " m, f = " << base::format_number(r["frequency_hz"].get<double>()) << " Hz, for "
+      << "container moves as x = X sin(2 pi f t) along " << r["drive_axis"].get<std::string>()
+      << ", X = " << format_number(r["amplitude_m"].get<double>())
+      << " m, f = " << format_number(r["frequency_hz"].get<double>()) << " Hz, for "
       << r["transient_periods"].get<int>() << " transient and " << r["analysed_periods"].get<int>()
-      << " analysed periods\nat a time step of " << base::format_number(r["time_step_s"].get<double>()) << " s ("
+      << " analysed periods\nat a time step of " << format_number(r["time_step_s"].get<double>()) << " s ("
       << r["steps_per_period"].get<long long>() << " steps a period). It writes " << kLiggghtsForceFile
       << " (the force of the bed on the\ncontainer walls, mean over each of " << r["samples_per_period"].get<int>()
       << " samples a period) and " << kLiggghtsEnergyFile << " (kinetic energy and centre of\nmass at each sample).\n\n"
       << "Files: " << kLiggghtsInputFile << " (the input), particles.data (the spheres at pdamp's initial positions,\n"
-      << "radii and densities), container.stl (the inner walls"
-      << (cylinder ? "; the mantle as flat facets" : "") << "), " << kLiggghtsExportRecord << "\n(what was exported; "
+      << "radii and densities), container.stl (the inner walls" << (cylinder ? "; the mantle as flat facets" : "")
+      << "), " << kLiggghtsExportRecord << "\n(what was exported; "
       << "pdamp import liggghts reads it).\n\n"
       << "Run it in this folder:\n"
       << "  liggghts -in " << kLiggghtsInputFile << "                      (one process)\n"
-      << "  mpirun -np 4 liggghts -in " << kLiggghtsInputFile << "         (4 processes: the box is split into 4 parts)\n"
+      << "  mpirun -np 4 liggghts -in " << kLiggghtsInputFile
+      << "         (4 processes: the box is split into 4 parts)\n"
       << "On a cluster (Slurm), e.g. 2 nodes of 32 cores:\n"
       << "  #SBATCH --nodes=2\n  #SBATCH --ntasks-per-node=32\n  srun liggghts -in " << kLiggghtsInputFile
       << "       (or mpirun -np 64 liggghts -in " << kLiggghtsInputFile << ")\n"
@@ -270,7 +268,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
     for (int b = 0; b < types; ++b) rolling = rolling || pair_of(world_options, a, b).rolling_friction > 0.0;
   const auto per_type = [&](auto value) {
     std::string s;
-    for (int a = 0; a < types; ++a) s += " " + num(value(world_options.materials[a].material));
+    for (int a = 0; a < types; ++a) s += " " + format_number(value(world_options.materials[a].material), kDeckDigits);
     return s;
   };
   const auto per_pair = [&](auto value) {
@@ -279,7 +277,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
     for (int a = 0; a < types; ++a)
       for (int b = 0; b < types; ++b) {
         s += ' ';
-        s += num(value(pair_of(world_options, a, b)));
+        s += format_number(value(pair_of(world_options, a, b)), kDeckDigits);
       }
     return s;
   };
@@ -298,8 +296,8 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("# LIGGGHTS-PUBLIC 3.8 deck of pdamp dem's run of case '" + base::printable(c.name) + "'");
   line("# written by pdamp " + pdamp_version + "; README.txt says how to run it, docs/liggghts.md of pdamp");
   line("# maps every pdamp parameter to the commands below.");
-  line("# Drive: x_c(t) = X sin(2 pi f t) along " + std::string(kAxisNames[axis]) + ", X = " + num(x) + " m, f = " + num(f) +
-       " Hz, t = 0 at the drive's start.");
+  line("# Drive: x_c(t) = X sin(2 pi f t) along " + std::string(kAxisNames[axis]) + ", X = " +
+       format_number(x, kDeckDigits) + " m, f = " + format_number(f, kDeckDigits) + " Hz, t = 0 at the drive's start.");
   line("atom_style granular");
   line("atom_modify map array");
   line("boundary f f f");
@@ -311,14 +309,15 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("read_data particles.data");
   line("");
   line("# Neighbour skin as pdamp's: skin_fraction x the largest radius.");
-  line("neighbor " + num(world_options.integration.skin_fraction * max_radius) + " bin");
+  line("neighbor " + format_number(world_options.integration.skin_fraction * max_radius, kDeckDigits) + " bin");
   line("neigh_modify delay 0");
   line("");
   std::string names;
   for (int a = 0; a < types; ++a) names += (a ? ", " : "") + std::to_string(a + 1) + " " + world_options.materials[a].name;
   line("# Atom types = the case's materials (" + base::printable(names) + "); the walls are type " +
        std::to_string(wall_type) + ".");
-  line("# Young's moduli include /dem/stiffness_softening = " + num(c.dem.stiffness_softening) + " as in pdamp's DEM.");
+  line("# Young's moduli include /dem/stiffness_softening = " + format_number(c.dem.stiffness_softening, kDeckDigits) +
+       " as in pdamp's DEM.");
   line("fix pdamp_m1 all property/global youngsModulus peratomtype" +
        per_type([](const fm::Material& m) { return m.youngs_modulus_pa; }));
   line("fix pdamp_m2 all property/global poissonsRatio peratomtype" +
@@ -333,12 +332,13 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("pair_style gran " + model + " " + settings);
   line("pair_coeff * *");
   line("");
-  line("# pdamp's time step for this run: " + num(estimate.steps_per_period) + " steps a period, " +
-       std::to_string(steps_per_sample) + " a sample.");
-  line("timestep " + num(estimate.time_step_s));
+  line("# pdamp's time step for this run: " + format_number(estimate.steps_per_period, kDeckDigits) +
+       " steps a period, " + std::to_string(steps_per_sample) + " a sample.");
+  line("timestep " + format_number(estimate.time_step_s, kDeckDigits));
   if (g_norm > 0.0)
-    line("fix pdamp_gravity all gravity " + num(g_norm) + " vector " + num(g[0] / g_norm) + " " + num(g[1] / g_norm) + " " +
-         num(g[2] / g_norm));
+    line("fix pdamp_gravity all gravity " + format_number(g_norm, kDeckDigits) + " vector " +
+         format_number(g[0] / g_norm, kDeckDigits) + " " + format_number(g[1] / g_norm, kDeckDigits) + " " +
+         format_number(g[2] / g_norm, kDeckDigits));
   line("fix pdamp_container all mesh/surface/stress file container.stl type " + std::to_string(wall_type));
   line("fix pdamp_walls all wall/gran " + model + " mesh n_meshes 1 meshes pdamp_container " + settings);
   line("fix pdamp_integrate all nve/sphere");
@@ -350,8 +350,8 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("thermo_modify lost error norm no");
   line("");
   if (estimate.settling_steps > 0) {
-    line("# 1. Settling with the container at rest, as pdamp's run (" + num(estimate.settling_steps * estimate.time_step_s) +
-         " s).");
+    line("# 1. Settling with the container at rest, as pdamp's run (" +
+         format_number(estimate.settling_steps * estimate.time_step_s, kDeckDigits) + " s).");
     line("run " + std::to_string(estimate.settling_steps));
     line("");
   }
@@ -361,14 +361,16 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("# The bed starts with the container's velocity X*Omega along the drive, as in pdamp's run.");
   {
     std::string v;
-    for (int k = 0; k < 3; ++k) v += " " + num(k == axis ? x * omega * (d[k] > 0 ? 1 : -1) : 0.0);
+    for (int k = 0; k < 3; ++k)
+      v += " " + format_number(k == axis ? x * omega * (d[k] > 0 ? 1 : -1) : 0.0, kDeckDigits);
     line("velocity all set" + v + " sum yes units box");
   }
   line("# wiggle moves the mesh by A sin(2 pi t/T), t from this fix's creation: pdamp's sine.");
   {
     std::string a;
-    for (int k = 0; k < 3; ++k) a += " " + num(k == axis ? x * (d[k] > 0 ? 1 : -1) : 0.0);
-    line("fix pdamp_drive all move/mesh mesh pdamp_container wiggle amplitude" + a + " period " + num(1.0 / f));
+    for (int k = 0; k < 3; ++k) a += " " + format_number(k == axis ? x * (d[k] > 0 ? 1 : -1) : 0.0, kDeckDigits);
+    line("fix pdamp_drive all move/mesh mesh pdamp_container wiggle amplitude" + a + " period " +
+         format_number(1.0 / f, kDeckDigits));
   }
   const std::string title = "title1 \"# pdamp export EXPORT_ID\"";
   line("# Force of the bed on the walls (N, x y z), mean over each sample of " + std::to_string(steps_per_sample) + " steps.");
@@ -564,8 +566,8 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
     const auto& row = force_rows[static_cast<std::size_t>(m - 1)];
     if (row[0] != static_cast<double>(m * per_sample))
       throw InputError(force_path.string(), "",
-                       "sample " + std::to_string(m) + " is at step " + base::format_number(row[0], 12) +
-                           ", expected " + std::to_string(m * per_sample) + " (a step every " + std::to_string(per_sample) +
+                       "sample " + std::to_string(m) + " is at step " + format_number(row[0], 12) + ", expected " +
+                           std::to_string(m * per_sample) + " (a step every " + std::to_string(per_sample) +
                            " from the drive's start)");
     if (m < first) continue;
     // The force of the container on the bed is minus the force of the bed on the walls.
@@ -604,9 +606,9 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   const double a = std::numbers::pi / static_cast<double>(samples);
   const double bias = 1.0 - std::pow(std::sin(a) / a, 2);
   if (bias > 1e-3)
-    out.warnings.push_back("with " + std::to_string(samples) + " samples a period the sampled force's mean lowers eta* by " +
-                           base::format_number(100.0 * bias, 2) +
-                           "%: export with more /dem/samples_per_period (1000 gives 3e-6)");
+    out.warnings.push_back(
+        "with " + std::to_string(samples) + " samples a period the sampled force's mean lowers eta* by " +
+        format_number(100.0 * bias, 2) + "%: export with more /dem/samples_per_period (1000 gives 3e-6)");
   return out;
 }
 

@@ -352,7 +352,7 @@ TEST_CASE("Thornton's law from the yield stress uses p_y = 1.6 Y", "[formulas][c
 
 TEST_CASE("Thornton's law and the yield speed reject non-positive parameters", "[formulas][cor]") {
   CHECK_THROWS_WITH(pf::yield_speed(-1.0, 1e11, 0.01, 0.01),
-                    Contains("limiting_pressure_pa = -1: must be finite and > 0"));
+                    Contains("limiting_pressure_pa = -1: must be > 0 and finite"));
   CHECK_THROWS_WITH(pf::yield_speed(1e9, 0.0, 0.01, 0.01), Contains("effective_modulus_pa = 0"));
   CHECK_THROWS_AS(pf::yield_speed(1e9, 1e11, std::nan(""), 0.01), std::invalid_argument);
   CHECK_THROWS_AS(pf::make_thornton_restitution(1e9, 1e11, 0.01, 0.0), std::invalid_argument);

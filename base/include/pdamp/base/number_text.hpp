@@ -6,7 +6,9 @@
 namespace pdamp::base {
 
 /// `value` with `significant` significant digits in the shortest of fixed and scientific
-/// notation (std::ostream's default floatfield), "n/a" for NaN.
+/// notation, as std::ostream prints it by default (printf's %g) in the classic locale:
+/// "0.1", "1e-07", "inf", "-inf", "nan" (whatever the global locale's digit grouping or
+/// decimal mark).
 std::string format_number(double value, int significant = 6);
 
 }  // namespace pdamp::base

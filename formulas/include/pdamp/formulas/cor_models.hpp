@@ -76,7 +76,7 @@ struct ImpactData {
 /// skipped); std::invalid_argument naming file and line for a missing column, a
 /// short row, a non-numeric or non-finite value, a negative speed, ε outside (0, 1]
 /// or a file without data rows, and if the file cannot be read (missing, a directory,
-/// a FIFO: formulas::read_input_file).
+/// a FIFO: base::read_input_file).
 ImpactData read_impact_csv(const std::string& path);
 
 enum class RestitutionLaw {

@@ -104,7 +104,7 @@ nlohmann::json to_json(const EffectiveField& field);
 /// increasing, non-finite numbers, null where a value is required, table shape or
 /// coordinates not matching the axes.
 EffectiveField effective_field_from_json(const nlohmann::json& document, const std::string& file_name);
-/// Reads a field file through formulas::read_input_file and parse_json_document:
+/// Reads a field file through base::read_input_file and parse_json_document:
 /// std::invalid_argument "<path>: <reason>" for a missing file, a directory, a FIFO
 /// (refused at once, never read), a device or a file above 256 MiB, "<path>: malformed
 /// JSON: ..." or "<path>: <pointer>: duplicate key", and every rule of

@@ -42,7 +42,7 @@ struct MeasuredImportOptions {
 /// "<file_name>: line N[, column C]: <rule>" (quoted cells escaped to one printable line).
 EffectiveField measured_field_from_csv(std::string_view text, const std::string& file_name,
                                        const MeasuredImportOptions& options);
-/// The same, reading the file at `path` through formulas::read_input_file:
+/// The same, reading the file at `path` through base::read_input_file:
 /// std::invalid_argument "<path>: <reason>" for a missing file, a directory, a FIFO
 /// (refused at once, never read), a device or a file above 256 MiB.
 EffectiveField import_measured_csv(const std::filesystem::path& path, const MeasuredImportOptions& options);

@@ -4,7 +4,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pdamp::formulas {
+namespace pdamp::base {
 
 /// `text` without leading and trailing blanks (space, tab, CR, LF).
 inline std::string_view trim_blanks(std::string_view text) {
@@ -26,4 +26,4 @@ inline std::vector<std::string_view> split_csv_line(std::string_view line) {
   }
 }
 
-}  // namespace pdamp::formulas
+}  // namespace pdamp::base
