@@ -84,9 +84,9 @@ const base::Fields<FillingDesign>& FillingDesign::fields() {
   static const auto f =
       base::Fields<D>()
           .field("layers", &D::layers, "", "each layer's bed")
-          .derived("slabs", [](const D& d) { return d.slabs(); }, "", "n_k of each layer", base::kViewOnly)
+          .derived("slabs", [](const D& d) { return d.slabs(); }, "", "n_k of each layer", base::kHidden)
           .field("total_mass_kg", &D::total_mass_kg, "kg", "particle mass in all layers")
-          .field("total_slabs", &D::total_slabs, "", "slabs in all layers", base::kCodecOnly)
+          .field("total_slabs", &D::total_slabs, "", "slabs in all layers", base::kHidden)
           .field("feasible", &D::feasible, "", "within the mass budget and the slab limit")
           .field("settled", &D::settled, "", "the decay settles within the duration")
           .field("settling_time_s", &D::settling_time_s, "s", "time to settle (null: not settled)", base::kNullable)

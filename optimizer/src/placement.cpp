@@ -13,9 +13,41 @@
 #include "pdamp/optimizer/solve.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/beam.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
+
+const base::Fields<ModeAtSite>& ModeAtSite::fields() {
+  using M = ModeAtSite;
+  static const auto f =
+      base::Fields<M>()
+          .derived("mode", [](const M& m) { return m.mode + 1; }, "", "the mode, from 1")
+          .field("natural_frequency_hz", &M::natural_frequency_hz, "Hz", "backbone frequency with the damper")
+          .field("drive_shape", &M::drive_shape, "m per unit q", "the mode shape at the site along the drive")
+          .field("modal_amplitude", &M::modal_amplitude, "units of q", "the target's modal amplitude")
+          .field("damper_amplitude_m", &M::damper_amplitude_m, "m", "the damper's stroke")
+          .field("eta_star", &M::eta_star, "1", "the layers' reduced loss factor, bed-mass weighted")
+          .field("modal_mass_ratio", &M::modal_mass_ratio, "1", "bed mass in the mode over its modal mass")
+          .field("added_damping_ratio", &M::added_damping_ratio, "1", "the damping ratio the beds add")
+          .field("rotation_ratio", &M::rotation_ratio, "1",
+                 "stroke the container's ends gain or lose from the site's rotation (null: at a node)", base::kNullable)
+          .field("rotation_flagged", &M::rotation_flagged, "", "rotation_ratio above the warning fraction")
+          .derived("loss_warnings", [](const M& m) { return surrogate::describe_loss_warnings(m.loss_warnings); }, "",
+                   "where the loss model was outside its range");
+  return f;
+}
+
+const base::Fields<PlacementPoint>& PlacementPoint::fields() {
+  using P = PlacementPoint;
+  static const auto f = base::Fields<P>()
+                            .field("site", &P::site, "", "the point")
+                            .field("position_m", &P::position_m, "m", "along the beam (null: modal data)",
+                                   base::kNullable)
+                            .field("objective", &P::objective, "1", "the maximised damping ratio")
+                            .field("modes", &P::modes, "", "each target mode at the site");
+  return f;
+}
 
 namespace {
 

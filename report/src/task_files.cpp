@@ -97,28 +97,23 @@ void write_shard_files(OutputDir& out, const nlohmann::json& summary, const case
 }
 
 Warnings write_files(OutputDir& out, const tasks::SensitivityResult& study) {
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "parameter,value,unit,eta_star,eta_star_stderr,delta_eta_star,motion_mode,apparent_mass_fraction,"
-         "closed_form_eta_star,clearance_m,bed_mass_kg,status\n";
-  for (const auto& r : study.rows)
-    csv << r.parameter << ',' << r.value << ',' << r.unit << ',' << r.eta_star << ',' << r.eta_star_stderr << ','
-        << r.delta_eta_star << ',' << r.motion_mode << ',' << r.apparent_mass_fraction << ',' << r.closed_form_eta_star
-        << ',' << r.clearance_m << ',' << r.bed_mass_kg << ',' << r.status << '\n';
-  out.add("sensitivity.csv", csv.str());
+  const base::CsvTable<tasks::SensitivityRow> rows(
+      {"parameter", "value", "unit", "eta_star", "eta_star_stderr", "delta_eta_star", "motion_mode",
+       "apparent_mass_fraction", "closed_form_eta_star", "clearance_m", "bed_mass_kg", "status"});
+  std::string csv = rows.header() + "\n";
+  for (const auto& r : study.rows) csv += rows.row(r) + "\n";
+  out.add("sensitivity.csv", csv);
 
   // The bars sorted by how far each parameter moves η* from the baseline, largest on top,
   // each end labelled with its value and η*, the DEM's standard errors as error bars.
   const tasks::Tornado t = tasks::tornado(study);
-  std::ostringstream tornado;
-  tornado.precision(10);
-  tornado << "parameter,eta_star_low,eta_star_high,value_at_low,value_at_high,eta_star_stderr_at_low,"
-             "eta_star_stderr_at_high,effect\n";
-  for (const auto& b : t.bars)
-    tornado << b.parameter << ',' << b.low << ',' << b.high << ',' << b.value_at_low << ',' << b.value_at_high << ','
-            << (std::isfinite(b.stderr_at_low) ? b.stderr_at_low : 0.0) << ','
-            << (std::isfinite(b.stderr_at_high) ? b.stderr_at_high : 0.0) << ',' << b.effect << '\n';
-  out.add("sensitivity_tornado.csv", tornado.str());
+  const base::CsvTable<tasks::TornadoBar> bars(
+      {"parameter", "eta_star_low", "eta_star_high", "value_at_low", "value_at_high",
+       base::CsvColumn("eta_star_stderr_at_low").nan_as("0"), base::CsvColumn("eta_star_stderr_at_high").nan_as("0"),
+       "effect"});
+  std::string tornado = bars.header() + "\n";
+  for (const auto& b : t.bars) tornado += bars.row(b) + "\n";
+  out.add("sensitivity_tornado.csv", tornado);
   const double baseline = study.baseline_eta_star;
   std::string without;
   for (const auto& p : t.without_effect) without += (without.empty() ? "" : ", ") + p;
@@ -391,23 +386,19 @@ Warnings write_files(OutputDir& out, const tasks::FillingRatiosResult& res) {
 Warnings write_files(OutputDir& out, const tasks::PlacementStudy& study) {
   const auto& r = study.result;
   const bool beam = study.beam;
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << "site,position_m,objective";
-  for (const auto& m : r.best.modes) {
-    const std::string k = "mode" + std::to_string(m.mode + 1);
-    csv << ',' << k << "_frequency_hz," << k << "_damper_amplitude_m," << k << "_eta_star," << k
-        << "_added_damping_ratio," << k << "_rotation_ratio";
-  }
-  csv << '\n';
+  const base::CsvTable<opt::PlacementPoint> site_columns({"site", "position_m", "objective"});
+  const base::CsvTable<opt::ModeAtSite> mode_columns(
+      {"frequency_hz=natural_frequency_hz", "damper_amplitude_m", "eta_star", "added_damping_ratio",
+       base::CsvColumn("rotation_ratio").nan_as("-1")});
+  std::string csv = site_columns.header();
+  for (const auto& m : r.best.modes) csv.append(",").append(mode_columns.header({}, "mode" + std::to_string(m.mode + 1) + "_"));
+  csv += "\n";
   for (const auto& p : r.scan) {
-    csv << p.site << ',' << (beam ? p.position_m : NAN) << ',' << p.objective;
-    for (const auto& m : p.modes)
-      csv << ',' << m.natural_frequency_hz << ',' << m.damper_amplitude_m << ',' << m.eta_star << ','
-          << m.added_damping_ratio << ',' << (std::isfinite(m.rotation_ratio) ? m.rotation_ratio : -1.0);
-    csv << '\n';
+    csv += site_columns.row(p);
+    for (const auto& m : p.modes) csv.append(",").append(mode_columns.row(m));
+    csv += "\n";
   }
-  out.add("placement.csv", csv.str());
+  out.add("placement.csv", csv);
 
   std::ostringstream gp;
   gp << "# added damping against the damper's site (pdamp optimize, task placement); run: gnuplot placement.gp\n"

@@ -33,7 +33,7 @@ const base::Fields<SteppedSinePoint>& SteppedSinePoint::fields() {
           .field("analysed_periods", &P::analysed_periods, "", "periods analysed")
           .derived("periods", [](const P& p) { return p.periods(); }, "", "periods run at this frequency")
           .derived("first_magnitude", [](const P& p) { return p.magnitude.front(); }, "1 or m/N",
-                   "the first damper site's magnitude", base::kViewOnly)
+                   "the first damper site's magnitude", base::kHidden)
           .field("converged", &P::converged, "", "the transient converged before the analysed periods")
           .field("stable", &P::stable, "", "= converged (the former name)")
           .group("convergence", "the convergence window when the transient ended",
@@ -50,7 +50,7 @@ const base::Fields<SteppedSinePoint>& SteppedSinePoint::fields() {
           .field("steps", &P::steps, "", "integration steps")
           .field("time_step_s", &P::time_step_s, "s", "the integration step")
           .field("solve_time_s", &P::wall_time_s, "s", "wall time")
-          .field("warnings", &P::warnings, "", "the co-simulation's warnings", base::kCodecOnly);
+          .field("warnings", &P::warnings, "", "the co-simulation's warnings", base::kHidden);
   return f;
 }
 

@@ -79,11 +79,11 @@ const base::Fields<VerifiedDecay>& VerifiedDecay::fields() {
           .field("steps", &V::steps, "", "integration steps")
           .field("time_step_s", &V::time_step_s, "s", "the integration step")
           .field("solve_time_s", &V::wall_time_s, "s", "wall time")
-          .field("time_s", &V::time_s, "s", "the co-simulation's samples", base::kCodecOnly)
+          .field("time_s", &V::time_s, "s", "the co-simulation's samples", base::kHidden)
           .field("site_displacement_m", &V::site_displacement_m, "m",
-                 "displacement about the static offset at the first damper's site, per sample", base::kCodecOnly)
-          .field("settling", &V::settling, "", "the envelope and its settling", base::kCodecOnly)
-          .field("warnings", &V::warnings, "", "the co-simulation's warnings", base::kCodecOnly);
+                 "displacement about the static offset at the first damper's site, per sample", base::kHidden)
+          .field("settling", &V::settling, "", "the envelope and its settling", base::kHidden)
+          .field("warnings", &V::warnings, "", "the co-simulation's warnings", base::kHidden);
   return f;
 }
 

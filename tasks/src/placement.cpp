@@ -10,29 +10,7 @@
 namespace pdamp::tasks {
 
 namespace opt = optimizer;
-using detail::number_or_null;
 using nlohmann::json;
-
-namespace {
-
-json site_json(const opt::PlacementPoint& p) {
-  json modes = json::array();
-  for (const auto& m : p.modes)
-    modes.push_back({{"mode", m.mode + 1},
-                     {"natural_frequency_hz", m.natural_frequency_hz},
-                     {"drive_shape", m.drive_shape},
-                     {"modal_amplitude", m.modal_amplitude},
-                     {"damper_amplitude_m", m.damper_amplitude_m},
-                     {"eta_star", m.eta_star},
-                     {"modal_mass_ratio", m.modal_mass_ratio},
-                     {"added_damping_ratio", m.added_damping_ratio},
-                     {"rotation_ratio", number_or_null(m.rotation_ratio)},
-                     {"rotation_flagged", m.rotation_flagged},
-                     {"loss_warnings", surrogate::describe_loss_warnings(m.loss_warnings)}});
-  return {{"site", p.site}, {"position_m", number_or_null(p.position_m)}, {"objective", p.objective}, {"modes", modes}};
-}
-
-}  // namespace
 
 PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options) {
   const case_file::PlacementTask& task = *c.task.placement;
@@ -81,8 +59,8 @@ json to_json(const PlacementStudy& study) {
           {"damper", study.damper},
           {"objective", {{"kind", std::string(opt::to_string(study.objective))}, {"unit", "damping ratio"},
                          {"value", r.best.objective}}},
-          {"design", site_json(r.best)},
-          {"current", r.current ? site_json(*r.current) : json(nullptr)},
+          {"design", base::to_json(r.best)},
+          {"current", r.current ? base::to_json(*r.current) : json(nullptr)},
           {"improvement_over_current",
            r.current && r.current->objective > 0.0 ? json(r.best.objective / r.current->objective) : json(nullptr)},
           {"sites_evaluated", r.scan.size()},

@@ -205,35 +205,52 @@ Tornado tornado(const SensitivityResult& study) {
   return out;
 }
 
+const base::Fields<SensitivityRow>& SensitivityRow::fields() {
+  using R = SensitivityRow;
+  static const auto f =
+      base::Fields<R>()
+          .field("parameter", &R::parameter, "", "baseline, then the parameters varied one at a time")
+          .field("value", &R::value, "the row's unit", "the parameter's value (null: the baseline)", base::kNullable)
+          .field("unit", &R::unit, "", "the value's unit")
+          .field("status", &R::status, "", "ok, failed or missing (another shard's)")
+          .field("eta_star", &R::eta_star, "1", "reduced loss factor", base::kNullable)
+          .field("eta_star_stderr", &R::eta_star_stderr, "1", "its standard error", base::kNullable)
+          .field("delta_eta_star", &R::delta_eta_star, "1", "eta* - the baseline's", base::kNullable)
+          .field("motion_mode", &R::motion_mode, "", "the bed's motion mode")
+          .field("apparent_mass_fraction", &R::apparent_mass_fraction, "1", "apparent mass over bed mass",
+                 base::kNullable)
+          .field("closed_form_eta_star", &R::closed_form_eta_star, "1", "the closed forms' eta* at the same point",
+                 base::kNullable)
+          .field("closed_form_regime", &R::closed_form_regime, "", "the closed forms' regime")
+          .field("clearance_m", &R::clearance_m, "m", "the clearance of the variant")
+          .field("bed_mass_kg", &R::bed_mass_kg, "kg", "the bed mass of the variant")
+          .field("intensity", &R::intensity, "1", "X Omega^2 / g");
+  return f;
+}
+
+const base::Fields<TornadoBar>& TornadoBar::fields() {
+  using B = TornadoBar;
+  static const auto f =
+      base::Fields<B>()
+          .field("parameter", &B::parameter, "", "the parameter varied")
+          .field("effect", &B::effect, "1", "largest |eta* - the baseline's| over its values")
+          .field("eta_star_low", &B::low, "1", "the lowest eta* over its values")
+          .field("eta_star_high", &B::high, "1", "the highest")
+          .field("value_at_low", &B::value_at_low, "the parameter's unit", "the value giving the lowest",
+                 base::kNullable)
+          .field("value_at_high", &B::value_at_high, "the parameter's unit", "the value giving the highest",
+                 base::kNullable)
+          .field("eta_star_stderr_at_low", &B::stderr_at_low, "1", "the lowest's standard error", base::kHidden)
+          .field("eta_star_stderr_at_high", &B::stderr_at_high, "1", "the highest's standard error", base::kHidden);
+  return f;
+}
+
 json to_json(const SensitivityResult& r) {
-  json rows = json::array();
-  for (const auto& row : r.rows)
-    rows.push_back({{"parameter", row.parameter},
-                    {"value", detail::number_or_null(row.value)},
-                    {"unit", row.unit},
-                    {"status", row.status},
-                    {"eta_star", detail::number_or_null(row.eta_star)},
-                    {"eta_star_stderr", detail::number_or_null(row.eta_star_stderr)},
-                    {"delta_eta_star", detail::number_or_null(row.delta_eta_star)},
-                    {"motion_mode", row.motion_mode},
-                    {"apparent_mass_fraction", detail::number_or_null(row.apparent_mass_fraction)},
-                    {"closed_form_eta_star", detail::number_or_null(row.closed_form_eta_star)},
-                    {"closed_form_regime", row.closed_form_regime},
-                    {"clearance_m", row.clearance_m},
-                    {"bed_mass_kg", row.bed_mass_kg},
-                    {"intensity", row.intensity}});
   const Tornado t = tornado(r);
-  json bars = json::array();
-  for (auto it = t.bars.rbegin(); it != t.bars.rend(); ++it)  // largest effect first
-    bars.push_back({{"parameter", it->parameter},
-                    {"effect", it->effect},
-                    {"eta_star_low", it->low},
-                    {"eta_star_high", it->high},
-                    {"value_at_low", detail::number_or_null(it->value_at_low)},
-                    {"value_at_high", detail::number_or_null(it->value_at_high)}});
+  const std::vector<TornadoBar> largest_first(t.bars.rbegin(), t.bars.rend());
   return {{"case", r.case_name}, {"source", r.source}, {"frequency_hz", r.frequency_hz},
-          {"amplitude_m", r.amplitude_m}, {"rows", rows}, {"tornado", bars}, {"without_effect", t.without_effect},
-          {"sweep", r.sweep_report}};
+          {"amplitude_m", r.amplitude_m}, {"rows", base::to_json(r.rows)}, {"tornado", base::to_json(largest_first)},
+          {"without_effect", t.without_effect}, {"sweep", r.sweep_report}};
 }
 
 }  // namespace pdamp::tasks

@@ -53,7 +53,7 @@ struct Sample {
             .field("converged", &S::converged, "", "a flag")
             .group("window", "a nested object",
                    base::Fields<S>().field("change", &S::window_change, "1", "may be unknown", base::kNullable))
-            .field("series", &S::series, "m", "state only the codec carries", base::kCodecOnly)
+            .field("series", &S::series, "m", "state only the codec carries", base::kHidden)
             .field("inner", &S::inner, "", "present or not", base::kOmitEmpty)
             .field("analysed", &S::analysed, "", "periods analysed")
             .field("transient", &S::transient, "", "periods before")

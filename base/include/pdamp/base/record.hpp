@@ -16,7 +16,9 @@
 //   }
 //
 // Then `base::to_json(point)` is its result JSON, `nlohmann::json(point)` and
-// `j.get<Point>()` its exact codec, and `base::CsvTable<Point>` writes rows of it.
+// `j.get<Point>()` its exact codec, and `base::CsvTable<Point>` writes rows of it. The codec
+// carries the members listed and nothing else: a record that crosses processes (a job's
+// result) lists every member.
 #pragma once
 
 #include <cmath>
@@ -43,12 +45,11 @@ enum FieldFlag : unsigned {
   /// A vector with one value per output (a damper, a site): in a result an object keyed by
   /// the output names when they are known (JsonStyle::outputs), else an array.
   kPerOutput = 1u << 1,
-  /// Travels in the codec only: state a result does not show (a long sample series).
-  kCodecOnly = 1u << 2,
+  /// Left out of the result JSON: state a result does not show (a long sample series, a
+  /// value only a CSV table or a view names). The codec carries it when it is a member.
+  kHidden = 1u << 2,
   /// In a result, left out when it is empty (an optional without a value, a null).
   kOmitEmpty = 1u << 3,
-  /// Written only by a view that names it (Fields::view): a short form's own entry.
-  kViewOnly = 1u << 4,
 };
 
 /// Which form a record is written in.
@@ -245,7 +246,7 @@ class Fields {
   }
 
   /// The entries named, in that order: the same definitions written in a second place (a
-  /// shorter summary), kViewOnly ones included. "key=entry" writes an entry under another
+  /// shorter summary), kHidden ones included. "key=entry" writes an entry under another
   /// key; "group/name" is an entry of a group. std::logic_error for a name that is no entry.
   Fields view(std::initializer_list<std::string_view> names) const {
     Fields out;
@@ -256,7 +257,7 @@ class Fields {
       out.entries_.push_back(slash == std::string_view::npos ? entry(path)
                                                              : group_of(path.substr(0, slash)).entry(path.substr(slash + 1)));
       if (equals != std::string_view::npos) out.entries_.back().name = std::string(name.substr(0, equals));
-      out.entries_.back().flags &= ~kViewOnly;
+      out.entries_.back().flags &= ~kHidden;
     }
     return out;
   }
@@ -319,9 +320,9 @@ class Fields {
   }
 
  private:
-  /// The codec writes the members; a result every entry but codec-only and view-only ones.
+  /// The codec writes the members; a result every entry but the hidden ones.
   static bool written(const Entry& e, const JsonStyle& style) {
-    return style.exact ? static_cast<bool>(e.read) : !(e.flags & (kCodecOnly | kViewOnly));
+    return style.exact ? static_cast<bool>(e.read) : !(e.flags & kHidden);
   }
 
   template <class V>
@@ -358,7 +359,8 @@ nlohmann::json to_json(const std::vector<T>& records, const std::vector<std::str
 }
 
 /// Columns of a CSV table: a field of the row record by name ("group/name" inside a group,
-/// its header "group_name"), or several kPerOutput fields interleaved output by output.
+/// its header "group_name"; "header=entry" under another header), or several kPerOutput
+/// fields interleaved output by output.
 class CsvColumn {
  public:
   CsvColumn(const char* field) : fields_{field} {}  // NOLINT: a name is a column
@@ -407,18 +409,19 @@ class CsvTable {
     }
   }
 
-  /// The header line, without its newline; `leading` column names (the caller's) first.
-  std::string header(std::string_view leading = {}) const {
+  /// The header line, without its newline; `leading` column names (the caller's) first,
+  /// `prefix` before each of the table's own (a record repeated along a row: "mode1_").
+  std::string header(std::string_view leading = {}, const std::string& prefix = {}) const {
     std::vector<std::string> names;
     for (std::size_t k = 0; k < columns_.size(); ++k) {
       const auto& parts = parts_[k];
       if (!(parts.front().entry->flags & kPerOutput)) {
-        names.push_back(parts.front().header +
+        names.push_back(prefix + parts.front().header +
                         (columns_[k].named_for_first_output_ && !outputs_.empty() ? "_" + outputs_.front() : ""));
         continue;
       }
       for (std::size_t d = 0; d < shown(k, outputs_.size()); ++d)
-        for (const auto& part : parts) names.push_back(part.header + "_" + outputs_[d]);
+        for (const auto& part : parts) names.push_back(prefix + part.header + "_" + outputs_[d]);
     }
     return joined(leading, names);
   }
@@ -440,11 +443,13 @@ class CsvTable {
     const typename Fields<T>::Entry* entry;
     std::string header;
   };
-  static Column column(std::string_view path) {
+  static Column column(std::string_view name) {
+    const auto equals = name.find('=');
+    const std::string_view path = equals == std::string_view::npos ? name : name.substr(equals + 1);
     const auto slash = path.find('/');
-    if (slash == std::string_view::npos) return {&T::fields().entry(path), std::string(path)};
-    std::string header(path);
-    header[slash] = '_';
+    std::string header(equals == std::string_view::npos ? path : name.substr(0, equals));
+    if (slash == std::string_view::npos) return {&T::fields().entry(path), header};
+    if (equals == std::string_view::npos) header[slash] = '_';
     return {&T::fields().group_of(path.substr(0, slash)).entry(path.substr(slash + 1)), header};
   }
   std::size_t shown(std::size_t column, std::size_t count) const {

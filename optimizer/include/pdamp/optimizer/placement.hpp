@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/optimizer/summary.hpp"
 #include "pdamp/structure/beam.hpp"
@@ -92,6 +93,7 @@ struct ModeAtSite {
   double rotation_ratio = 0.0;
   bool rotation_flagged = false;       ///< rotation_ratio > options.rotation_warning_fraction
   std::uint32_t loss_warnings = 0;     ///< surrogate::LossWarning bits of the layers
+  static const base::Fields<ModeAtSite>& fields();
 };
 
 struct PlacementPoint {
@@ -99,6 +101,7 @@ struct PlacementPoint {
   double position_m = std::numeric_limits<double>::quiet_NaN();  ///< along the beam, m (NaN for modal data)
   std::vector<ModeAtSite> modes;       ///< in the order of options.targets
   double objective = 0.0;              ///< the maximised value (a damping ratio)
+  static const base::Fields<PlacementPoint>& fields();
 };
 
 struct PlacementResult {

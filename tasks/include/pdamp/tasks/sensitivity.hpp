@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/surrogate/sweep.hpp"
 #include "pdamp/base/executor.hpp"
@@ -58,6 +59,7 @@ struct SensitivityRow {
   double closed_form_eta_star = 0.0;
   std::string closed_form_regime;
   double clearance_m = 0.0, bed_mass_kg = 0.0, intensity = 0.0;
+  static const base::Fields<SensitivityRow>& fields();
 };
 
 struct SensitivityResult {
@@ -79,6 +81,7 @@ struct TornadoBar {
   double value_at_low = 0.0, value_at_high = 0.0;
   double stderr_at_low = 0.0, stderr_at_high = 0.0;
   double effect = 0.0;                          ///< max |η* − η*_baseline| over the values
+  static const base::Fields<TornadoBar>& fields();
 };
 struct Tornado {
   std::vector<TornadoBar> bars;                 ///< with an effect, smallest first (drawn bottom up)
