@@ -188,7 +188,8 @@ int run_damper_design(const ParsedArgs& args, CommandContext& context, const Cas
                                                std::string(fm::to_string(design.operating_point->loss.regime)) + ")"});
   if (design.sizing) rows.push_back({"clearance for target", format_number(design.sizing->clearance_m)});
   if (design.buffer) rows.push_back({"buffer layer_thickness_m", format_number(design.buffer->layer_thickness_m)});
-  return finish(args, files.get(), result, warnings, rows, {"design.json", &c, context.report, "outputs", true, true});
+  return finish(args, files.get(), result, warnings, rows,
+                {"design.json", &c, context.report, "outputs", true, true}, &design);
 }
 
 int run_run(const ParsedArgs& args, CommandContext& context) {

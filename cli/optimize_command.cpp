@@ -167,7 +167,7 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
     rows.push_back({"design loop round " + std::to_string(round.round), line});
   }
   if (result.rounds.size() > 1) rows.push_back({"design loop", std::string(tasks::to_string(*result.loop_outcome))});
-  const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report});
+  const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report}, &result);
   remove_checkpoints(result.checkpoints);
   return code;
 }
@@ -215,7 +215,7 @@ int run_placement_case(const ParsedArgs& args, CommandContext& context, const Ca
   }
   rows.push_back({"solver", r.refined ? r.summary.brief_report() : std::string("every candidate point evaluated")});
   rows.push_back({"time", format_number(r.solve_time_s, 4) + " s, " + std::to_string(r.evaluations) + " sites"});
-  return finish(args, files.get(), out, warnings, rows, {"placement.json", &c, context.report});
+  return finish(args, files.get(), out, warnings, rows, {"placement.json", &c, context.report}, &study);
 }
 
 }  // namespace

@@ -60,14 +60,14 @@ void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints) {
 }
 
 int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& result,
-           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how) {
+           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how, const report::TaskResult& typed) {
   if (how.refuse_non_finite) tasks::require_finite(result);
   nlohmann::json paths = nlohmann::json::array();
   if (files) {
     result["warnings"] = warnings;
     if (how.resolved) files->add_json("case_resolved.json", how.resolved->resolved);
     if (!how.json_name.empty()) files->add_json(how.json_name, result);
-    if (how.report && how.resolved) report::stage_report(*files, *how.resolved, result, warnings, provenance_line());
+    if (how.report && how.resolved) report::stage_report(*files, *how.resolved, typed, result, warnings, provenance_line());
     paths = files->commit();
   }
   result["warnings"] = warnings;

@@ -13,6 +13,7 @@
 #include "args.hpp"
 #include "commands.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/report/html_report.hpp"
 #include "pdamp/report/output_dir.hpp"
 #include "pdamp/tasks/output_folder.hpp"
 
@@ -52,9 +53,11 @@ struct ResultFiles {
 };
 
 /// The end of a command: with `files`, result["warnings"], the result JSON, the resolved
-/// case and the report staged and all committed; the warnings on stderr; the result on
-/// stdout with --json, else `rows` and a "wrote" row per file. Returns the exit code.
+/// case and the report (answering from `typed`) staged and all committed; the warnings on
+/// stderr; the result on stdout with --json, else `rows` and a "wrote" row per file.
+/// Returns the exit code.
 int finish(const ParsedArgs& args, report::OutputDir* files, nlohmann::json& result,
-           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how);
+           const std::vector<std::string>& warnings, Rows rows, const ResultFiles& how,
+           const report::TaskResult& typed = {});
 
 }  // namespace pdamp::cli

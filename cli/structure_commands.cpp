@@ -45,16 +45,16 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
     for (auto& w : report::write_files(*files, modes)) warnings.push_back(w);
   json result = tasks::to_json(modes, output_folder(files.get()));
   Rows rows = {{"case", c.name}, {"method", std::string(case_file::to_string(options.method))}};
-  for (const auto& mode : result["modes"]) {
-    std::string row = format_number(mode["frequency_hz"].get<double>(), 6) + " Hz (bare " +
-                      format_number(mode["bare_frequency_hz"].get<double>(), 6) + " Hz), mu = " +
-                      format_number(mode["modal_mass_ratio"].get<double>(), 4);
-    if (!mode["backbone"].is_null())
-      row += ", zeta_add max " + format_number(mode["backbone"]["max_added_damping_ratio"].get<double>(), 4) + " at X = " +
-             format_number(mode["backbone"]["max_added_damping_amplitude_m"].get<double>(), 4) + " m";
-    rows.push_back({"mode " + std::to_string(mode["mode"].get<int>()), row});
+  for (Eigen::Index j = 0; j < modes.mode_count; ++j) {
+    std::string row = format_number(modes.frequencies_with_containers_hz[j], 6) + " Hz (bare " +
+                      format_number(modes.modal.natural_frequencies_hz[j], 6) + " Hz), mu = " +
+                      format_number(modes.modal_mass_ratio(j), 4);
+    if (const auto backbone = tasks::backbone_summary(modes, j))
+      row += ", zeta_add max " + format_number(backbone->max_added_damping_ratio, 4) + " at X = " +
+             format_number(backbone->max_added_damping_amplitude_m, 4) + " m";
+    rows.push_back({"mode " + std::to_string(j + 1), row});
   }
-  return finish(args, files.get(), result, warnings, rows, {"modes.json", &c, context.report});
+  return finish(args, files.get(), result, warnings, rows, {"modes.json", &c, context.report}, &modes);
 }
 
 // ---------------------------------------------------------------- frf
@@ -162,27 +162,27 @@ Rows linear_rows(const tasks::LinearSweepFrf& l) {
   return rows;
 }
 
-Rows compare_rows(const json& compare, const tasks::FrfResult& r) {
+Rows compare_rows(const tasks::FrfResult& r) {
   Rows rows = {{"method", "compare (formulas, field, dem)"}};
-  const auto row = [&](const std::string& name, const json& a) {
-    if (a.is_null()) {
+  const auto row = [&](const std::string& name, const std::optional<tasks::PeakAgreement>& a) {
+    if (!a) {
       rows.push_back({name, "-"});
       return;
     }
-    const auto percent = [](const json& v) { return v.is_null() ? std::string("-") : format_number(100.0 * v.get<double>(), 3); };
-    const auto zeta = [](const json& v) { return v.is_null() ? std::string("-") : format_number(v.get<double>(), 3); };
-    rows.push_back({name, format_number(a["frequency_hz"].get<double>(), 5) + " Hz, |out| = " +
-                              format_number(a["magnitude"].get<double>(), 4) + " (vs dem: f " +
-                              percent(a["frequency_relative_difference"]) + "%, 0.9 band centre " +
-                              percent(a["band_centre_relative_difference"]) + "%, |out| " +
-                              percent(a["magnitude_relative_difference"]) + "%; zeta " + zeta(a["damping_ratio"]) + " vs " +
-                              zeta(a["dem_damping_ratio"]) + ")"});
+    const auto percent = [](double v) { return std::isfinite(v) ? format_number(100.0 * v, 3) : std::string("-"); };
+    const auto zeta = [](double v) { return std::isfinite(v) ? format_number(v, 3) : std::string("-"); };
+    rows.push_back({name, format_number(a->frequency_hz, 5) + " Hz, |out| = " + format_number(a->magnitude, 4) +
+                              " (vs dem: f " + percent(a->frequency_relative_difference) + "%, 0.9 band centre " +
+                              percent(a->band_centre_relative_difference) + "%, |out| " +
+                              percent(a->magnitude_relative_difference) + "%; zeta " + zeta(a->damping_ratio) + " vs " +
+                              zeta(a->dem_damping_ratio) + ")"});
   };
   for (std::size_t k = 0; k < r.stepped->branches.size(); ++k) {
     const auto& branch = r.stepped->branches[k];
-    rows.push_back({"peak dem " + std::string(st::to_string(branch.sweep)), dem_peak_row(st::stepped_sine_peak(branch), branch.points.size())});
-    row("peak formulas vs " + std::string(st::to_string(branch.sweep)), compare["agreement"][k]["formulas"]);
-    row("peak field vs " + std::string(st::to_string(branch.sweep)), compare["agreement"][k]["field"]);
+    const std::string sweep(st::to_string(branch.sweep));
+    rows.push_back({"peak dem " + sweep, dem_peak_row(st::stepped_sine_peak(branch), branch.points.size())});
+    row("peak formulas vs " + sweep, r.agreement[k].formulas);
+    row("peak field vs " + sweep, r.agreement[k].field);
   }
   return rows;
 }
@@ -219,11 +219,11 @@ int run_frf_case(const ParsedArgs& args, CommandContext& context, const Case& c)
     case tasks::FrfMethod::kFormulas:
     case tasks::FrfMethod::kField: rows = harmonic_rows(*result.harmonic); break;
     case tasks::FrfMethod::kDem: rows = result.linear ? linear_rows(*result.linear) : stepped_rows(*result.stepped); break;
-    case tasks::FrfMethod::kCompare: rows = compare_rows(out["compare"], result); break;
+    case tasks::FrfMethod::kCompare: rows = compare_rows(result); break;
   }
   rows.insert(rows.begin(), {"case", c.name});
   if (out.contains("frf")) out["frf"]["warnings"] = warnings;
-  return finish(args, files.get(), out, warnings, rows, {"frf.json", &c, context.report});
+  return finish(args, files.get(), out, warnings, rows, {"frf.json", &c, context.report}, &result);
 }
 
 // ---------------------------------------------------------------- decay
@@ -252,27 +252,26 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
     for (auto& w : report::write_files(*files, result)) warnings.push_back(w);
   json out = tasks::to_json(result, output_folder(files.get()));
   out["decay"]["warnings"] = warnings;
-  const auto& d = out["decay"];
-  const bool settled = d["outcome"] == "settled";
+  const tasks::DecaySummary d = tasks::decay_summary(result);
   Rows rows = {{"case", c.name},
-               {"method", d["method"].get<std::string>()},
-               {"outcome", d["outcome"].get<std::string>()},
-               {"settling_time_s", settled ? format_number(d["settling_time_s"].get<double>(), 6) : "not settled"},
-               {"damping_ratio", d["damping_ratio"].is_number() ? format_number(d["damping_ratio"].get<double>(), 4) : "-"},
-               {"dominant mode", std::to_string(d["dominant_mode"].get<int>())},
-               {"threshold_m", format_number(d["threshold_m"].get<double>(), 4)}};
+               {"method", d.method},
+               {"outcome", d.settled ? "settled" : "not_settled"},
+               {"settling_time_s", d.settled ? format_number(d.settling_time_s, 6) : "not settled"},
+               {"damping_ratio", std::isfinite(d.damping_ratio) ? format_number(d.damping_ratio, 4) : "-"},
+               {"dominant mode", std::to_string(d.dominant_mode)},
+               {"threshold_m", format_number(d.threshold_m, 4)}};
   if (options.method == tasks::DecayMethod::kDem) {
     const auto& r = result.dem.cosimulation;
     rows.push_back({"energy_error", format_number(r.energy.relative_error, 3)});
     rows.push_back({"DEM steps", std::to_string(r.steps) + " of " + format_number(r.time_step_s, 3) + " s in " +
                                      format_number(r.wall_time_s, 3) + " s"});
   } else {
-    for (const auto& l : d["layers"])
+    for (const auto& l : out["decay"]["layers"])
       rows.push_back({"dissipated by " + l["name"].get<std::string>(),
                       format_number(l["dissipated_energy_j"].get<double>(), 4) + " J (" +
                           format_number(100.0 * l["share"].get<double>(), 3) + "%)"});
   }
-  const int code = finish(args, files.get(), out, warnings, rows, {"decay.json", &c, context.report});
+  const int code = finish(args, files.get(), out, warnings, rows, {"decay.json", &c, context.report}, &result);
   remove_checkpoints({options.checkpoint.file.path});
   return code;
 }

@@ -1,4 +1,5 @@
-// DIR/report.html of pdamp run: a page built from the result JSON and the staged pictures.
+// DIR/report.html of pdamp run: a page built from the typed result (the answer and its
+// evidence), the result JSON (every number) and the staged pictures.
 // The CLI only formats here: numbers come from the result, pictures from gnuplot.
 #include "pdamp/report/html_report.hpp"
 
@@ -66,8 +67,10 @@ void flatten(const json& object, const std::string& prefix, int depth, std::vect
   for (const auto& [key, value] : object.items()) {
     if (rows.size() >= kMaxGenericRows || skipped_key(key)) continue;
     const std::string name = prefix.empty() ? key : prefix + " / " + key;
-    if (value.is_number() && ends_with(key, "_m")) rows.push_back({name.substr(0, name.size() - 2) + " (mm)", in_mm(value)});
-    else if (value.is_number() && ends_with(key, "_kg")) rows.push_back({name.substr(0, name.size() - 3) + " (g)", in_g(value)});
+    if (value.is_number() && ends_with(key, "_m"))
+      rows.push_back({name.substr(0, name.size() - 2) + " (mm)", in_mm(value.get<double>())});
+    else if (value.is_number() && ends_with(key, "_kg"))
+      rows.push_back({name.substr(0, name.size() - 3) + " (g)", in_g(value.get<double>())});
     else if (is_scalar(value)) rows.push_back({name, scalar_text(value)});
     else if (is_short_number_list(value)) rows.push_back({name, list_text(value)});
     else if (value.is_object() && depth < 1) flatten(value, name, depth + 1, rows);
@@ -119,31 +122,38 @@ std::string array_tables(const json& result) {
   return out.str();
 }
 
-std::string mm(const json& v) { return v.is_number() ? three_digits(v.get<double>() * 1e3) : "–"; }
-std::string seconds(const json& v) { return v.is_number() ? three_digits(v.get<double>()) : "not settled"; }
+std::string mm(double v) { return three_digits(v * 1e3); }
+std::string seconds(double v) { return std::isfinite(v) ? three_digits(v) : "not settled"; }
+std::string slab_list(const std::vector<double>& slabs) {
+  std::string out;
+  for (const double n : slabs) out += (out.empty() ? "" : ", ") + three_digits(n);
+  return out;
+}
+std::string difference_text(double relative, const std::string& prefix = "") {
+  return std::isfinite(relative) ? prefix + format_number(100.0 * relative, 3) + " %" : "only one settled";
+}
 
 /// filling_ratios: the designs side by side.
-std::string designs_section(json& result) {
-  if (!result.contains("designs") || !result["designs"].is_object()) return "";
+std::string designs_section(const tasks::FillingRatiosResult& result) {
+  const auto& r = result.optimum;
+  const std::pair<const char*, const optimizer::FillingDesign*> designs[] = {
+      {"chosen", &r.chosen}, {"baseline", &r.baseline}, {"bare", &r.bare},
+      {"same_mass", &r.same_mass}, {"initial", &r.initial}, {"relaxed", &r.relaxed}};
   std::vector<std::vector<std::string>> rows;
-  for (const char* name : {"chosen", "baseline", "bare", "same_mass", "initial", "relaxed"}) {
-    if (!result["designs"].contains(name)) continue;
-    json& d = result["designs"][name];
-    std::string slabs, clearances;
-    for (auto& l : d["layers"]) {
-      slabs += (slabs.empty() ? "" : ", ") + scalar_text(l["slabs"]);
-      clearances += (clearances.empty() ? "" : ", ") + mm(l["clearance_m"]);
-    }
-    rows.push_back({name, slabs, clearances, in_g(d["total_mass_kg"]), seconds(d["settling_time_s"]),
-                    scalar_text(d["objective"])});
+  for (const auto& [name, d] : designs) {
+    std::string clearances;
+    for (const auto& l : d->layers) clearances += (clearances.empty() ? "" : ", ") + mm(l.clearance_m);
+    rows.push_back({name, slab_list(d->slabs()), clearances, in_g(d->total_mass_kg), seconds(d->settling_time_s),
+                    three_digits(d->objective)});
   }
   std::string layers;
-  for (auto& l : result["designs"]["chosen"]["layers"]) layers += (layers.empty() ? "" : ", ") + scalar_text(l["name"]);
+  for (const auto& l : r.chosen.layers) layers += (layers.empty() ? "" : ", ") + l.name;
   return "<h3>Designs</h3>\n<p>Layers: " + html_escape(layers) + " (whole slabs n, clearance h = L − n·2r).</p>\n" +
          table({"design", "slabs n", "clearance h / mm", "particle mass", "settling time / s", "objective"}, rows);
 }
 
-std::string solver_section(json& result) {
+/// The optimiser's numbers (the result JSON's solver block) and the rounding rule.
+std::string solver_section(const json& result) {
   if (!result.contains("solver") || !result["solver"].is_object()) return "";
   std::vector<std::pair<std::string, std::string>> rows;
   flatten(result["solver"], "", 1, rows);
@@ -155,97 +165,66 @@ std::string solver_section(json& result) {
   return "<h3>Optimiser</h3>\n" + table({"", ""}, cells);
 }
 
-std::string verification_section(json& result) {
-  if (!result.contains("verification") || !result["verification"].is_object()) return "";
-  json& v = result["verification"];
-  const bool settling = v.value("objective", std::string()) == "settling_time";
+std::string verification_section(const tasks::Verification& v) {
+  const bool settling = v.settling_objective;
+  const auto objective = [&](double settling_time_s, double value) {
+    return settling ? seconds(settling_time_s) : three_digits(value);
+  };
   std::vector<std::vector<std::string>> rows;
-  for (const char* name : {"chosen", "baseline"}) {
-    if (!v["designs"].contains(name)) continue;
-    json& d = v["designs"][name];
-    const auto objective = [&](json& side) {
-      return settling ? seconds(side["settling_time_s"]) : scalar_text(side["objective"]);
-    };
-    rows.push_back({name, objective(d["predicted"]), objective(d["dem"]), mm(d["predicted"]["end_envelope_m"]),
-                    mm(d["dem"]["end_envelope_m"]), scalar_text(d["dem"]["energy_error"]),
-                    d["relative_difference"].is_number() ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
-                                                         : "only one settled",
-                    d["passed"].get<bool>() ? "pass" : "FAIL"});
-    if (d.contains("softening_check")) {
-      json& s = d["softening_check"];
-      rows.push_back({std::string(name) + ", check at softening " + scalar_text(s["stiffness_softening"]), "",
-                      objective(s["dem"]), "", mm(s["dem"]["end_envelope_m"]), scalar_text(s["dem"]["energy_error"]),
-                      s["relative_difference"].is_number()
-                          ? "judged run " + format_number(100.0 * s["relative_difference"].get<double>(), 3) + " %"
-                          : "only one settled",
-                      s["converged"].get<bool>() ? "converged" : "NOT CONVERGED"});
-    }
+  for (const auto& d : v.designs) {
+    rows.push_back({d.name, objective(d.predicted.settling_time_s, d.predicted_objective),
+                    objective(d.dem.settling.settling_time_s, d.dem.objective), mm(d.predicted_end_envelope_m),
+                    mm(d.dem.end_envelope_m), three_digits(d.dem.energy_error), difference_text(d.agreement.relative_difference),
+                    d.passed ? "pass" : "FAIL"});
+    if (const auto& s = d.softening_check)
+      rows.push_back({d.name + ", check at softening " + three_digits(s->stiffness_softening), "",
+                      objective(s->dem.settling.settling_time_s, s->dem.objective), "", mm(s->dem.end_envelope_m),
+                      three_digits(s->dem.energy_error), difference_text(s->agreement.relative_difference, "judged run "),
+                      s->agreement.within ? "converged" : "NOT CONVERGED"});
   }
   const std::string unit = settling ? "settling time / s" : "½∫e² dt / m² s";
   std::ostringstream out;
-  out << "<h3>DEM verification</h3>\n<p>" << html_escape(scalar_text(v["what"])) << ". Simulated "
-      << html_escape(scalar_text(v["duration_s"])) << " s each, stiffness softening "
-      << html_escape(scalar_text(v["effective_stiffness_softening"])) << ", tolerance "
-      << html_escape(format_number(100.0 * v["tolerance_relative"].get<double>(), 3)) << " %.</p>\n"
+  out << "<h3>DEM verification</h3>\n<p>" << html_escape(tasks::Verification::kWhat)
+      << ". Simulated " << three_digits(v.spec.duration_s) << " s each, stiffness softening "
+      << three_digits(v.dem_stiffness_softening * v.spec.stiffness_softening) << ", tolerance "
+      << format_number(100.0 * v.spec.tolerance_relative, 3) << " %.</p>\n"
       << table({"design", "predicted " + unit, "DEM " + unit, "predicted envelope at end / mm", "DEM envelope at end / mm",
                 "DEM energy error", "DEM − predicted", "result"},
                rows);
-  json& r = v["ranking"];
   out << "<p>Ranking (chosen design ahead of the best single layer): predicted "
-      << (r["predicted_chosen_ahead"].get<bool>() ? "yes" : "no") << ", DEM "
-      << (r["dem_chosen_ahead"].get<bool>() ? "yes" : "no") << ": " << (r["passed"].get<bool>() ? "pass" : "FAIL")
-      << ".</p>\n<p class=\"verdict " << (v["passed"].get<bool>() ? "pass" : "fail") << "\">Verification: "
-      << (v["passed"].get<bool>() ? "PASS" : "FAIL") << "</p>\n";
+      << (v.predicted_chosen_ahead ? "yes" : "no") << ", DEM " << (v.dem_chosen_ahead ? "yes" : "no") << ": "
+      << (v.ranking_passed ? "pass" : "FAIL") << ".</p>\n<p class=\"verdict " << (v.passed ? "pass" : "fail")
+      << "\">Verification: " << (v.passed ? "PASS" : "FAIL") << "</p>\n";
   return out.str();
 }
 
 /// filling_ratios on calibrated beds: the beds, and the rounds of the design loop.
-std::string calibration_section(json& result) {
+std::string calibration_section(const tasks::FillingRatiosResult& result) {
   std::ostringstream out;
-  if (result.contains("calibration") && result["calibration"].is_object()) {
-    json& c = result["calibration"];
+  if (const auto& c = result.calibration) {
     std::vector<std::vector<std::string>> rows;
-    for (auto& b : c["beds"])
-      rows.push_back({html_escape(scalar_text(b["layer"])), scalar_text(b["slabs"]), scalar_text(b["extra_damping_ratio"]),
-                      scalar_text(b["periods"]), mm(b["stroke_min_m"]) + " – " + mm(b["stroke_max_m"]),
-                      b["cached"].get<bool>() ? "cache" : "run now (" + seconds(b["wall_time_s"]) + " s)"});
-    out << "<h3>Calibrated beds</h3>\n<p>" << html_escape(scalar_text(c["what"])) << ": "
-        << html_escape(scalar_text(c["duration_s"])) << " s each, stiffness softening "
-        << html_escape(scalar_text(c["stiffness_softening"])) << "; " << html_escape(scalar_text(c["runs"]))
-        << " DEM decays run now, the others from " << html_escape(scalar_text(c["cache_dir"])) << ".</p>\n"
+    for (const auto& b : c->beds)
+      rows.push_back({html_escape(b.layer), std::to_string(b.slabs), three_digits(b.extra_damping_ratio),
+                      std::to_string(b.periods.size()), mm(b.stroke_min_m()) + " – " + mm(b.stroke_max_m()),
+                      b.cached ? "cache" : "run now (" + seconds(b.wall_time_s) + " s)"});
+    out << "<h3>Calibrated beds</h3>\n<p>"
+        << html_escape(tasks::BedCalibration::kWhat) << ": "
+        << three_digits(c->spec.duration_s) << " s each, stiffness softening " << three_digits(c->spec.stiffness_softening)
+        << "; " << c->runs << " DEM decays run now, the others from " << html_escape(c->cache_dir.string()) << ".</p>\n"
         << table({"layer", "slabs", "extra damping ratio", "periods", "strokes / mm", "source"}, rows);
   }
-  if (result.contains("design_loop") && result["design_loop"].is_object()) {
-    json& loop = result["design_loop"];
+  if (result.loop_outcome) {
     std::vector<std::vector<std::string>> rows;
-    for (auto& r : loop["rounds"]) {
-      for (const char* name : {"chosen", "baseline"}) {
-        if (!r["designs"].contains(name)) continue;
-        json& d = r["designs"][name];
-        std::string slabs;
-        for (auto& n : d["slabs"]) slabs += (slabs.empty() ? "" : ", ") + scalar_text(n);
-        rows.push_back({scalar_text(r["round"]), name, slabs, seconds(d["predicted_objective"]), seconds(d["dem_objective"]),
-                        d["relative_difference"].is_number()
-                            ? format_number(100.0 * d["relative_difference"].get<double>(), 3) + " %"
-                            : "only one settled",
-                        d["passed"].get<bool>() ? "pass" : "FAIL",
-                        std::string(name) == "chosen" ? std::to_string(r["recalibrated"].size()) : ""});
-      }
-    }
-    out << "<h3>Design loop</h3>\n<p>Outcome: " << html_escape(scalar_text(loop["outcome"])) << ".</p>\n"
+    for (const auto& r : result.rounds)
+      for (const auto& d : r.designs)
+        rows.push_back({std::to_string(r.round), d.name, slab_list(d.slabs), seconds(d.predicted_objective),
+                        seconds(d.dem_objective), difference_text(d.relative_difference), d.passed ? "pass" : "FAIL",
+                        d.name == "chosen" ? std::to_string(r.recalibrated.size()) : ""});
+    out << "<h3>Design loop</h3>\n<p>Outcome: " << tasks::to_string(*result.loop_outcome) << ".</p>\n"
         << table({"round", "design", "slabs", "predicted", "DEM", "DEM − predicted", "result", "beds recalibrated after"},
                  rows);
   }
   return out.str();
-}
-
-/// A section, or a note where the result lacks what it needs (an older or partial result).
-std::string guarded(std::string (*section)(json&), json& result) {
-  try {
-    return section(result);
-  } catch (const json::exception&) {
-    return "<p class=\"note\">(A section is left out: the result lacks some of its numbers.)</p>\n";
-  }
 }
 
 /// What a picture shows, by its file name.
@@ -330,10 +309,9 @@ std::string base64(std::string_view bytes) {
 }
 
 std::string report_html(const ReportInput& in) {
-  // A copy the sections may read with operator[]: a key missing from an incomplete result
-  // reads as null there, and a section that cannot be drawn says so (guarded below).
-  json r = in.result;
+  const json& r = in.result;
   const std::string task = r.is_object() && r.contains("task") ? scalar_text(r["task"]) : "";
+  const auto* design = std::get_if<const tasks::FillingRatiosResult*>(&in.typed);
   std::ostringstream out;
   out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       // No script and no fetch may run, whatever a text contains: pictures are data: URIs.
@@ -350,7 +328,8 @@ std::string report_html(const ReportInput& in) {
       << ". Lengths in mm, masses in g, times in s; three significant digits (every digit in the result JSON).</p>\n";
 
   // 1. The answer: the design and what it gains, then the verdict of the check behind it.
-  const Answer answer = r.is_object() ? report_answer(r, in.case_resolved) : Answer{};
+  static const case_file::Case kNoCase;
+  const Answer answer = report_answer(in.typed, in.case_read ? *in.case_read : kNoCase);
   out << "<section class=\"answer\">\n<h2>Answer</h2>\n";
   if (answer.paragraphs.empty()) out << "<p>The result's numbers are under Details below.</p>\n";
   for (const auto& paragraph : answer.paragraphs) out << "<p>" << html_escape(paragraph) << "</p>\n";
@@ -375,7 +354,8 @@ std::string report_html(const ReportInput& in) {
         << ";base64," << base64(p.bytes) << "\">\n<figcaption>" << html_escape(caption(p.file_name)) << " ("
         << html_escape(p.file_name) << ")</figcaption>\n</figure>\n";
   }
-  if (r.is_object()) out << guarded(verification_section, r) << guarded(calibration_section, r);
+  if (design && (*design)->verification) out << verification_section(*(*design)->verification);
+  if (design) out << calibration_section(**design);
   out << "<h3>Warnings</h3>\n";
   if (in.warnings.empty()) out << "<p>None.</p>\n";
   else {
@@ -391,7 +371,8 @@ std::string report_html(const ReportInput& in) {
   if (r.is_object()) flatten(r, "", 0, rows);
   std::vector<std::vector<std::string>> cells;
   for (const auto& [k, v] : rows) cells.push_back({k, v});
-  if (r.is_object()) out << guarded(designs_section, r) << guarded(solver_section, r);
+  if (design) out << designs_section(**design);
+  if (r.is_object()) out << solver_section(r);
   out << "<h3>Numbers</h3>\n" << table({"quantity", "value"}, cells);
   if (r.is_object()) out << array_tables(r);
   out << "<h3>Provenance</h3>\n<p class=\"note\">" << html_escape(in.provenance.empty() ? "pdamp" : in.provenance)
@@ -400,15 +381,16 @@ std::string report_html(const ReportInput& in) {
   return out.str();
 }
 
-void stage_report(OutputDir& files, const case_file::Case& c, const json& result, const std::vector<std::string>& warnings,
-                  const std::string& provenance) {
+void stage_report(OutputDir& files, const case_file::Case& c, const TaskResult& typed, const json& result,
+                  const std::vector<std::string>& warnings, const std::string& provenance) {
   const fs::path page = files.staged_path("report.html");
   ReportInput in;
   in.case_name = c.name;
   in.case_description = c.description;
   in.case_file = c.path;
-  in.case_resolved = c.resolved;
+  in.case_read = &c;
   in.provenance = provenance;
+  in.typed = typed;
   in.result = result;
   in.warnings = warnings;
   in.pictures = staged_pictures(page.parent_path());

@@ -1,5 +1,5 @@
 // The report's first paragraph: the answer to the question the case asks, in the units a
-// damper is built with (g, mm, s), from the result JSON and the resolved case alone.
+// damper is built with (g, mm, s), from the typed result and the case.
 #include "report_answer.hpp"
 
 #include <cmath>
@@ -13,44 +13,28 @@ namespace pdamp::report {
 
 namespace {
 
-using nlohmann::json;
 using base::format_number;
+namespace opt = optimizer;
 
-/// The value at `path` ("a/b/0/c") or null: a missing key is "not known", never an error.
-const json& at(const json& object, std::initializer_list<const char*> path) {
-  static const json kNull;
-  const json* node = &object;
-  for (const char* key : path) {
-    if (node->is_object() && node->contains(key)) node = &(*node)[key];
-    else if (node->is_array() && std::string(key).find_first_not_of("0123456789") == std::string::npos &&
-             std::stoul(key) < node->size())
-      node = &(*node)[std::stoul(key)];
-    else return kNull;
-  }
-  return *node;
-}
-
-bool number(const json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
+bool number(double v) { return std::isfinite(v); }
 
 }  // namespace
 
 std::string three_digits(double value) { return std::isfinite(value) ? format_number(value, 3) : "–"; }
-std::string in_mm(const json& metres) { return number(metres) ? three_digits(metres.get<double>() * 1e3) + " mm" : "–"; }
-std::string in_g(const json& kilograms) { return number(kilograms) ? three_digits(kilograms.get<double>() * 1e3) + " g" : "–"; }
+std::string in_mm(double metres) { return number(metres) ? three_digits(metres * 1e3) + " mm" : "–"; }
+std::string in_g(double kilograms) { return number(kilograms) ? three_digits(kilograms * 1e3) + " g" : "–"; }
 
 namespace {
 
-std::string in_s(const json& seconds) { return number(seconds) ? three_digits(seconds.get<double>()) + " s" : "–"; }
-std::string plain(const json& v) { return number(v) ? three_digits(v.get<double>()) : v.is_string() ? v.get<std::string>() : "–"; }
+std::string in_s(double seconds) { return number(seconds) ? three_digits(seconds) + " s" : "–"; }
 /// A name as words: "sub_peak" -> "sub peak".
-std::string words(const json& v) {
-  std::string text = plain(v);
+std::string words(std::string_view name) {
+  std::string text(name);
   for (char& ch : text)
     if (ch == '_') ch = ' ';
   return text;
 }
 std::string percent(double fraction) { return three_digits(100.0 * fraction) + " %"; }
-std::string percent_of(const json& fraction) { return number(fraction) ? percent(fraction.get<double>()) : "–"; }
 
 /// "X times faster" of a settling time t against a reference t_ref (both finite).
 std::string times_faster(double t, double t_ref) {
@@ -60,14 +44,14 @@ std::string times_faster(double t, double t_ref) {
 }
 
 /// One design's layers: "1 slab (16 spheres, 16.4 g) in wide (clearance 60.0 mm)".
-std::string layers_text(const json& design, bool skip_empty) {
+std::string layers_text(const opt::FillingDesign& design, bool skip_empty) {
   std::vector<std::string> parts;
-  for (const auto& l : at(design, {"layers"})) {
-    const double slabs = number(at(l, {"slabs"})) ? at(l, {"slabs"}).get<double>() : 0.0;
+  for (const auto& l : design.layers) {
+    const double slabs = number(l.slabs) ? l.slabs : 0.0;
     if (skip_empty && slabs == 0.0) continue;
     std::ostringstream part;
-    part << three_digits(slabs) << (slabs == 1.0 ? " slab" : " slabs") << " (" << plain(at(l, {"particles"})) << " spheres, "
-         << in_g(at(l, {"bed_mass_kg"})) << ") in " << plain(at(l, {"name"})) << " (clearance " << in_mm(at(l, {"clearance_m"})) << ")";
+    part << three_digits(slabs) << (slabs == 1.0 ? " slab" : " slabs") << " (" << three_digits(l.particles) << " spheres, "
+         << in_g(l.bed_mass_kg) << ") in " << l.name << " (clearance " << in_mm(l.clearance_m) << ")";
     parts.push_back(part.str());
   }
   std::string out;
@@ -76,201 +60,208 @@ std::string layers_text(const json& design, bool skip_empty) {
 }
 
 /// "settles in 9.59 s" or "does not settle within 20.0 s".
-std::string settling_text(const json& time_s, const json& duration_s) {
+std::string settling_text(double time_s, double duration_s) {
   return number(time_s) ? "settles in " + in_s(time_s) : "does not settle within " + in_s(duration_s);
 }
 
-Answer filling_ratios_answer(const json& r, const json& c) {
+const tasks::DesignCheck* check_named(const tasks::Verification& v, std::string_view name) {
+  for (const auto& d : v.designs)
+    if (d.name == name) return &d;
+  return nullptr;
+}
+
+Answer filling_ratios_answer(const tasks::FillingRatiosResult& r, const case_file::Case& c) {
   Answer a;
-  const json& chosen = at(r, {"designs", "chosen"});
-  const json& baseline = at(r, {"designs", "baseline"});
-  const json& bare = at(r, {"designs", "bare"});
-  const json& task = at(c, {"task"});
-  const bool settling = at(r, {"objective", "kind"}) == "settling_time";
-  const json& duration = at(task, {"duration_s"});
+  const opt::FillingDesign& chosen = r.optimum.chosen;
+  const opt::FillingDesign& baseline = r.optimum.baseline;
+  const opt::FillingDesign& bare = r.optimum.bare;
+  const auto& task = c.task.filling_ratios;
+  const double duration = task ? task->decay.duration_s : NAN;
+  const bool settling = r.problem.options.objective == opt::FillingObjective::kSettlingTime;
   std::ostringstream p;
-  p << "Fill " << layers_text(chosen, true) << ": " << in_g(at(chosen, {"total_mass_kg"})) << " of particles";
-  if (number(at(r, {"mass_budget_kg"}))) p << " of the " << in_g(at(r, {"mass_budget_kg"})) << " allowed";
+  p << "Fill " << layers_text(chosen, true) << ": " << in_g(chosen.total_mass_kg) << " of particles";
+  if (number(r.mass_budget_kg)) p << " of the " << in_g(r.mass_budget_kg) << " allowed";
   p << ". ";
-  const json& v = at(r, {"verification"});
+  const tasks::Verification* v = r.verification ? &*r.verification : nullptr;
   if (settling) {
-    const std::string threshold = number(at(task, {"settling_threshold"}))
-                                      ? percent(at(task, {"settling_threshold"}).get<double>()) + " of its initial envelope"
-                                      : "its threshold";
+    const std::string threshold =
+        task && number(task->decay.settling_threshold) ? percent(task->decay.settling_threshold) + " of its initial envelope"
+                                                       : "its threshold";
     p << "Released from the case's initial state, the structure is predicted to settle to " << threshold << " in "
-      << in_s(at(chosen, {"settling_time_s"})) << "; the best single layer (" << layers_text(baseline, true) << ") "
-      << settling_text(at(baseline, {"settling_time_s"}), duration) << " and without particles the structure "
-      << settling_text(at(bare, {"settling_time_s"}), duration) << ". ";
-    const json& dem_chosen = at(v, {"designs", "chosen", "dem", "settling_time_s"});
-    const json& dem_baseline = at(v, {"designs", "baseline", "dem", "settling_time_s"});
-    if (number(dem_chosen)) {
-      p << "The DEM in the loop settles the chosen design in " << in_s(dem_chosen);
-      if (number(dem_baseline))
-        p << ", " << times_faster(dem_chosen.get<double>(), dem_baseline.get<double>()) << " the best single layer ("
-          << in_s(dem_baseline) << ")";
-      else if (!v.is_null())
-        p << "; the best single layer does not settle within " << in_s(at(v, {"duration_s"}));
+      << in_s(chosen.settling_time_s) << "; the best single layer (" << layers_text(baseline, true) << ") "
+      << settling_text(baseline.settling_time_s, duration) << " and without particles the structure "
+      << settling_text(bare.settling_time_s, duration) << ". ";
+    const tasks::DesignCheck* dem_chosen = v ? check_named(*v, "chosen") : nullptr;
+    const tasks::DesignCheck* dem_baseline = v ? check_named(*v, "baseline") : nullptr;
+    const double chosen_s = dem_chosen ? dem_chosen->dem.settling.settling_time_s : NAN;
+    const double baseline_s = dem_baseline ? dem_baseline->dem.settling.settling_time_s : NAN;
+    if (number(chosen_s)) {
+      p << "The DEM in the loop settles the chosen design in " << in_s(chosen_s);
+      if (number(baseline_s))
+        p << ", " << times_faster(chosen_s, baseline_s) << " the best single layer (" << in_s(baseline_s) << ")";
+      else
+        p << "; the best single layer does not settle within " << in_s(v->spec.duration_s);
       p << ". ";
     }
   } else {
-    p << "Objective (" << plain(at(r, {"objective", "kind"})) << "): " << plain(at(chosen, {"objective"})) << " "
-      << plain(at(r, {"objective", "unit"})) << ", against " << plain(at(baseline, {"objective"}))
-      << " for the best single layer and " << plain(at(bare, {"objective"})) << " without particles. ";
+    const std::string unit = "m2_s";
+    p << "Objective (" << opt::to_string(r.problem.options.objective) << "): " << three_digits(chosen.objective) << " "
+      << unit << ", against " << three_digits(baseline.objective) << " for the best single layer and "
+      << three_digits(bare.objective) << " without particles. ";
   }
   a.paragraphs.push_back(p.str());
-  if (v.is_object()) {
-    const bool passed = at(v, {"passed"}) == true;
+  if (v) {
     std::ostringstream verdict;
-    verdict << "DEM check: " << (passed ? "PASS" : "FAIL") << ". ";
+    verdict << "DEM check: " << (v->passed ? "PASS" : "FAIL") << ". ";
     std::vector<std::string> failed;
     for (const char* name : {"chosen", "baseline"}) {
-      const json& d = at(v, {"designs", name});
-      if (d.is_null()) continue;
-      if (at(d, {"passed"}) != true) failed.push_back(std::string("the ") + (std::string(name) == "chosen" ? "chosen design" : "best single layer") + " differs from its prediction by more than " + percent_of(at(v, {"tolerance_relative"})));
-      if (at(d, {"softening_check", "converged"}) == false)
-        failed.push_back(std::string("the ") + name + " design's DEM result changes with stiffer contacts (the softening has not converged)");
+      const tasks::DesignCheck* d = check_named(*v, name);
+      if (!d) continue;
+      if (!d->passed)
+        failed.push_back(std::string("the ") + (std::string(name) == "chosen" ? "chosen design" : "best single layer") +
+                         " differs from its prediction by more than " + percent(v->spec.tolerance_relative));
+      if (d->softening_check && !d->softening_check->agreement.within)
+        failed.push_back(std::string("the ") + name +
+                         " design's DEM result changes with stiffer contacts (the softening has not converged)");
     }
-    if (at(v, {"ranking", "passed"}) == false) failed.push_back("the DEM does not rank the chosen design ahead of the best single layer");
-    if (passed)
-      verdict << "The DEM in the loop agrees with the prediction within the case's "
-              << percent_of(at(v, {"tolerance_relative"}))
+    if (!v->ranking_passed) failed.push_back("the DEM does not rank the chosen design ahead of the best single layer");
+    if (v->passed) {
+      const tasks::DesignCheck* d = check_named(*v, "chosen");
+      verdict << "The DEM in the loop agrees with the prediction within the case's " << percent(v->spec.tolerance_relative)
               << ", ranks the chosen design ahead of the best single layer"
-              << (at(v, {"designs", "chosen", "softening_check"}).is_object() ? ", and gives the same with stiffer contacts" : "")
+              << (d && d->softening_check ? ", and gives the same with stiffer contacts" : "")
               << ": the prediction can be trusted for this design.";
-    else {
+    } else {
       verdict << "Do not build on the prediction: ";
       for (std::size_t i = 0; i < failed.size(); ++i) verdict << (i ? "; " : "") << failed[i];
       verdict << ". The DEM's numbers above are the better estimate.";
     }
     a.verdict = verdict.str();
-    a.passed = passed;
+    a.passed = v->passed;
   } else {
     a.verdict = "Not checked by the DEM (run with the verification to check the prediction).";
   }
   return a;
 }
 
-Answer damper_design_answer(const json& r, const json& c) {
+Answer damper_design_answer(const tasks::DamperDesignResult& r, const case_file::Case& c) {
   Answer a;
-  const json& op = at(r, {"operating_point"});
-  const json& opt = at(r, {"optimum"});
-  const json& particles = at(c, {"damper", "particles"});
+  const case_file::LayerSpec* layer =
+      c.dampers.empty() || c.dampers.front().layers.empty() ? nullptr : &c.dampers.front().layers.front();
+  const auto& op = r.operating_point;
   std::ostringstream p;
-  p << "A bed of " << plain(at(particles, {"count"})) << " " << plain(at(particles, {"material"})) << " spheres of "
-    << in_mm(at(particles, {"radius_m"})) << " radius (" << in_g(at(r, {"bed_mass_kg"})) << ") with a clearance of "
-    << in_mm(at(r, {"clearance_m"})) << " along the drive";
-  if (number(at(r, {"sizing", "container_inner_length_along_drive_m"})))
-    p << " (container inner length " << in_mm(at(r, {"sizing", "container_inner_length_along_drive_m"})) << ")";
-  p << ", shaken at " << plain(at(c, {"excitation", "frequency_hz"})) << " Hz with a stroke of " << in_mm(at(op, {"amplitude_m"}))
-    << " (intensity Γ = " << plain(at(op, {"intensity"})) << "), has a reduced loss factor η* = " << plain(at(op, {"eta_star"}))
-    << ": it dissipates " << (number(at(op, {"e_diss_j"})) ? three_digits(at(op, {"e_diss_j"}).get<double>() * 1e3) : "–")
-    << " mJ per cycle (" << plain(at(op, {"model_used"})) << " collect-and-collide model, state " << words(at(op, {"regime"}))
-    << "). For this clearance the best stroke is " << in_mm(at(opt, {"x_opt_m"})) << " (η* = " << plain(at(opt, {"eta_star_at_design"}))
-    << ").";
+  p << "A bed of " << (layer ? three_digits(layer->particle_count) : "–") << " " << (layer ? layer->particle_material : "–")
+    << " spheres of " << in_mm(layer ? layer->particle_radius_m : NAN) << " radius (" << in_g(r.bed_mass_kg)
+    << ") with a clearance of " << in_mm(r.clearance_m) << " along the drive";
+  if (r.sizing && number(r.sizing->container_inner_length_along_drive_m))
+    p << " (container inner length " << in_mm(r.sizing->container_inner_length_along_drive_m) << ")";
+  p << ", shaken at " << three_digits(c.excitation.frequency_hz) << " Hz with a stroke of "
+    << in_mm(op ? r.operating_amplitude_m : NAN) << " (intensity Γ = " << three_digits(op ? op->loss.intensity : NAN)
+    << "), has a reduced loss factor η* = " << three_digits(op ? op->loss.eta_star : NAN) << ": it dissipates "
+    << (op && number(op->e_diss_j) ? three_digits(op->e_diss_j * 1e3) : "–") << " mJ per cycle ("
+    << (op ? std::string(formulas::to_string(op->loss.model_used)) : "–") << " collect-and-collide model, state "
+    << (op ? words(formulas::to_string(op->loss.regime)) : "–") << "). For this clearance the best stroke is "
+    << in_mm(r.optimum.x_opt_m) << " (η* = " << three_digits(r.eta_star_at_design) << ").";
   a.paragraphs.push_back(p.str());
-  if (at(r, {"buffer"}).is_object()) {
-    const json& b = at(r, {"buffer"});
-    a.paragraphs.push_back("Buffered walls: a " + plain(at(b, {"layer_material"})) + " layer " +
-                           in_mm(at(b, {"layer_thickness_m"})) + " thick keeps the strain at " +
-                           plain(at(b, {"allowable_strain"})) + " in an impact at " + plain(at(b, {"impact_velocity_m_s"})) +
-                           " m/s (peak force " + plain(at(b, {"max_force_n"})) + " N, contact " +
-                           (number(at(b, {"contact_time_s"})) ? three_digits(at(b, {"contact_time_s"}).get<double>() * 1e3) : "–") +
+  if (const auto& b = r.buffer) {
+    a.paragraphs.push_back("Buffered walls: a " + r.buffer_layer_material + " layer " + in_mm(b->layer_thickness_m) +
+                           " thick keeps the strain at " + three_digits(b->allowable_strain) + " in an impact at " +
+                           three_digits(b->impact_velocity_m_s) + " m/s (peak force " + three_digits(b->max_force_n) +
+                           " N, contact " + (number(b->contact_time_s) ? three_digits(b->contact_time_s * 1e3) : "–") +
                            " ms).");
   }
-  const json& margin = at(op, {"stroke_over_onset"});
-  if (number(margin)) {
-    const double s = margin.get<double>();
+  if (op && number(op->loss.stroke_over_onset)) {
+    const double s = op->loss.stroke_over_onset;
     a.passed = s >= 1.1;
     a.verdict = s >= 1.0 ? "Margin to the cliff: the stroke is " + three_digits(s) + " times the onset of collect-and-collide (" +
-                               in_mm(at(opt, {"x_onset_m"})) + ")" +
+                               in_mm(r.optimum.x_onset_m) + ")" +
                                (s < 1.1 ? ", less than 10 % above it: a smaller stroke in service drops η* to the scattered state's." : ".")
                          : "Below the cliff: the stroke is " + three_digits(s) + " times the onset of collect-and-collide (" +
-                               in_mm(at(opt, {"x_onset_m"})) + "), so the bed is in the scattered state and η* is its empirical fit's.";
+                               in_mm(r.optimum.x_onset_m) + "), so the bed is in the scattered state and η* is its empirical fit's.";
   }
   return a;
 }
 
-Answer decay_answer(const json& r, const json& c) {
+Answer decay_answer(const tasks::DecayResult& r, const case_file::Case& c) {
   Answer a;
-  const json& d = at(r, {"decay"});
-  const json& bare = at(d, {"without_beds"});
-  const json& duration = at(c, {"task", "duration_s"});
+  const tasks::DecaySummary d = tasks::decay_summary(r);
+  const tasks::BareDecaySummary bare = tasks::without_beds_summary(r);
+  const double duration = c.task.decay ? c.task.decay->duration_s : NAN;
   std::ostringstream p;
-  p << "Released from the case's initial state (envelope " << in_mm(at(d, {"initial_envelope_m"})) << " at '"
-    << plain(at(d, {"threshold_point"})) << "'), the structure with its dampers "
-    << settling_text(at(d, {"settling_time_s"}), duration) << " to "
-    << (number(at(d, {"threshold_fraction"})) ? percent(at(d, {"threshold_fraction"}).get<double>()) : "–")
-    << " of it (" << plain(at(r, {"method"})) << ")";
-  if (bare.is_object()) {
-    p << "; without particles (empty containers) it " << settling_text(at(bare, {"settling_time_s"}), duration);
-    if (number(at(d, {"settling_time_s"})) && number(at(bare, {"settling_time_s"})))
-      p << ": the particles settle it " << times_faster(at(d, {"settling_time_s"}).get<double>(), at(bare, {"settling_time_s"}).get<double>())
-        << " the empty containers";
-    else if (!number(at(bare, {"settling_time_s"})))
-      p << " (its envelope at the end: " << in_mm(at(bare, {"final_envelope_m"})) << ")";
-  }
+  p << "Released from the case's initial state (envelope " << in_mm(d.initial_envelope_m) << " at '" << d.threshold_point
+    << "'), the structure with its dampers " << settling_text(d.settling_time_s, duration) << " to "
+    << (number(d.threshold_fraction) ? percent(d.threshold_fraction) : "–") << " of it (" << d.method << ")";
+  p << "; without particles (empty containers) it " << settling_text(bare.settling_time_s, duration);
+  if (number(d.settling_time_s) && number(bare.settling_time_s))
+    p << ": the particles settle it " << times_faster(d.settling_time_s, bare.settling_time_s) << " the empty containers";
+  else if (!number(bare.settling_time_s))
+    p << " (its envelope at the end: " << in_mm(bare.final_envelope_m) << ")";
   p << ".";
   a.paragraphs.push_back(p.str());
   return a;
 }
 
-Answer frf_answer(const json& r) {
+Answer frf_answer(const tasks::FrfResult& r) {
   Answer a;
-  const json& f = at(r, {"frf"});
-  const json& peaks = at(f, {"peaks"});
-  const json& linear = at(f, {"linear_peaks"});
-  if (!peaks.is_array() || peaks.empty()) return a;
-  a.paragraphs.push_back("Response " + plain(at(f, {"magnitude"})) + ", with the particles and without them (empty containers):");
+  const std::vector<tasks::PeakSummary> peaks = tasks::response_peaks(r);
+  if (peaks.empty()) return a;
+  // Without particles: the harmonic balance's linear peaks (the other methods draw the
+  // structure without particles but report no peaks of it).
+  const std::vector<tasks::PeakSummary> linear =
+      r.harmonic && r.method != tasks::FrfMethod::kCompare
+          ? tasks::peak_summaries(r.harmonic->response.linear_peaks, r.harmonic->response.output_names)
+          : std::vector<tasks::PeakSummary>{};
+  a.paragraphs.push_back("Response " + tasks::magnitude_description(r) +
+                         ", with the particles and without them (empty containers):");
   for (const auto& peak : peaks) {
     std::ostringstream p;
-    p << "Peak of '" << plain(at(peak, {"output"})) << "': " << plain(at(peak, {"magnitude"})) << " at " << plain(at(peak, {"frequency_hz"}))
-      << " Hz, equivalent damping ratio " << plain(at(peak, {"damping_ratio"}));
+    p << "Peak of '" << peak.output << "': " << three_digits(peak.magnitude) << " at " << three_digits(peak.frequency_hz)
+      << " Hz, equivalent damping ratio " << three_digits(peak.damping_ratio);
     // Without particles: the same output's peak nearest in frequency (the same mode).
-    const json* nearest = nullptr;
+    const tasks::PeakSummary* nearest = nullptr;
     for (const auto& lin : linear)
-      if (at(lin, {"output"}) == at(peak, {"output"}) && number(at(lin, {"magnitude"})) && number(at(lin, {"frequency_hz"})) &&
-          number(at(peak, {"frequency_hz"})) &&
-          (!nearest || std::abs(at(lin, {"frequency_hz"}).get<double>() - at(peak, {"frequency_hz"}).get<double>()) <
-                           std::abs(at(*nearest, {"frequency_hz"}).get<double>() - at(peak, {"frequency_hz"}).get<double>())))
+      if (lin.output == peak.output && number(lin.magnitude) && number(lin.frequency_hz) && number(peak.frequency_hz) &&
+          (!nearest || std::abs(lin.frequency_hz - peak.frequency_hz) < std::abs(nearest->frequency_hz - peak.frequency_hz)))
         nearest = &lin;
-    if (nearest && number(at(peak, {"magnitude"}))) {
-      const double ratio = at(*nearest, {"magnitude"}).get<double>() / at(peak, {"magnitude"}).get<double>();
-      p << "; without particles " << plain(at(*nearest, {"magnitude"})) << " at " << plain(at(*nearest, {"frequency_hz"}))
-        << " Hz (damping ratio " << plain(at(*nearest, {"damping_ratio"})) << "): the particles lower the peak "
+    if (nearest && number(peak.magnitude)) {
+      const double ratio = nearest->magnitude / peak.magnitude;
+      p << "; without particles " << three_digits(nearest->magnitude) << " at " << three_digits(nearest->frequency_hz)
+        << " Hz (damping ratio " << three_digits(nearest->damping_ratio) << "): the particles lower the peak "
         << three_digits(ratio) << " times (" << three_digits(-20.0 * std::log10(ratio)) << " dB)";
     }
     p << ".";
     a.paragraphs.push_back(p.str());
   }
-  if (at(f, {"jumps"}).is_array() && !at(f, {"jumps"}).empty())
-    a.paragraphs.push_back("The response jumps at " + std::to_string(at(f, {"jumps"}).size()) +
+  if (r.harmonic && r.method != tasks::FrfMethod::kCompare && !r.harmonic->response.branch_ends.empty())
+    a.paragraphs.push_back("The response jumps at " + std::to_string(r.harmonic->response.branch_ends.size()) +
                            " frequencies, where a bed crosses the onset of collect-and-collide: see the plot.");
   return a;
 }
 
-Answer placement_answer(const json& r) {
+Answer placement_answer(const tasks::PlacementStudy& study) {
   Answer a;
+  const auto& r = study.result;
+  const double gain = r.current && r.current->objective > 0.0 ? r.best.objective / r.current->objective : NAN;
   std::ostringstream p;
-  const json& gain = at(r, {"improvement_over_current"});
-  p << "Put the damper " << plain(at(r, {"design", "position_m"})) << " m along the structure: its objective ("
-    << words(at(r, {"objective", "kind"})) << " of the " << plain(at(r, {"objective", "unit"})) << " added to the target modes) is "
-    << plain(at(r, {"objective", "value"})) << ", ";
-  if (number(gain) && std::abs(gain.get<double>() - 1.0) < 5e-3) p << "the same as at the case's own site";
-  else p << plain(gain) << " times that at the case's own site (" << plain(at(r, {"current", "objective"})) << ")";
-  p << "; " << plain(at(r, {"sites_evaluated"})) << " positions tried.";
+  p << "Put the damper " << three_digits(r.best.position_m) << " m along the structure: its objective ("
+    << words(opt::to_string(study.objective)) << " of the damping ratio added to the target modes) is "
+    << three_digits(r.best.objective) << ", ";
+  if (number(gain) && std::abs(gain - 1.0) < 5e-3) p << "the same as at the case's own site";
+  else p << three_digits(gain) << " times that at the case's own site (" << three_digits(r.current ? r.current->objective : NAN) << ")";
+  p << "; " << three_digits(static_cast<double>(r.scan.size())) << " positions tried.";
   a.paragraphs.push_back(p.str());
   return a;
 }
 
-Answer modes_answer(const json& r) {
+Answer modes_answer(const tasks::ModesResult& r) {
   Answer a;
-  for (const auto& m : at(r, {"modes"})) {
+  for (Eigen::Index j = 0; j < r.mode_count; ++j) {
     std::ostringstream p;
-    p << "Mode " << plain(at(m, {"mode"})) << ": " << plain(at(m, {"frequency_hz"})) << " Hz with the empty containers ("
-      << plain(at(m, {"bare_frequency_hz"})) << " Hz without them)";
-    if (number(at(m, {"backbone", "max_added_damping_ratio"})))
-      p << "; the particles add up to ζ = " << plain(at(m, {"backbone", "max_added_damping_ratio"})) << " at a damper amplitude of "
-        << in_mm(at(m, {"backbone", "max_added_damping_amplitude_m"}));
+    p << "Mode " << three_digits(static_cast<double>(j + 1)) << ": " << three_digits(r.frequencies_with_containers_hz[j])
+      << " Hz with the empty containers (" << three_digits(r.modal.natural_frequencies_hz[j]) << " Hz without them)";
+    if (const auto backbone = tasks::backbone_summary(r, j); backbone && number(backbone->max_added_damping_ratio))
+      p << "; the particles add up to ζ = " << three_digits(backbone->max_added_damping_ratio)
+        << " at a damper amplitude of " << in_mm(backbone->max_added_damping_amplitude_m);
     p << ".";
     a.paragraphs.push_back(p.str());
   }
@@ -279,15 +270,18 @@ Answer modes_answer(const json& r) {
 
 }  // namespace
 
-Answer report_answer(const json& result, const json& case_resolved) {
-  const std::string task = result.is_object() && result.contains("task") && result["task"].is_string() ? result["task"].get<std::string>() : "";
-  if (task == "filling_ratios" || at(result, {"designs", "chosen"}).is_object()) return filling_ratios_answer(result, case_resolved);
-  if (task == "damper_design") return damper_design_answer(result, case_resolved);
-  if (task == "decay") return decay_answer(result, case_resolved);
-  if (task == "frf") return frf_answer(result);
-  if (task == "placement") return placement_answer(result);
-  if (task == "modes") return modes_answer(result);
-  return {};
+Answer report_answer(const TaskResult& result, const case_file::Case& c) {
+  struct Visit {
+    const case_file::Case& c;
+    Answer operator()(std::monostate) const { return {}; }
+    Answer operator()(const tasks::FillingRatiosResult* r) const { return filling_ratios_answer(*r, c); }
+    Answer operator()(const tasks::DamperDesignResult* r) const { return damper_design_answer(*r, c); }
+    Answer operator()(const tasks::DecayResult* r) const { return decay_answer(*r, c); }
+    Answer operator()(const tasks::FrfResult* r) const { return frf_answer(*r); }
+    Answer operator()(const tasks::PlacementStudy* r) const { return placement_answer(*r); }
+    Answer operator()(const tasks::ModesResult* r) const { return modes_answer(*r); }
+  };
+  return std::visit(Visit{c}, result);
 }
 
 }  // namespace pdamp::report

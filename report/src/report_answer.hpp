@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "pdamp/report/html_report.hpp"
 
 namespace pdamp::report {
 
@@ -16,13 +16,14 @@ struct Answer {
   std::optional<bool> passed;           ///< colours the verdict; none: neutral
 };
 
-/// From the task's result JSON and the resolved case (case_resolved.json); empty
-/// paragraphs for a task without a written answer.
-Answer report_answer(const nlohmann::json& result, const nlohmann::json& case_resolved);
+/// From the task's typed result and its case; empty paragraphs for a task without a
+/// written answer.
+Answer report_answer(const TaskResult& result, const case_file::Case& c);
 
-/// Numbers as the page prints them: three significant digits; lengths in mm, masses in g.
+/// Numbers as the page prints them: three significant digits ("–" where not finite);
+/// lengths in mm, masses in g.
 std::string three_digits(double value);
-std::string in_mm(const nlohmann::json& metres);
-std::string in_g(const nlohmann::json& kilograms);
+std::string in_mm(double metres);
+std::string in_g(double kilograms);
 
 }  // namespace pdamp::report

@@ -277,34 +277,54 @@ std::vector<std::string> recalibrate_in_design(const Case& c, const case_file::F
   return changed;
 }
 
-json to_json(const BedCalibration& calibration) {
-  json beds = json::array();
-  for (const auto& b : calibration.beds) {
-    double lowest = INFINITY, highest = 0.0;
-    for (const auto& p : b.periods) lowest = std::min(lowest, p.stroke_m), highest = std::max(highest, p.stroke_m);
-    beds.push_back({{"layer", b.layer},
-                    {"slabs", b.slabs},
-                    {"extra_damping_ratio", b.extra_damping_ratio},
-                    {"key", b.key},
-                    {"cached", b.cached},
-                    {"file", b.file.string()},
-                    {"periods", b.periods.size()},
-                    {"stroke_min_m", lowest},
-                    {"stroke_max_m", highest},
-                    {"steps", b.steps},
-                    {"energy_error", b.energy_error},
-                    {"wall_time_s", b.wall_time_s}});
-  }
-  return {{"method", "dem_decay"},
-          {"what", "each candidate bed alone in a DEM-in-the-loop free decay of the structure from the task's initial "
-                   "state; its response period by period binned into a field over the strokes the decay passed"},
-          {"duration_s", calibration.spec.duration_s},
-          {"stiffness_softening", calibration.spec.stiffness_softening},
-          {"strokes_per_decade", calibration.spec.strokes_per_decade},
-          {"cache_dir", calibration.cache_dir.string()},
-          {"runs", calibration.runs},
-          {"beds", beds},
-          {"wall_time_s", calibration.wall_time_s}};
+double CalibratedBed::stroke_min_m() const {
+  double lowest = INFINITY;
+  for (const auto& p : periods) lowest = std::min(lowest, p.stroke_m);
+  return lowest;
+}
+
+double CalibratedBed::stroke_max_m() const {
+  double highest = 0.0;
+  for (const auto& p : periods) highest = std::max(highest, p.stroke_m);
+  return highest;
+}
+
+const base::Fields<CalibratedBed>& CalibratedBed::fields() {
+  using B = CalibratedBed;
+  static const auto f =
+      base::Fields<B>()
+          .field("layer", &B::layer, "", "the layer")
+          .field("slabs", &B::slabs, "", "whole slabs in it")
+          .field("extra_damping_ratio", &B::extra_damping_ratio, "1",
+                 "damping added to every mode in its decay (0: the bed alone)")
+          .field("key", &B::key, "", "16 hex digits of the physics the calibration depends on")
+          .field("cached", &B::cached, "", "read from the cache, not run now")
+          .derived("file", [](const B& b) { return b.file.string(); }, "", "its cache file")
+          .derived("periods", [](const B& b) { return b.periods.size(); }, "", "periods of its decay binned")
+          .derived("stroke_min_m", [](const B& b) { return b.stroke_min_m(); }, "m", "the smallest stroke its periods passed")
+          .derived("stroke_max_m", [](const B& b) { return b.stroke_max_m(); }, "m", "the largest")
+          .field("steps", &B::steps, "", "integration steps of its DEM decay")
+          .field("energy_error", &B::energy_error, "1", "its energy ledger's relative error")
+          .field("wall_time_s", &B::wall_time_s, "s", "wall time of its DEM decay (when it ran)");
+  return f;
+}
+
+const base::Fields<BedCalibration>& BedCalibration::fields() {
+  using C = BedCalibration;
+  static const auto f =
+      base::Fields<C>()
+          .derived("method", [](const C&) { return std::string("dem_decay"); }, "", "how the beds were calibrated")
+          .derived("what", [](const C&) { return std::string(C::kWhat); }, "", "what was run")
+          .derived("duration_s", [](const C& c) { return c.spec.duration_s; }, "s", "each bed's decay")
+          .derived("stiffness_softening", [](const C& c) { return c.spec.stiffness_softening; }, "1",
+                   "the DEM's softening in the calibration")
+          .derived("strokes_per_decade", [](const C& c) { return c.spec.strokes_per_decade; }, "",
+                   "stroke bins per decade of the field")
+          .derived("cache_dir", [](const C& c) { return c.cache_dir.string(); }, "", "where the beds are cached")
+          .field("runs", &C::runs, "", "beds run now (the others from the cache)")
+          .field("beds", &C::beds, "", "each calibrated bed")
+          .field("wall_time_s", &C::wall_time_s, "s", "wall time of the calibration");
+  return f;
 }
 
 }  // namespace pdamp::tasks

@@ -437,13 +437,10 @@ json to_json(const st::CosimulationEnergy& e) {
 namespace {
 
 json without_beds_json(const DecayResult& res, const OutputFolder& folder) {
-  const auto& bare = res.without_beds;
-  return {{"what", "the same release with the containers empty (beds removed), judged against the same threshold"},
-          {"file", folder.file("decay_without_beds.csv")},
-          {"settling_time_s", number_or_null(bare.settling_time_s)},
-          {"outcome", bare.outcome == st::FreeDecay::Outcome::kSettled ? "settled" : "not_settled"},
-          {"damping_ratio", number_or_null(bare.equivalent_damping_ratio)},
-          {"final_envelope_m", bare.samples.empty() ? json(nullptr) : json(bare.samples.back().threshold_measure_m)}};
+  json out = base::to_json(without_beds_summary(res));
+  out["what"] = "the same release with the containers empty (beds removed), judged against the same threshold";
+  out["file"] = folder.file("decay_without_beds.csv");
+  return out;
 }
 
 json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
@@ -451,41 +448,27 @@ json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
   const auto& r = decay.cosimulation;
   const auto& h = r.history;
   const auto& settle = decay.settling;
-  const bool settled = std::isfinite(settle.settling_time_s);
-  const Eigen::VectorXd& q0 = res.initial_modal_amplitudes;
-  std::vector<double> initial(q0.data(), q0.data() + q0.size());
   json envelope = json::array();
   for (std::size_t k = 0; k < settle.envelope_m.size(); ++k) envelope.push_back({settle.envelope_time_s[k], settle.envelope_m[k]});
-  json d = {{"file", folder.file("decay_dem.csv")},
-            {"plot", folder.file("decay_dem.png")},
-            {"method", "dem"},
-            {"settling_time_s", number_or_null(settle.settling_time_s)},
-            {"damping_ratio", number_or_null(settle.damping_ratio)},
-            {"dominant_mode", decay.dominant_mode + 1},
-            {"outcome", settled ? "settled" : "not_settled"},
-            {"threshold_point", res.threshold_point},
-            {"threshold_m", decay.threshold_m},
-            {"threshold_fraction", res.threshold_fraction},
-            {"initial_envelope_m", decay.initial_envelope_m},
-            {"initial_modal_amplitudes", initial},
-            {"static_offset_m", decay.static_offset_m},
-            {"envelope", "the largest |y - static_offset_m| of the first damper's site along its drive over each whole "
-                         "period of the dominant mode (with the empty containers)"},
-            {"envelope_period_s", 1.0 / decay.dominant_frequency_hz},
-            {"envelope_points", envelope},
-            {"frequency_hz", settle.frequency_hz},
-            {"final_time_s", h.time_s.back()},
-            {"final_envelope_m", settle.envelope_m.empty() ? json(nullptr) : json(settle.envelope_m.back())},
-            {"energy_error", r.energy.relative_error},
-            {"energy", to_json(r.energy)},
-            {"structural_dissipated_energy_j", r.energy.structural_damping_j},
-            {"dem_dissipated_energy_j", r.energy.dem_dissipated_j()},
-            {"samples", h.time_s.size()},
-            {"steps", r.steps},
-            {"settling_steps", r.settling_steps},
-            {"time_step_s", r.time_step_s},
-            {"solve_time_s", r.wall_time_s},
-            {"warnings", res.warnings}};
+  json d = base::to_json(decay_summary(res));
+  d["file"] = folder.file("decay_dem.csv");
+  d["plot"] = folder.file("decay_dem.png");
+  d["static_offset_m"] = decay.static_offset_m;
+  d["envelope"] = "the largest |y - static_offset_m| of the first damper's site along its drive over each whole period of "
+                  "the dominant mode (with the empty containers)";
+  d["envelope_period_s"] = 1.0 / decay.dominant_frequency_hz;
+  d["envelope_points"] = envelope;
+  d["frequency_hz"] = settle.frequency_hz;
+  d["energy_error"] = r.energy.relative_error;
+  d["energy"] = to_json(r.energy);
+  d["structural_dissipated_energy_j"] = r.energy.structural_damping_j;
+  d["dem_dissipated_energy_j"] = r.energy.dem_dissipated_j();
+  d["samples"] = h.time_s.size();
+  d["steps"] = r.steps;
+  d["settling_steps"] = r.settling_steps;
+  d["time_step_s"] = r.time_step_s;
+  d["solve_time_s"] = r.wall_time_s;
+  d["warnings"] = res.warnings;
   d["without_beds"] = without_beds_json(res, folder);
   json result = {{"task", "decay"}, {"case", res.case_name}, {"method", "dem"}};
   result["file"] = d["file"];
@@ -498,7 +481,6 @@ json dem_decay_json(const DecayResult& res, const OutputFolder& folder) {
 
 json averaged_decay_json(const DecayResult& res, const OutputFolder& folder) {
   const auto& decay = res.decay;
-  const bool settled = decay.outcome == st::FreeDecay::Outcome::kSettled;
   const auto& first = decay.samples.front();
   const auto& last = decay.samples.back();
   json layers = json::array();
@@ -508,34 +490,20 @@ json averaged_decay_json(const DecayResult& res, const OutputFolder& folder) {
     layers.push_back({{"name", decay.layer_names[l]},
                       {"dissipated_energy_j", last.layer_dissipated_energy_j[l]},
                       {"share", dissipated > 0.0 ? last.layer_dissipated_energy_j[l] / dissipated : 0.0}});
-  const Eigen::VectorXd& q0 = res.initial_modal_amplitudes;
-  std::vector<double> initial(q0.data(), q0.data() + q0.size());
-  const std::string method = res.method == DecayMethod::kField ? "field" : "formulas";
-  json d = {{"file", folder.file("decay.csv")},
-            {"plot", folder.file("decay.png")},
-            {"method", method},
-            {"settling_time_s", number_or_null(decay.settling_time_s)},
-            {"damping_ratio", number_or_null(decay.equivalent_damping_ratio)},
-            {"dominant_mode", decay.dominant_mode + 1},
-            {"outcome", settled ? "settled" : "not_settled"},
-            {"threshold_point", res.threshold_point},
-            {"threshold_m", decay.threshold_used_m},
-            {"threshold_fraction", res.threshold_fraction},
-            {"initial_envelope_m", first.threshold_measure_m},
-            {"initial_modal_amplitudes", initial},
-            {"initial_energy_j", first.mechanical_energy_j},
-            {"final_time_s", last.time_s},
-            {"final_envelope_m", last.threshold_measure_m},
-            {"final_energy_j", last.mechanical_energy_j},
-            {"structural_dissipated_energy_j", last.structural_dissipated_energy_j},
-            {"layers", layers},
-            {"samples", decay.samples.size()},
-            {"steps", decay.steps},
-            {"solve_time_s", decay.solve_time_s},
-            {"report", decay.brief_report()},
-            {"warnings", res.warnings}};
+  json d = base::to_json(decay_summary(res));
+  d["file"] = folder.file("decay.csv");
+  d["plot"] = folder.file("decay.png");
+  d["initial_energy_j"] = first.mechanical_energy_j;
+  d["final_energy_j"] = last.mechanical_energy_j;
+  d["structural_dissipated_energy_j"] = last.structural_dissipated_energy_j;
+  d["layers"] = layers;
+  d["samples"] = decay.samples.size();
+  d["steps"] = decay.steps;
+  d["solve_time_s"] = decay.solve_time_s;
+  d["report"] = decay.brief_report();
+  d["warnings"] = res.warnings;
   d["without_beds"] = without_beds_json(res, folder);
-  json result = {{"task", "decay"}, {"case", res.case_name}, {"method", method}};
+  json result = {{"task", "decay"}, {"case", res.case_name}, {"method", d["method"]}};
   result["file"] = d["file"];
   result["settling_time_s"] = d["settling_time_s"];
   result["damping_ratio"] = d["damping_ratio"];
@@ -544,6 +512,82 @@ json averaged_decay_json(const DecayResult& res, const OutputFolder& folder) {
 }
 
 }  // namespace
+
+const base::Fields<DecaySummary>& DecaySummary::fields() {
+  using D = DecaySummary;
+  static const auto f =
+      base::Fields<D>()
+          .field("method", &D::method, "", "formulas, field or dem")
+          .field("settling_time_s", &D::settling_time_s, "s", "when the envelope reached the threshold (null: not settled)",
+                 base::kNullable)
+          .field("damping_ratio", &D::damping_ratio, "1", "equivalent damping ratio down to the threshold",
+                 base::kNullable)
+          .field("dominant_mode", &D::dominant_mode, "", "the mode the envelope is taken over, from 1")
+          .field("settled", &D::settled, "", "settled within the duration", base::kHidden)
+          .derived("outcome", [](const D& d) { return std::string(d.settled ? "settled" : "not_settled"); }, "",
+                   "settled or not_settled")
+          .field("threshold_point", &D::threshold_point, "", "the first damper's site")
+          .field("threshold_m", &D::threshold_m, "m", "the settling threshold")
+          .field("threshold_fraction", &D::threshold_fraction, "1", "the threshold over the initial envelope")
+          .field("initial_envelope_m", &D::initial_envelope_m, "m", "the envelope the decay starts from")
+          .field("initial_modal_amplitudes", &D::initial_modal_amplitudes, "units of q", "the release, q0")
+          .field("final_time_s", &D::final_time_s, "s", "the end of the record")
+          .field("final_envelope_m", &D::final_envelope_m, "m", "the envelope at the end", base::kNullable);
+  return f;
+}
+
+DecaySummary decay_summary(const DecayResult& r) {
+  DecaySummary s;
+  s.threshold_point = r.threshold_point;
+  s.threshold_fraction = r.threshold_fraction;
+  s.initial_modal_amplitudes.assign(r.initial_modal_amplitudes.data(),
+                                    r.initial_modal_amplitudes.data() + r.initial_modal_amplitudes.size());
+  if (r.method == DecayMethod::kDem) {
+    const DemDecay& d = r.dem;
+    s.method = "dem";
+    s.settling_time_s = d.settling.settling_time_s;
+    s.damping_ratio = d.settling.damping_ratio;
+    s.dominant_mode = static_cast<int>(d.dominant_mode) + 1;
+    s.settled = std::isfinite(d.settling.settling_time_s);
+    s.threshold_m = d.threshold_m;
+    s.initial_envelope_m = d.initial_envelope_m;
+    s.final_time_s = d.cosimulation.history.time_s.back();
+    s.final_envelope_m = d.settling.envelope_m.empty() ? NAN : d.settling.envelope_m.back();
+    return s;
+  }
+  const auto& decay = r.decay;
+  s.method = r.method == DecayMethod::kField ? "field" : "formulas";
+  s.settling_time_s = decay.settling_time_s;
+  s.damping_ratio = decay.equivalent_damping_ratio;
+  s.dominant_mode = static_cast<int>(decay.dominant_mode) + 1;
+  s.settled = decay.outcome == st::FreeDecay::Outcome::kSettled;
+  s.threshold_m = decay.threshold_used_m;
+  s.initial_envelope_m = decay.samples.front().threshold_measure_m;
+  s.final_time_s = decay.samples.back().time_s;
+  s.final_envelope_m = decay.samples.back().threshold_measure_m;
+  return s;
+}
+
+const base::Fields<BareDecaySummary>& BareDecaySummary::fields() {
+  using B = BareDecaySummary;
+  static const auto f =
+      base::Fields<B>()
+          .field("settling_time_s", &B::settling_time_s, "s", "when the envelope reached the threshold (null: not settled)",
+                 base::kNullable)
+          .field("settled", &B::settled, "", "settled within the duration", base::kHidden)
+          .derived("outcome", [](const B& b) { return std::string(b.settled ? "settled" : "not_settled"); }, "",
+                   "settled or not_settled")
+          .field("damping_ratio", &B::damping_ratio, "1", "equivalent damping ratio down to the threshold",
+                 base::kNullable)
+          .field("final_envelope_m", &B::final_envelope_m, "m", "the envelope at the end", base::kNullable);
+  return f;
+}
+
+BareDecaySummary without_beds_summary(const DecayResult& r) {
+  const auto& bare = r.without_beds;
+  return {bare.settling_time_s, bare.outcome == st::FreeDecay::Outcome::kSettled, bare.equivalent_damping_ratio,
+          bare.samples.empty() ? NAN : bare.samples.back().threshold_measure_m};
+}
 
 json to_json(const DecayResult& result, const OutputFolder& folder) {
   return result.method == DecayMethod::kDem ? dem_decay_json(result, folder) : averaged_decay_json(result, folder);

@@ -140,14 +140,7 @@ const base::Fields<Verification>& Verification::fields() {
   static const auto f =
       base::Fields<V>()
           .derived("method", [](const V&) { return std::string("dem"); }, "", "the judge: the DEM in the loop")
-          .derived("what",
-                   [](const V&) {
-                     return std::string(
-                         "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the "
-                         "optimiser's modal model, from the task's initial state, against the prediction (the "
-                         "optimiser's bed models) over the same time");
-                   },
-                   "", "what was run")
+          .derived("what", [](const V&) { return std::string(V::kWhat); }, "", "what was run")
           .derived("objective",
                    [](const V& v) { return std::string(v.settling_objective ? "settling_time" : "integral_square"); },
                    "", "settling_time or integral_square")
@@ -707,7 +700,7 @@ json to_json(const FillingRatiosResult& res) {
                   {"report", s.brief_report()}}},
       {"decay_evaluations", r.decay_evaluations},
       {"solve_time_s", r.solve_time_s}};
-  result["calibration"] = res.calibration ? to_json(*res.calibration) : json(nullptr);
+  result["calibration"] = res.calibration ? base::to_json(*res.calibration) : json(nullptr);
   result["verification"] = res.verification ? base::to_json(*res.verification) : json(nullptr);
   result["design_loop"] = res.rounds.empty() ? json(nullptr)
                                              : json{{"rounds", base::to_json(res.rounds)}, {"outcome", to_string(*res.loop_outcome)}};

@@ -459,8 +459,7 @@ json harmonic_result(const FrfResult& r, const HarmonicFrf& h, const OutputFolde
               {"plot", folder.file("frf.png")},
               {"method", case_file::to_string(h.method)},
               {"outputs", response.output_names},
-              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude)"
-                                 : "receptance |X/F| in m/N"},
+              {"magnitude", magnitude_description(r)},
               {"excitation", base_motion ? "base" : "force"},
               {"frequencies", {{"min_hz", response.points.front().frequency_hz},
                                {"max_hz", response.points.back().frequency_hz},
@@ -509,8 +508,7 @@ json stepped_result(const FrfResult& r, const SteppedSineFrf& s, const OutputFol
               {"plot", folder.file("frf_dem.png")},
               {"method", "dem"},
               {"outputs", names},
-              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic"
-                                 : "receptance |X/F| in m/N, first harmonic"},
+              {"magnitude", magnitude_description(r)},
               {"excitation", base_motion ? "base" : "force"},
               {"frequencies", {{"min_hz", s.frequencies_hz.front()}, {"max_hz", s.frequencies_hz.back()},
                                {"points", s.frequencies_hz.size()}, {"spacing", "linear"}}},
@@ -561,9 +559,7 @@ json linear_result(const FrfResult& r, const LinearSweepFrf& l, const OutputFold
               {"method", "dem"},
               {"signal", "linear_sweep"},
               {"outputs", names},
-              {"magnitude", base_motion ? "transmissibility |X/U| (absolute site motion over base amplitude), first harmonic "
-                                   "of each drive cycle"
-                                 : "receptance |X/F| in m/N, first harmonic of each drive cycle"},
+              {"magnitude", magnitude_description(r)},
               {"excitation", base_motion ? "base" : "force"},
               {"rate_hz_per_s", l.rate_hz_s},
               {"rate_basis", l.rate_basis},
@@ -781,6 +777,38 @@ FrfResult run_frf(const Case& c, const FrfOptions& options, base::RunHooks& hook
 
 std::string magnitude_label(const FrfResult& r) {
   return r.base_excitation ? "transmissibility |X/U|" : "receptance |X/F| / (m/N)";
+}
+
+std::string magnitude_description(const FrfResult& r) {
+  const std::string what = r.base_excitation ? "transmissibility |X/U| (absolute site motion over base amplitude)"
+                                             : "receptance |X/F| in m/N";
+  if (r.linear) return what + ", first harmonic of each drive cycle";
+  if (r.method == FrfMethod::kDem) return what + ", first harmonic";
+  return what;
+}
+
+std::vector<PeakSummary> response_peaks(const FrfResult& r) {
+  const auto brief = [](const DemPeak& p) {
+    return PeakSummary{p.output, p.frequency_hz, p.magnitude, p.damping_ratio, p.band_centre_hz};
+  };
+  std::vector<PeakSummary> out;
+  switch (r.method) {
+    case FrfMethod::kFormulas:
+    case FrfMethod::kField: return peak_summaries(r.harmonic->response.peaks, r.harmonic->response.output_names);
+    case FrfMethod::kDem:
+      if (r.linear) {
+        for (const auto& s : r.linear->sweeps)
+          for (std::size_t d = 0; d < r.linear->damper_names.size(); ++d)
+            out.push_back(brief(sweep_peak(r.linear->damper_names[d], s, d)));
+      } else {
+        for (const auto& branch : r.stepped->branches)
+          for (std::size_t d = 0; d < r.stepped->damper_names.size(); ++d)
+            out.push_back(brief(dem_peak(r.stepped->damper_names[d], branch, st::stepped_sine_peak(branch, d))));
+      }
+      return out;
+    case FrfMethod::kCompare: return out;
+  }
+  return out;
 }
 
 json to_json(const FrfResult& r, const OutputFolder& folder) {

@@ -107,6 +107,40 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options) {
   return out;
 }
 
+const base::Fields<BackboneSummary>& BackboneSummary::fields() {
+  using B = BackboneSummary;
+  static const auto f =
+      base::Fields<B>()
+          .field("points", &B::points, "", "amplitudes of the backbone")
+          .field("modal_mass_ratio", &B::modal_mass_ratio, "1", "bed mass in the mode over its modal mass")
+          .field("max_added_damping_ratio", &B::max_added_damping_ratio, "1", "the most damping the beds add")
+          .field("max_added_damping_amplitude_m", &B::max_added_damping_amplitude_m, "m",
+                 "the damper amplitude where they add it")
+          .field("min_damped_frequency_hz", &B::min_damped_frequency_hz, "Hz", "the lowest damped frequency")
+          .field("max_damped_frequency_hz", &B::max_damped_frequency_hz, "Hz", "the highest");
+  return f;
+}
+
+std::optional<BackboneSummary> backbone_summary(const ModesResult& r, Eigen::Index j) {
+  const auto it = r.backbone_of_mode.find(j);
+  if (it == r.backbone_of_mode.end()) return std::nullopt;
+  const auto& b = r.backbones[it->second];
+  const auto best = std::max_element(b.points.begin(), b.points.end(), [](const auto& a, const auto& x) {
+    return a.added_damping_ratio < x.added_damping_ratio;
+  });
+  BackboneSummary out;
+  out.points = b.points.size();
+  out.modal_mass_ratio = b.modal_mass_ratio;
+  out.max_added_damping_ratio = best->added_damping_ratio;
+  out.max_added_damping_amplitude_m = best->damper_amplitude_m;
+  out.min_damped_frequency_hz = out.max_damped_frequency_hz = b.points.front().damped_frequency_hz;
+  for (const auto& p : b.points) {
+    out.min_damped_frequency_hz = std::min(out.min_damped_frequency_hz, p.damped_frequency_hz);
+    out.max_damped_frequency_hz = std::max(out.max_damped_frequency_hz, p.damped_frequency_hz);
+  }
+  return out;
+}
+
 json to_json(const ModesResult& r, const OutputFolder& folder) {
   const st::ModalModel& modal = r.modal;
   json modes = json::array();
@@ -116,37 +150,24 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
       shapes[p.name] = {{"translation_x", p.translation(0, j)}, {"translation_y", p.translation(1, j)},
                         {"rotation", p.rotation(j)}};
     json ratio_per_damper = json::object(), drive = json::object();
-    double ratio_total = 0.0;
     for (std::size_t d = 0; d < r.damper_names.size(); ++d) {
       const auto col = static_cast<Eigen::Index>(d);
       ratio_per_damper[r.damper_names[d]] = r.mass_ratio(j, col);
       drive[r.damper_names[d]] = r.drive_shapes(j, col);
-      ratio_total += r.mass_ratio(j, col);
     }
     json mode = {{"mode", j + 1},
                  {"frequency_hz", r.frequencies_with_containers_hz[j]},
                  {"bare_frequency_hz", modal.natural_frequencies_hz[j]},
                  {"damping_ratio", modal.damping_ratios[j]},
                  {"modal_mass_kg", modal.modal_masses_kg[j]},
-                 {"modal_mass_ratio", ratio_total},
+                 {"modal_mass_ratio", r.modal_mass_ratio(j)},
                  {"modal_mass_ratio_per_damper", ratio_per_damper},
                  {"drive_shape_per_damper", drive},
                  {"shapes", shapes},
                  {"backbone", nullptr}};
-    if (const auto it = r.backbone_of_mode.find(j); it != r.backbone_of_mode.end()) {
-      const auto& b = r.backbones[it->second];
-      const auto best = std::max_element(b.points.begin(), b.points.end(), [](const auto& a, const auto& x) {
-        return a.added_damping_ratio < x.added_damping_ratio;
-      });
-      double f_min = b.points.front().damped_frequency_hz, f_max = f_min;
-      for (const auto& p : b.points) f_min = std::min(f_min, p.damped_frequency_hz), f_max = std::max(f_max, p.damped_frequency_hz);
-      mode["backbone"] = {{"file", folder.file("backbone_mode" + std::to_string(j + 1) + ".csv")},
-                          {"points", b.points.size()},
-                          {"modal_mass_ratio", b.modal_mass_ratio},
-                          {"max_added_damping_ratio", best->added_damping_ratio},
-                          {"max_added_damping_amplitude_m", best->damper_amplitude_m},
-                          {"min_damped_frequency_hz", f_min},
-                          {"max_damped_frequency_hz", f_max}};
+    if (const auto backbone = backbone_summary(r, j)) {
+      mode["backbone"] = base::to_json(*backbone);
+      mode["backbone"]["file"] = folder.file("backbone_mode" + std::to_string(j + 1) + ".csv");
     }
     modes.push_back(std::move(mode));
   }

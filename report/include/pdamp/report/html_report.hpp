@@ -8,20 +8,33 @@
 
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "pdamp/report/output_dir.hpp"
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/report/output_dir.hpp"
+#include "pdamp/tasks/damper_design.hpp"
+#include "pdamp/tasks/decay.hpp"
+#include "pdamp/tasks/filling_ratios.hpp"
+#include "pdamp/tasks/frf.hpp"
+#include "pdamp/tasks/modes.hpp"
+#include "pdamp/tasks/placement.hpp"
 
 namespace pdamp::report {
 
-/// Stages report.html built from the result JSON, the warnings and the pictures already
-/// staged in `files` (PNG, else SVG, as produced by gnuplot): call it just before
-/// files.commit().
+/// The typed result whose question the report answers (none: a task whose report shows
+/// its numbers only).
+using TaskResult = std::variant<std::monostate, const tasks::FillingRatiosResult*, const tasks::DamperDesignResult*,
+                                const tasks::DecayResult*, const tasks::FrfResult*, const tasks::PlacementStudy*,
+                                const tasks::ModesResult*>;
+
+/// Stages report.html built from the typed result (the answer and its evidence), the result
+/// JSON (every number, in the details), the warnings and the pictures already staged in
+/// `files` (PNG, else SVG, as produced by gnuplot): call it just before files.commit().
 /// `provenance`: the program's version and commit, printed at the end.
-void stage_report(OutputDir& files, const case_file::Case& c, const nlohmann::json& result,
+void stage_report(OutputDir& files, const case_file::Case& c, const TaskResult& typed, const nlohmann::json& result,
                   const std::vector<std::string>& warnings, const std::string& provenance);
 
 /// A picture for the report: its file name (caption key) and its bytes.
@@ -35,9 +48,10 @@ struct ReportInput {
   std::string case_name;
   std::string case_description;
   std::string case_file;
-  nlohmann::json case_resolved;       ///< the resolved case (case_resolved.json): what was built
+  const case_file::Case* case_read = nullptr;  ///< what the answer reads of the case (none: nothing)
   std::string provenance;             ///< "pdamp 0.1.0, commit ..."
-  nlohmann::json result;              ///< the task's result JSON (results.json of the run)
+  TaskResult typed;                   ///< what the answer and the evidence read
+  nlohmann::json result;              ///< the task's result JSON: every number, in the details
   std::vector<std::string> warnings;
   std::vector<ReportPicture> pictures;
   bool gnuplot_found = true;          ///< false: a note instead of the plots

@@ -20,6 +20,7 @@
 #include "pdamp/surrogate/decay_field.hpp"
 #include "pdamp/surrogate/loss_model.hpp"
 #include "pdamp/base/executor.hpp"
+#include "pdamp/base/record.hpp"
 #include "pdamp/base/run_hooks.hpp"
 
 namespace pdamp::tasks {
@@ -41,6 +42,9 @@ struct CalibratedBed {
   std::int64_t steps = 0;          ///< of its DEM decay
   double energy_error = 0.0;       ///< the DEM decay's energy-ledger error
   double wall_time_s = 0.0;        ///< of its DEM decay (when it ran)
+  double stroke_min_m() const;     ///< the smallest stroke its periods passed (inf: none)
+  double stroke_max_m() const;     ///< the largest (0: none)
+  static const base::Fields<CalibratedBed>& fields();
 };
 
 struct BedCalibration {
@@ -51,6 +55,11 @@ struct BedCalibration {
   double wall_time_s = 0.0;
   /// The beds as optimizer::FillingRatioOptions::bed_models ([layer][slabs], entry 0 empty).
   std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> models() const;
+  /// What the calibration runs, in words.
+  static constexpr std::string_view kWhat =
+      "each candidate bed alone in a DEM-in-the-loop free decay of the structure from the task's initial state; its "
+      "response period by period binned into a field over the strokes the decay passed";
+  static const base::Fields<BedCalibration>& fields();
 };
 
 /// The default cache folder: $XDG_CACHE_HOME/pdamp/bed_calibration, else
@@ -83,9 +92,5 @@ std::vector<std::string> recalibrate_in_design(const case_file::Case& c, const c
                                                BedCalibration& calibration, const std::vector<long>& slabs,
                                                double design_damping_ratio, double design_threshold_m, base::RunHooks& hooks,
                                                base::Executor& executor);
-
-/// The calibration's result keys (spec, cache folder, per bed: layer, slabs, key, cached, file,
-/// periods, stroke range, steps, wall time).
-nlohmann::json to_json(const BedCalibration& calibration);
 
 }  // namespace pdamp::tasks

@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/cosimulation.hpp"
@@ -116,6 +117,30 @@ struct DecayResult {
   std::vector<dem_reference::WorldOptions> bed_worlds;  ///< kDem: each damper's bed (the containers for ParaView)
   std::vector<std::string> warnings;
 };
+/// A decay's settling at the first damper's site, whichever method ran it.
+struct DecaySummary {
+  std::string method;              ///< formulas, field or dem
+  double settling_time_s = NAN;    ///< NaN: not settled within the duration
+  double damping_ratio = NAN;      ///< the equivalent damping ratio down to the threshold
+  int dominant_mode = 1;           ///< from 1
+  bool settled = false;
+  std::string threshold_point;
+  double threshold_m = NAN, threshold_fraction = NAN, initial_envelope_m = NAN;
+  std::vector<double> initial_modal_amplitudes;
+  double final_time_s = NAN, final_envelope_m = NAN;
+  static const base::Fields<DecaySummary>& fields();
+};
+DecaySummary decay_summary(const DecayResult& result);
+
+/// The same release with the containers empty, against the same threshold.
+struct BareDecaySummary {
+  double settling_time_s = NAN;
+  bool settled = false;
+  double damping_ratio = NAN, final_envelope_m = NAN;
+  static const base::Fields<BareDecaySummary>& fields();
+};
+BareDecaySummary without_beds_summary(const DecayResult& result);
+
 /// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
 DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, base::RunHooks& hooks);
 /// The result keys (task, case, method, file, settling_time_s, damping_ratio, decay, ...).

@@ -121,6 +121,10 @@ struct Verification {
   bool passed = false;
   double wall_time_s = 0.0;
   nlohmann::json mpi;  ///< how the two decays spread over processes, or null
+  /// What the verification runs, in words.
+  static constexpr std::string_view kWhat =
+      "DEM-in-the-loop free decay (structure::cosimulate) of the chosen and baseline designs on the optimiser's modal "
+      "model, from the task's initial state, against the prediction (the optimiser's bed models) over the same time";
   static const base::Fields<Verification>& fields();
 };
 

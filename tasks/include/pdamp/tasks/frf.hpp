@@ -141,6 +141,11 @@ FrfResult run_frf(const case_file::Case& c, const FrfOptions& options, base::Run
 nlohmann::json to_json(const FrfResult& result, const OutputFolder& folder);
 /// "transmissibility |X/U|" or "receptance |X/F| / (m/N)": the magnitude's axis label.
 std::string magnitude_label(const FrfResult& result);
+/// What the magnitude is, in words (the result's frf.magnitude).
+std::string magnitude_description(const FrfResult& result);
+/// Each output's peaks as the result reports them: the harmonic balance's, or each DEM
+/// direction's (stepped sine or sweep, NaN where a sweep found none); none for --compare.
+std::vector<PeakSummary> response_peaks(const FrfResult& result);
 /// The largest peak of the first output, or nullptr.
 const structure::ResponsePeak* first_output_peak(const structure::FrequencyResponse& response);
 /// "fold", "discontinuity" or "stroke_range".

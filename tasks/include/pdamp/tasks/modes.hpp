@@ -4,12 +4,14 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/backbone.hpp"
@@ -40,7 +42,24 @@ struct ModesResult {
   int rigid_modes_dropped = 0;
   bool converged = true;                           ///< every backbone point converged
   std::vector<std::string> warnings;
+  /// Mode j's μ_j summed over the dampers, in their order.
+  double modal_mass_ratio(Eigen::Index mode) const {
+    double total = 0.0;
+    for (Eigen::Index d = 0; d < mass_ratio.cols(); ++d) total += mass_ratio(mode, d);
+    return total;
+  }
 };
+
+/// A mode's backbone in brief: where the beds add the most damping, over which frequencies.
+struct BackboneSummary {
+  std::size_t points = 0;
+  double modal_mass_ratio = NAN;
+  double max_added_damping_ratio = NAN, max_added_damping_amplitude_m = NAN;
+  double min_damped_frequency_hz = NAN, max_damped_frequency_hz = NAN;
+  static const base::Fields<BackboneSummary>& fields();
+};
+/// Mode j's backbone (0-based), if it has one.
+std::optional<BackboneSummary> backbone_summary(const ModesResult& result, Eigen::Index mode);
 
 /// The modes study of a format-2 case (any task kind: the backbone range is the modes
 /// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance).
