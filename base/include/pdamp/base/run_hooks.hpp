@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace pdamp::base {
 
@@ -42,6 +43,28 @@ class RunHooks {
   virtual int stop_requested() { return 0; }
   /// Whether a run estimated to take longer than kMaxDemWallTime_s (a week) may start.
   virtual bool long_runs_accepted() { return false; }
+};
+
+/// Hooks that pass everything on to `inner`, the progress reports under `label`: a library
+/// reports its run's stage and numbers, its caller names the run ("pdamp dem", "pdamp frf
+/// (dem) up"). A report that has a label of its own (a point of a sweep) keeps it after the
+/// caller's.
+class LabelledHooks : public RunHooks {
+ public:
+  LabelledHooks(RunHooks& inner, std::string label) : inner_(inner), label_(std::move(label)) {}
+  void progress(const Progress& p) override {
+    Progress labelled = p;
+    labelled.label = p.label.empty() ? label_ : label_ + " " + p.label;
+    inner_.progress(labelled);
+  }
+  void note(const std::string& line) override { inner_.note(line); }
+  bool checkpoint_due(double seconds_since_checkpoint) override { return inner_.checkpoint_due(seconds_since_checkpoint); }
+  int stop_requested() override { return inner_.stop_requested(); }
+  bool long_runs_accepted() override { return inner_.long_runs_accepted(); }
+
+ private:
+  RunHooks& inner_;
+  std::string label_;
 };
 
 /// The hooks that report nothing, save no checkpoint and never stop.
