@@ -86,7 +86,7 @@ int run_optimum(const ParsedArgs& args, CommandContext&) {
   const auto model = model_flag(args, {"rolling", "bouncing"});
   const double h = args.number("--clearance", limits::kClearance);
   const auto result = fm::optimum_stroke(model, h, model_options(args, model));
-  json out = tasks::to_json(result);
+  json out = base::to_json(result);
   return finish(args, nullptr, out, length_scale_warnings(args, {"--clearance"}), optimum_rows(result), kPrintOnly);
 }
 
@@ -94,7 +94,7 @@ int run_size(const ParsedArgs& args, CommandContext&) {
   const auto model = model_flag(args, {"rolling", "bouncing"});
   const double stroke = args.number("--stroke", limits::kStroke);
   const auto sizing = tasks::size_for_stroke(model, stroke, model_options(args, model));
-  json out = tasks::to_json(sizing);
+  json out = base::to_json(sizing);
   return finish(args, nullptr, out, length_scale_warnings(args, {"--stroke"}),
                 {{"model", std::string(fm::to_string(model))},
                  {"stroke_m", format_number(stroke)},
@@ -154,7 +154,7 @@ int run_buffer(const ParsedArgs& args, CommandContext&) {
   const auto problems = in.validate();
   if (!problems.empty()) throw InputError("pdamp buffer", "", problems.front());
   const auto design = fm::size_buffer_layer(in);
-  json out = tasks::to_json(design);
+  json out = base::to_json(design);
   return finish(args, nullptr, out, design.warnings,
                 {{"model", std::string(design.model == fm::BufferModel::kLayered ? "layered" : "half_space")},
                  {"layer_thickness_m", format_number(design.layer_thickness_m)},

@@ -12,6 +12,21 @@
 #include <vector>
 
 namespace pdamp::formulas {
+
+const base::Fields<OptimumStroke>& OptimumStroke::fields() {
+  using O = OptimumStroke;
+  static const auto f =
+      base::Fields<O>()
+          .field("model", &O::model, "", "rolling or bouncing")
+          .field("clearance_m", &O::clearance_m, "m", "the clearance h")
+          .field("x_opt_m", &O::x_opt_m, "m", "the design stroke, calibration_factor times the ideal peak")
+          .field("x_opt_ideal_m", &O::x_opt_ideal_m, "m", "the ideal peak (1 + kappa) h / pi")
+          .field("x_onset_m", &O::x_onset_m, "m", "the onset of collect-and-collide, the cliff")
+          .field("calibration_factor", &O::calibration_factor, "1", "the design stroke over the ideal peak")
+          .field("eta_star_peak", &O::eta_star_peak, "1", "eta* at the ideal peak")
+          .field("eta_star_onset", &O::eta_star_onset, "1", "eta* at the onset");
+  return f;
+}
 namespace {
 
 /// Above this multiple of μ the friction takes less than 5% of the drive's acceleration

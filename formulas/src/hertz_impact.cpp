@@ -11,6 +11,30 @@
 #include "pdamp/formulas/layered_contact.hpp"
 
 namespace pdamp::formulas {
+
+const base::Fields<BufferDesign>& BufferDesign::fields() {
+  using B = BufferDesign;
+  static const auto f =
+      base::Fields<B>()
+          .derived("model", [](const B& b) { return std::string(b.model == BufferModel::kLayered ? "layered" : "half_space"); },
+                   "", "the contact law the layer was sized with: layered or half_space")
+          .field("layer_thickness_m", &B::layer_thickness_m, "m", "the layer thickness t")
+          .field("allowable_strain", &B::allowable_strain, "1", "the tip strain t was sized to")
+          .field("impact_velocity_m_s", &B::impact_velocity_m_s, "m/s", "the design impact speed")
+          .field("max_penetration_m", &B::max_penetration_m, "m", "delta_max at that speed")
+          .field("contact_time_s", &B::contact_time_s, "s", "the elastic contact time")
+          .field("contact_time_over_period", &B::contact_time_over_period, "1", "contact time times the frequency")
+          .field("effective_mass_kg", &B::effective_mass_kg, "kg", "the mass behind one contact")
+          .field("max_force_n", &B::max_force_n, "N", "the peak contact force")
+          .field("contact_radius_m", &B::contact_radius_m, "m", "the contact radius at delta_max")
+          .field("contact_radius_over_thickness", &B::contact_radius_over_thickness, "1", "a/t at delta_max")
+          .field("half_space_thickness_m", &B::half_space_thickness_m, "m", "the half-space rule's thickness")
+          .field("layered_compression_of_half_space_design", &B::layered_compression_of_half_space_design, "1",
+                 "delta_max/t of a layer of that thickness under the layered law")
+          .field("assumptions", &B::assumptions, "", "sentences with the numbers used")
+          .field("warnings", &B::warnings, "", "validity-range violations");
+  return f;
+}
 namespace {
 
 /// Thresholds of the buffer's validity warnings (docs/hertz_and_buffer.md).

@@ -11,13 +11,6 @@ namespace pdamp::tasks {
 namespace fm = formulas;
 using nlohmann::json;
 
-json to_json(const fm::OptimumStroke& o) {
-  return {{"model", fm::to_string(o.model)},          {"clearance_m", o.clearance_m},
-          {"x_opt_m", o.x_opt_m},                     {"x_opt_ideal_m", o.x_opt_ideal_m},
-          {"x_onset_m", o.x_onset_m},                 {"calibration_factor", o.calibration_factor},
-          {"eta_star_peak", o.eta_star_peak},         {"eta_star_onset", o.eta_star_onset}};
-}
-
 StrokeSizing size_for_stroke(fm::DamperModel model, double stroke_m, const fm::ModelOptions& options) {
   StrokeSizing out;
   out.model = model;
@@ -27,9 +20,16 @@ StrokeSizing size_for_stroke(fm::DamperModel model, double stroke_m, const fm::M
   return out;
 }
 
-json to_json(const StrokeSizing& s) {
-  return {{"model", fm::to_string(s.model)}, {"stroke_m", s.stroke_m}, {"clearance_m", s.clearance_m},
-          {"x_opt_ideal_m", s.at.x_opt_ideal_m}, {"x_onset_m", s.at.x_onset_m}};
+const base::Fields<StrokeSizing>& StrokeSizing::fields() {
+  using S = StrokeSizing;
+  static const auto f =
+      base::Fields<S>()
+          .field("model", &S::model, "", "rolling or bouncing")
+          .field("stroke_m", &S::stroke_m, "m", "the target stroke X")
+          .field("clearance_m", &S::clearance_m, "m", "the clearance whose design stroke is X")
+          .derived("x_opt_ideal_m", [](const S& s) { return s.at.x_opt_ideal_m; }, "m", "its ideal peak")
+          .derived("x_onset_m", [](const S& s) { return s.at.x_onset_m; }, "m", "its onset: strokes below fall off the cliff");
+  return f;
 }
 
 std::vector<CurvePoint> eta_curve(fm::DamperModel model, double clearance_m, double frequency_hz,
@@ -54,21 +54,26 @@ LossPoint loss_point(const fm::LossResult& loss, double bed_mass_kg, double freq
   return p;
 }
 
-json to_json(const LossPoint& p) {
-  const auto& loss = p.loss;
-  return {{"model", fm::to_string(loss.model_requested)},
-          {"model_used", fm::to_string(loss.model_used)},
-          {"eta_star", loss.eta_star},
-          {"e_diss_j", p.e_diss_j},
-          {"energy_per_cycle_j", p.energy_per_cycle_j},
-          {"equivalent_damping_n_s_m", p.equivalent_damping_n_s_m},
-          {"regime", fm::to_string(loss.regime)},
-          {"inertia_factor", loss.inertia_factor},
-          {"intensity", loss.intensity},
-          {"stroke_over_onset", loss.stroke_over_onset},
-          {"velocity_amplitude_m_s", loss.velocity_amplitude_m_s},
-          {"bed_mass_kg", p.bed_mass_kg},
-          {"warnings", loss.warnings}};
+const base::Fields<LossPoint>& LossPoint::fields() {
+  using P = LossPoint;
+  static const auto f =
+      base::Fields<P>()
+          .derived("model", [](const P& p) { return p.loss.model_requested; }, "", "the model asked for")
+          .derived("model_used", [](const P& p) { return p.loss.model_used; }, "", "the model that answered")
+          .derived("eta_star", [](const P& p) { return p.loss.eta_star; }, "1", "reduced loss factor")
+          .field("e_diss_j", &P::e_diss_j, "J", "energy dissipated per cycle, eta* 1/2 m_bed V^2")
+          .field("energy_per_cycle_j", &P::energy_per_cycle_j, "J", "the same over a whole cycle, pi E_diss")
+          .field("equivalent_damping_n_s_m", &P::equivalent_damping_n_s_m, "N s/m", "eta* m_bed Omega")
+          .derived("regime", [](const P& p) { return p.loss.regime; }, "", "the bed's state")
+          .derived("inertia_factor", [](const P& p) { return p.loss.inertia_factor; }, "1", "kappa of the rolling model")
+          .derived("intensity", [](const P& p) { return p.loss.intensity; }, "1", "X Omega^2 / g")
+          .derived("stroke_over_onset", [](const P& p) { return p.loss.stroke_over_onset; }, "1",
+                   "the stroke over the onset of collect-and-collide")
+          .derived("velocity_amplitude_m_s", [](const P& p) { return p.loss.velocity_amplitude_m_s; }, "m/s",
+                   "the container's velocity amplitude")
+          .field("bed_mass_kg", &P::bed_mass_kg, "kg", "the bed mass the energies are for")
+          .derived("warnings", [](const P& p) { return p.loss.warnings; }, "", "the model's range warnings");
+  return f;
 }
 
 LossStudy run_loss(const LossOptions& o) {
@@ -94,25 +99,10 @@ LossStudy run_loss(const LossOptions& o) {
 }
 
 json to_json(const LossStudy& s) {
-  json out = to_json(s.point);
+  json out = base::to_json(s.point);
   out.update({{"clearance_m", s.options.clearance_m}, {"amplitude_m", s.options.amplitude_m},
               {"frequency_hz", s.options.frequency_hz}});
   return out;
-}
-
-json to_json(const fm::BufferDesign& b) {
-  return {{"model", b.model == fm::BufferModel::kLayered ? "layered" : "half_space"},
-          {"layer_thickness_m", b.layer_thickness_m},   {"allowable_strain", b.allowable_strain},
-          {"impact_velocity_m_s", b.impact_velocity_m_s},
-          {"max_penetration_m", b.max_penetration_m},   {"contact_time_s", b.contact_time_s},
-          {"contact_time_over_period", b.contact_time_over_period},
-          {"effective_mass_kg", b.effective_mass_kg},   {"max_force_n", b.max_force_n},
-          {"contact_radius_m", b.contact_radius_m},
-          {"contact_radius_over_thickness", b.contact_radius_over_thickness},
-          {"half_space_thickness_m", b.half_space_thickness_m},
-          {"layered_compression_of_half_space_design", b.layered_compression_of_half_space_design},
-          {"assumptions", b.assumptions},
-          {"warnings", b.warnings}};
 }
 
 void require_finite(const json& result) {

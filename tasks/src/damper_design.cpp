@@ -72,7 +72,7 @@ DamperDesignResult run_damper_design(const case_file::Case& c) {
 
 json to_json(const DamperDesignResult& r) {
   json result = {{"task", "damper_design"}, {"case", r.case_name}, {"model", fm::to_string(r.family)},
-                 {"clearance_m", r.clearance_m}, {"bed_mass_kg", r.bed_mass_kg}, {"optimum", to_json(r.optimum)}};
+                 {"clearance_m", r.clearance_m}, {"bed_mass_kg", r.bed_mass_kg}, {"optimum", base::to_json(r.optimum)}};
   result["optimum"]["eta_star_at_design"] = r.eta_star_at_design;
   result["optimum"]["intensity_at_design"] = r.intensity_at_design;
   if (r.sizing)
@@ -80,11 +80,11 @@ json to_json(const DamperDesignResult& r) {
                         {"clearance_m", r.sizing->clearance_m},
                         {"container_inner_length_along_drive_m", r.sizing->container_inner_length_along_drive_m}};
   if (r.operating_point) {
-    result["operating_point"] = to_json(*r.operating_point);
+    result["operating_point"] = base::to_json(*r.operating_point);
     result["operating_point"]["amplitude_m"] = r.operating_amplitude_m;
   }
   if (r.buffer) {
-    result["buffer"] = to_json(*r.buffer);
+    result["buffer"] = base::to_json(*r.buffer);
     result["buffer"]["layer_material"] = r.buffer_layer_material;
   }
   return result;

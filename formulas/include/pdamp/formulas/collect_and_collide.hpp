@@ -17,6 +17,8 @@
 #include <string_view>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
+
 namespace pdamp::formulas {
 
 /// Standard gravity g, m/s^2 (intensity Γ = XΩ²/g).
@@ -164,6 +166,7 @@ struct OptimumStroke {
   double eta_star_peak = 0.0;  ///< 4/(π(1+κ))
   double eta_star_onset = 0.0; ///< 4π/((π²+4)(1+κ))
   double calibration_factor = 1.0;
+  static const base::Fields<OptimumStroke>& fields();
 };
 /// Onset, ideal peak and design stroke of the rolling (κ = options.rolling_inertia_factor)
 /// or bouncing (κ = 0) model for clearance h: x_opt_ideal = (1+κ)h/π,

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
+
 namespace pdamp::formulas {
 
 /// Isotropic elastic material. Defaults: structural steel.
@@ -128,6 +130,7 @@ struct BufferDesign {
   double layered_compression_of_half_space_design = 0.0;
   std::vector<std::string> assumptions;   ///< readable sentences with the numbers used
   std::vector<std::string> warnings;      ///< validity-range violations (docs/command_line.md)
+  static const base::Fields<BufferDesign>& fields();
 };
 /// Sizes the layer: X from Γ if needed, v = 2XΩ unless given, m* from the bed's sharing,
 /// E* from particle and layer; kLayered: t from ½m*v² = U(ε_a t; t) with the layered law

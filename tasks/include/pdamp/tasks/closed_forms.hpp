@@ -9,13 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
 
 namespace pdamp::tasks {
-
-/// The optimum stroke's keys (model, clearance_m, x_opt_m, x_opt_ideal_m, x_onset_m, ...).
-nlohmann::json to_json(const formulas::OptimumStroke& optimum);
 
 /// pdamp size: the clearance whose design stroke is `stroke_m`, and its landmarks.
 struct StrokeSizing {
@@ -23,9 +21,9 @@ struct StrokeSizing {
   double stroke_m = 0.0;       ///< the target stroke X, m
   double clearance_m = 0.0;    ///< h with x_opt(h) = X, m
   formulas::OptimumStroke at;  ///< the landmarks of that clearance
+  static const base::Fields<StrokeSizing>& fields();
 };
 StrokeSizing size_for_stroke(formulas::DamperModel model, double stroke_m, const formulas::ModelOptions& options);
-nlohmann::json to_json(const StrokeSizing& sizing);
 
 /// One point of a closed-form eta*(X) curve.
 struct CurvePoint {
@@ -46,9 +44,9 @@ struct LossPoint {
   double e_diss_j = 0.0;
   double energy_per_cycle_j = 0.0;
   double equivalent_damping_n_s_m = 0.0;
+  static const base::Fields<LossPoint>& fields();
 };
 LossPoint loss_point(const formulas::LossResult& loss, double bed_mass_kg, double frequency_hz);
-nlohmann::json to_json(const LossPoint& point);
 
 /// pdamp loss: what to evaluate.
 struct LossOptions {
@@ -76,8 +74,5 @@ nlohmann::json to_json(const LossStudy& study);
 /// A closed form's result that holds a number that is not finite (a formula at the edge of
 /// its range) is a numerical failure: base::NumericalError naming its JSON pointer.
 void require_finite(const nlohmann::json& result);
-
-/// The buffered-wall sizing's keys (layer_thickness_m, impact_velocity_m_s, ...).
-nlohmann::json to_json(const formulas::BufferDesign& design);
 
 }  // namespace pdamp::tasks
