@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
   damper.world = bed();
   damper.world.integration.time_step_s = kStep;
   damper.rotation = false;
-  st::CosimulationOptions options;
+  st::SteadyStateRun options;
   options.excitation.kind = st::CosimulationExcitationKind::kBaseTranslation;
   options.excitation.direction = {0.0, 1.0};
   options.excitation.amplitude = 0.00133;
@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
 
   // The coupled run's container trajectory, every step (an untimed run: the timed ones keep
   // the default sampling). The runs are deterministic, so each timed run moves the bed the same.
-  st::CosimulationOptions traced = options;
+  st::SteadyStateRun traced = options;
   traced.sample_interval_s = kStep;
   const auto trace = st::cosimulate(one_mode(), {damper}, traced);
   if (trace.outcome != dr::Outcome::kCompleted) {

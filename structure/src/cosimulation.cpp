@@ -1,11 +1,13 @@
 // The co-simulation run (docs/cosimulation.md §3-5, §8): its state as members, a coupled step
-// as named, timed stages, and the measures fed after each step behind one interface.
-#include "pdamp/structure/cosimulation_run.hpp"
+// as named, timed stages, and the measures fed after each step behind one interface; and
+// cosimulate(), which runs it through (cosimulation.hpp).
+#include "pdamp/structure/cosimulation.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string_view>
@@ -13,6 +15,7 @@
 #include "cosimulation_plan.hpp"
 #include "numbers.hpp"
 #include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
 
 namespace pdamp::structure {
@@ -170,7 +173,7 @@ class SampledHistory final : public RunMeasure {
 /// beds' η* and m_app from them.
 class SteadyStateMeasure final : public RunMeasure {
  public:
-  SteadyStateMeasure(const CosimulationOptions& options, std::int64_t steps_per_period, double frequency_hz,
+  SteadyStateMeasure(const detail::RunOptions& options, std::int64_t steps_per_period, double frequency_hz,
                      std::vector<double> bed_masses_kg, Eigen::Index modes)
       : steps_per_period_(steps_per_period),
         transient_steps_(options.transient_periods * steps_per_period),
@@ -339,8 +342,8 @@ class StageClock {
 struct Cosimulation::Impl {
   /// A fresh run (`state` and `earlier` null), a continuation of `state`, or a restored free
   /// decay (`state` and `earlier` from a checkpoint). Throws before it takes `state`.
-  Impl(const ModalModel& model, const std::vector<CosimulationDamper>& dampers, const CosimulationOptions& options,
-       CosimulationState* state, const CosimulationResult* earlier, CosimulationProgressCallback progress);
+  Impl(const ModalModel& model, const std::vector<CosimulationDamper>& dampers, const detail::RunOptions& options,
+       CosimulationState* state, const CosimulationResult* earlier, base::RunHooks& hooks);
 
   // --- Construction, in order.
   void check_inputs(const ModalModel& model, const CosimulationState* state, const CosimulationResult* earlier) const;
@@ -364,7 +367,7 @@ struct Cosimulation::Impl {
   [[gnu::always_inline]] void commit_step();
   [[gnu::always_inline]] void feed_measures();
   void report_progress();
-  /// Every bed's particles and container now (CosimulationOptions::snapshots): at the
+  /// Every bed's particles and container now (CosimulationSettings::snapshots): at the
   /// planned steps only, so the copy is outside the step loop's allocation-free path.
   void take_snapshots();
   std::int64_t snapshot_step(std::size_t s) const {
@@ -389,7 +392,7 @@ struct Cosimulation::Impl {
   /// T' and V of the structure at the run's present step.
   std::pair<double, double> structure_energy_now() const;
 
-  std::int64_t advance(std::int64_t steps, const std::function<bool()>& stop);
+  std::int64_t advance(std::int64_t steps);
   bool finished() const { return outcome_ != dem::Outcome::kCompleted || step_ >= end_step_; }
   /// The run so far; `release`: the measures' large parts moved out (the run is spent).
   CosimulationResult result(bool release);
@@ -397,8 +400,9 @@ struct Cosimulation::Impl {
 
   // --- Inputs.
   std::vector<CosimulationDamper> dampers_;
-  CosimulationOptions options_;
-  CosimulationProgressCallback progress_;
+  detail::RunOptions options_;
+  base::RunHooks* hooks_;
+  int stop_signal_ = 0;  ///< the stop request that ended advance() early
   bool continuation_ = false;  ///< continues a CosimulationState (no settling)
   bool restored_ = false;      ///< a free decay restored from its checkpoint
   bool is_harmonic_ = false, is_sweep_ = false, is_base_ = false, periodic_ = false;
@@ -460,9 +464,9 @@ struct Cosimulation::Impl {
 };
 
 Cosimulation::Impl::Impl(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                         const CosimulationOptions& options, CosimulationState* state,
-                         const CosimulationResult* earlier, CosimulationProgressCallback progress)
-    : dampers_(dampers), options_(options), progress_(std::move(progress)) {
+                         const detail::RunOptions& options, CosimulationState* state,
+                         const CosimulationResult* earlier, base::RunHooks& hooks)
+    : dampers_(dampers), options_(options), hooks_(&hooks) {
   const auto wall_start = Clock::now();
   continuation_ = state != nullptr && earlier == nullptr;
   restored_ = earlier != nullptr;
@@ -546,7 +550,7 @@ void Cosimulation::Impl::plan(const ModalModel& model, const CosimulationState* 
   if (!restored_) warnings_.insert(warnings_.end(), modal_.warnings.begin(), modal_.warnings.end());
   if (continuation_) {
     // The step this frequency would take on its own: a warning if the carried one is longer.
-    CosimulationOptions automatic = options_;
+    detail::RunOptions automatic = options_;
     automatic.time_step_s = 0.0;
     const detail::StepPlan own = detail::plan_step(modal_, dampers_, automatic, f_plan_);
     if (dt_ > own.dt * (1.0 + detail::kCarriedStepMargin))
@@ -693,18 +697,22 @@ void Cosimulation::Impl::build_and_settle_worlds() {
                                                                 : dem::automatic_settling_time_s(world_options_[d]);
     const auto steps = static_cast<std::int64_t>(std::llround(settling / dt_));
     settling_steps_ = std::max(settling_steps_, steps);
-    if (progress_) progress_(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps_) * dt_, 0.0});
-    // A big bed settles for hours: a "settling" report about every progress_interval_s
-    // (read every kStopPollSteps steps), where the caller may also end the run by throwing.
+    const double end_s = static_cast<double>(planned_steps_) * dt_;
+    hooks_->progress({"", "settling", 0.0, end_s, false, 0.0, NAN});
+    // A big bed settles for hours: a "settling" report about every progress_interval_s, and
+    // a stop request met within kStopPollSteps steps. No consistent state exists yet, so a
+    // stop ends the run without one.
     auto last = Clock::now();
     const auto observe = [&](std::int64_t k) {
-      if (!progress_ || (k + 1) % Cosimulation::kStopPollSteps != 0) return;
+      if ((k + 1) % Cosimulation::kStopPollSteps != 0) return;
+      if (const int signal = hooks_->stop_requested(); signal != 0)
+        throw base::Interrupted(signal, "the co-simulation stopped while its beds settled, before its coupled steps: "
+                                        "nothing was kept");
       const auto now = Clock::now();
       const double since = std::chrono::duration<double>(now - last).count();
       if (since < options_.progress_interval_s) return;
       last = now;
-      progress_(CosimulationProgress{"settling", 0.0, static_cast<double>(planned_steps_) * dt_,
-                                     static_cast<double>(Cosimulation::kStopPollSteps) / since});
+      hooks_->progress({"", "settling", 0.0, end_s, false, static_cast<double>(Cosimulation::kStopPollSteps) / since, NAN});
     };
     if (!dem::settle(worlds[d], containers_[d], steps, observe)) {
       outcome_ = worlds[d].status().outcome;
@@ -793,12 +801,13 @@ void Cosimulation::Impl::take_snapshots() {
       snapshots_.size() < static_cast<std::size_t>(options_.snapshots) ? snapshot_step(snapshots_.size()) : -1;
 }
 
-std::int64_t Cosimulation::Impl::advance(std::int64_t steps, const std::function<bool()>& stop) {
+std::int64_t Cosimulation::Impl::advance(std::int64_t steps) {
   const auto wall_start = Clock::now();
   std::int64_t taken = 0;
+  stop_signal_ = 0;
   while (taken < steps && step_ < end_step_ && outcome_ == dem::Outcome::kCompleted && step()) {
     ++taken;
-    if (stop && taken % kStopPollSteps == 0 && stop()) break;
+    if (taken % kStopPollSteps == 0 && (stop_signal_ = hooks_->stop_requested()) != 0) break;
   }
   wall_s_ += seconds_since(wall_start);
   return taken;
@@ -912,13 +921,13 @@ inline void Cosimulation::Impl::feed_measures() {
 
 // About every progress_interval_s of wall time, read every kProgressStride steps.
 void Cosimulation::Impl::report_progress() {
-  if (!progress_ || step_ % kProgressStride != 0) return;
+  if (step_ % kProgressStride != 0) return;
   const auto now = Clock::now();
   const double since = std::chrono::duration<double>(now - last_report_).count();
   if (since < options_.progress_interval_s) return;
-  progress_(CosimulationProgress{measures_.front()->stage(), static_cast<double>(step_) * dt_,
-                                 static_cast<double>(end_step_) * dt_,
-                                 static_cast<double>(step_ - last_report_step_) / since});
+  hooks_->progress({"", std::string(measures_.front()->stage()), static_cast<double>(step_) * dt_,
+                    static_cast<double>(end_step_) * dt_, false, static_cast<double>(step_ - last_report_step_) / since,
+                    NAN});
   last_report_ = now;
   last_report_step_ = step_;
 }
@@ -1043,34 +1052,33 @@ void Cosimulation::Impl::sync_state() {
 Cosimulation::Cosimulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Cosimulation::Cosimulation(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                           const CosimulationOptions& options, CosimulationProgressCallback progress)
-    : impl_(std::make_unique<Impl>(model, dampers, options, nullptr, nullptr, std::move(progress))) {}
+                           const CosimulationRun& run, base::RunHooks& hooks)
+    : impl_(std::make_unique<Impl>(model, dampers, detail::run_options(run), nullptr, nullptr, hooks)) {}
 
 Cosimulation::Cosimulation(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                           const CosimulationOptions& options, CosimulationState&& state,
-                           CosimulationProgressCallback progress)
-    : impl_(std::make_unique<Impl>(model, dampers, options, state.started() ? &state : nullptr, nullptr,
-                                   std::move(progress))) {}
+                           const CosimulationRun& run, CosimulationState&& state, base::RunHooks& hooks)
+    : impl_(std::make_unique<Impl>(model, dampers, detail::run_options(run), state.started() ? &state : nullptr, nullptr,
+                                   hooks)) {}
 
 Cosimulation Cosimulation::restore(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                   const CosimulationOptions& options, dem::StateReader& in,
-                                   CosimulationProgressCallback progress) {
+                                   const DecayRun& run, dem::StateReader& in, base::RunHooks& hooks) {
+  const detail::RunOptions options = detail::run_options(run);
   detail::validate_inputs(model, dampers, options, false);
   CosimulationState state = restore_cosimulation_state(model, dampers, in);
   const CosimulationResult earlier = restore_cosimulation_result(in, model.mode_count(), dampers.size());
-  return Cosimulation(std::make_unique<Impl>(model, dampers, options, &state, &earlier, std::move(progress)));
+  return Cosimulation(std::make_unique<Impl>(model, dampers, options, &state, &earlier, hooks));
 }
 
 Cosimulation::Cosimulation(Cosimulation&&) noexcept = default;
 Cosimulation& Cosimulation::operator=(Cosimulation&&) noexcept = default;
 Cosimulation::~Cosimulation() = default;
 
-std::int64_t Cosimulation::advance(std::int64_t steps) { return advance(steps, {}); }
-
-std::int64_t Cosimulation::advance(std::int64_t steps, const std::function<bool()>& stop) {
+std::int64_t Cosimulation::advance(std::int64_t steps) {
   if (impl_->state_.worlds.empty()) throw std::logic_error("Cosimulation::advance: the state was handed over");
-  return impl_->advance(steps, stop);
+  return impl_->advance(steps);
 }
+
+int Cosimulation::stop_signal() const { return impl_->stop_signal_; }
 
 bool Cosimulation::finished() const { return impl_->finished(); }
 std::int64_t Cosimulation::steps_done() const { return impl_->step_; }
@@ -1101,6 +1109,38 @@ void Cosimulation::save(dem::StateWriter& out) const {
     throw std::logic_error("Cosimulation::save: a harmonic run's measures are not in a checkpoint (save its state)");
   save_cosimulation_state(state(), out);
   save_cosimulation_result(result(), out);
+}
+
+// ------------------------------------------------------------------ the free functions
+
+CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                                            const CosimulationRun& run) {
+  const detail::RunOptions options = detail::run_options(run);
+  detail::validate_inputs(model, dampers, options, false);
+  const Eigen::Index n = model.mode_count();
+  const double f = options.excitation.frequency_hz;
+  const detail::Prepared P = detail::prepare(model, dampers, options, f,
+                                             detail::start_vector(options.initial_modal_displacements, n),
+                                             detail::start_vector(options.initial_modal_velocities, n));
+  detail::StepPlan plan = detail::plan_step(P, dampers, options, f);
+  return {plan.dt, plan.steps_per_period, std::move(plan.warnings)};
+}
+
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationRun& run, base::RunHooks& hooks) {
+  CosimulationState state;
+  return cosimulate(model, dampers, run, state, hooks);
+}
+
+CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
+                              const CosimulationRun& run, CosimulationState& state, base::RunHooks& hooks) {
+  Cosimulation cosimulation(model, dampers, run, std::move(state), hooks);
+  cosimulation.advance(std::numeric_limits<std::int64_t>::max());
+  if (const int signal = cosimulation.stop_signal(); signal != 0)
+    throw base::Interrupted(signal, "the co-simulation stopped; it had no checkpoint, so nothing was kept");
+  CosimulationResult result = std::move(cosimulation).result();
+  state = std::move(cosimulation).take_state();
+  return result;
 }
 
 }  // namespace pdamp::structure

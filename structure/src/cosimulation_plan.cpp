@@ -1,6 +1,7 @@
-// Co-simulation of a modal model with one reference-DEM World per damper (docs/cosimulation.md):
-// input checks, planning, the free functions over the Cosimulation class, checkpoints.
-#include "pdamp/structure/cosimulation.hpp"
+// What a co-simulation run needs before its first step (cosimulation_plan.hpp): the run's
+// options as one struct and their checks, the dampers' checks, the modal arrays with the
+// containers, the excitation's shapes and the common step (docs/cosimulation.md §1-3).
+#include "cosimulation_plan.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,38 +11,13 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "cosimulation_plan.hpp"
 #include "numbers.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/dem_reference/drive_time_step.hpp"
-#include "pdamp/structure/cosimulation_run.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 
 namespace pdamp::structure {
-
-const base::Fields<CosimulationSweepCycle>& CosimulationSweepCycle::fields() {
-  using C = CosimulationSweepCycle;
-  static const auto f =
-      base::Fields<C>()
-          .field("time_s", &C::time_s, "s", "the cycle's middle")
-          .field("frequency_hz", &C::frequency_hz, "Hz", "the cycle's mean frequency")
-          .field("magnitude", &C::site_amplitude_per_excitation, "1 or m/N",
-                 "first-harmonic amplitude of each damper's site per unit excitation", base::kPerOutput)
-          .derived(
-              "phase_deg",
-              [](const C& c) {
-                std::vector<double> phase;
-                for (const auto& a : c.site_amplitudes_m) phase.push_back(std::arg(a) * 180.0 / std::numbers::pi);
-                return phase;
-              },
-              "deg", "phase of each damper site's first harmonic", base::kPerOutput)
-          .field("bed_eta_star", &C::bed_reduced_loss_factor, "1", "each bed's reduced loss factor in the cycle",
-                 base::kPerOutput | base::kNullable)
-          .field("bed_apparent_mass_fraction", &C::bed_apparent_mass_fraction, "1",
-                 "each bed's apparent mass over its mass in the cycle", base::kPerOutput | base::kNullable);
-  return f;
-}
 
 namespace {
 
@@ -112,31 +88,6 @@ std::string join(const std::vector<std::string>& lines) {
 
 }  // namespace detail
 
-AmplitudeWindow amplitude_window(const std::vector<double>& period_amplitudes, std::size_t window) {
-  AmplitudeWindow out;
-  const std::size_t n = period_amplitudes.size(), w = std::min(window, n);
-  if (w < 2) return out;
-  const auto first = period_amplitudes.end() - static_cast<std::ptrdiff_t>(w);
-  double mean = 0.0;
-  for (auto it = first; it != period_amplitudes.end(); ++it) mean += *it;
-  mean /= static_cast<double>(w);
-  if (!(mean > 0.0)) return out;
-  double change = 0.0, ss = 0.0;
-  for (auto it = first; it != period_amplitudes.end(); ++it) {
-    ss += (*it - mean) * (*it - mean);
-    if (it != first) change = std::max(change, std::abs(*it - *(it - 1)));
-  }
-  out.periods = static_cast<int>(w);
-  out.max_relative_change = change / mean;
-  out.relative_drift = std::abs(period_amplitudes.back() - *first) / mean;
-  out.relative_spread = std::sqrt(ss / static_cast<double>(w - 1)) / mean;
-  return out;
-}
-
-bool amplitudes_converged(const AmplitudeWindow& w, double tolerance, std::size_t window) {
-  return w.periods >= static_cast<int>(window) && w.max_relative_change <= tolerance && w.relative_drift <= tolerance;
-}
-
 dem::Matrix3 rotation_about(const dem::Vec3& k, double angle_rad) {
   const double c = std::cos(angle_rad), s = std::sin(angle_rad), t = 1.0 - c;
   return {t * k[0] * k[0] + c,        t * k[0] * k[1] - s * k[2], t * k[0] * k[2] + s * k[1],
@@ -166,11 +117,51 @@ std::vector<std::string> CosimulationDamper::validate(const ModalModel& model) c
   return problems;
 }
 
-std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) const {
+const CosimulationSettings& settings_of(const CosimulationRun& run) {
+  return std::visit([](const auto& r) -> const CosimulationSettings& { return r; }, run);
+}
+
+std::vector<std::string> validate(const CosimulationRun& run, const ModalModel& model) {
+  return detail::run_options(run).validate(model);
+}
+
+namespace detail {
+
+RunOptions run_options(const CosimulationRun& run) {
+  RunOptions o;
+  static_cast<CosimulationSettings&>(o) = settings_of(run);
+  if (const auto* decay = std::get_if<DecayRun>(&run)) {
+    o.kind = RunOptions::Kind::kDecay;
+    o.duration_s = decay->duration_s;
+  } else if (const auto* steady = std::get_if<SteadyStateRun>(&run)) {
+    o.kind = RunOptions::Kind::kSteadyState;
+    o.excitation = steady->excitation;
+    o.excitation_phase_rad = steady->excitation_phase_rad;
+    o.transient_periods = steady->transient_periods;
+    o.min_transient_periods = steady->min_transient_periods;
+    o.analysed_periods = steady->analysed_periods;
+    o.settle_until_stable = steady->settle_until_stable;
+    o.stable_tolerance = steady->stable_tolerance;
+  } else {
+    const auto& sweep = std::get<SweepRun>(run);
+    o.kind = RunOptions::Kind::kSweep;
+    o.excitation = sweep.excitation;
+    o.excitation_phase_rad = sweep.excitation_phase_rad;
+    o.sweep_end_frequency_hz = sweep.sweep_end_frequency_hz;
+    o.duration_s = sweep.duration_s;
+  }
+  return o;
+}
+
+std::vector<std::string> RunOptions::validate(const ModalModel& model) const {
   std::vector<std::string> p;
   const std::string at = "cosimulation.";
   const Eigen::Index modes = model.mode_count();
   const auto& e = excitation;
+  if (kind != Kind::kDecay && !harmonic(e))
+    p.push_back(at + "excitation.kind = free decay: a harmonic run is driven by a base translation or a point force");
+  if (kind == Kind::kSweep && sweep_end_frequency_hz == 0.0)
+    p.push_back(at + "sweep_end_frequency_hz = 0: must be in [0.01, 10000] Hz (a linear sweep)");
   if (harmonic(e)) {
     if (!(std::abs(e.direction.norm() - 1.0) <= kUnitTolerance))
       p.push_back(at + "excitation.direction = " + vec2(e.direction) + ": must be a unit vector");
@@ -242,12 +233,11 @@ std::vector<std::string> CosimulationOptions::validate(const ModalModel& model) 
   return p;
 }
 
-namespace detail {
 
 /// Every violation of the inputs, one per line (a continuation drops the free decay's
 /// need of a non-zero start: it starts from the state).
 void validate_inputs(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                     const CosimulationOptions& options, bool continuation) {
+                     const RunOptions& options, bool continuation) {
   std::vector<std::string> problems = model.validate();
   if (dampers.empty()) problems.push_back("dampers: must hold at least one damper");
   for (std::size_t d = 0; d < dampers.size(); ++d)
@@ -263,7 +253,7 @@ void validate_inputs(const ModalModel& model, const std::vector<CosimulationDamp
 
 /// Whether `state` can be continued with these inputs: one line per misfit.
 void validate_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                    const CosimulationOptions& options, const CosimulationState& state) {
+                    const RunOptions& options, const CosimulationState& state) {
   std::vector<std::string> p;
   const std::string at = "cosimulation state: ";
   if (state.worlds.size() != dampers.size())
@@ -306,7 +296,7 @@ void validate_state(const ModalModel& model, const std::vector<CosimulationDampe
 
 /// Modal arrays, excitation shapes and peak speeds for the start q, v at frequency f_hz.
 Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                 const CosimulationOptions& options, double f_hz, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+                 const RunOptions& options, double f_hz, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
   Prepared P;
   const auto& exc = options.excitation;
   const bool is_harmonic = harmonic(exc);
@@ -412,7 +402,7 @@ Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>&
   return P;
 }
 
-StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const CosimulationOptions& options,
+StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const RunOptions& options,
                    double f_hz) {
   StepPlan plan;
   const bool is_harmonic = harmonic(options.excitation);
@@ -483,276 +473,5 @@ Eigen::VectorXd start_vector(const Eigen::VectorXd& given, Eigen::Index n) {
 }
 
 }  // namespace detail
-
-CosimulationTimeStep cosimulation_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                            const CosimulationOptions& options) {
-  validate_inputs(model, dampers, options, false);
-  const Eigen::Index n = model.mode_count();
-  const double f = options.excitation.frequency_hz;
-  const Prepared P = prepare(model, dampers, options, f, start_vector(options.initial_modal_displacements, n),
-                             start_vector(options.initial_modal_velocities, n));
-  StepPlan plan = plan_step(P, dampers, options, f);
-  return {plan.dt, plan.steps_per_period, std::move(plan.warnings)};
-}
-
-CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                              const CosimulationOptions& options, const CosimulationProgressCallback& progress) {
-  CosimulationState state;
-  return cosimulate(model, dampers, options, state, progress);
-}
-
-CosimulationResult cosimulate(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                              const CosimulationOptions& options, CosimulationState& state,
-                              const CosimulationProgressCallback& progress) {
-  Cosimulation run(model, dampers, options, std::move(state), progress);
-  run.advance(std::numeric_limits<std::int64_t>::max());
-  CosimulationResult result = std::move(run).result();
-  state = std::move(run).take_state();
-  return result;
-}
-
-// ------------------------------------------------------------------ checkpoints
-
-namespace {
-
-constexpr std::size_t kMaxModes = 100000;
-constexpr std::size_t kMaxDampers = 1000;
-constexpr std::size_t kMaxSamples = 100000000;
-constexpr std::size_t kMaxWarningBytes = 1 << 16;
-
-void write_matrix(dem::StateWriter& out, const Eigen::MatrixXd& m) {
-  out.i64(m.rows());
-  out.i64(m.cols());
-  for (Eigen::Index j = 0; j < m.cols(); ++j)
-    for (Eigen::Index i = 0; i < m.rows(); ++i) out.f64(m(i, j));
-}
-
-Eigen::MatrixXd read_matrix(dem::StateReader& in, const char* field, std::size_t rows, std::size_t cols) {
-  const std::size_t r = in.count(field, kMaxSamples, 0), c = in.count(field, kMaxModes, 0);
-  if (r != rows || c != cols)
-    in.fail(field, std::to_string(r) + " x " + std::to_string(c) + ": must be " + std::to_string(rows) + " x " +
-                       std::to_string(cols));
-  if (c > 0 && r > in.remaining() / (8 * c)) in.fail(field, "holds more values than the bytes left");
-  Eigen::MatrixXd m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
-  for (Eigen::Index j = 0; j < m.cols(); ++j)
-    for (Eigen::Index i = 0; i < m.rows(); ++i) m(i, j) = in.finite(field);
-  return m;
-}
-
-void write_vector(dem::StateWriter& out, const Eigen::VectorXd& v) {
-  out.f64s(std::vector<double>(v.data(), v.data() + v.size()));
-}
-
-Eigen::VectorXd read_vector(dem::StateReader& in, const char* field, std::size_t size) {
-  const std::vector<double> v = in.finite_f64s(field, size);
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-}
-
-}  // namespace
-
-void save_cosimulation_state(const CosimulationState& state, dem::StateWriter& out) {
-  out.tag("cosimulation state");
-  out.i64(static_cast<std::int64_t>(state.worlds.size()));
-  for (const dem::World& world : state.worlds) {
-    const auto& integ = world.options().integration;
-    out.f64(integ.time_step_s);
-    out.i32(integ.steps_per_contact);
-    for (double v : {integ.rayleigh_fraction, integ.max_impact_speed_m_s, integ.skin_fraction, integ.max_overlap_fraction})
-      out.f64(v);
-    world.save_state(out);
-  }
-  write_vector(out, state.modal_displacements);
-  write_vector(out, state.modal_velocities);
-  out.f64(state.time_s);
-  out.i64(state.steps);
-  out.f64(state.time_step_s);
-  const auto& e = state.excitation;
-  out.i32(static_cast<std::int32_t>(e.kind));
-  out.f64(e.direction.x());
-  out.f64(e.direction.y());
-  out.f64(e.amplitude);
-  out.f64(e.frequency_hz);
-  out.text(e.point);
-  out.f64(state.excitation_phase_rad);
-  CosimulationEnergy e_since = state.energy_since_start;
-  for (double* v : energy_terms(e_since)) out.f64(*v);
-  out.f64(state.start_structure_kinetic_j);
-  out.f64(state.start_structure_potential_j);
-  for (const auto& a : state.start_world_energy)
-    for (double v : {a.container_work_j, a.normal_damping_j, a.friction_j, a.rolling_j, a.kinetic_j, a.potential_j,
-                     a.elastic_j})
-      out.f64(v);
-  out.tag("end of cosimulation state");
-}
-
-CosimulationState restore_cosimulation_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                             dem::StateReader& in) {
-  CosimulationState state;
-  in.expect_tag("cosimulation state");
-  const std::size_t worlds = in.count("worlds", kMaxDampers, 8);
-  if (worlds != dampers.size())
-    in.fail("worlds", std::to_string(worlds) + " in the state for " + std::to_string(dampers.size()) +
-                          " damper(s): a state of another case");
-  for (std::size_t d = 0; d < worlds; ++d) {
-    dem::WorldOptions options = dampers[d].world;
-    auto& integ = options.integration;
-    integ.time_step_s = in.finite("integration.time_step_s");
-    integ.steps_per_contact = in.i32("integration.steps_per_contact");
-    for (double* v : {&integ.rayleigh_fraction, &integ.max_impact_speed_m_s, &integ.skin_fraction,
-                      &integ.max_overlap_fraction})
-      *v = in.finite("integration");
-    try {
-      state.worlds.emplace_back(options);
-    } catch (const std::invalid_argument& e) {
-      in.fail("damper " + dampers[d].name, std::string("its world cannot be built with the saved settings: ") + e.what());
-    }
-    state.worlds.back().restore_state(in);
-  }
-  const auto modes = static_cast<std::size_t>(model.mode_count());
-  state.modal_displacements = read_vector(in, "modal_displacements", modes);
-  state.modal_velocities = read_vector(in, "modal_velocities", modes);
-  state.time_s = in.finite("time_s");
-  state.steps = in.i64("steps");
-  state.time_step_s = in.finite("time_step_s");
-  if (state.steps < 0 || !(state.time_step_s > 0.0)) in.fail("steps", "a negative count or a step that is not > 0");
-  for (const auto& w : state.worlds)
-    if (w.time_step_s() != state.time_step_s) in.fail("time_step_s", "differs from the worlds' step");
-  auto& e = state.excitation;
-  e.kind = static_cast<CosimulationExcitationKind>(in.i32_in("excitation.kind", 0, 2));
-  const double ex = in.finite("excitation.direction"), ey = in.finite("excitation.direction");
-  e.direction = {ex, ey};
-  e.amplitude = in.finite("excitation.amplitude");
-  e.frequency_hz = in.finite("excitation.frequency_hz");
-  e.point = in.text("excitation.point", 4096);
-  state.excitation_phase_rad = in.finite("excitation_phase_rad");
-  for (double* v : energy_terms(state.energy_since_start)) *v = in.finite("energy_since_start");
-  state.energy_since_start.relative_error = ledger_error(state.energy_since_start);
-  state.start_structure_kinetic_j = in.finite("start_structure_kinetic_j");
-  state.start_structure_potential_j = in.finite("start_structure_potential_j");
-  state.start_world_energy.resize(worlds);
-  for (auto& a : state.start_world_energy)
-    for (double* v : {&a.container_work_j, &a.normal_damping_j, &a.friction_j, &a.rolling_j, &a.kinetic_j, &a.potential_j,
-                      &a.elastic_j})
-      *v = in.finite("start_world_energy");
-  in.expect_tag("end of cosimulation state");
-  return state;
-}
-
-void save_cosimulation_result(const CosimulationResult& r, dem::StateWriter& out) {
-  // "2": with the beds' snapshots (an older checkpoint is refused at this tag).
-  out.tag("cosimulation result 2");
-  out.i32(static_cast<std::int32_t>(r.outcome));
-  out.text(r.message);
-  out.f64(r.time_step_s);
-  for (std::int64_t v : {r.steps, r.steps_per_period, r.settling_steps}) out.i64(v);
-  out.f64(r.simulated_time_s);
-  out.f64(r.start_time_s);
-  out.u8(r.continued ? 1 : 0);
-  out.f64(r.wall_time_s);
-  write_vector(out, r.frequencies_with_containers_hz);
-  write_vector(out, r.final_modal_displacements);
-  write_vector(out, r.final_modal_velocities);
-  const auto& h = r.history;
-  out.f64s(h.time_s);
-  for (const auto* m : {&h.modal_displacements, &h.site_displacement_m, &h.site_rotation_rad, &h.container_load_n,
-                        &h.container_moment_nm})
-    write_matrix(out, *m);
-  out.f64s(h.pending_load_sum_n);
-  out.f64s(h.pending_moment_sum_nm);
-  out.i64(h.pending_steps);
-  out.i64(static_cast<std::int64_t>(r.warnings.size()));
-  for (const auto& w : r.warnings) out.text(w);
-  out.i64(static_cast<std::int64_t>(r.bed_snapshots.size()));
-  for (const auto& beds : r.bed_snapshots)
-    for (const auto& bed : beds) {
-      dem::save_particle_snapshot(out, bed.particles);
-      for (double x : bed.container_position_m) out.f64(x);
-    }
-  out.tag("end of cosimulation result");
-}
-
-CosimulationResult restore_cosimulation_result(dem::StateReader& in, Eigen::Index modes, std::size_t dampers) {
-  CosimulationResult r;
-  in.expect_tag("cosimulation result 2");
-  r.outcome = static_cast<dem::Outcome>(in.i32_in("outcome", 0, 2));
-  r.message = in.text("message", kMaxWarningBytes);
-  r.time_step_s = in.finite("time_step_s");
-  for (std::int64_t* v : {&r.steps, &r.steps_per_period, &r.settling_steps}) {
-    *v = in.i64("steps");
-    if (*v < 0) in.fail("steps", "must not be negative");
-  }
-  r.simulated_time_s = in.finite("simulated_time_s");
-  r.start_time_s = in.finite("start_time_s");
-  r.continued = in.boolean("continued");
-  r.wall_time_s = in.finite("wall_time_s");
-  const auto n = static_cast<std::size_t>(modes);
-  r.frequencies_with_containers_hz = read_vector(in, "frequencies_with_containers_hz", n);
-  r.final_modal_displacements = read_vector(in, "final_modal_displacements", n);
-  r.final_modal_velocities = read_vector(in, "final_modal_velocities", n);
-  auto& h = r.history;
-  h.time_s = in.finite_f64s_up_to("history.time_s", kMaxSamples);
-  const std::size_t samples = h.time_s.size();
-  h.modal_displacements = read_matrix(in, "history.modal_displacements", samples, n);
-  h.site_displacement_m = read_matrix(in, "history.site_displacement_m", samples, dampers);
-  h.site_rotation_rad = read_matrix(in, "history.site_rotation_rad", samples, dampers);
-  h.container_load_n = read_matrix(in, "history.container_load_n", samples, dampers);
-  h.container_moment_nm = read_matrix(in, "history.container_moment_nm", samples, dampers);
-  h.pending_load_sum_n = in.finite_f64s_up_to("history.pending_load_sum_n", dampers);
-  h.pending_moment_sum_nm = in.finite_f64s_up_to("history.pending_moment_sum_nm", dampers);
-  h.pending_steps = in.i64("history.pending_steps");
-  if (h.pending_steps < 0) in.fail("history.pending_steps", "must not be negative");
-  const std::size_t warnings = in.count("warnings", 10000, 8);
-  for (std::size_t k = 0; k < warnings; ++k) r.warnings.push_back(in.text("warnings", kMaxWarningBytes));
-  const std::size_t snapshots = in.count("bed_snapshots", static_cast<std::size_t>(dem::limits::kMaxSnapshots), 8);
-  for (std::size_t k = 0; k < snapshots; ++k) {
-    std::vector<BedSnapshot> beds(dampers);
-    for (auto& bed : beds) {
-      bed.particles = dem::restore_particle_snapshot(in, "bed_snapshot");
-      for (double& x : bed.container_position_m) x = in.finite("bed_snapshot.container_position_m");
-    }
-    r.bed_snapshots.push_back(std::move(beds));
-  }
-  in.expect_tag("end of cosimulation result");
-  return r;
-}
-
-void append_continuation(CosimulationResult& total, const CosimulationResult& next, const CosimulationState& state) {
-  auto& h = total.history;
-  const auto& g = next.history;
-  const Eigen::Index have = static_cast<Eigen::Index>(h.time_s.size());
-  const Eigen::Index add = std::max<Eigen::Index>(0, static_cast<Eigen::Index>(g.time_s.size()) - 1);
-  h.time_s.insert(h.time_s.end(), g.time_s.begin() + std::min<std::size_t>(1, g.time_s.size()), g.time_s.end());
-  for (auto [to, from] : {std::pair{&h.modal_displacements, &g.modal_displacements},
-                          std::pair{&h.site_displacement_m, &g.site_displacement_m},
-                          std::pair{&h.site_rotation_rad, &g.site_rotation_rad},
-                          std::pair{&h.container_load_n, &g.container_load_n},
-                          std::pair{&h.container_moment_nm, &g.container_moment_nm}}) {
-    to->conservativeResize(have + add, from->cols());
-    if (add > 0) to->bottomRows(add) = from->bottomRows(add);
-  }
-  h.pending_load_sum_n = g.pending_load_sum_n;
-  h.pending_moment_sum_nm = g.pending_moment_sum_nm;
-  h.pending_steps = g.pending_steps;
-  total.energy = state.energy_since_start;
-  total.steps += next.steps;
-  total.simulated_time_s += next.simulated_time_s;
-  total.wall_time_s += next.wall_time_s;
-  auto& times = total.stage_times;
-  const auto& more = next.stage_times;
-  times.settling_s += more.settling_s;
-  times.modal_kick_drift_s += more.modal_kick_drift_s;
-  times.bed_steps_s += more.bed_steps_s;
-  times.closing_kick_s += more.closing_kick_s;
-  times.ledger_s += more.ledger_s;
-  times.measures_s += more.measures_s;
-  total.outcome = next.outcome;
-  total.message = next.message;
-  total.final_modal_displacements = next.final_modal_displacements;
-  total.final_modal_velocities = next.final_modal_velocities;
-  total.world_status = next.world_status;
-  total.final_container_states = next.final_container_states;
-  for (const auto& w : next.warnings)
-    if (std::find(total.warnings.begin(), total.warnings.end(), w) == total.warnings.end()) total.warnings.push_back(w);
-}
 
 }  // namespace pdamp::structure

@@ -11,7 +11,10 @@
 
 #include <Eigen/Dense>
 
-#include "pdamp/structure/cosimulation.hpp"
+#include "pdamp/structure/cosimulation_damper.hpp"
+#include "pdamp/structure/cosimulation_options.hpp"
+#include "pdamp/structure/cosimulation_result.hpp"
+#include "pdamp/structure/cosimulation_state.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 
 namespace pdamp::structure::detail {
@@ -29,8 +32,24 @@ inline constexpr double kStructureStepTarget = 0.05;
 inline constexpr double kFrequencyChangeWarning = 1e-4;
 inline constexpr double kCarriedStepMargin = 0.1;
 
+/// A run of any kind in one struct: what the run's code reads (CosimulationRun's kinds each
+/// fill their part; the others keep their defaults).
+struct RunOptions : CosimulationSettings {
+  enum class Kind { kDecay, kSteadyState, kSweep } kind = Kind::kDecay;  ///< which CosimulationRun
+  CosimulationExcitation excitation;   ///< kFreeDecay for a DecayRun
+  double duration_s = 0.0;             ///< DecayRun, SweepRun
+  double sweep_end_frequency_hz = 0.0; ///< SweepRun; 0 otherwise
+  int transient_periods = 0, min_transient_periods = 0, analysed_periods = 1;  ///< SteadyStateRun
+  bool settle_until_stable = false;    ///< SteadyStateRun
+  double stable_tolerance = 1e-3;      ///< SteadyStateRun
+  double excitation_phase_rad = 0.0;   ///< SteadyStateRun, SweepRun
+  /// All violations, one line each, "field = value: rule" (prefix "cosimulation.").
+  std::vector<std::string> validate(const ModalModel& model) const;
+};
+RunOptions run_options(const CosimulationRun& run);
+
 inline bool harmonic(const CosimulationExcitation& e) { return e.kind != CosimulationExcitationKind::kFreeDecay; }
-inline bool sweeping(const CosimulationOptions& o) { return harmonic(o.excitation) && o.sweep_end_frequency_hz > 0.0; }
+inline bool sweeping(const RunOptions& o) { return harmonic(o.excitation) && o.sweep_end_frequency_hz > 0.0; }
 
 /// Joins violations into one message, one per line.
 std::string join(const std::vector<std::string>& lines);
@@ -53,15 +72,15 @@ struct Prepared {
 /// Every violation of the inputs, one per line (a continuation drops the free decay's
 /// need of a non-zero start: it starts from the state).
 void validate_inputs(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                     const CosimulationOptions& options, bool continuation);
+                     const RunOptions& options, bool continuation);
 
 /// Whether `state` can be continued with these inputs: one line per misfit.
 void validate_state(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                    const CosimulationOptions& options, const CosimulationState& state);
+                    const RunOptions& options, const CosimulationState& state);
 
 /// Modal arrays, excitation shapes and peak speeds for the start q, v at frequency f_hz.
 Prepared prepare(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                 const CosimulationOptions& options, double f_hz, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
+                 const RunOptions& options, double f_hz, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
 
 /// The common time step of a fresh start and the worlds' options (time_step_s still theirs).
 struct StepPlan {
@@ -70,7 +89,7 @@ struct StepPlan {
   std::vector<dem_reference::WorldOptions> world_options;
   std::vector<std::string> warnings;
 };
-StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const CosimulationOptions& options,
+StepPlan plan_step(const Prepared& P, const std::vector<CosimulationDamper>& dampers, const RunOptions& options,
                    double f_hz);
 
 /// |W − (D_s + D_dem + ΔE_s + ΔE_bed)| / max(|W|, D_s + D_dem, |ΔE_s|) (CosimulationEnergy).

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "pdamp/base/number_text.hpp"
+
 namespace pdamp::structure {
 
 std::string_view to_string(SweepDirection direction) { return direction == SweepDirection::kUp ? "up" : "down"; }
@@ -91,7 +93,7 @@ const base::Fields<SteppedSineBranch>& SteppedSineBranch::fields() {
   return f;
 }
 
-CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling) {
+SteadyStateRun stepped_sine_options(SteadyStateRun steady, const SteadyStateSettling& settling) {
   steady.transient_periods = std::max(settling.max_transient_periods, settling.min_transient_periods);
   steady.min_transient_periods = settling.min_transient_periods;
   steady.settle_until_stable = true;
@@ -108,28 +110,52 @@ std::vector<std::int64_t> stepped_sine_steps_per_period(const std::vector<double
 }
 
 double stepped_sine_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                              const CosimulationOptions& options, const std::vector<double>& frequencies_hz) {
+                              const SteadyStateRun& run, const std::vector<double>& frequencies_hz) {
   double dt = INFINITY;
   for (const double f : frequencies_hz) {
-    CosimulationOptions o = options;
+    SteadyStateRun o = run;
     o.excitation.frequency_hz = f;
     dt = std::min(dt, cosimulation_time_step(model, dampers, o).time_step_s);
   }
   return dt;
 }
 
+namespace {
+
+/// Point `index` of `count` at `frequency_hz`: its reports as "<k>/<n> <f> Hz <stage>" with
+/// the share of the branch done (a point's end time is an upper bound, so its share is capped).
+class PointHooks : public base::ForwardingHooks {
+ public:
+  PointHooks(base::RunHooks& inner, std::size_t index, std::size_t count, double frequency_hz)
+      : ForwardingHooks(inner), index_(index), count_(count),
+        name_(std::to_string(index + 1) + "/" + std::to_string(count) + " " + base::format_number(frequency_hz, 4) +
+              " Hz ") {}
+  void progress(const base::Progress& p) override {
+    base::Progress point = p;
+    point.stage = name_ + p.stage;
+    const double share = p.total > 0.0 ? std::min(1.0, p.done / p.total) : 0.0;
+    point.fraction_done = (static_cast<double>(index_) + share) / static_cast<double>(count_);
+    inner_.progress(point);
+  }
+
+ private:
+  std::size_t index_, count_;
+  std::string name_;
+};
+
+}  // namespace
+
 SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                      CosimulationOptions options, const std::vector<double>& frequencies_hz,
-                                      SweepDirection sweep, double time_step_s, const SteppedSineProgress& progress) {
+                                      SteadyStateRun run, const std::vector<double>& frequencies_hz,
+                                      SweepDirection sweep, double time_step_s, base::RunHooks& hooks) {
   SteppedSineBranch branch;
   branch.sweep = sweep;
   CosimulationState state;  // the bed, the modes and the drive's phase, carried over
   for (std::size_t i = 0; i < frequencies_hz.size(); ++i) {
-    options.excitation.frequency_hz = frequencies_hz[i];
-    options.time_step_s = state.started() ? 0.0 : time_step_s;
-    const auto r = cosimulate(model, dampers, options, state, [&](const CosimulationProgress& p) {
-      if (progress) progress(i, p);
-    });
+    run.excitation.frequency_hz = frequencies_hz[i];
+    run.time_step_s = state.started() ? 0.0 : time_step_s;
+    PointHooks point(hooks, i, frequencies_hz.size(), frequencies_hz[i]);
+    const auto r = cosimulate(model, dampers, run, state, point);
     branch.wall_time_s += r.wall_time_s;
     if (r.outcome != dem_reference::Outcome::kCompleted) {
       branch.outcome = r.outcome;
@@ -155,7 +181,7 @@ SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector
       for (std::size_t k = per.size() - na; k < per.size(); ++k) mean += per[k];
       mean /= static_cast<double>(na);
       for (std::size_t k = per.size() - na; k < per.size(); ++k) var += (per[k] - mean) * (per[k] - mean);
-      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / options.excitation.amplitude;
+      p.spread = std::sqrt(var / static_cast<double>(na - 1)) / run.excitation.amplitude;
       p.standard_error = p.spread / std::sqrt(static_cast<double>(na));
     }
     p.energy_error = r.energy.relative_error;
@@ -166,7 +192,7 @@ SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector
     p.window_max_relative_change = ss.window_max_relative_change;
     p.window_relative_drift = ss.window_relative_drift;
     p.window_relative_spread = ss.window_relative_spread;
-    for (const double a : per) p.period_magnitudes.push_back(a / options.excitation.amplitude);
+    for (const double a : per) p.period_magnitudes.push_back(a / run.excitation.amplitude);
     p.steps = r.steps;
     p.time_step_s = r.time_step_s;
     p.wall_time_s = r.wall_time_s;
@@ -216,29 +242,33 @@ SweepPeak sweep_peak(const std::vector<CosimulationSweepCycle>& cycles, std::siz
   return out;
 }
 
+SweepRun linear_sweep_run(const SteadyStateRun& steady, double start_hz, double end_hz, double rate_hz_s) {
+  SweepRun run;
+  static_cast<CosimulationSettings&>(run) = steady;
+  run.excitation = steady.excitation;
+  run.excitation.frequency_hz = start_hz;
+  run.excitation_phase_rad = steady.excitation_phase_rad;
+  run.sweep_end_frequency_hz = end_hz;
+  run.duration_s = std::abs(end_hz - start_hz) / rate_hz_s;
+  return run;
+}
+
 LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                  const CosimulationOptions& steady, SweepDirection sweep, double start_hz,
-                                  double end_hz, double rate_hz_s, const SteppedSineProgress& progress) {
+                                  const SteadyStateRun& steady, SweepDirection sweep, double start_hz, double end_hz,
+                                  double rate_hz_s, base::RunHooks& hooks) {
   LinearSineSweep s;
   s.sweep = sweep;
   s.start_hz = start_hz;
   s.end_hz = end_hz;
   s.rate_hz_s = rate_hz_s;
   s.duration_s = std::abs(end_hz - start_hz) / rate_hz_s;
-  CosimulationOptions run = steady;
-  run.excitation.frequency_hz = start_hz;
-  run.sweep_end_frequency_hz = end_hz;
-  run.duration_s = s.duration_s;
-  CosimulationOptions start = steady;  // the steady state at the start, on the sweep's step
+  const SweepRun run = linear_sweep_run(steady, start_hz, end_hz, rate_hz_s);
+  SteadyStateRun start = steady;  // the steady state at the start, on the sweep's step
   start.excitation.frequency_hz = start_hz;
   start.time_step_s = cosimulation_time_step(model, dampers, run).time_step_s;
   CosimulationState state;
-  const auto report = [&](std::size_t index) {
-    return [&, index](const CosimulationProgress& p) {
-      if (progress) progress(index, p);
-    };
-  };
-  const auto first = cosimulate(model, dampers, start, state, report(0));
+  base::LabelledHooks starting(hooks, "start " + base::format_number(start_hz, 5) + " Hz");
+  const auto first = cosimulate(model, dampers, start, state, starting);
   s.wall_time_s = first.wall_time_s;
   s.steps = first.steps;
   for (const auto& w : first.warnings) s.warnings.push_back(std::string(to_string(sweep)) + " sweep: " + w);
@@ -249,7 +279,8 @@ LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<Cos
   }
   s.start_transient_periods = first.steady_state.transient_periods;
   s.start_stable = first.steady_state.stable;
-  const auto r = cosimulate(model, dampers, run, state, report(1));
+  base::LabelledHooks sweeping(hooks, "sweep");
+  const auto r = cosimulate(model, dampers, run, state, sweeping);
   for (const auto& w : r.warnings) s.warnings.push_back(std::string(to_string(sweep)) + " sweep: " + w);
   s.wall_time_s += r.wall_time_s;
   s.steps += r.steps;

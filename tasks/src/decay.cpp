@@ -13,7 +13,7 @@
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/backbone.hpp"
-#include "pdamp/structure/cosimulation_run.hpp"
+#include "pdamp/structure/cosimulation.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/tasks/case_checks.hpp"
@@ -51,13 +51,9 @@ constexpr double kFirstSegmentFraction = 0.01;
 /// A segment is at most this many times the last one.
 constexpr std::int64_t kSegmentGrowth = 4;
 
-void report_progress(base::RunHooks& hooks, const std::string& label, const st::CosimulationProgress& p) {
-  hooks.progress({label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN});
-}
-
 /// What must match for a resume besides the case's physics: the structure, the task, the
 /// run's own settings (duration, sampling, q0, step) and the caller's (a design).
-std::string decay_settings(const Case& c, const st::CosimulationOptions& o, double dt, const std::string& own) {
+std::string decay_settings(const Case& c, const st::DecayRun& o, double dt, const std::string& own) {
   std::ostringstream s;
   s.precision(17);
   s << "structure " << surrogate::case_hash(c.resolved.value("structure", json())) << "; task "
@@ -68,30 +64,14 @@ std::string decay_settings(const Case& c, const st::CosimulationOptions& o, doub
   return s.str();
 }
 
-/// The co-simulation's progress as the hooks' lines. A stop asked while the beds settle ends
-/// the run there (Interrupted): no checkpoint holds that phase. A run without checkpoints
-/// (`checkpointed` false: a library caller's, docs/python.md) stops at any report.
-st::CosimulationProgressCallback progress_to_hooks(base::RunHooks& hooks, const std::string& label, bool checkpointed) {
-  return [&hooks, label, checkpointed](const st::CosimulationProgress& p) {
-    report_progress(hooks, label, p);
-    if (p.stage == "settling" || !checkpointed)
-      if (const int signal = hooks.stop_requested(); signal != 0)
-        throw base::Interrupted(signal, checkpointed ? "the run stopped while its beds settled, before its first "
-                                                              "checkpoint: run the same command again"
-                                                            : "the run stopped; it had no checkpoint file, so nothing was kept");
-  };
-}
-
-/// One co-simulation run of `options`, its refusals as the case's errors.
+/// One co-simulation run of `options`, its refusals as the case's errors; a stop request
+/// ends it keeping nothing (base::Interrupted).
 st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
-                                       const std::vector<st::CosimulationDamper>& dampers,
-                                       const st::CosimulationOptions& options, const std::string& label, base::RunHooks& hooks,
-                                       st::CosimulationState* state = nullptr) {
+                                       const std::vector<st::CosimulationDamper>& dampers, const st::DecayRun& options,
+                                       const std::string& label, base::RunHooks& hooks) {
   detail::check_cosimulation(c, modal, dampers, options);
-  const auto report = progress_to_hooks(hooks, label, false);
-  auto r = detail::call_dem(c, [&] {
-    return state ? st::cosimulate(modal, dampers, options, *state, report) : st::cosimulate(modal, dampers, options, report);
-  });
+  base::LabelledHooks labelled(hooks, label);
+  auto r = detail::call_dem(c, [&] { return st::cosimulate(modal, dampers, options, labelled); });
   detail::check_outcome(r.outcome, r.message, label);
   return r;
 }
@@ -101,7 +81,7 @@ st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& moda
 /// when the hooks say so; segments give the bits of one uninterrupted run.
 st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& modal,
                                           const std::vector<st::CosimulationDamper>& dampers,
-                                          const st::CosimulationOptions& options, const std::string& label,
+                                          const st::DecayRun& options, const std::string& label,
                                           const std::string& estimate, const DemDecayCheckpoint& cp, base::RunHooks& hooks) {
   detail::check_cosimulation(c, modal, dampers, options);
   const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
@@ -114,14 +94,14 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   header.settings = decay_settings(c, options, dt, cp.settings);
   header.end_time_s = static_cast<double>(total) * dt;
   const std::string shown = base::printable(cp.file.path.string());
-  const auto report = progress_to_hooks(hooks, label, true);
+  base::LabelledHooks labelled(hooks, label);
 
   std::optional<st::Cosimulation> run;
   if (cp.file.resume) {
     const std::string payload = read_checkpoint(cp.file, header);
     try {
       dem_reference::StateReader in(payload, "checkpoint state");
-      run.emplace(st::Cosimulation::restore(modal, dampers, options, in, report));
+      run.emplace(st::Cosimulation::restore(modal, dampers, options, in, labelled));
       in.finish();
     } catch (const std::invalid_argument& e) {
       throw InputError(cp.file.path.string(), "", e.what());
@@ -137,7 +117,12 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
     hooks.note(estimate);
     if (std::filesystem::exists(cp.file.path))
       hooks.note("pdamp: warning: " + shown + " of an earlier run is replaced (--resume continues it)");
-    run.emplace(detail::call_dem(c, [&] { return st::Cosimulation(modal, dampers, options, report); }));
+    try {
+      run.emplace(detail::call_dem(c, [&] { return st::Cosimulation(modal, dampers, options, labelled); }));
+    } catch (const base::Interrupted& e) {  // no checkpoint holds the beds' settling
+      throw base::Interrupted(e.signal_number(), "the run stopped while its beds settled, before its first checkpoint: "
+                                                 "run the same command again");
+    }
   }
 
   auto last_checkpoint = std::chrono::steady_clock::now();
@@ -146,7 +131,7 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
   while (!run->finished()) {
     const auto started = std::chrono::steady_clock::now();
     // A stop request is met inside the segment (a segment of a big bed can be long).
-    const std::int64_t steps = run->advance(segment, [&] { return hooks.stop_requested() != 0; });
+    const std::int64_t steps = run->advance(segment);
     if (run->finished() && run->steps_done() < total) {  // a World stopped
       const auto r = run->result();
       detail::check_outcome(r.outcome, r.message, label);
@@ -157,13 +142,12 @@ st::CosimulationResult checkpointed_decay(const Case& c, const st::ModalModel& m
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const double rate = static_cast<double>(steps) / std::max(wall, 1e-3);
     // A progress line per segment (the run's own lines come only from long segments).
-    report_progress(hooks, label,
-                    st::CosimulationProgress{"decay", static_cast<double>(run->steps_done()) * dt, header.end_time_s, rate});
+    labelled.progress({"", "decay", static_cast<double>(run->steps_done()) * dt, header.end_time_s, false, rate, NAN});
     segment = std::min(kSegmentGrowth * std::max<std::int64_t>(steps, 1),
                        sample_every * std::max<std::int64_t>(1, std::llround(kSegmentWallSeconds * rate /
                                                                              static_cast<double>(sample_every))));
     segment = std::max(segment, sample_every);
-    const int signal = hooks.stop_requested();
+    const int signal = run->stop_signal() != 0 ? run->stop_signal() : hooks.stop_requested();
     const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
     // At the end a stop still gets a checkpoint: the results are not written yet.
     if (signal != 0 || (!run->finished() && hooks.checkpoint_due(since))) {
@@ -270,10 +254,8 @@ CoupledRunEstimate estimate_coupled_steps(const std::vector<st::CosimulationDamp
   return e;
 }
 
-st::CosimulationOptions dem_decay_options(const Case& c, const st::ModalModel& modal, const Eigen::VectorXd& q0,
-                                          double duration_s) {
-  st::CosimulationOptions options;
-  options.excitation.kind = st::CosimulationExcitationKind::kFreeDecay;
+st::DecayRun dem_decay_options(const Case& c, const st::ModalModel& modal, const Eigen::VectorXd& q0, double duration_s) {
+  st::DecayRun options;
   options.initial_modal_displacements = q0;
   options.initial_modal_velocities = Eigen::VectorXd::Zero(q0.size());
   options.duration_s = duration_s;
@@ -284,7 +266,7 @@ st::CosimulationOptions dem_decay_options(const Case& c, const st::ModalModel& m
 
 CoupledRunEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& modal,
                                             const std::vector<st::CosimulationDamper>& dampers,
-                                            const st::CosimulationOptions& options) {
+                                            const st::DecayRun& options) {
   detail::check_cosimulation(c, modal, dampers, options);
   const double dt = detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, options).time_step_s; });
   double settling_s = 0.0;
@@ -301,7 +283,7 @@ CoupledRunEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& m
 
 CoupledRunEstimate check_coupled_decay(const Case& c, const st::ModalModel& modal,
                                          const std::vector<st::CosimulationDamper>& dampers,
-                                         const st::CosimulationOptions& options, const std::string& label,
+                                         const st::DecayRun& options, const std::string& label,
                                          const std::string& duration_pointer, base::RunHooks& hooks) {
   const CoupledRunEstimate e = estimate_coupled_decay(c, modal, dampers, options);
   if (const double available = available_memory_bytes(); e.memory_bytes > available)
@@ -337,7 +319,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   Eigen::Index dominant = 0;
   weights.cwiseProduct(q0.cwiseAbs()).maxCoeff(&dominant);
 
-  st::CosimulationOptions options = dem_decay_options(c, modal, q0, task.duration_s);
+  st::DecayRun options = dem_decay_options(c, modal, q0, task.duration_s);
   options.snapshots = snapshots;
   // Refused here when it cannot fit; said once a resume's checkpoint is accepted.
   const std::string estimate = label + ": " + estimate_text(check_coupled_decay(c, modal, dampers, options, label,

@@ -127,10 +127,10 @@ HarmonicFrf compared_response(const Case& c, detail::Setup& setup) {
 
 /// The frf task's harmonic co-simulation options: excitation, each frequency settled to a
 /// steady state, the case's DEM settings; the excitation checked (InputError naming /task/excitation).
-st::CosimulationOptions dem_frf_options(const Case& c, const st::ModalModel& modal, const st::SteadyStateSettling& settling) {
+st::SteadyStateRun dem_frf_options(const Case& c, const st::ModalModel& modal, const st::SteadyStateSettling& settling) {
   const auto& task = *c.task.frf;
   const bool base_motion = base_excitation(c);
-  st::CosimulationOptions options;
+  st::SteadyStateRun options;
   options.excitation.kind = base_motion ? st::CosimulationExcitationKind::kBaseTranslation : st::CosimulationExcitationKind::kPointForce;
   options.excitation.direction = {task.direction[0], task.direction[1]};
   options.excitation.amplitude = base_motion ? task.base_amplitude_m : task.force_amplitude_n;
@@ -204,13 +204,13 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
   const st::SteadyStateSettling settling = case_settling(c, o.settling);
-  const st::CosimulationOptions options = dem_frf_options(c, modal, settling);
+  const st::SteadyStateRun options = dem_frf_options(c, modal, settling);
   SteppedSineFrf out;
   out.frequencies_hz = detail::spaced(o.min_frequency_hz, o.max_frequency_hz, o.points, false);
   out.analysed_periods = options.analysed_periods;
   out.settling = settling;
   for (const double f : out.frequencies_hz) {  // every point's options checked before any runs
-    st::CosimulationOptions o = options;
+    st::SteadyStateRun o = options;
     o.excitation.frequency_hz = f;
     detail::check_cosimulation(c, modal, dampers, o);
   }
@@ -254,18 +254,10 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
           return "pdamp frf (dem) " + sweep_name + " " + std::to_string(i + 1) + "/" + std::to_string(n) + " " +
                  format_number(frequencies[i], 5) + " Hz";
         };
-        // One progress line per direction: the point and its stage, with the share of the
-        // sweep done for the ETA (a point's end time is an upper bound, so its share is capped).
-        const auto report = [&](std::size_t i, const st::CosimulationProgress& p) {
-          const double point_share = p.end_time_s > 0.0 ? std::min(1.0, p.simulated_time_s / p.end_time_s) : 0.0;
-          hooks.progress({"pdamp frf (dem) " + sweep_name,
-                          std::to_string(i + 1) + "/" + std::to_string(n) + " " + format_number(frequencies[i], 4) +
-                              " Hz " + std::string(p.stage),
-                          p.simulated_time_s, p.end_time_s, false, p.steps_per_s, NAN,
-                          (static_cast<double>(i) + point_share) / static_cast<double>(n)});
-        };
+        // One progress line per direction: the point and its stage (stepped_sine_branch).
+        base::LabelledHooks direction(hooks, "pdamp frf (dem) " + sweep_name);
         auto branch = detail::call_dem(
-            c, [&] { return st::stepped_sine_branch(modal, dampers, options, frequencies, sweep, out.time_step_s, report); });
+            c, [&] { return st::stepped_sine_branch(modal, dampers, options, frequencies, sweep, out.time_step_s, direction); });
         // The point that stopped the branch is the first without a result; a completed branch has none.
         detail::check_outcome(branch.outcome, branch.message, label(std::min(branch.points.size(), n - 1)));
         for (std::size_t i = 0; i < branch.points.size(); ++i)
@@ -309,7 +301,7 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
   const st::ModalModel& modal = setup.s.modal;
   auto dampers = detail::dem_dampers(c);
   const st::SteadyStateSettling settling = case_settling(c, o.settling);
-  const st::CosimulationOptions steady = dem_frf_options(c, modal, settling);
+  const st::SteadyStateRun steady = dem_frf_options(c, modal, settling);
   LinearSweepFrf out;
   out.min_frequency_hz = o.min_frequency_hz;
   out.max_frequency_hz = o.max_frequency_hz;
@@ -327,10 +319,8 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
     for (auto& d : dampers) d.world.threads = 1;
   const auto up = [](st::SweepDirection d) { return d == st::SweepDirection::kUp; };
   for (const auto direction : o.directions) {  // every run's options checked before any starts
-    st::CosimulationOptions run = steady;
-    run.excitation.frequency_hz = up(direction) ? o.min_frequency_hz : o.max_frequency_hz;
-    run.sweep_end_frequency_hz = up(direction) ? o.max_frequency_hz : o.min_frequency_hz;
-    run.duration_s = out.duration_s;
+    const st::SweepRun run = st::linear_sweep_run(steady, up(direction) ? o.min_frequency_hz : o.max_frequency_hz,
+                                                  up(direction) ? o.max_frequency_hz : o.min_frequency_hz, out.rate_hz_s);
     detail::check_cosimulation(c, modal, dampers, run);
     detail::call_dem(c, [&] { return st::cosimulation_time_step(modal, dampers, run); });
   }
@@ -341,13 +331,9 @@ LinearSweepFrf linear_sweep(const Case& c, detail::Setup& setup, const DemFrfOpt
     const double end = up(direction) ? o.max_frequency_hz : o.min_frequency_hz;
     const std::string label = "pdamp frf (dem) linear " + std::string(st::to_string(direction));
     const std::string labels[2] = {label + " start " + format_number(start, 5) + " Hz", label + " sweep"};
-    auto s = detail::call_dem(c, [&] {
-      return st::linear_sine_sweep(modal, dampers, steady, direction, start, end, out.rate_hz_s,
-                                   [&](std::size_t i, const st::CosimulationProgress& p) {
-                                     hooks.progress({labels[i], std::string(p.stage), p.simulated_time_s, p.end_time_s,
-                                                     false, p.steps_per_s, NAN});
-                                   });
-    });
+    base::LabelledHooks labelled(hooks, label);
+    auto s = detail::call_dem(
+        c, [&] { return st::linear_sine_sweep(modal, dampers, steady, direction, start, end, out.rate_hz_s, labelled); });
     detail::check_outcome(s.outcome, s.message, labels[s.cycles.empty() && s.start_transient_periods == 0 ? 0 : 1]);
     for (const auto& cycle : s.cycles)
       for (double m : cycle.site_amplitude_per_excitation)

@@ -36,8 +36,8 @@ std::vector<structure::CosimulationDamper> dem_dampers(const case_file::Case& c)
 }
 
 void check_cosimulation(const case_file::Case& c, const structure::ModalModel& modal,
-                        const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationOptions& options) {
-  if (const auto problems = options.validate(modal); !problems.empty())
+                        const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationRun& run) {
+  if (const auto problems = structure::validate(run, modal); !problems.empty())
     throw base::InputError(c.path, "/task", problems.front());
   for (std::size_t d = 0; d < dampers.size(); ++d)
     if (const auto problems = dampers[d].validate(modal); !problems.empty())

@@ -45,7 +45,7 @@ std::vector<structure::CosimulationDamper> dem_dampers(const case_file::Case& c)
 
 /// The co-simulation options refused as the case's: /task for the run's own, /dampers/d for a damper's.
 void check_cosimulation(const case_file::Case& c, const structure::ModalModel& modal,
-                        const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationOptions& options);
+                        const std::vector<structure::CosimulationDamper>& dampers, const structure::CosimulationRun& run);
 
 /// The DEM's refusal of its options (a step above its bound) as the case's /dem.
 template <class F>

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   }
   namespace st = pdamp::structure;
   namespace dem = pdamp::dem_reference;
-  st::CosimulationOptions options;
+  st::DecayRun options;
   options.initial_modal_displacements = Eigen::VectorXd::Constant(1, 0.01);
   options.duration_s = 0.02;
   options.sample_interval_s = 0.002;

@@ -81,7 +81,7 @@ double mean_period_s(const std::vector<double>& t, const Eigen::VectorXd& y) {
 TEST_CASE("without bed contact a free decay is the exact damped 1-DOF with the container mass", "[cosimulation]") {
   const double f = 10.0, zeta = 0.02, m = 1.0, mc = 0.25, q0 = 1e-3;
   const ModalModel model = one_dof(f, zeta, m);
-  CosimulationOptions o;
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, q0);
   o.duration_s = 1.0;
   const CosimulationResult r = cosimulate(model, {tip_damper(lone_sphere(), mc)}, o);
@@ -113,7 +113,7 @@ TEST_CASE("the container's rotary inertia at a rotating site lowers the frequenc
   const ModalModel model = one_dof(f, 0.02, m, 1.0, theta);  // damped: the ledger has work to close
   CosimulationDamper damper = tip_damper(lone_sphere(), mc);
   damper.container_rotary_inertia_kg_m2 = J;
-  CosimulationOptions o;
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, 1e-3);
   o.duration_s = 1.0;
   const CosimulationResult r = cosimulate(model, {damper}, o);
@@ -154,7 +154,7 @@ TEST_CASE("two dampers on two modes: coupled frequencies, per-site kinematics an
   CosimulationDamper at_b = at(tip_damper(lone_sphere(), mc_b), "at_b", "b");
 
   SECTION("no contact: the coupled 2-DOF") {
-    CosimulationOptions o;
+    DecayRun o;
     o.initial_modal_displacements = Eigen::Vector2d(1e-3, 5e-4);
     o.duration_s = 0.5;
     const CosimulationResult r = cosimulate(model, {at_a, at_b}, o);
@@ -181,7 +181,7 @@ TEST_CASE("two dampers on two modes: coupled frequencies, per-site kinematics an
                                             dem::InitialPlacement::kCollectedLattice);
     at_a.world = impacting;
     at_b.world = impacting;
-    CosimulationOptions o;
+    SteadyStateRun o;
     o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
     o.excitation.direction = {0.0, 1.0};
     o.excitation.amplitude = 1e-3;
@@ -212,7 +212,7 @@ TEST_CASE("without bed contact forced steady states equal the exact receptance a
     const ModalModel model = one_dof(f, zeta, m);
     const double F = 0.5;
     const cd qhat = F / D;
-    CosimulationOptions o;
+    SteadyStateRun o;
     o.excitation.kind = CosimulationExcitationKind::kPointForce;
     o.excitation.point = "tip";
     o.excitation.direction = {0.0, 1.0};
@@ -235,7 +235,7 @@ TEST_CASE("without bed contact forced steady states equal the exact receptance a
     const double gamma = 0.8, U = 1e-4;
     const ModalModel model = one_dof(f, zeta, m, 1.0, 0.0, gamma);
     const cd qhat = W * W * (gamma + mc) * U / D;  // relative; absolute site = U + q̂
-    CosimulationOptions o;
+    SteadyStateRun o;
     o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
     o.excitation.direction = {0.0, 1.0};
     o.excitation.amplitude = U;
@@ -269,7 +269,7 @@ TEST_CASE("a bed that cannot move relative to the container shifts the frequency
   const double k = m * std::pow(2 * kPi * f, 2);
   const double bed_mass = 4 * 7850.0 * 4.0 / 3.0 * kPi * std::pow(0.01, 3);
   const double q_static = -bed_mass * 9.80665 / k;  // the bed's weight on the container
-  CosimulationOptions o;
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, q_static + 3e-4);
   o.duration_s = 1.0;
   const CosimulationResult r = cosimulate(model, {damper}, o);
@@ -297,7 +297,7 @@ TEST_CASE("a held bed's in-loop complex power gives its mass and no dissipation"
   const double fd = 9.0, F = 0.3, W = 2 * kPi * fd, k = m * std::pow(2 * kPi * f, 2), c = 2 * 0.02 * 2 * kPi * f * m;
   const double bed_mass = 4 * 7850.0 * 4.0 / 3.0 * kPi * std::pow(0.01, 3);
   const cd qhat = F / (k - W * W * (m + mc + bed_mass) + cd(0, 1) * W * c);
-  CosimulationOptions o;
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kPointForce;
   o.excitation.point = "tip";
   o.excitation.direction = {0.0, 1.0};
@@ -335,7 +335,7 @@ TEST_CASE("the site's motion across the drive reaches the bed and its load retur
   const double bed_mass = 4 * 7850.0 * 4.0 / 3.0 * kPi * std::pow(0.01, 3);
   // The bed's weight along container −y is along structure +x (t = z × n = −x, c = +y ↔ t).
   const double q_static = bed_mass * 9.80665 / k;
-  CosimulationOptions o;
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, q_static + 3e-4);
   o.duration_s = 1.0;
   const CosimulationResult r = cosimulate(model, {damper}, o);
@@ -357,7 +357,7 @@ TEST_CASE("the energy ledger closes within 1% with impacting spheres, free and f
                                       dem::InitialPlacement::kCollectedLattice);
   SECTION("free decay") {
     const ModalModel model = one_dof(10.0, 0.01, 0.1);
-    CosimulationOptions o;
+    DecayRun o;
     o.initial_modal_displacements = Eigen::VectorXd::Constant(1, 0.01);
     o.duration_s = 0.5;
     const CosimulationResult r = cosimulate(model, {tip_damper(world, 0.02)}, o);
@@ -370,7 +370,7 @@ TEST_CASE("the energy ledger closes within 1% with impacting spheres, free and f
   }
   SECTION("base excitation") {
     const ModalModel model = one_dof(10.0, 0.01, 0.1, 1.0, 0.0, 0.08);
-    CosimulationOptions o;
+    SteadyStateRun o;
     o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
     o.excitation.direction = {0.0, 1.0};
     o.excitation.amplitude = 1e-3;
@@ -407,7 +407,7 @@ TEST_CASE("a rotating site turns the container and the bed's moment returns to t
   const double sphere = 7850.0 * 4.0 / 3.0 * kPi * std::pow(0.01, 3);
   const double k = std::pow(2 * kPi * f0, 2);
   const double q_static = -phi_theta * sphere * 9.80665 * d / k;
-  CosimulationOptions o;
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, q_static + 1e-4);
   o.duration_s = 0.6;
   const CosimulationResult r = cosimulate(model, {damper}, o);
@@ -432,7 +432,7 @@ TEST_CASE("a rotating site turns the container and the bed's moment returns to t
 // (its documented exception, seen as 2 allocations in 0.2 s of the impact case above).
 TEST_CASE("the co-simulation step loop does not allocate", "[cosimulation]") {
   const ModalModel model = one_dof(10.0, 0.01, 0.1, 1.0, 0.0, 0.05);
-  CosimulationOptions o;
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = 1e-4;
@@ -442,19 +442,22 @@ TEST_CASE("the co-simulation step loop does not allocate", "[cosimulation]") {
   o.sample_interval_s = 1e-4;
   const dem::WorldOptions world = lone_sphere();
   o.progress_interval_s = 1e-9;
-  long long previous = -1, worst = 0;
-  int calls = 0;
-  const CosimulationResult r = cosimulate(model, {tip_damper(world, 0.02)}, o, [&](const CosimulationProgress& p) {
-    const long long now = g_allocations.load();
-    if (p.stage != "settling" && previous >= 0) {
-      worst = std::max(worst, now - previous);
-      ++calls;
+  struct AllocationProbe : pdamp::base::RunHooks {
+    long long previous = -1, worst = 0;
+    int calls = 0;
+    void progress(const pdamp::base::Progress& p) override {
+      const long long now = g_allocations.load();
+      if (p.stage != "settling" && previous >= 0) {
+        worst = std::max(worst, now - previous);
+        ++calls;
+      }
+      previous = p.stage != "settling" ? now : -1;
     }
-    previous = p.stage != "settling" ? now : -1;
-  });
+  } probe;
+  const CosimulationResult r = cosimulate(model, {tip_damper(world, 0.02)}, o, probe);
   REQUIRE(r.outcome == dem::Outcome::kCompleted);
-  CHECK(calls > 10);
-  CHECK(worst == 0);
+  CHECK(probe.calls > 10);
+  CHECK(probe.worst == 0);
 }
 
 TEST_CASE("invalid co-simulation inputs are refused naming field and rule", "[cosimulation]") {
@@ -462,7 +465,7 @@ TEST_CASE("invalid co-simulation inputs are refused naming field and rule", "[co
   CosimulationDamper damper = tip_damper(lone_sphere(), 0.1);
   damper.point = "nowhere";
   damper.container_rotation_axis = {1.0, 0.0, 0.0};
-  CosimulationOptions o;  // free decay without a start
+  DecayRun o;  // free decay without a start
   o.duration_s = -1.0;
   try {
     cosimulate(model, {damper}, o);
@@ -489,7 +492,7 @@ TEST_CASE("two continued runs equal one run of the combined length and the ledge
                                       dem::InitialPlacement::kCollectedLattice);
   const ModalModel model = one_dof(10.0, 0.01, 0.1, 1.0, 0.0, 0.08);
   const std::vector<CosimulationDamper> dampers{tip_damper(world, 0.02)};
-  CosimulationOptions o;
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = 1e-3;
@@ -497,14 +500,14 @@ TEST_CASE("two continued runs equal one run of the combined length and the ledge
   for (const double phase : {0.0, kPi / 2}) {
     INFO("start phase " << phase);
     o.excitation_phase_rad = phase;
-    CosimulationOptions whole = o;
+    SteadyStateRun whole = o;
     whole.transient_periods = 2;
     whole.analysed_periods = 3;
     CosimulationState one;
     const CosimulationResult r = cosimulate(model, dampers, whole, one);
     REQUIRE(r.outcome == dem::Outcome::kCompleted);
     CHECK(!r.continued);
-    CosimulationOptions first = o, second = o;
+    SteadyStateRun first = o, second = o;
     first.analysed_periods = 2;
     second.analysed_periods = 3;
     CosimulationState state;
@@ -556,7 +559,7 @@ TEST_CASE("a continuation at a new frequency keeps the step, the phase and the b
           "[cosimulation]") {
   const ModalModel model = one_dof(10.0, 0.02, 1.0, 1.0, 0.0, 0.8);
   const std::vector<CosimulationDamper> dampers{tip_damper(lone_sphere(), 0.25)};
-  CosimulationOptions o;
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = 1e-4;
@@ -579,7 +582,7 @@ TEST_CASE("a continuation at a new frequency keeps the step, the phase and the b
   CHECK(b.history.site_displacement_m(0, 0) == Approx(a.final_modal_displacements[0] + 1e-4).epsilon(1e-12));
   CHECK(a.final_container_states[0].position_m[0] == Approx(a.final_modal_displacements[0] + 1e-4).epsilon(1e-12));
   // Misfits: another amplitude, initial values, a state for other dampers.
-  CosimulationOptions bad = o;
+  SteadyStateRun bad = o;
   bad.excitation.amplitude = 2e-4;
   bad.initial_modal_displacements = Eigen::VectorXd::Constant(1, 0.0);
   try {

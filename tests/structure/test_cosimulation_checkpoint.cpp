@@ -33,8 +33,8 @@ std::vector<CosimulationDamper> impacting_bed() {
                      0.02)};
 }
 
-CosimulationOptions decay(double duration_s) {
-  CosimulationOptions o;
+DecayRun decay(double duration_s) {
+  DecayRun o;
   o.initial_modal_displacements = Eigen::VectorXd::Constant(1, 0.01);
   o.duration_s = duration_s;
   o.sample_interval_s = 0.002;
@@ -65,7 +65,7 @@ TEST_CASE("a free decay continued from a checkpoint after every segment equals t
   std::string bytes;
   for (std::int64_t done = 0; done < total;) {
     const std::int64_t steps = std::min(segment, total - done);
-    CosimulationOptions o = decay(static_cast<double>(steps) * dt);
+    DecayRun o = decay(static_cast<double>(steps) * dt);
     CosimulationState state;
     if (done > 0) {
       // A new process: the state and the result so far from the checkpoint's bytes.

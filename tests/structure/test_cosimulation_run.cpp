@@ -4,10 +4,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <csignal>
 #include <limits>
 #include <stdexcept>
 
-#include "pdamp/structure/cosimulation_run.hpp"
+#include "pdamp/base/run_errors.hpp"
+#include "pdamp/structure/cosimulation.hpp"
 #include "structure/cosimulation_support.hpp"
 
 namespace {
@@ -51,8 +53,8 @@ std::vector<CosimulationDamper> impacting_bed() {
                      0.02)};
 }
 
-CosimulationOptions decay(double duration_s) {
-  CosimulationOptions o;
+DecayRun decay(double duration_s) {
+  DecayRun o;
   o.initial_modal_displacements = Eigen::Vector2d(0.01, 0.003);
   o.duration_s = duration_s;
   o.sample_interval_s = 0.002;
@@ -98,7 +100,7 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
           "[cosimulation]") {
   const ModalModel model = two_modes();
   const auto dampers = impacting_bed();
-  CosimulationOptions options = decay(0.3);
+  DecayRun options = decay(0.3);
   options.snapshots = 40;  // the beds for ParaView, some before the checkpoint and some after
   CosimulationState whole_state;
   const CosimulationResult whole = cosimulate(model, dampers, options, whole_state);
@@ -108,7 +110,13 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
   std::string bytes;
   std::int64_t done = 0;
   {
-    Cosimulation run(model, dampers, options);
+    // Stops at its third poll once armed (an interrupt).
+    struct Stopper : pdamp::base::RunHooks {
+      bool armed = false;
+      int polls = 0;
+      int stop_requested() override { return armed && ++polls == 3 ? SIGINT : 0; }
+    } stopper;
+    Cosimulation run(model, dampers, options, stopper);
     CHECK(run.time_step_s() == whole.time_step_s);
     CHECK(run.total_steps() == whole.steps);
     CHECK(run.steps_done() == 0);
@@ -117,8 +125,9 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
       done += steps;
     }
     // A stop request ends a long segment at the next poll, a step boundary like any other.
-    int polls = 0;
-    CHECK(run.advance(1000000, [&] { return ++polls == 3; }) == 3 * Cosimulation::kStopPollSteps);
+    stopper.armed = true;
+    CHECK(run.advance(1000000) == 3 * Cosimulation::kStopPollSteps);
+    CHECK(run.stop_signal() == SIGINT);
     done += 3 * Cosimulation::kStopPollSteps;
     CHECK(run.steps_done() == done);
     CHECK(!run.finished());
@@ -194,7 +203,7 @@ TEST_CASE("a harmonic run advanced in segments equals one call, and its end move
           "[cosimulation]") {
   const ModalModel model = one_mode_on_a_base();
   const auto dampers = impacting_bed();
-  CosimulationOptions o;
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = 1e-3;
@@ -241,22 +250,12 @@ TEST_CASE("a restore refuses a checkpoint of other settings, and a continuation 
   run.save(out);
   const std::string bytes = out.take();
   SECTION("another step") {
-    CosimulationOptions other = decay(0.01);
+    DecayRun other = decay(0.01);
     other.time_step_s = 0.5 * run.time_step_s();
     dem::StateReader in(bytes, "checkpoint");
     CHECK_THROWS_WITH(Cosimulation::restore(model, dampers, other, in),
                       Catch::Contains("cosimulation checkpoint: time_step_s = ") &&
                           Catch::Contains("a checkpoint of other settings"));
-  }
-  SECTION("a harmonic run") {
-    CosimulationOptions forced;
-    forced.excitation.kind = CosimulationExcitationKind::kPointForce;
-    forced.excitation.point = "tip";
-    forced.excitation.amplitude = 0.1;
-    forced.excitation.frequency_hz = 9.0;
-    dem::StateReader in(bytes, "checkpoint");
-    CHECK_THROWS_WITH(Cosimulation::restore(model, dampers, forced, in),
-                      Catch::Contains("continues a free decay only"));
   }
   SECTION("a continuation with initial values") {
     CosimulationState state = std::move(run).take_state();
@@ -276,13 +275,13 @@ TEST_CASE("a restore refuses a checkpoint of other settings, and a continuation 
 TEST_CASE("the sampled bed force is the mean over its sample interval, so impacts are not aliased", "[cosimulation]") {
   const ModalModel model = two_modes();
   const auto dampers = impacting_bed();
-  CosimulationOptions fine = decay(0.1);
+  DecayRun fine = decay(0.1);
   CosimulationState fine_state;
   const CosimulationResult first = cosimulate(model, dampers, fine, fine_state);
   fine.sample_interval_s = first.time_step_s;
   CosimulationState every_state;
   const CosimulationResult every = cosimulate(model, dampers, fine, every_state);
-  CosimulationOptions coarse = fine;
+  DecayRun coarse = fine;
   const int k = 40;
   coarse.sample_interval_s = k * first.time_step_s;
   CosimulationState coarse_state;
@@ -301,18 +300,24 @@ TEST_CASE("the sampled bed force is the mean over its sample interval, so impact
 }
 
 // The beds settle before any checkpoint can hold them; a big bed settles for hours. The
-// progress callback hears from the settling about every progress_interval_s, and an exception
-// it throws (a stop request) ends the construction there: here at the first report after the
-// one that opens the settling, kStopPollSteps steps in.
-TEST_CASE("the settling reports its progress, and a callback that throws ends it at once", "[cosimulation]") {
-  CosimulationOptions options = decay(0.3);
+// hooks hear from the settling about every progress_interval_s and are asked every
+// kStopPollSteps steps whether to stop: a stop ends the construction there, keeping nothing
+// (base::Interrupted); here at the poll after the second report.
+TEST_CASE("the settling reports its progress, and a stop request ends it at once", "[cosimulation]") {
+  DecayRun options = decay(0.3);
   options.progress_interval_s = 1e-9;  // every poll
-  struct Stop {};
-  int settling_reports = 0;
-  const auto progress = [&](const CosimulationProgress& p) {
-    if (p.stage != "settling") return;
-    if (++settling_reports == 2) throw Stop{};
-  };
-  CHECK_THROWS_AS(Cosimulation(two_modes(), impacting_bed(), options, progress), Stop);
-  CHECK(settling_reports == 2);
+  struct StopAfterTwoReports : pdamp::base::RunHooks {
+    int settling_reports = 0;
+    void progress(const pdamp::base::Progress& p) override {
+      if (p.stage == "settling") ++settling_reports;
+    }
+    int stop_requested() override { return settling_reports >= 2 ? SIGTERM : 0; }
+  } hooks;
+  try {
+    Cosimulation(two_modes(), impacting_bed(), options, hooks);
+    FAIL("the settling did not stop");
+  } catch (const pdamp::base::Interrupted& e) {
+    CHECK(e.signal_number() == SIGTERM);
+  }
+  CHECK(hooks.settling_reports == 2);
 }

@@ -1,4 +1,4 @@
-// Tests of the co-simulation's linear sine sweep (CosimulationOptions::sweep_end_frequency_hz):
+// Tests of the co-simulation's linear sine sweep (SweepRun):
 // the drive against an independent integration of the swept 1-DOF, the cycle-by-cycle first
 // harmonic against the exact transmissibility when the sweep is slow, the lag of a fast sweep
 // in its own direction, and the energy ledger with impacting spheres.
@@ -33,8 +33,8 @@ ModalModel base_oscillator(double f_hz, double zeta, double mass_kg) {
 /// away; the modes see no bed force (checked by the container work).
 dem::WorldOptions lone_sphere() { return pdamp::test::lone_sphere(1.0); }
 
-CosimulationOptions base_sweep(double amplitude_m, double f0_hz, double f1_hz, double duration_s) {
-  CosimulationOptions o;
+SweepRun base_sweep(double amplitude_m, double f0_hz, double f1_hz, double duration_s) {
+  SweepRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = amplitude_m;
@@ -177,7 +177,7 @@ TEST_CASE("the energy ledger closes over a sweep with impacting spheres", "[cosi
 
 TEST_CASE("invalid sweep inputs are refused naming field and rule", "[cosimulation]") {
   const ModalModel model = base_oscillator(10.0, 0.01, 1.0);
-  CosimulationOptions o = base_sweep(1e-4, 5.0, -3.0, 0.0);
+  SweepRun o = base_sweep(1e-4, 5.0, -3.0, 0.0);
   try {
     cosimulate(model, {tip_damper(lone_sphere(), 0.1)}, o);
     FAIL("no exception");
@@ -186,10 +186,12 @@ TEST_CASE("invalid sweep inputs are refused naming field and rule", "[cosimulati
     CHECK_THAT(what, Catch::Contains("cosimulation.sweep_end_frequency_hz = -3"));
     CHECK_THAT(what, Catch::Contains("cosimulation.duration_s = 0: must be > 0 and finite for a linear sweep"));
   }
-  CosimulationOptions decay;
-  decay.initial_modal_displacements = Eigen::VectorXd::Constant(1, 1e-3);
-  decay.duration_s = 0.1;
-  decay.sweep_end_frequency_hz = 5.0;
-  CHECK_THROWS_WITH(cosimulate(model, {tip_damper(lone_sphere(), 0.1)}, decay),
-                    Catch::Contains("sweep_end_frequency_hz = 5: must be 0 for a free decay"));
+  // A sweep runs between two frequencies, driven by the base or a force.
+  CHECK_THROWS_WITH(cosimulate(model, {tip_damper(lone_sphere(), 0.1)}, base_sweep(1e-4, 5.0, 0.0, 1.0)),
+                    Catch::Contains("sweep_end_frequency_hz = 0: must be in [0.01, 10000] Hz (a linear sweep)"));
+  SweepRun undriven = base_sweep(1e-4, 5.0, 6.0, 1.0);
+  undriven.excitation.kind = CosimulationExcitationKind::kFreeDecay;
+  undriven.initial_modal_displacements = Eigen::VectorXd::Constant(1, 1e-3);
+  CHECK_THROWS_WITH(cosimulate(model, {tip_damper(lone_sphere(), 0.1)}, undriven),
+                    Catch::Contains("excitation.kind = free decay: a harmonic run is driven by a base translation"));
 }

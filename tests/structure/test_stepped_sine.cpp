@@ -38,8 +38,8 @@ std::vector<CosimulationDamper> container_only() {
   return {tip_damper(pdamp::test::lone_sphere(0.12), kMc)};
 }
 
-CosimulationOptions base_drive() {
-  CosimulationOptions o;
+SteadyStateRun base_drive() {
+  SteadyStateRun o;
   o.excitation.kind = CosimulationExcitationKind::kBaseTranslation;
   o.excitation.direction = {0.0, 1.0};
   o.excitation.amplitude = kU;
@@ -55,9 +55,9 @@ SteppedSineBranch jump_branch(const SteadyStateSettling& settling) {
   const ModalModel model = lightly_damped_mode();
   const auto dampers = container_only();
   const std::vector<double> f = {7.0, 8.8};
-  const CosimulationOptions o = stepped_sine_options(base_drive(), settling);
+  const SteadyStateRun o = stepped_sine_options(base_drive(), settling);
   const double dt = stepped_sine_time_step(model, dampers, o, f);
-  return stepped_sine_branch(model, dampers, o, f, SweepDirection::kUp, dt, {});
+  return stepped_sine_branch(model, dampers, o, f, SweepDirection::kUp, dt, pdamp::base::silent_hooks());
 }
 
 }  // namespace
@@ -187,11 +187,11 @@ TEST_CASE("a stepped sine runs at least the least transient periods at every poi
   CHECK(slow.points[0].transient_periods == least);
   CHECK(slow.points[0].converged);
 
-  CosimulationOptions o = base_drive();
+  SteadyStateRun o = base_drive();
   o.excitation.frequency_hz = 8.0;
   o.transient_periods = 5;
   o.min_transient_periods = 6;
-  const auto problems = o.validate(lightly_damped_mode());
+  const auto problems = validate(o, lightly_damped_mode());
   REQUIRE(problems.size() == 1);
   CHECK(problems.front().find("min_transient_periods = 6") != std::string::npos);
 }

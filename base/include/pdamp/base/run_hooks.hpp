@@ -45,25 +45,34 @@ class RunHooks {
   virtual bool long_runs_accepted() { return false; }
 };
 
-/// Hooks that pass everything on to `inner`, the progress reports under `label`: a library
-/// reports its run's stage and numbers, its caller names the run ("pdamp dem", "pdamp frf
-/// (dem) up"). A report that has a label of its own (a point of a sweep) keeps it after the
-/// caller's.
-class LabelledHooks : public RunHooks {
+/// Hooks that pass everything on to `inner`: a subclass changes what it needs (the label
+/// of the progress reports, the share of a longer run they stand for).
+class ForwardingHooks : public RunHooks {
  public:
-  LabelledHooks(RunHooks& inner, std::string label) : inner_(inner), label_(std::move(label)) {}
-  void progress(const Progress& p) override {
-    Progress labelled = p;
-    labelled.label = p.label.empty() ? label_ : label_ + " " + p.label;
-    inner_.progress(labelled);
-  }
+  explicit ForwardingHooks(RunHooks& inner) : inner_(inner) {}
+  void progress(const Progress& p) override { inner_.progress(p); }
   void note(const std::string& line) override { inner_.note(line); }
   bool checkpoint_due(double seconds_since_checkpoint) override { return inner_.checkpoint_due(seconds_since_checkpoint); }
   int stop_requested() override { return inner_.stop_requested(); }
   bool long_runs_accepted() override { return inner_.long_runs_accepted(); }
 
- private:
+ protected:
   RunHooks& inner_;
+};
+
+/// The progress reports under `label`: a library reports its run's stage and numbers, its
+/// caller names the run ("pdamp dem", "pdamp frf (dem) up"). A report that has a label of
+/// its own (a part of the run) keeps it after the caller's.
+class LabelledHooks : public ForwardingHooks {
+ public:
+  LabelledHooks(RunHooks& inner, std::string label) : ForwardingHooks(inner), label_(std::move(label)) {}
+  void progress(const Progress& p) override {
+    Progress labelled = p;
+    labelled.label = p.label.empty() ? label_ : label_ + " " + p.label;
+    inner_.progress(labelled);
+  }
+
+ private:
   std::string label_;
 };
 

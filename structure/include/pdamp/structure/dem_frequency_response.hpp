@@ -40,7 +40,7 @@ struct SteadyStateSettling {
 /// the drive's phase π/2 at each frequency's start (U sin(Ω(t − t_i) + π/2): every run ends
 /// on whole periods, so each junction is at the turning point, base displacement and
 /// velocity, or the force, continuous).
-CosimulationOptions stepped_sine_options(CosimulationOptions steady, const SteadyStateSettling& settling);
+SteadyStateRun stepped_sine_options(SteadyStateRun steady, const SteadyStateSettling& settling);
 
 /// Whole steps per period of each frequency on the step `time_step_s` (N = round(1/(f·dt)),
 /// the frequency run 1/(N·dt)); two equal counts are two points on one frequency.
@@ -91,20 +91,19 @@ struct SteppedSineBranch {
   static const base::Fields<SteppedSineBranch>& fields();
 };
 
-/// Progress of point `index` of a branch.
-using SteppedSineProgress = std::function<void(std::size_t index, const CosimulationProgress&)>;
-
 /// The common step of a stepped sine over `frequencies`: the smallest automatic step (each
 /// period then the nearest whole number of steps). std::invalid_argument as cosimulate.
 double stepped_sine_time_step(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                              const CosimulationOptions& options, const std::vector<double>& frequencies_hz);
+                              const SteadyStateRun& run, const std::vector<double>& frequencies_hz);
 
 /// One direction of a stepped sine over `frequencies_hz` in the order given: each frequency
 /// continues the previous one's final state (modes, bed, the drive's phase); the bed is
-/// settled once, before the first. `options` from stepped_sine_options, validated.
+/// settled once, before the first. `run` from stepped_sine_options, validated. Each point's
+/// progress reaches `hooks` as "<k>/<n> <f> Hz <stage>", with the share of the branch done;
+/// a stop request throws base::Interrupted.
 SteppedSineBranch stepped_sine_branch(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                      CosimulationOptions options, const std::vector<double>& frequencies_hz,
-                                      SweepDirection sweep, double time_step_s, const SteppedSineProgress& progress);
+                                      SteadyStateRun run, const std::vector<double>& frequencies_hz,
+                                      SweepDirection sweep, double time_step_s, base::RunHooks& hooks);
 
 /// The points of a branch in ascending frequency and their resonance measures (sampled_peak)
 /// of one output; the standard errors are the first output's (its per-period amplitudes are
@@ -155,11 +154,15 @@ struct LinearSineSweep {
   static const base::Fields<LinearSineSweep>& fields();
 };
 
+/// The sweep of linear_sine_sweep: `steady`'s settings and drive, from `start_hz` to `end_hz`
+/// at `rate_hz_s`.
+SweepRun linear_sweep_run(const SteadyStateRun& steady, double start_hz, double end_hz, double rate_hz_s);
+
 /// Runs one direction: `steady` (stepped_sine_options) settles the structure at `start_hz`
-/// on the sweep's step, then the sweep runs to `end_hz` at `rate_hz_s`. `progress` gets the
-/// start (index 0) and the sweep (index 1).
+/// on the sweep's step, then the sweep runs to `end_hz` at `rate_hz_s`. Progress reaches
+/// `hooks` labelled "start <f> Hz", then "sweep"; a stop request throws base::Interrupted.
 LinearSineSweep linear_sine_sweep(const ModalModel& model, const std::vector<CosimulationDamper>& dampers,
-                                  const CosimulationOptions& steady, SweepDirection sweep, double start_hz,
-                                  double end_hz, double rate_hz_s, const SteppedSineProgress& progress);
+                                  const SteadyStateRun& steady, SweepDirection sweep, double start_hz, double end_hz,
+                                  double rate_hz_s, base::RunHooks& hooks);
 
 }  // namespace pdamp::structure

@@ -79,18 +79,18 @@ CoupledRunEstimate estimate_coupled_steps(const std::vector<structure::Cosimulat
                                           std::int64_t steps);
 /// The co-simulation options of a DEM-in-the-loop free decay of the case from q0 over
 /// duration_s (sampled finely enough for the settling measure).
-structure::CosimulationOptions dem_decay_options(const case_file::Case& c, const structure::ModalModel& modal,
+structure::DecayRun dem_decay_options(const case_file::Case& c, const structure::ModalModel& modal,
                                                  const Eigen::VectorXd& q0, double duration_s);
 /// The estimate alone (InputError for options the co-simulation refuses).
 CoupledRunEstimate estimate_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
                                             const std::vector<structure::CosimulationDamper>& dampers,
-                                            const structure::CosimulationOptions& options);
+                                            const structure::DecayRun& options);
 /// The estimate of a decay of `options` (a free decay), and its checks: InputError naming
 /// /dem when it cannot fit in the memory available, and check_wall_time (`duration_pointer`
 /// names the duration to shorten). The one-line text for the user is estimate_text().
 CoupledRunEstimate check_coupled_decay(const case_file::Case& c, const structure::ModalModel& modal,
                                          const std::vector<structure::CosimulationDamper>& dampers,
-                                         const structure::CosimulationOptions& options,
+                                         const structure::DecayRun& options,
                                          const std::string& label, const std::string& duration_pointer, base::RunHooks& hooks);
 /// "N particles in B beds, S coupled steps of dt s = P particle-steps, about T s; memory about M".
 std::string estimate_text(const CoupledRunEstimate& estimate);
