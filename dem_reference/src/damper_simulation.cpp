@@ -34,50 +34,49 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return text;
 }
 
-/// Reports progress about twice a second. The clock is read every `stride` steps, a
-/// power of two with stride × particles ≈ 65,536 particle-steps (every step from 65,536
-/// particles on, every 2048th for 36): one read costs ~20 ns, a step of a large world
-/// milliseconds, so that the first report of a 1e6-particle run comes after 0.5 s and
+/// Reports progress to the hooks about twice a second. The clock is read every `stride`
+/// steps, a power of two with stride × particles ≈ 65,536 particle-steps (every step from
+/// 65,536 particles on, every 2048th for 36): one read costs ~20 ns, a step of a large
+/// world milliseconds, so that the first report of a 1e6-particle run comes after 0.5 s and
 /// not after 4096 steps (minutes), as with a fixed stride.
 class ProgressReporter {
  public:
-  ProgressReporter(const ProgressCallback& callback, double end_time_s, int particles)
-      : callback_(callback), end_time_s_(end_time_s), start_(Clock::now()), last_(start_) {
+  ProgressReporter(base::RunHooks& hooks, double end_time_s, int particles)
+      : hooks_(hooks), end_time_s_(end_time_s), start_(Clock::now()), last_(start_) {
     std::int64_t stride = 1;
     while (stride < 4096 && stride * 2 * std::max(particles, 1) <= 65536) stride *= 2;
     mask_ = stride - 1;
   }
-  /// Reports now (the set-up stages, before any step).
-  void report_now(std::string_view stage, double time_s, double eta_s) {
-    if (!callback_) return;
-    Progress p;
+  /// Reports now (the set-up stages, before any step: no rate yet).
+  void report_now(const char* stage, double time_s, double eta_s) {
+    base::Progress p;
     p.stage = stage;
-    p.simulated_time_s = time_s;
-    p.end_time_s = end_time_s_;
+    p.done = time_s;
+    p.total = end_time_s_;
     p.eta_s = eta_s;
-    callback_(p);
+    hooks_.progress(p);
     last_ = Clock::now();
   }
   /// The stepping starts: the rate is measured from here.
   void start_stepping() { start_ = Clock::now(); }
-  void maybe_report(std::string_view stage, std::int64_t step, std::int64_t total_steps, double time_s) {
-    if (!callback_ || (step & mask_) != 0) return;
+  void maybe_report(const char* stage, std::int64_t step, std::int64_t total_steps, double time_s) {
+    if ((step & mask_) != 0) return;
     const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last_).count() < 0.5) return;
     last_ = now;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double rate = elapsed > 0.0 ? static_cast<double>(step) / elapsed : 0.0;
-    Progress p;
+    base::Progress p;
     p.stage = stage;
-    p.simulated_time_s = time_s;
-    p.end_time_s = end_time_s_;
+    p.done = time_s;
+    p.total = end_time_s_;
     p.steps_per_s = rate;
     p.eta_s = rate > 0.0 ? static_cast<double>(total_steps - step) / rate : 0.0;
-    callback_(p);
+    hooks_.progress(p);
   }
 
  private:
-  const ProgressCallback& callback_;
+  base::RunHooks& hooks_;
   double end_time_s_;
   Clock::time_point start_;
   Clock::time_point last_;
@@ -343,8 +342,8 @@ bool approach(World& world, const DamperSimulationOptions& o, const RunPlan& pla
 
 }  // namespace
 
-DamperResult run_harmonic(const DamperSimulationOptions& options, const ProgressCallback& progress,
-                          const HarmonicCheckpoints* checkpoints) {
+DamperResult run_harmonic(const DamperSimulationOptions& options, base::RunHooks& hooks,
+                          const CheckpointStorage& checkpoints) {
   const auto wall_start = Clock::now();
   const RunPlan plan = plan_run(options);
   const HarmonicMotion motion(options.drive_axis, options.amplitude_m, options.frequency_hz);
@@ -358,7 +357,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   const std::int64_t transient_steps = plan.transient_steps;
   const std::int64_t total_steps = plan.total_steps;
   const int periods = options.analysed_periods;
-  ProgressReporter reporter(progress, static_cast<double>(transient_steps + plan.analysed_steps) * dt, plan.particles);
+  ProgressReporter reporter(hooks, static_cast<double>(transient_steps + plan.analysed_steps) * dt, plan.particles);
   // Before the world is built (placement, lists and first forces take seconds for a
   // million spheres) and after: the estimate's wall time is the best ETA there is.
   const double eta_s = static_cast<double>(plan.particles) * static_cast<double>(total_steps) /
@@ -399,7 +398,7 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   BlockRecorder recorder(recording);
   DriveBinMeasure drive_bin(steps_per_period, options.frequency_hz, m_bed);
 
-  double wall_before_s = 0.0;  // of the runs before a resume (HarmonicCheckpoints)
+  double wall_before_s = 0.0;  // of the runs before a resume (CheckpointStorage::resume_state)
   const auto finish = [&](Outcome outcome, const std::string& message) {
     auto& s = result.summary;
     s.outcome = outcome;
@@ -428,20 +427,18 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
   // A stop asked while the bed settles or approaches (no checkpoint can hold those phases)
   // ends the run at once without one: a big bed's settling can take hours.
   struct StoppedBeforeDrive {};
-  const auto stop_asked = [&](std::int64_t k) {
-    return checkpoints != nullptr && checkpoints->stop && k % kStopPollSteps == 0 && checkpoints->stop();
-  };
+  const auto stop_asked = [&](std::int64_t k) { return k % kStopPollSteps == 0 && hooks.stop_requested() != 0; };
   const auto report_settling = [&](std::int64_t k) {
     reporter.maybe_report("settling", k, total_steps, static_cast<double>(k - settle_steps) * dt);
     if (stop_asked(k + 1)) throw StoppedBeforeDrive{};
   };
   // A resumed run starts where its checkpoint was written; a new one settles first.
-  const bool resuming = checkpoints != nullptr && !checkpoints->resume_state.empty();
+  const bool resuming = !checkpoints.resume_state.empty();
   std::optional<StateReader> saved;
   std::int64_t first_step = 1;  // the next drive step
   bool analysing = false;
   if (resuming) {
-    saved.emplace(checkpoints->resume_state, "harmonic run state");
+    saved.emplace(checkpoints.resume_state, "harmonic run state");
     saved->expect_tag("harmonic run 3");  // 2: the drive bins and the block in progress; 3: snapshots' contacts
     analysing = saved->i32_in("phase", 1, 2) == 2;
     first_step = saved->i64("step") + 1;
@@ -491,29 +488,36 @@ DamperResult run_harmonic(const DamperSimulationOptions& options, const Progress
     saved->finish();
   }
   // A checkpoint at a period end when due, and at any step once a stop is asked (polled
-  // every kStopPollSteps steps: a period of a big bed can take an hour); the run then ends.
+  // every kStopPollSteps steps and at period ends: a period of a big bed can take an hour);
+  // the run then ends.
+  auto last_checkpoint = wall_start;
   const auto checkpoint = [&](std::int64_t step) {
-    if (checkpoints == nullptr) return false;
-    const bool stopping = stop_asked(step);
-    if (!stopping && (step % steps_per_period != 0 || !checkpoints->due || !checkpoints->due())) return false;
-    StateWriter out;
-    out.tag("harmonic run 3");
-    out.i32(analysing ? 2 : 1);
-    out.i64(step);
-    out.f64(wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count());
-    world.save_state(out);
-    motion_modes.save(out);
-    if (analysing) {
-      const EnergyAccount& a = ledger->opening();
-      for (double v : {a.container_work_j, a.normal_damping_j, a.friction_j, a.rolling_j, a.kinetic_j, a.potential_j,
-                       a.elastic_j})
-        out.f64(v);
-      drive_bin.save(out);
-      recorder.save(out);
+    const bool period_end = step % steps_per_period == 0;
+    const bool stopping = (period_end || step % kStopPollSteps == 0) && hooks.stop_requested() != 0;
+    if (!stopping &&
+        (!period_end || !hooks.checkpoint_due(std::chrono::duration<double>(Clock::now() - last_checkpoint).count())))
+      return false;
+    if (checkpoints.sink != nullptr) {
+      StateWriter out;
+      out.tag("harmonic run 3");
+      out.i32(analysing ? 2 : 1);
+      out.i64(step);
+      out.f64(wall_before_s + std::chrono::duration<double>(Clock::now() - wall_start).count());
+      world.save_state(out);
+      motion_modes.save(out);
+      if (analysing) {
+        const EnergyAccount& a = ledger->opening();
+        for (double v : {a.container_work_j, a.normal_damping_j, a.friction_j, a.rolling_j, a.kinetic_j, a.potential_j,
+                         a.elastic_j})
+          out.f64(v);
+        drive_bin.save(out);
+        recorder.save(out);
+      }
+      out.tag("end of harmonic run");
+      checkpoints.sink->store(out.bytes(), static_cast<double>(step) * dt);
+      last_checkpoint = Clock::now();
     }
-    out.tag("end of harmonic run");
-    checkpoints->write(out.bytes(), static_cast<double>(step) * dt);
-    return stopping || (checkpoints->stop && checkpoints->stop());
+    return stopping || hooks.stop_requested() != 0;
   };
   const auto stop_here = [&]() {
     result.stopped = true;

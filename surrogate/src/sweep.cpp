@@ -373,7 +373,8 @@ using IndexEvaluator = std::function<FieldPoint(std::size_t index, const DrivePo
 
 /// run_sweep and run_point_sweep: every point of options' shard not yet in the results
 /// file, options.threads at a time (the documentation of run_sweep says the rest).
-PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, const SweepOptions& options) {
+PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, const SweepOptions& options,
+                            base::RunHooks& hooks) {
   detail::throw_if_any(options.validate(), "sweep options");
   const auto start = Clock::now();
   const std::vector<std::size_t> nodes = shard_nodes(all.count, options);
@@ -393,28 +394,41 @@ PointSweepResult run_points(const Points& all, const IndexEvaluator& evaluator, 
     if (!done[k]) pending.push_back(k);
   }
 
-  std::mutex mutex;  // guards points, the file, the counters, the progress callback and `error`
+  std::mutex mutex;  // guards points, the file, the counters, the progress reports and `error`
   std::exception_ptr error;
   std::atomic<bool> stop{false};
   std::size_t computed = 0;
   auto report_progress = [&] {
-    if (!options.progress) return;
     const double elapsed = seconds_since(start);
     const std::size_t left = pending.size() - computed;
     // Wall time per finished point of this run already reflects the parallelism.
     const double eta_s = computed == 0 ? std::numeric_limits<double>::quiet_NaN()
                                        : elapsed * static_cast<double>(left) / static_cast<double>(computed);
-    options.progress(resumed + computed, total, eta_s);
+    base::Progress p;
+    p.stage = options.progress_stage;
+    p.done = static_cast<double>(resumed + computed);
+    p.total = static_cast<double>(total);
+    p.counts_points = true;
+    p.eta_s = eta_s;
+    hooks.progress(p);
   };
   auto fail = [&](std::exception_ptr e) {
     std::lock_guard lock(mutex);
     if (!error) error = e;
     stop = true;
   };
-  // Pending point `slot`, unless a point failed or the progress callback threw: then no
-  // further point starts (those written so far stay in the results file for a resume).
+  // Pending point `slot`, unless a point failed, the progress report threw or the hooks ask
+  // to stop: then no further point starts (those written so far stay in the results file
+  // for a resume).
   auto compute = [&](std::size_t slot) {
     if (stop) return;
+    if (const int signal = hooks.stop_requested(); signal != 0) {
+      fail(std::make_exception_ptr(base::Interrupted(
+          signal, file ? "the sweep stopped; its finished points are saved in " + detail::file_label(options.results_path) +
+                             ": the same command resumes from them"
+                       : "the sweep stopped; it had no results file, so nothing was kept")));
+      return;
+    }
     const std::size_t k = pending[slot];
     try {
       const DrivePoint drive = all.drive(k);
@@ -485,7 +499,8 @@ std::size_t pending_points(const Points& all, const SweepOptions& options) {
 
 }  // namespace
 
-SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options) {
+SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options,
+                      base::RunHooks& hooks) {
   if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   return run_sweep(
       grid,
@@ -493,26 +508,26 @@ SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const S
         const DrivePoint drive = drive_point(grid, k, options.clearance_m);
         return evaluator(drive.frequency_hz, drive.amplitude_m);
       },
-      options);
+      options, hooks);
 }
 
 SweepResult run_sweep(const Grid& grid, const std::function<FieldPoint(std::size_t node)>& evaluator,
-                      const SweepOptions& options) {
+                      const SweepOptions& options, base::RunHooks& hooks) {
   detail::throw_if_any(grid.validate(), "sweep grid");
   detail::throw_if_any(options.validate(), "sweep options");
   if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   PointSweepResult r = run_points(
       grid_points(grid, options.clearance_m), [&evaluator](std::size_t k, const DrivePoint&) { return evaluator(k); },
-      options);
+      options, hooks);
   return {field_of(grid, std::move(r.points), options), std::move(r.summary)};
 }
 
 PointSweepResult run_point_sweep(const SweepPoints& points, const PointIndexEvaluator& evaluator,
-                                 const SweepOptions& options) {
+                                 const SweepOptions& options, base::RunHooks& hooks) {
   detail::throw_if_any(points.validate(), "sweep points");
   if (!evaluator) throw std::invalid_argument("sweep evaluator: must be callable");
   return run_points(list_points(points), [&evaluator](std::size_t k, const DrivePoint&) { return evaluator(k); },
-                    options);
+                    options, hooks);
 }
 
 std::size_t pending_sweep_points(const Grid& grid, const SweepOptions& options) {

@@ -1,7 +1,6 @@
 // pdamp dem as a study (dem_run.hpp).
 #include "pdamp/tasks/dem_run.hpp"
 
-#include <chrono>
 #include <fstream>
 #include <limits>
 #include <regex>
@@ -140,23 +139,21 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
     header.settings = settings.str();
   }
   header.end_time_s = (options.transient_periods + options.analysed_periods) / f;
-  dem_reference::HarmonicCheckpoints saving;
-  auto last_checkpoint = std::chrono::steady_clock::now();
-  // Without a checkpoint file the stop requests are still polled (a library caller's
-  // KeyboardInterrupt, docs/python.md), and nothing is written.
-  saving.due = [&] {
-    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count();
-    return hooks.stop_requested() != 0 || (checkpointing && hooks.checkpoint_due(since));
-  };
-  saving.stop = [&] { return hooks.stop_requested() != 0; };
-  bool wrote_checkpoint = false;
-  saving.write = [&](const std::string& state, double t) {
-    if (!checkpointing) return;
-    header.simulated_time_s = t;
-    write_checkpoint(checkpoint, header, state);
-    wrote_checkpoint = true;
-    last_checkpoint = std::chrono::steady_clock::now();
-  };
+  // The checkpoint file takes the states. Without one the run still asks the hooks whether
+  // to stop (a library caller's KeyboardInterrupt, docs/python.md) and nothing is written.
+  struct FileSink : dem_reference::CheckpointSink {
+    const CheckpointFile& file;
+    dem_reference::CheckpointHeader& header;
+    bool wrote = false;
+    FileSink(const CheckpointFile& f, dem_reference::CheckpointHeader& h) : file(f), header(h) {}
+    void store(const std::string& state, double simulated_time_s) override {
+      header.simulated_time_s = simulated_time_s;
+      write_checkpoint(file, header, state);
+      wrote = true;
+    }
+  } sink(checkpoint, header);
+  dem_reference::CheckpointStorage saving;
+  if (checkpointing) saving.sink = &sink;
   if (checkpoint.resume) saving.resume_state = read_checkpoint(checkpoint, header);  // refused before any work
   check_wall_time(c, plan.estimate.wall_time_s, plan.label, "/dem",
                   "fewer /dem/analysed_periods or /dem/transient_periods, a larger /dem/time_step_s, or fewer particles",
@@ -181,20 +178,15 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
     out.approach_ramp_periods = options.approach_ramp_periods;
   }
   try {
-    out.dem = dem_reference::run_harmonic(
-        options,
-        [&](const dem_reference::Progress& p) {
-          hooks.progress({plan.label, std::string(p.stage), p.simulated_time_s, p.end_time_s, false,
-                          p.stage == "setup" ? NAN : p.steps_per_s, p.eta_s});
-        },
-        &saving);
+    base::LabelledHooks labelled(hooks, plan.label);
+    out.dem = dem_reference::run_harmonic(options, labelled, saving);
   } catch (const std::invalid_argument& e) {  // e.g. a time step above the stable bound, a resume that does not fit
     throw InputError(checkpoint.resume ? checkpoint.path.string() : c.path, checkpoint.resume ? "" : "/dem", e.what());
   }
   if (out.dem.stopped)
     throw base::Interrupted(hooks.stop_requested(),
                                    !checkpointing ? "the run stopped; it had no checkpoint file, so nothing was kept"
-                                   : wrote_checkpoint || checkpoint.resume
+                                   : sink.wrote || checkpoint.resume
                                        ? resume_advice(checkpoint, header)
                                        : "the run stopped while its bed settled, before its first checkpoint: run the "
                                          "same command again");

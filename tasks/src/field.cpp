@@ -144,11 +144,11 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::Run
                     ? " (shard " + std::to_string(plan.options.shard_index) + "/" + std::to_string(plan.options.shard_count) + ")"
                     : "") +
                (executor.processes() > 1 ? ", spread over " + std::to_string(executor.processes()) + " MPI ranks" : ""));
-    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
-      hooks.progress({plan.options.label, "points", static_cast<double>(done), static_cast<double>(total), true, NAN, eta_s});
-    };
   }
-  const auto result = surrogate::run_sweep(grid, [&](std::size_t k) { return jobs(k); }, sweep);
+  // A DEM sweep reports its points and stops on request; a formulas sweep takes microseconds.
+  base::LabelledHooks labelled(hooks, plan.options.label);
+  const auto result =
+      surrogate::run_sweep(grid, [&](std::size_t k) { return jobs(k); }, sweep, dem ? labelled : base::silent_hooks());
   FieldResult out;
   out.case_name = c.name;
   out.field = result.field;

@@ -155,11 +155,12 @@ SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPla
   sweep.threads = executor.concurrency(sweep.threads);
   if (dem) {
     hooks.note(plan.options.label + ": " + plan.estimate);
-    sweep.progress = [&](std::size_t done, std::size_t total, double eta_s) {
-      hooks.progress({plan.options.label, "runs", static_cast<double>(done), static_cast<double>(total), true, NAN, eta_s});
-    };
   }
-  const auto result = surrogate::run_point_sweep(study.points, [&](std::size_t k) { return jobs(k); }, sweep);
+  // A DEM study reports its runs and stops on request; the closed forms take microseconds.
+  sweep.progress_stage = "runs";
+  base::LabelledHooks labelled(hooks, plan.options.label);
+  const auto result = surrogate::run_point_sweep(study.points, [&](std::size_t k) { return jobs(k); }, sweep,
+                                                 dem ? labelled : base::silent_hooks());
   SensitivityResult out = study_result(c, study, result, plan.options.source);
   out.sweep_report = result.summary.brief_report();
   out.mpi = jobs.balance();

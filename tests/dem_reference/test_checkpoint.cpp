@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <string>
 
@@ -222,43 +223,61 @@ TEST_CASE("a harmonic run stopped at checkpoints and resumed equals the uninterr
   const dr::DamperResult whole = dr::run_harmonic(o);
   REQUIRE(whole.summary.outcome == dr::Outcome::kCompleted);
 
-  std::string state;
-  double written_at = 0.0;
-  int checkpoints = 0;
-  dr::HarmonicCheckpoints hook;
-  hook.due = [] { return true; };  // every period end
-  hook.write = [&](const std::string& bytes, double t) {
-    state = bytes;
-    written_at = t;
-    ++checkpoints;
-  };
-  // stop() is a state (a signal arrived), polled after each write and every
-  // kStopPollSteps steps. The first run stops at its first checkpoint (the transient's first
-  // period end). The second, with no periodic checkpoint due, is asked to stop at its
-  // poll that falls 2.5 periods on: it writes its state there, mid-period in the analysis
-  // (the drive bins and a block in progress). The third runs to the end (one checkpoint at
-  // the period end after 3.5 periods, none at the run's end).
-  hook.stop = [&] { return checkpoints == 1; };
-  const dr::DamperResult first = dr::run_harmonic(o, {}, &hook);
+  // The test's hooks and sink: checkpoint_due() and stop_requested() say what the test sets.
+  struct Hooks : pdamp::base::RunHooks {
+    std::function<bool()> due;
+    std::function<bool()> stop;
+    bool checkpoint_due(double seconds_since_checkpoint) override {
+      CHECK(seconds_since_checkpoint >= 0.0);
+      return due();
+    }
+    int stop_requested() override { return stop() ? 15 : 0; }
+  } hooks;
+  struct Sink : dr::CheckpointSink {
+    std::string state;
+    double written_at = 0.0;
+    int checkpoints = 0;
+    void store(const std::string& bytes, double t) override {
+      state = bytes;
+      written_at = t;
+      ++checkpoints;
+    }
+  } sink;
+  dr::CheckpointStorage storage;
+  storage.sink = &sink;
+  const std::string& state = sink.state;
+  const double& written_at = sink.written_at;
+  const int& checkpoints = sink.checkpoints;
+  hooks.due = [] { return true; };  // every period end
+  // stop_requested() is a state (a signal arrived), polled every kStopPollSteps steps, at
+  // period ends and after each write. The first run stops at its first checkpoint (the
+  // transient's first period end). The second, with no periodic checkpoint due, is asked to
+  // stop at its poll that falls 2.5 periods on (a period is 64 blocks, a multiple of
+  // kStopPollSteps steps: its ends are polls): it writes its state there, mid-period in the
+  // analysis (the drive bins and a block in progress). The third runs to the end (one
+  // checkpoint at the period end after 3.5 periods, none at the run's end).
+  hooks.stop = [&] { return checkpoints == 1; };
+  const dr::DamperResult first = dr::run_harmonic(o, hooks, storage);
   CHECK(first.stopped);
   CHECK(written_at == Approx(1.0 / o.frequency_hz).epsilon(1e-9));
-  hook.resume_state = state;
-  hook.due = [] { return false; };
+  storage.resume_state = state;
+  hooks.due = [] { return false; };
   const std::int64_t period = whole.steps_per_period;
+  REQUIRE(period % dr::kStopPollSteps == 0);
   const std::int64_t stop_poll = (5 * period / 2) / dr::kStopPollSteps;
   std::int64_t polls = 0;
-  hook.stop = [&] { return ++polls == stop_poll; };
-  const dr::DamperResult second = dr::run_harmonic(o, {}, &hook);
+  hooks.stop = [&] { return ++polls == stop_poll; };
+  const dr::DamperResult second = dr::run_harmonic(o, hooks, storage);
   CHECK(second.stopped);
   CHECK(checkpoints == 2);
   const double periods_at_stop = written_at * o.frequency_hz;
   CHECK(periods_at_stop > 3.0);  // in the analysis
   CHECK(periods_at_stop < 4.0);
   CHECK(std::abs(periods_at_stop - std::round(periods_at_stop)) > 1e-3);  // not at a period end
-  hook.resume_state = state;
-  hook.due = [] { return true; };
-  hook.stop = [] { return false; };
-  const dr::DamperResult last = dr::run_harmonic(o, {}, &hook);
+  storage.resume_state = state;
+  hooks.due = [] { return true; };
+  hooks.stop = [] { return false; };
+  const dr::DamperResult last = dr::run_harmonic(o, hooks, storage);
   REQUIRE_FALSE(last.stopped);
   REQUIRE(last.summary.outcome == dr::Outcome::kCompleted);
   CHECK(last.eta_star == whole.eta_star);
@@ -276,17 +295,24 @@ TEST_CASE("a harmonic run stopped at checkpoints and resumed equals the uninterr
   CHECK(checkpoints == 3);
 
   // Asked to stop while the bed settles: the run ends at once, without a checkpoint.
-  hook.resume_state.clear();
-  hook.stop = [] { return true; };
-  const dr::DamperResult settling = dr::run_harmonic(o, {}, &hook);
+  storage.resume_state.clear();
+  hooks.stop = [] { return true; };
+  const dr::DamperResult settling = dr::run_harmonic(o, hooks, storage);
   CHECK(settling.stopped);
   CHECK(checkpoints == 3);
   CHECK(settling.summary.steps == dr::kStopPollSteps);  // at the first poll
   CHECK_THAT(settling.summary.message, Catch::Contains("no checkpoint"));
 
+  // Without a sink a stop still ends the run, and nothing is stored.
+  polls = 0;
+  hooks.stop = [&] { return ++polls == stop_poll; };
+  const dr::DamperResult unsaved = dr::run_harmonic(o, hooks, dr::CheckpointStorage{});
+  CHECK(unsaved.stopped);
+  CHECK(checkpoints == 3);
+
   // A state of other options is refused naming the field.
   dr::DamperSimulationOptions other = o;
   other.analysed_periods = 1;
-  hook.resume_state = state;
-  CHECK_THROWS_WITH(dr::run_harmonic(other, {}, &hook), Catch::Contains("step"));
+  storage.resume_state = state;
+  CHECK_THROWS_WITH(dr::run_harmonic(other, hooks, storage), Catch::Contains("step"));
 }

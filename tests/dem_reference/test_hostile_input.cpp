@@ -268,14 +268,26 @@ TEST_CASE("estimate_run predicts the time step, the steps and the recorded sampl
 
 TEST_CASE("the first progress report comes before the world is built, as stage setup", "[dem_reference]") {
   auto o = low_intensity();
-  std::vector<std::string> stages;
-  std::vector<double> etas;
-  dr::run_harmonic(o, [&](const dr::Progress& p) {
-    stages.emplace_back(p.stage);
-    etas.push_back(p.eta_s);
-  });
-  REQUIRE(stages.size() >= 2);
-  CHECK(stages[0] == "setup");
-  CHECK(stages[1] == "setup");
-  CHECK(etas[0] > 0.0);
+  struct Hooks : pdamp::base::RunHooks {
+    std::vector<pdamp::base::Progress> reports;
+    void progress(const pdamp::base::Progress& p) override { reports.push_back(p); }
+  } hooks;
+  const auto r = dr::run_harmonic(o, hooks);
+  const auto& reports = hooks.reports;
+  REQUIRE(reports.size() >= 2);
+  CHECK(reports[0].stage == "setup");
+  CHECK(reports[1].stage == "setup");
+  CHECK(reports[0].eta_s > 0.0);
+  CHECK(std::isnan(reports[0].steps_per_s));  // no rate before the first step
+  // Simulated time since the drive started, from the settling's start (negative) to the
+  // run's end; no label (the caller names the run).
+  const double end_s = (o.transient_periods + o.analysed_periods) / o.frequency_hz;
+  const std::int64_t settling_steps = r.summary.steps - (o.transient_periods + o.analysed_periods) * r.steps_per_period;
+  CHECK(reports[0].done == Approx(-static_cast<double>(settling_steps) * r.time_step_s).epsilon(1e-12));
+  for (const auto& p : reports) {
+    CHECK(p.label.empty());
+    CHECK_FALSE(p.counts_points);
+    CHECK(p.total == Approx(end_s).epsilon(1e-12));
+    CHECK(p.done <= p.total);
+  }
 }

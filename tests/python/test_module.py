@@ -127,3 +127,24 @@ def test_keyboard_interrupt_stops_a_dem_run(tmp_path):
         timer.cancel()
     # Stopped where it was, not at its end: the last report is early in the 2000 periods.
     assert reports and reports[-1]["done"] < 0.5 * reports[-1]["total"]
+
+
+def test_keyboard_interrupt_stops_a_dem_field_before_its_next_point(tmp_path):
+    document = small_dem_case()
+    document["dem"]["analysed_periods"] = 20  # about a second a point: the interrupt lands mid-sweep
+    document["field"] = {"axis0": {"min": 1.5, "max": 2.5, "count": 4}, "axis1": {"min": 0.015, "max": 0.07, "count": 4},
+                         "threads": 1}
+    path = tmp_path / "field.json"
+    path.write_text(json.dumps(document))
+    case = pdamp.load_case(str(path))
+    reports = []
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            pdamp.field(case, source="dem", progress=reports.append)
+    finally:
+        timer.cancel()
+    # The point in flight finished, no other started: the sweep ended well before its 16 points.
+    assert reports and all(r["counts_points"] for r in reports)
+    assert reports[-1]["done"] < reports[-1]["total"] == 16

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/sweep.hpp"
 #include "surrogate/hostile_files.hpp"
 
@@ -94,6 +95,14 @@ SweepOptions sweep_options(const fs::path& results) {
   return options;
 }
 
+/// Hooks that hand the progress reports and the stop polls to the test.
+struct TestHooks : pdamp::base::RunHooks {
+  std::function<void(const pdamp::base::Progress&)> on_progress = [](const pdamp::base::Progress&) {};
+  std::function<int()> on_stop = [] { return 0; };
+  void progress(const pdamp::base::Progress& p) override { on_progress(p); }
+  int stop_requested() override { return on_stop(); }
+};
+
 /// The field an uninterrupted run without a results file gives.
 EffectiveField reference_field() {
   RecordingEvaluator evaluator;
@@ -110,12 +119,16 @@ TEST_CASE("a sweep evaluates every node once and fills the derived columns", "[s
   std::vector<std::size_t> done;
   double first_eta = 0.0;
   SweepOptions options = sweep_options(dir.path / "sweep.jsonl");
-  options.progress = [&](std::size_t points_done, std::size_t total, double eta_s) {
-    if (done.empty()) first_eta = eta_s;
-    done.push_back(points_done);
-    CHECK(total == 18);
+  TestHooks hooks;
+  hooks.on_progress = [&](const pdamp::base::Progress& p) {
+    if (done.empty()) first_eta = p.eta_s;
+    done.push_back(static_cast<std::size_t>(p.done));
+    CHECK(p.total == 18);
+    CHECK(p.counts_points);
+    CHECK(p.stage == "points");
+    CHECK(p.label.empty());  // the caller names the sweep
   };
-  const SweepResult result = run_sweep(sweep_grid(), by_reference(evaluator), options);
+  const SweepResult result = run_sweep(sweep_grid(), by_reference(evaluator), options, hooks);
   CHECK(evaluator.calls() == 18);
   CHECK(evaluator.finished().size() == 18);
   CHECK(result.summary.points_computed == 18);
@@ -408,10 +421,11 @@ TEST_CASE("progress is reported once before the first point is evaluated", "[sur
   };
   SweepOptions options = sweep_options(results);
   options.threads = 1;
-  options.progress = [&](std::size_t done, std::size_t total, double eta_s) {
-    calls.push_back({done, total, eta_s, evaluations.load()});
+  TestHooks hooks;
+  hooks.on_progress = [&](const pdamp::base::Progress& p) {
+    calls.push_back({static_cast<std::size_t>(p.done), static_cast<std::size_t>(p.total), p.eta_s, evaluations.load()});
   };
-  run_sweep(sweep_grid(), evaluator, options);
+  run_sweep(sweep_grid(), evaluator, options, hooks);
   REQUIRE(calls.size() == 19);
   CHECK(calls[0].done == 0);
   CHECK(calls[0].total == 18);
@@ -423,11 +437,59 @@ TEST_CASE("progress is reported once before the first point is evaluated", "[sur
   std::ofstream(results, std::ios::binary | std::ios::trunc) << text;
   calls.clear();
   evaluations = 0;
-  run_sweep(sweep_grid(), evaluator, options);
+  run_sweep(sweep_grid(), evaluator, options, hooks);
   REQUIRE(calls.size() == 5);
   CHECK(calls[0].done == 14);
   CHECK(calls[0].evaluations_before == 0);
   CHECK(calls[4].done == 18);
+}
+
+TEST_CASE("a stop request or a throwing progress report stops new points, and the sweep resumes", "[surrogate]") {
+  TempDir dir("sweep_stop");
+  const fs::path results = dir.path / "sweep.jsonl";
+  const SweepOptions options = sweep_options(results);
+  // Asked to stop (a signal arrived) once 5 points are saved: no point starts after that, the
+  // points in flight finish and are saved, and the sweep throws Interrupted with the signal.
+  RecordingEvaluator first;
+  TestHooks hooks;
+  std::atomic<std::size_t> saved{0};
+  hooks.on_progress = [&](const pdamp::base::Progress& p) { saved = static_cast<std::size_t>(p.done); };
+  hooks.on_stop = [&] { return saved >= 5 ? 2 : 0; };
+  try {
+    run_sweep(sweep_grid(), by_reference(first), options, hooks);
+    FAIL("the sweep did not stop");
+  } catch (const pdamp::base::Interrupted& e) {
+    CHECK(e.signal_number() == 2);
+    CHECK_THAT(e.what(), Catch::Contains("finished points are saved in") && Catch::Contains("sweep.jsonl"));
+  }
+  const auto first_run = first.finished();
+  CHECK(first_run.size() >= 5);
+  CHECK(first_run.size() <= 6);  // the other thread's point in flight
+  CHECK(line_count(results) == 1 + first_run.size());
+  // Without a results file the sweep says nothing was kept.
+  TestHooks stopping;
+  stopping.on_stop = [] { return 15; };
+  RecordingEvaluator none;
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(none), sweep_options({}), stopping),
+                    Catch::Contains("signal 15") && Catch::Contains("nothing was kept"));
+  CHECK(none.calls() == 0);
+
+  // A progress report that throws stops new points the same way; its exception reaches the caller.
+  RecordingEvaluator second;
+  TestHooks throwing;
+  int reports = 0;
+  throwing.on_progress = [&](const pdamp::base::Progress&) {
+    if (++reports == 3) throw std::runtime_error("progress says stop");
+  };
+  CHECK_THROWS_WITH(run_sweep(sweep_grid(), by_reference(second), options, throwing), "progress says stop");
+  CHECK(first.finished().size() + second.finished().size() < 18);
+
+  // Resumed: only the points never saved are computed, and the field is the serial run's.
+  RecordingEvaluator third;
+  const SweepResult resumed = run_sweep(sweep_grid(), by_reference(third), options);
+  CHECK(resumed.summary.points_resumed == first.finished().size() + second.finished().size());
+  for (const auto& point : third.finished()) CHECK(first_run.count(point) == 0);
+  CHECK(resumed.field.points == reference_field().points);
 }
 
 TEST_CASE("pending_sweep_points counts the nodes a run would still evaluate", "[surrogate]") {

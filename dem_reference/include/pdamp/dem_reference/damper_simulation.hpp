@@ -5,11 +5,10 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
-#include <string_view>
 #include <vector>
 
+#include "pdamp/base/run_hooks.hpp"
 #include "pdamp/dem_reference/motion_modes.hpp"
 #include "pdamp/dem_reference/run_measures.hpp"
 #include "pdamp/dem_reference/run_recorder.hpp"
@@ -109,40 +108,37 @@ struct DamperResult {
   TimeSeries series;
   std::vector<ParticleSnapshot> snapshots;
   std::vector<std::string> warnings;   ///< validity-range remarks (docs/command_line.md)
-  /// The checkpoint hook asked the run to stop (HarmonicCheckpoints::stop) after it wrote
-  /// its state: the measures are unset, the run continues from that state.
+  /// The hooks asked the run to stop (RunHooks::stop_requested): after it stored its state
+  /// (the run continues from it), or while the bed settled or approached, without one. The
+  /// measures are unset.
   bool stopped = false;
 };
 
-/// Checkpoints of a harmonic run (docs/dem.md "Checkpoints"). At the end of
-/// every drive period of the transient and the analysis the run asks `due()`; when it says
-/// so, the run passes its whole state to `write` (the World, the step, the motion-mode sums
-/// and, once analysing, the drive bins, the energy ledger's opening and the recorded series,
-/// block in progress and snapshots) and then asks `stop()`: true ends the run there
-/// (DamperResult::stopped). `stop()` is also asked every kStopPollSteps steps: true writes
-/// the state at that step and ends the run (a period of a big bed can take an hour), or,
-/// while the bed still settles or approaches (phases no checkpoint holds), ends it without
-/// a write. With `resume_state` (bytes an earlier run of the same options wrote) the run
-/// starts there instead of settling: its result is bit for bit the uninterrupted run's.
-inline constexpr std::int64_t kStopPollSteps = 16;
-struct HarmonicCheckpoints {
-  std::function<bool()> due;
-  std::function<bool()> stop;
-  std::function<void(const std::string& state, double simulated_time_s)> write;
+/// Where a harmonic run's checkpoints go (docs/dem.md "Checkpoints"): a file, memory. The
+/// run hands over its whole state each time it takes one; the sink keeps it (the last
+/// replaces the ones before) or throws, which ends the run with that exception.
+class CheckpointSink {
+ public:
+  virtual ~CheckpointSink() = default;
+  /// `state`: bytes that resume the run (CheckpointStorage::resume_state), taken
+  /// `simulated_time_s` after the drive started.
+  virtual void store(const std::string& state, double simulated_time_s) = 0;
+};
+
+/// The checkpoint data of a harmonic run: where its states go and the state it starts
+/// from. When a checkpoint is taken and when the run stops are its hooks' (run_harmonic).
+struct CheckpointStorage {
+  /// Receives the run's state at each checkpoint; nullptr: none is kept (a stop still
+  /// ends the run, with nothing written).
+  CheckpointSink* sink = nullptr;
+  /// Bytes an earlier run of the same options stored: the run starts there instead of
+  /// settling, and its result is bit for bit the uninterrupted run's. Empty: a new run.
   std::string resume_state;
 };
 
-/// Progress of a run: once at the start ("setup", before the world is built, with the
-/// RunEstimate's wall time as eta_s), once the world is built, then about twice a
-/// second (the clock is read every step for large worlds).
-struct Progress {
-  std::string_view stage;        ///< "setup", "settling", "transient", "analysis"
-  double simulated_time_s = 0.0; ///< since the drive started (negative while settling)
-  double end_time_s = 0.0;       ///< simulated time at the end of the run
-  double steps_per_s = 0.0;
-  double eta_s = 0.0;            ///< estimated wall time left
-};
-using ProgressCallback = std::function<void(const Progress&)>;
+/// A harmonic run asks its hooks whether to stop every kStopPollSteps drive, settling or
+/// approach steps (and at period ends): a period of a big bed can take an hour.
+inline constexpr std::int64_t kStopPollSteps = 16;
 
 /// What a run will cost, computed without building the world (run_harmonic's time step
 /// and step counts exactly; memory from the sizes the world reserves; wall time at a
@@ -211,8 +207,24 @@ void check_initial_placement(const DamperSimulationOptions& options);
 /// failure during a step (e.g. a restitution model that throws, on any thread) returns
 /// with kFailed and the exception's message. A resume_state that does not fit the options
 /// throws std::invalid_argument naming the field.
-DamperResult run_harmonic(const DamperSimulationOptions& options,
-                          const ProgressCallback& progress = {},
-                          const HarmonicCheckpoints* checkpoints = nullptr);
+///
+/// What the run reports and asks, through `hooks` (docs/dem.md "Checkpoints"):
+/// - progress: stage "setup" before the world is built (eta_s the RunEstimate's wall time,
+///   no rate) and once it is built, then "settling", "approach", "transient" and "analysis"
+///   about twice a second (the clock is read every stride of ~65,536 particle-steps) with
+///   done = simulated time since the drive started (negative while settling and
+///   approaching), total = the run's end, steps_per_s and eta_s. No label: the caller names
+///   the run (base::LabelledHooks).
+/// - checkpoints: at the end of every drive period of the transient and the analysis the run
+///   asks checkpoint_due(wall seconds since its last checkpoint, or since it started); when
+///   due it passes its whole state to checkpoints.sink (the World, the step, the motion-mode
+///   sums and, once analysing, the drive bins, the energy ledger's opening and the recorded
+///   series, block in progress and snapshots), then asks stop_requested().
+/// - stop: stop_requested() is also asked every kStopPollSteps steps and at period ends;
+///   nonzero stores the state at that step and ends the run (DamperResult::stopped), or,
+///   while the bed still settles or approaches (phases no checkpoint holds), ends it without
+///   storing. The caller throws base::Interrupted.
+DamperResult run_harmonic(const DamperSimulationOptions& options, base::RunHooks& hooks = base::silent_hooks(),
+                          const CheckpointStorage& checkpoints = {});
 
 }  // namespace pdamp::dem_reference

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/run_hooks.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/surrogate/grid.hpp"
@@ -22,13 +23,6 @@ namespace pdamp::surrogate {
 /// kFailed (values ignored; say why in motion_mode) to record a point that cannot be
 /// computed; throwing stops the sweep (the exception reaches run_sweep's caller).
 using PointEvaluator = std::function<FieldPoint(double frequency_hz, double amplitude_m)>;
-
-/// Progress: called once before the first point is evaluated (points_done = the resumed
-/// points, 0 for a new sweep, so the user sees a line at once) and after each finished
-/// point: points done (resumed ones included), points in the grid, and the estimated
-/// seconds left (NaN until this run has finished a point). Called from worker threads,
-/// one call at a time.
-using SweepProgress = std::function<void(std::size_t points_done, std::size_t points_total, double eta_s)>;
 
 /// What a sweep writes where, and the identity that guards its results file.
 struct SweepOptions {
@@ -48,7 +42,9 @@ struct SweepOptions {
   /// shard_count in [1, kMaxShards], shard_index in [0, shard_count); 0/1 is the whole grid.
   int shard_index = 0;
   int shard_count = 1;
-  SweepProgress progress;    ///< optional
+  /// The stage of the progress reports (base::Progress::stage): what a point is to the user
+  /// ("points" of a field, a sensitivity study's "runs").
+  std::string progress_stage = "points";
   /// One line per violated rule ("threads = 0: must be in [1, 256]"); empty if valid.
   std::vector<std::string> validate() const;
 };
@@ -103,17 +99,28 @@ struct SweepResult {
 /// Ok points with NaN e_diss_j get η*·½ m_bed (XΩ)² (docs/theory.md §1), and NaN
 /// apparent_mass_fraction gets apparent_mass_kg/m_bed.
 ///
-/// If the evaluator or the progress callback throws, no new point is started, points in
-/// flight finish and are saved, and the first exception is rethrown: a killed or failed
-/// sweep loses at most the points in flight. An evaluator returning status ok with a
-/// non-finite η*, or status missing, counts as throwing std::runtime_error.
-/// Throws std::invalid_argument for an invalid grid or options, std::runtime_error for I/O.
-SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options);
+/// Progress goes to hooks.progress (no label: the caller names the sweep with
+/// base::LabelledHooks; stage options.progress_stage, counts_points): once before the first
+/// point is evaluated (done = the resumed points, 0 for a new sweep, so the user sees a line
+/// at once) and after each finished point: points done (resumed ones included), points of
+/// the shard, and eta_s, the estimated seconds left (NaN until this run has finished a
+/// point). Called from worker threads, one call at a time. hooks.stop_requested() is asked
+/// before each point starts.
+///
+/// If the evaluator or hooks.progress throws, or a stop is requested, no new point is
+/// started, points in flight finish and are saved, and the first exception is rethrown
+/// (for a stop base::Interrupted with the signal, saying where the finished points are): a
+/// killed, stopped or failed sweep loses at most the points in flight. An evaluator
+/// returning status ok with a non-finite η*, or status missing, counts as throwing
+/// std::runtime_error. Throws std::invalid_argument for an invalid grid or options,
+/// std::runtime_error for I/O.
+SweepResult run_sweep(const Grid& grid, const PointEvaluator& evaluator, const SweepOptions& options,
+                      base::RunHooks& hooks = base::silent_hooks());
 /// The same with an evaluator of the node index k (Grid::index order; its drive is
 /// drive_point(grid, k, options.clearance_m)): for callers that hand nodes to other
 /// processes by number.
 SweepResult run_sweep(const Grid& grid, const std::function<FieldPoint(std::size_t node)>& evaluator,
-                      const SweepOptions& options);
+                      const SweepOptions& options, base::RunHooks& hooks = base::silent_hooks());
 
 /// Grid nodes a run_sweep(grid, evaluator, options) would evaluate now: the nodes of
 /// options' shard (grid.size() unless sharded) minus the points already saved in options.results_path (0 saved if the path is
@@ -161,9 +168,9 @@ struct PointSweepResult {
   std::vector<FieldPoint> points;  ///< one per point; of other shards status kMissing
   SweepSummary summary;
 };
-/// run_sweep over `points` (the same results file, resume, shard, progress and error rules).
+/// run_sweep over `points` (the same results file, resume, shard, hooks and error rules).
 PointSweepResult run_point_sweep(const SweepPoints& points, const PointIndexEvaluator& evaluator,
-                                 const SweepOptions& options);
+                                 const SweepOptions& options, base::RunHooks& hooks = base::silent_hooks());
 /// pending_sweep_points for a list of points.
 std::size_t pending_point_sweep(const SweepPoints& points, const SweepOptions& options);
 /// merge_sweep_shards for a list of points.
