@@ -263,7 +263,7 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
        {"particle_steps_per_s", format_number(r.particle_steps_per_s, 3)},
        {"run", r.summary.brief_report()}},
       {"summary.json", nullptr, false, "files", false, false});
-  remove_checkpoints({checkpoint.path});
+  remove_checkpoints(files.get(), {checkpoint.path});
   return code;
 }
 
@@ -311,7 +311,7 @@ int run_import_liggghts(const ParsedArgs& args, CommandContext& context) {
     // The deck's folder belongs to the export: a commit there would remove its files.
     std::error_code e1, e2;
     if (std::filesystem::weakly_canonical(*out_dir, e1) == std::filesystem::weakly_canonical(deck, e2))
-      throw InputError("-o", "", "'" + base::printable(*out_dir) +
+      throw InputError("-o", "", std::string("'").append(base::printable(*out_dir)) +
                                      "' is the deck's folder (pdamp export liggghts owns it): write the summary elsewhere");
   }
   const auto result = tasks::import_liggghts(deck);  // refused before -o is touched

@@ -107,8 +107,8 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   options.skip_verify = args.has("--no-verify");
   const bool verify = !options.skip_verify && (options.force_verify || c.task.filling_ratios->verify);
   if (!verify) refuse_checkpoint_flags(args, "applies to the DEM verification (--verify)");
-  // Under mpirun only the verification's DEM runs are spread over the ranks.
-  if (!context.primary && !verify) return kExitOk;
+  // Under mpirun only the calibration's and the verification's DEM runs are spread over the ranks.
+  if (!context.primary && !verify && !calibrated) return kExitOk;
   auto files = output_dir(args, context);
   if (verify) {
     const tasks::CheckpointFile folder = checkpoint_file(args, "verify");
@@ -168,7 +168,7 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   }
   if (result.rounds.size() > 1) rows.push_back({"design loop", std::string(tasks::to_string(*result.loop_outcome))});
   const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report}, &result);
-  remove_checkpoints(result.checkpoints);
+  remove_checkpoints(files.get(), result.checkpoints);
   return code;
 }
 

@@ -37,10 +37,12 @@ tasks::OutputFolder output_folder(const report::OutputDir* files);
 /// optimize and run), whose signals are deferred from its start to its commit (the
 /// command holds a report::DeferredSignals that long): the run is complete, so a signal
 /// from now on waits until its results are committed instead of abandoning them
-/// (report::OutputDir::finish_despite_signals); a test may pause here ("run-ended").
+/// (report::OutputDir::finish_despite_signals); a test may pause here ("run-ended"). Without
+/// files (a process that writes nothing) there is nothing to commit.
 void dem_results_ready(report::OutputDir* files);
-/// After the commit: the run's checkpoints go, its results being kept.
-void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints);
+/// After the commit into `files`: the run's checkpoints go, its results being kept. Without
+/// files nothing was committed (no -o, or a process that writes nothing): they stay.
+void remove_checkpoints(const report::OutputDir* files, const std::vector<std::filesystem::path>& checkpoints);
 
 /// How a command ends.
 struct ResultFiles {

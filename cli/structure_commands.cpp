@@ -272,7 +272,7 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
                           format_number(100.0 * l["share"].get<double>(), 3) + "%)"});
   }
   const int code = finish(args, files.get(), out, warnings, rows, {"decay.json", &c, context.report}, &result);
-  remove_checkpoints({options.checkpoint.file.path});
+  remove_checkpoints(files.get(), {options.checkpoint.file.path});
   return code;
 }
 

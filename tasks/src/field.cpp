@@ -149,6 +149,7 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::Run
     };
   }
   const auto result = surrogate::run_sweep(grid, [&](std::size_t k) { return jobs(k); }, sweep);
+  jobs.end();  // the field is this process's alone (some points from its log): the others' part ends
   FieldResult out;
   out.case_name = c.name;
   out.field = result.field;
