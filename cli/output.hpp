@@ -27,9 +27,16 @@ std::string key_value_table(const Rows& rows);
 /// One line each on stderr, "pdamp: warning: ...", made printable.
 void print_warnings(const std::vector<std::string>& warnings);
 
+/// Whether this process writes the results: the executor's primary process (under mpirun
+/// rank 0; the other ranks only compute the jobs they are sent). The one place cli/ asks.
+bool writes_results(const CommandContext& context);
 /// The -o folder, checked before any work (report::OutputDir), or none: without -o, and on
-/// a process that writes nothing (an MPI worker).
+/// a process that writes nothing (writes_results).
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context);
+/// A study's folder `dir` (field, sensitivity: always one), with `in_place` (a results log
+/// the study writes into it as it goes) when not empty; none on a process that writes nothing.
+std::unique_ptr<report::OutputDir> study_dir(const std::string& dir, const CommandContext& context,
+                                             const std::string& in_place = "");
 /// Where a task's result JSON says its files are.
 tasks::OutputFolder output_folder(const report::OutputDir* files);
 

@@ -161,7 +161,8 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::Run
   return out;
 }
 
-FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv) {
+FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv, base::Executor& executor) {
+  executor.primary_only();
   const detail::SingleDamper single = detail::single_damper(c, "pdamp field");
   surrogate::MeasuredImportOptions options;
   options.clearance_m = single.layer.clearance_m;
