@@ -174,7 +174,7 @@ int run_buffer(const ParsedArgs& args, CommandContext&) {
 
 int run_damper_design(const ParsedArgs& args, CommandContext& context, const Case& c) {
   auto files = output_dir(args, context);
-  const auto design = tasks::run_damper_design(c);
+  const auto design = tasks::run_damper_design(c, context.executor);
   std::vector<std::string> warnings = design.warnings;
   if (files)
     for (auto& w : report::write_files(*files, design)) warnings.push_back(w);
@@ -194,10 +194,6 @@ int run_damper_design(const ParsedArgs& args, CommandContext& context, const Cas
 
 int run_run(const ParsedArgs& args, CommandContext& context) {
   const Case c = case_file::load_case(args.positional().at(0));
-  // Under mpirun the DEM jobs of frf and filling_ratios tasks are spread over the ranks;
-  // every other task runs on rank 0 alone.
-  if (!context.primary && c.task.kind != case_file::TaskKind::kFrf && c.task.kind != case_file::TaskKind::kFillingRatios)
-    return kExitOk;
   context.report = true;  // with -o DIR, the task also writes DIR/report.html
   const std::string kind(case_file::to_string(c.task.kind));
   for (const char* flag : {"--no-verify", "--calibration-cache"})
@@ -241,7 +237,7 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
   // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
   const std::optional<report::DeferredSignals> deferred =
       checkpoint.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
-  tasks::DemRunResult result = tasks::run_dem(c, plan, checkpoint, hooks);
+  tasks::DemRunResult result = tasks::run_dem(c, plan, checkpoint, hooks, context.executor);
   if (deferred) dem_results_ready(files.get());
   std::vector<std::string> warnings = result.warnings;
   if (files)
@@ -263,7 +259,7 @@ int run_dem(const ParsedArgs& args, CommandContext& context) {
        {"particle_steps_per_s", format_number(r.particle_steps_per_s, 3)},
        {"run", r.summary.brief_report()}},
       {"summary.json", nullptr, false, "files", false, false});
-  remove_checkpoints({checkpoint.path});
+  remove_checkpoints(files.get(), {checkpoint.path});
   return code;
 }
 
@@ -311,7 +307,7 @@ int run_import_liggghts(const ParsedArgs& args, CommandContext& context) {
     // The deck's folder belongs to the export: a commit there would remove its files.
     std::error_code e1, e2;
     if (std::filesystem::weakly_canonical(*out_dir, e1) == std::filesystem::weakly_canonical(deck, e2))
-      throw InputError("-o", "", "'" + base::printable(*out_dir) +
+      throw InputError("-o", "", std::string("'").append(base::printable(*out_dir)) +
                                      "' is the deck's folder (pdamp export liggghts owns it): write the summary elsewhere");
   }
   const auto result = tasks::import_liggghts(deck);  // refused before -o is touched
@@ -397,9 +393,9 @@ int run_field(const ParsedArgs& args, CommandContext& context) {
   const auto [shard_index, shard_count] = shard_flag(args);
   const std::string dir = args.optional_text("-o").value_or(default_dir(c, "_field_" + source));
   if (source == "measured") {
-    if (!context.primary) return kExitOk;  // rank 0 imports it
-    report::OutputDir files(dir);
-    return field_outputs(args, c, tasks::import_measured_field(c, args.text("--measured")), files, json::object());
+    const auto files = study_dir(dir, context);
+    const auto result = tasks::import_measured_field(c, args.text("--measured"), context.executor);
+    return field_outputs(args, c, result, *files, json::object());
   }
   tasks::FieldOptions options;
   options.source = source;
@@ -411,11 +407,7 @@ int run_field(const ParsedArgs& args, CommandContext& context) {
   // keeps one too; it also makes a rerun of the same shard command resume.
   if (source == "dem" || options.sharded) options.results_log = std::filesystem::path(dir) / kSweepLog;
   const auto plan = tasks::plan_field(c, options, context.executor);
-  std::unique_ptr<report::OutputDir> files;
-  if (context.primary) {
-    files = std::make_unique<report::OutputDir>(dir);
-    if (!options.results_log.empty()) files->in_place(kSweepLog);
-  }
+  const auto files = study_dir(dir, context, options.results_log.empty() ? "" : kSweepLog);
   CliHooks hooks;
   const auto result = tasks::run_field(c, plan, hooks, context.executor);
   json out = {{"sweep", result.sweep_report}, {"warnings", result.warnings}};
@@ -552,11 +544,7 @@ int run_sensitivity(const ParsedArgs& args, CommandContext& context) {
   options.sharded = args.has("--shard");
   if (options.source == "dem" || options.sharded) options.results_log = std::filesystem::path(dir) / kSensitivityLog;
   const auto plan = tasks::plan_sensitivity(c, options, context.executor);
-  std::unique_ptr<report::OutputDir> files;
-  if (context.primary) {
-    files = std::make_unique<report::OutputDir>(dir);
-    if (!options.results_log.empty()) files->in_place(kSensitivityLog);
-  }
+  const auto files = study_dir(dir, context, options.results_log.empty() ? "" : kSensitivityLog);
   CliHooks hooks;
   const auto result = tasks::run_sensitivity(c, plan, hooks, context.executor);
   json extra = json::object();
@@ -673,7 +661,7 @@ const std::vector<Command>& commands() {
                                     "                          dem.checkpoint while the run lasts: --resume)"},
                       kJsonFlag},
                      kCheckpointFlags), 1},
-       run_dem},
+       run_dem, true},
       {{"field", "pdamp field CASE.json --source formulas|dem|measured [--measured FILE] [-o DIR] [--json]",
         "effective field: eta*, E_diss, apparent mass and motion mode over the case's grid\n"
         "(frequency x amplitude or intensity x X/h); DEM sweeps resume where they stopped",

@@ -13,10 +13,9 @@ namespace pdamp::cli {
 
 /// What a command runs with besides its flags (main sets it up).
 struct CommandContext {
-  base::Executor& executor;  ///< where independent jobs run (this process, or MPI ranks)
-  /// This process writes and prints the results (under mpirun: rank 0; the other ranks only
-  /// compute the jobs they are sent).
-  bool primary = true;
+  /// Where a task's independent jobs run (this process, or MPI ranks); its primary() process
+  /// writes and prints the results (output.hpp), the others only compute what they are sent.
+  base::Executor& executor;
   bool report = false;        ///< pdamp run: also DIR/report.html
   std::string command;        ///< the command's name ("run", "field merge"), for the output folder's owner
 };
@@ -24,9 +23,10 @@ struct CommandContext {
 struct Command {
   CommandSpec spec;
   std::function<int(const ParsedArgs&, CommandContext&)> run;
-  /// Under mpirun (docs/distributed.md): the command runs on every rank, its jobs spread
-  /// over them by the executor; otherwise it runs on rank 0 while the others wait.
-  bool every_rank = false;
+  /// The command runs a study of the tasks library, which decides whether it is distributed
+  /// (docs/distributed.md): under mpirun the command starts on every rank. A command that runs
+  /// none (closed forms, validate, merges, export and import) runs on rank 0 alone.
+  bool runs_task = false;
 };
 
 /// Every subcommand, in the order `pdamp --help` lists them.

@@ -5,11 +5,15 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <streambuf>
 #include <thread>
@@ -35,9 +39,9 @@ int launcher_rank() {
   return -1;
 }
 
-/// What a job is asked by: its index and the asker's fingerprint (base::Jobs), as raw
-/// doubles, so a worker computes bit for bit what rank 0 would.
-using Request = std::array<double, 2>;
+/// What a job is asked by: its batch (every rank numbers its task's batches alike), its
+/// index in the batch and the asker's fingerprint of its inputs (base::Jobs), exact.
+using Request = std::array<std::uint64_t, 3>;
 
 }  // namespace
 
@@ -72,6 +76,8 @@ namespace {
 constexpr int kTagRequest = 1;
 constexpr int kTagReply = 2;
 constexpr int kTagStop = 3;
+constexpr int kTagBatchEnd = 4;  // {batch, 1 with results}; then the results (kTagResults)
+constexpr int kTagResults = 5;
 bool g_mpi = false;
 bool g_stopped = false;  // a worker: rank 0 said stop
 std::mutex g_mpi_mutex;  // rank 0's job threads: one MPI call at a time (MPI_THREAD_SERIALIZED)
@@ -131,33 +137,68 @@ std::vector<char> receive_bytes(const MPI_Status& status) {
   return bytes;
 }
 
-void send_bytes(const std::vector<char>& bytes, int to, int tag) {
-  MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, to, tag, MPI_COMM_WORLD);
+/// Whether `size` bytes fit one MPI message (its count is an int).
+bool fits_one_message(std::size_t size) { return size <= static_cast<std::size_t>(std::numeric_limits<int>::max()); }
+std::string too_large(std::size_t size) {
+  return "a result of " + std::to_string(size) + " bytes is beyond what one MPI message carries";
 }
 
-/// A worker: the next message from rank 0. A request is answered by `answer`; returns
-/// false once rank 0 says stop.
-bool serve_one(const std::function<std::vector<char>(const Request&)>& answer) {
-  const MPI_Status status = wait_for(0, MPI_ANY_TAG);
-  if (status.MPI_TAG == kTagStop) {
-    MPI_Recv(nullptr, 0, MPI_BYTE, 0, kTagStop, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    g_stopped = true;
-    return false;
+void send_bytes(const char* data, std::size_t size, int to, int tag) {
+  MPI_Send(data, static_cast<int>(size), MPI_BYTE, to, tag, MPI_COMM_WORLD);
+}
+void send_bytes(const std::vector<char>& bytes, int to, int tag) { send_bytes(bytes.data(), bytes.size(), to, tag); }
+
+/// How rank 0 ended a batch, as a worker receives it.
+struct BatchEnd {
+  std::uint64_t batch = 0;
+  std::optional<std::string> results;  ///< none: the worker's part of the task ends
+};
+
+/// A worker: answers rank 0's requests with `answer` until rank 0 ends a batch (returned) or
+/// says stop (nothing).
+std::optional<BatchEnd> serve(const std::function<std::vector<char>(const Request&)>& answer) {
+  for (;;) {
+    const MPI_Status status = wait_for(0, MPI_ANY_TAG);
+    if (status.MPI_TAG == kTagStop) {
+      MPI_Recv(nullptr, 0, MPI_BYTE, 0, kTagStop, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      g_stopped = true;
+      return std::nullopt;
+    }
+    if (status.MPI_TAG == kTagBatchEnd) {
+      std::array<std::uint64_t, 2> header{};
+      MPI_Recv(header.data(), 2, MPI_UINT64_T, 0, kTagBatchEnd, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      BatchEnd end{header[0], std::nullopt};
+      if (header[1] != 0) {
+        const auto bytes = receive_bytes(wait_for(0, kTagResults));
+        end.results = std::string(bytes.begin(), bytes.end());
+      }
+      return end;
+    }
+    if (status.MPI_TAG != kTagRequest) {  // not of this protocol: dropped
+      (void)receive_bytes(status);
+      continue;
+    }
+    Request request{};
+    MPI_Recv(request.data(), 3, MPI_UINT64_T, 0, kTagRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    std::vector<char> reply = answer(request);
+    if (!fits_one_message(reply.size())) reply = encode_error(too_large(reply.size()));
+    send_bytes(reply, 0, kTagReply);
   }
-  Request request{};
-  MPI_Recv(request.data(), 2, MPI_DOUBLE, 0, kTagRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  send_bytes(answer(request), 0, kTagReply);
-  return true;
 }
 
 /// Rank 0's jobs: each to a free rank, or here when none is free; the balance per rank.
 class RankChannel : public base::JobChannel {
  public:
-  RankChannel() : points_(static_cast<std::size_t>(g_ranks), 0), busy_s_(static_cast<std::size_t>(g_ranks), 0.0) {
+  /// `ended_alone`: called when the batch ends without results (the workers leave the task).
+  RankChannel(std::uint64_t batch, std::function<void()> ended_alone)
+      : batch_(batch),
+        ended_alone_(std::move(ended_alone)),
+        points_(static_cast<std::size_t>(g_ranks), 0),
+        busy_s_(static_cast<std::size_t>(g_ranks), 0.0) {
     for (int r = g_ranks - 1; r >= 1; --r) free_.push_back(r);
   }
 
-  std::optional<std::string> run_elsewhere(std::size_t index, double fingerprint) override {
+  std::optional<std::string> run_elsewhere(std::size_t index, std::uint64_t fingerprint) override {
     const auto start = std::chrono::steady_clock::now();
     int rank = 0;
     {
@@ -167,10 +208,10 @@ class RankChannel : public base::JobChannel {
       rank = free_.back();
       free_.pop_back();
     }
-    const Request request{static_cast<double>(index), fingerprint};
+    const Request request{batch_, static_cast<std::uint64_t>(index), fingerprint};
     {
       std::lock_guard lock(g_mpi_mutex);
-      MPI_Send(request.data(), 2, MPI_DOUBLE, rank, kTagRequest, MPI_COMM_WORLD);
+      MPI_Send(request.data(), 3, MPI_UINT64_T, rank, kTagRequest, MPI_COMM_WORLD);
     }
     const MPI_Status status = wait_for(rank, kTagReply);
     std::vector<char> reply;
@@ -187,6 +228,21 @@ class RankChannel : public base::JobChannel {
   }
 
   void ran_here(std::chrono::steady_clock::time_point start) override { account(0, start); }
+
+  /// Every job has its result (none in flight): each worker learns that the batch ended,
+  /// with its results or without.
+  void end(const std::optional<std::string>& results) override {
+    if (results && !fits_one_message(results->size())) throw std::runtime_error(too_large(results->size()));
+    const std::array<std::uint64_t, 2> header{batch_, results ? 1u : 0u};
+    {
+      std::lock_guard lock(g_mpi_mutex);
+      for (int r = 1; r < g_ranks; ++r) {
+        MPI_Send(header.data(), 2, MPI_UINT64_T, r, kTagBatchEnd, MPI_COMM_WORLD);
+        if (results) send_bytes(results->data(), results->size(), r, kTagResults);
+      }
+    }
+    if (!results) ended_alone_();
+  }
 
   nlohmann::json balance() const override {
     std::lock_guard lock(mutex_);
@@ -206,6 +262,8 @@ class RankChannel : public base::JobChannel {
     last_ = std::max(last_, now);
   }
 
+  const std::uint64_t batch_;
+  const std::function<void()> ended_alone_;
   mutable std::mutex mutex_;  // free_, points_, busy_s_, first_, last_
   std::vector<int> free_;     // ranks > 0 waiting for a job
   std::vector<std::size_t> points_;
@@ -214,27 +272,67 @@ class RankChannel : public base::JobChannel {
   bool started_ = false;
 };
 
+/// A worker's batch: the results rank 0 ended it with.
+class SharedChannel : public base::JobChannel {
+ public:
+  explicit SharedChannel(std::string results) : results_(std::move(results)) {}
+  std::optional<std::string> run_elsewhere(std::size_t, std::uint64_t) override {
+    throw std::logic_error("a batch served to rank 0 has no jobs left to run");
+  }
+  std::optional<std::string> shared_results() const override { return results_; }
+
+ private:
+  std::string results_;
+};
+
 class MpiExecutor : public base::Executor {
  public:
-  int concurrency(int local_jobs) const override { return g_ranks > 1 ? g_ranks : local_jobs; }
+  int concurrency(int local_jobs) const override { return spread() ? g_ranks : local_jobs; }
   int processes() const override { return g_ranks; }
+  bool primary() const override { return g_rank == 0; }
+  void primary_only() override {
+    if (g_rank != 0) throw base::JobsServedElsewhere();
+    alone_ = true;  // the workers leave this task: its batches run here
+  }
+
   std::unique_ptr<base::JobChannel> open(EncodedJob encoded_job) override {
     if (!g_mpi || g_ranks == 1) return base::local_executor().open(std::move(encoded_job));
-    if (g_rank == 0) return std::make_unique<RankChannel>();
-    // A worker: compute what rank 0 sends until it says stop; it has no result of its own.
+    const std::uint64_t batch = ++batches_;
+    if (g_rank == 0) {
+      if (alone_) return base::local_executor().open(std::move(encoded_job));
+      return std::make_unique<RankChannel>(batch, [this] { alone_ = true; });
+    }
+    if (alone_) throw base::JobsServedElsewhere();
+    // A worker: compute what rank 0 sends in this batch until it ends the batch.
     const auto answer = [&](const Request& request) {
       try {
-        return encode_reply(kResult, encoded_job(static_cast<std::size_t>(request[0]), request[1]));
+        if (request[0] != batch)
+          throw std::runtime_error("was asked for a job of batch " + std::to_string(request[0]) + " in batch " +
+                                   std::to_string(batch) + " of its task: the processes run different tasks");
+        return encode_reply(kResult, encoded_job(static_cast<std::size_t>(request[1]), request[2]));
       } catch (const std::exception& e) {
         return encode_error(e.what());
       } catch (...) {
         return encode_error("an unknown exception");
       }
     };
-    while (serve_one(answer)) {
+    const std::optional<BatchEnd> end = serve(answer);
+    if (!end) throw base::JobsServedElsewhere();  // rank 0 ended the command
+    if (end->batch != batch)
+      throw std::runtime_error("rank 0 ended batch " + std::to_string(end->batch) + " while this rank served batch " +
+                               std::to_string(batch) + ": the processes run different tasks");
+    if (!end->results) {
+      alone_ = true;
+      throw base::JobsServedElsewhere();
     }
-    throw base::JobsServedElsewhere();
+    return std::make_unique<SharedChannel>(std::move(*end->results));
   }
+
+ private:
+  bool spread() const { return g_mpi && g_ranks > 1; }
+
+  std::uint64_t batches_ = 0;  // opened by this process's task
+  bool alone_ = false;         // the workers left the task (primary_only, a batch ended without results)
 };
 
 }  // namespace
@@ -282,8 +380,7 @@ Session::~Session() {
     // answering, with the reason, so that rank 0 reports it instead of waiting.
     const std::string why = g_failure.empty() ? "takes no part in this command's jobs"
                                               : "could not set up its part of the jobs: " + g_failure;
-    while (!g_stopped && serve_one([&](const Request&) { return encode_error(why); })) {
-    }
+    while (!g_stopped) (void)serve([&](const Request&) { return encode_error(why); });
     std::cout.rdbuf(g_cout);
     std::cerr.rdbuf(g_cerr);
   }

@@ -1,12 +1,14 @@
 // Independent jobs spread over MPI ranks (docs/distributed.md). In a build with
-// -DPDAMP_MPI=ON launched by mpirun, every rank runs the same command and the same checks;
-// rank 0 runs the task as usual (results log, resume, progress, outputs) and hands each job
-// (a sweep's point, a stepped sine's direction, a verification's decay) to whichever rank is
-// free (dynamic load balancing: DEM points differ tenfold in cost), itself included, while
-// the other ranks only compute what they are sent. A job is computed by the same code with
-// the same inputs wherever it runs, so the result equals the serial one bit for bit. Without
-// MPI (the default build, or the MPI build run without mpirun) this is one rank and the
-// executor runs every job here.
+// -DPDAMP_MPI=ON launched by mpirun, every rank runs the same command, the same checks and
+// the same task; rank 0 runs it as usual (results log, resume, progress, outputs) and hands
+// each job of a batch (a sweep's point, a stepped sine's direction, a bed's calibration, a
+// verification's decay) to whichever rank is free (dynamic load balancing: DEM points differ
+// tenfold in cost), itself included, while the other ranks compute what they are sent and,
+// when rank 0 ends the batch with its results, go on with the task to its next batch. A job
+// is computed by the same code with the same inputs wherever it runs, so the result equals
+// the serial one bit for bit. The task decides whether it is distributed at all
+// (base::Executor::primary_only). Without MPI (the default build, or the MPI build run
+// without mpirun) this is one rank and the executor runs every job here.
 #pragma once
 
 #include <string>
@@ -37,9 +39,9 @@ inline bool worker() { return rank() != 0; }
 /// Why this rank's command failed (a worker's only way to tell rank 0, in its replies).
 void note_failure(const std::string& message);
 
-/// The executor of this process: the ranks of mpirun (rank 0 hands jobs out, one at a time
-/// to whichever rank is free, and works itself when none is; a worker serves them), or this
-/// process alone. One task per command opens its jobs.
+/// The executor of this process: the ranks of mpirun (rank 0 hands a batch's jobs out, one
+/// at a time to whichever rank is free, and works itself when none is; a worker serves them
+/// until rank 0 ends the batch), or this process alone. Its primary() is rank 0.
 base::Executor& executor();
 
 }  // namespace pdamp::cli::distributed

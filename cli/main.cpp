@@ -94,8 +94,8 @@ int run_command(const std::vector<std::string>& args) {
     std::size_t words = 0;
     const Command* match = find_command(args, words);
     if (match == nullptr) throw InputError(args[0], "", "unknown command (see pdamp --help)");
-    CommandContext context{distributed::executor(), !distributed::worker(), false, match->spec.name};
-    if (!context.primary && !match->every_rank) return kExitOk;  // rank 0 runs it; this rank waits
+    CommandContext context{distributed::executor(), false, match->spec.name};
+    if (!context.executor.primary() && !match->runs_task) return kExitOk;  // rank 0 runs it; this rank waits
     const ParsedArgs parsed(match->spec, std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(words), args.end()));
     if (parsed.help_requested()) {
       std::cout << help_text(match->spec);

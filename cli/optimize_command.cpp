@@ -107,8 +107,6 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   options.skip_verify = args.has("--no-verify");
   const bool verify = !options.skip_verify && (options.force_verify || c.task.filling_ratios->verify);
   if (!verify) refuse_checkpoint_flags(args, "applies to the DEM verification (--verify)");
-  // Under mpirun only the verification's DEM runs are spread over the ranks.
-  if (!context.primary && !verify) return kExitOk;
   auto files = output_dir(args, context);
   if (verify) {
     const tasks::CheckpointFile folder = checkpoint_file(args, "verify");
@@ -168,7 +166,7 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   }
   if (result.rounds.size() > 1) rows.push_back({"design loop", std::string(tasks::to_string(*result.loop_outcome))});
   const int code = finish(args, files.get(), out, warnings, rows, {"optimize.json", &c, context.report}, &result);
-  remove_checkpoints(result.checkpoints);
+  remove_checkpoints(files.get(), result.checkpoints);
   return code;
 }
 
@@ -198,7 +196,7 @@ int run_placement_case(const ParsedArgs& args, CommandContext& context, const Ca
   options.method = loss_method(args);
   auto files = output_dir(args, context);
   options.backend = backend_flag(args);
-  const auto study = tasks::run_placement(c, options);
+  const auto study = tasks::run_placement(c, options, context.executor);
   std::vector<std::string> warnings = study.warnings;
   if (files)
     for (auto& w : report::write_files(*files, study)) warnings.push_back(w);
@@ -221,10 +219,7 @@ int run_placement_case(const ParsedArgs& args, CommandContext& context, const Ca
 }  // namespace
 
 int run_optimize_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
-  if (c.task.kind == case_file::TaskKind::kPlacement && c.task.placement) {
-    if (!context.primary) return kExitOk;  // rank 0 alone
-    return run_placement_case(args, context, c);
-  }
+  if (c.task.kind == case_file::TaskKind::kPlacement && c.task.placement) return run_placement_case(args, context, c);
   if (c.task.kind != case_file::TaskKind::kFillingRatios || !c.task.filling_ratios)
     throw InputError(c.path, "/task",
                      "pdamp optimize needs a task of kind filling_ratios or placement (this case's task is '" +

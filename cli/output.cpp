@@ -24,8 +24,10 @@ void print_warnings(const std::vector<std::string>& warnings) {
   for (const auto& w : warnings) std::cerr << "pdamp: warning: " << base::printable(w) << "\n";
 }
 
+bool writes_results(const CommandContext& context) { return context.executor.primary(); }
+
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context) {
-  if (!context.primary) return nullptr;
+  if (!writes_results(context)) return nullptr;
   const auto dir = args.optional_text("-o");
   if (!dir) return nullptr;
   // Results name their files in JSON, which holds UTF-8 only: refused now, not after the work.
@@ -44,16 +46,26 @@ std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const Comm
   return std::make_unique<report::OutputDir>(*dir, "-o", owner, args.has("--overwrite"));
 }
 
+std::unique_ptr<report::OutputDir> study_dir(const std::string& dir, const CommandContext& context,
+                                             const std::string& in_place) {
+  if (!writes_results(context)) return nullptr;
+  auto files = std::make_unique<report::OutputDir>(dir);
+  if (!in_place.empty()) files->in_place(in_place);
+  return files;
+}
+
 tasks::OutputFolder output_folder(const report::OutputDir* files) {
   return files ? tasks::OutputFolder{files->dir()} : tasks::OutputFolder{};
 }
 
 void dem_results_ready(report::OutputDir* files) {
-  if (files) files->finish_despite_signals();
+  if (!files) return;  // nothing to commit here
+  files->finish_despite_signals();
   report::test_pause_point("run-ended");
 }
 
-void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints) {
+void remove_checkpoints(const report::OutputDir* files, const std::vector<std::filesystem::path>& checkpoints) {
+  if (!files) return;
   std::error_code ignored;
   for (const auto& checkpoint : checkpoints)
     if (!checkpoint.empty()) std::filesystem::remove(checkpoint, ignored);

@@ -27,9 +27,16 @@ std::string key_value_table(const Rows& rows);
 /// One line each on stderr, "pdamp: warning: ...", made printable.
 void print_warnings(const std::vector<std::string>& warnings);
 
+/// Whether this process writes the results: the executor's primary process (under mpirun
+/// rank 0; the other ranks only compute the jobs they are sent). The one place cli/ asks.
+bool writes_results(const CommandContext& context);
 /// The -o folder, checked before any work (report::OutputDir), or none: without -o, and on
-/// a process that writes nothing (an MPI worker).
+/// a process that writes nothing (writes_results).
 std::unique_ptr<report::OutputDir> output_dir(const ParsedArgs& args, const CommandContext& context);
+/// A study's folder `dir` (field, sensitivity: always one), with `in_place` (a results log
+/// the study writes into it as it goes) when not empty; none on a process that writes nothing.
+std::unique_ptr<report::OutputDir> study_dir(const std::string& dir, const CommandContext& context,
+                                             const std::string& in_place = "");
 /// Where a task's result JSON says its files are.
 tasks::OutputFolder output_folder(const report::OutputDir* files);
 
@@ -37,10 +44,12 @@ tasks::OutputFolder output_folder(const report::OutputDir* files);
 /// optimize and run), whose signals are deferred from its start to its commit (the
 /// command holds a report::DeferredSignals that long): the run is complete, so a signal
 /// from now on waits until its results are committed instead of abandoning them
-/// (report::OutputDir::finish_despite_signals); a test may pause here ("run-ended").
+/// (report::OutputDir::finish_despite_signals); a test may pause here ("run-ended"). Without
+/// files (a process that writes nothing) there is nothing to commit.
 void dem_results_ready(report::OutputDir* files);
-/// After the commit: the run's checkpoints go, its results being kept.
-void remove_checkpoints(const std::vector<std::filesystem::path>& checkpoints);
+/// After the commit into `files`: the run's checkpoints go, its results being kept. Without
+/// files nothing was committed (no -o, or a process that writes nothing): they stay.
+void remove_checkpoints(const report::OutputDir* files, const std::vector<std::filesystem::path>& checkpoints);
 
 /// How a command ends.
 struct ResultFiles {

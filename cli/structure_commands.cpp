@@ -39,7 +39,7 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
   tasks::ModesOptions options;
   options.method = loss_method(args);
   auto files = output_dir(args, context);
-  const auto modes = tasks::run_modes(c, options);
+  const auto modes = tasks::run_modes(c, options, context.executor);
   std::vector<std::string> warnings = modes.warnings;
   if (files)
     for (auto& w : report::write_files(*files, modes)) warnings.push_back(w);
@@ -203,10 +203,6 @@ int run_frf_case(const ParsedArgs& args, CommandContext& context, const Case& c)
     options.dem = dem_frf_options(args, c);
   else
     refuse_flags(args, kDemSweepFlags, "applies to --method dem or --compare (the DEM in the loop)");
-  // Under mpirun only the stepped sine's directions are spread over the ranks.
-  const bool spread = options.method == tasks::FrfMethod::kCompare ||
-                      (options.method == tasks::FrfMethod::kDem && !options.dem.linear_sweep);
-  if (!context.primary && !spread) return kExitOk;
   auto files = output_dir(args, context);
   CliHooks hooks;
   const auto result = tasks::run_frf(c, options, hooks, context.executor);
@@ -245,7 +241,7 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
   // Signals wait for a checkpoint during the run, then for the commit (dem_results_ready).
   const std::optional<report::DeferredSignals> deferred =
       options.checkpoint.file.path.empty() ? std::nullopt : std::make_optional<report::DeferredSignals>();
-  tasks::DecayResult result = tasks::run_decay(c, options, hooks);
+  tasks::DecayResult result = tasks::run_decay(c, options, hooks, context.executor);
   if (deferred) dem_results_ready(files.get());
   std::vector<std::string> warnings = result.warnings;
   if (files)
@@ -272,7 +268,7 @@ int run_decay_case(const ParsedArgs& args, CommandContext& context, const Case& 
                           format_number(100.0 * l["share"].get<double>(), 3) + "%)"});
   }
   const int code = finish(args, files.get(), out, warnings, rows, {"decay.json", &c, context.report}, &result);
-  remove_checkpoints({options.checkpoint.file.path});
+  remove_checkpoints(files.get(), {options.checkpoint.file.path});
   return code;
 }
 
@@ -308,7 +304,7 @@ std::vector<Command> structure_commands() {
         {kMethodFlag, {"-o", "DIR", "write modes.csv, backbone_mode<j>.csv, backbone.gp/png/svg, modes.json\n"
                                     "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
-       run_modes},
+       run_modes, true},
       {{"frf", "pdamp frf CASE.json [--method formulas|field|dem | --compare] [--dem-points N] [--dem-sweep D] [-o DIR] [--json]",
         "frequency response of the structure with its dampers (task kind frf): every harmonic-\n"
         "balance root, its stability, branches, jumps and peaks, and the response without beds",
@@ -332,7 +328,7 @@ std::vector<Command> structure_commands() {
                                     "                          into DIR, atomically (dem: decay_dem.checkpoint while running)"},
                       kJsonFlag},
                      kCheckpointFlags), 1},
-       run_decay},
+       run_decay, true},
       optimize_command(),
   };
 }

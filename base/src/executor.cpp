@@ -1,4 +1,4 @@
-// The local executor and the concurrency helper of executor.hpp.
+// The local executor, the job fingerprint and the concurrency helper of executor.hpp.
 #include "pdamp/base/executor.hpp"
 
 #include <algorithm>
@@ -10,10 +10,19 @@ namespace {
 
 class LocalChannel : public JobChannel {
  public:
-  std::optional<std::string> run_elsewhere(std::size_t, double) override { return std::nullopt; }
+  std::optional<std::string> run_elsewhere(std::size_t, std::uint64_t) override { return std::nullopt; }
 };
 
 }  // namespace
+
+std::uint64_t fingerprint(std::string_view text) {
+  std::uint64_t hash = 14695981039346656037ULL;
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ULL;
+  }
+  return hash;
+}
 
 std::unique_ptr<JobChannel> LocalExecutor::open(EncodedJob) {
   return std::make_unique<LocalChannel>();

@@ -159,8 +159,17 @@ std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> BedCalibra
 
 namespace {
 
+/// What identifies bed's calibration run beyond its place in the list: its layer, slabs,
+/// extra damping and key (the physics); a process asked for it checks that it set up the same.
+std::string bed_inputs(const CalibratedBed& bed) {
+  return bed.layer + " " + std::to_string(bed.slabs) + " slabs, extra damping " +
+         base::format_number(bed.extra_damping_ratio, 17) + ", key " + bed.key;
+}
+
 /// Reads or runs `beds` (their key and file set here): cached ones from the cache, the others
-/// as jobs of `executor`. Returns how many ran.
+/// as one batch of jobs of `executor` (job b: bed b). Every process gets every bed as the
+/// primary has it: the processes that served the batch get each bed's document, cached or
+/// run, so their beds are the primary's whatever their own cache holds. Returns how many ran.
 int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
                 const std::filesystem::path& cache_dir, std::vector<CalibratedBed>& beds, base::RunHooks& hooks,
                 base::Executor& executor) {
@@ -183,20 +192,43 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
       to_run.push_back(b);
     }
   }
-  const auto documents = base::run_jobs<json>(
-      executor, to_run.size(), base::parallel_jobs(executor, to_run.size()),
-      [&](std::size_t j) { return calibrate_bed(c, p, spec, beds[to_run[j]], hooks); }, nullptr,
-      [&](std::size_t j) { return static_cast<double>(to_run[j]); },
-      static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
-  for (std::size_t j = 0; j < to_run.size(); ++j) {
-    CalibratedBed& bed = beds[to_run[j]];
-    std::string why;
-    // What the job returned is what it wrote to the cache (on this process or another).
-    if (!bed_from_document(documents[j], bed, why))
-      throw base::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
-                                        std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
+  base::Jobs<json> jobs(
+      executor, [&](std::size_t b) { return calibrate_bed(c, p, spec, beds.at(b), hooks); },
+      [&](std::size_t b) { return bed_inputs(beds.at(b)); });
+  auto shared = jobs.shared_results();  // every bed's document, as the primary has it
+  if (!shared) {
+    std::vector<json> ran(to_run.size());
+    base::for_each_concurrently(
+        to_run.size(), base::parallel_jobs(executor, to_run.size()), [&](std::size_t j) { ran[j] = jobs(to_run[j]); },
+        static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
+    for (std::size_t j = 0; j < to_run.size(); ++j) {
+      CalibratedBed& bed = beds[to_run[j]];
+      std::string why;
+      // What the job returned is what it wrote to the cache (on this process or another).
+      if (!bed_from_document(ran[j], bed, why))
+        throw base::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
+                                   std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
+    }
+    std::vector<json> documents;
+    for (const auto& bed : beds) documents.push_back(cache_document(bed));
+    for (std::size_t b = 0; b < beds.size(); ++b) documents[b]["cached"] = beds[b].cached;
+    jobs.end(documents);
+    return static_cast<int>(to_run.size());
   }
-  return static_cast<int>(to_run.size());
+  if (shared->size() != beds.size())
+    throw std::runtime_error("the primary process calibrated " + std::to_string(shared->size()) + " beds, this one " +
+                             std::to_string(beds.size()) + ": the processes differ");
+  int runs = 0;
+  for (std::size_t b = 0; b < beds.size(); ++b) {
+    CalibratedBed& bed = beds[b];
+    std::string why;
+    if (!bed_from_document((*shared)[b], bed, why))
+      throw std::runtime_error("the primary process's calibration of " + bed.layer + " with " +
+                               std::to_string(bed.slabs) + " slabs is not this process's (" + why + ")");
+    bed.cached = (*shared)[b].at("cached").get<bool>();
+    runs += bed.cached ? 0 : 1;
+  }
+  return runs;
 }
 
 }  // namespace

@@ -25,7 +25,8 @@ fm::DamperModel design_family(const detail::SingleDamper& single, const case_fil
 
 }  // namespace
 
-DamperDesignResult run_damper_design(const case_file::Case& c) {
+DamperDesignResult run_damper_design(const case_file::Case& c, base::Executor& executor) {
+  executor.primary_only();  // the closed forms: nothing to spread
   DamperDesignResult out;
   const detail::SingleDamper single = detail::single_damper(c, "the damper_design task");
   try {

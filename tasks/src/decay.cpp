@@ -363,7 +363,8 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   return out;
 }
 
-DecayResult run_decay(const Case& c, const DecayOptions& options, base::RunHooks& hooks) {
+DecayResult run_decay(const Case& c, const DecayOptions& options, base::RunHooks& hooks, base::Executor& executor) {
+  executor.primary_only();  // one co-simulation, or none: nothing to spread
   require_task(c, case_file::TaskKind::kDecay);
   const bool dem = options.method == DecayMethod::kDem;
   detail::Setup setup = detail::make_setup(

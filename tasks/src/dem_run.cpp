@@ -119,7 +119,9 @@ DemRunPlan plan_dem(const case_file::Case& c, const DemRunOptions& o) {
   return plan;
 }
 
-DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks) {
+DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks,
+                     base::Executor& executor) {
+  executor.primary_only();  // one DEM run (its own threads): nothing to spread
   const auto& options = plan.options;
   const double x = plan.amplitude_m, f = plan.frequency_hz;
   const bool checkpointing = !checkpoint.path.empty();

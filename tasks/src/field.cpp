@@ -149,6 +149,7 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::Run
   base::LabelledHooks labelled(hooks, plan.options.label);
   const auto result =
       surrogate::run_sweep(grid, [&](std::size_t k) { return jobs(k); }, sweep, dem ? labelled : base::silent_hooks());
+  jobs.end();  // the field is this process's alone (some points from its log): the others' part ends
   FieldResult out;
   out.case_name = c.name;
   out.field = result.field;
@@ -160,7 +161,8 @@ FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::Run
   return out;
 }
 
-FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv) {
+FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv, base::Executor& executor) {
+  executor.primary_only();
   const detail::SingleDamper single = detail::single_damper(c, "pdamp field");
   surrogate::MeasuredImportOptions options;
   options.clearance_m = single.layer.clearance_m;

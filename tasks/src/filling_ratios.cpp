@@ -263,14 +263,6 @@ std::vector<long> whole_slabs(const opt::FillingDesign& design) {
   return slabs;
 }
 
-/// The design's slabs as one number, exact for up to five layers of < 1000 slabs: a process
-/// asked to verify a design checks that its own optimisation chose the same.
-double design_fingerprint(const opt::FillingDesign& design) {
-  double fingerprint = 0.0, place = 1.0;
-  for (const double n : design.slabs()) fingerprint += n * place, place *= 1000.0;
-  return fingerprint;
-}
-
 /// The checkpoint of design `name`'s verification decay at verify softening `softening`
 /// (`suffix` "" for the judged run, "_stiffer" for the softening check's).
 DemDecayCheckpoint verification_checkpoint(const FillingRatiosOptions& o, const std::string& name,
@@ -415,10 +407,11 @@ DesignCheck check_design(const case_file::FillingRatioProblem& p, const case_fil
 }
 
 /// The DEM verification of the chosen and baseline designs: independent DEM runs (one World
-/// each, single-threaded by default), jobs of `executor` on two threads or over processes:
-/// each design at the verification's softening, then (softening check) each ten times
-/// stiffer. Every process optimised the same way (NLopt's seed is fixed); a job carries the
-/// design it verifies, so a process that chose another design refuses it.
+/// each, single-threaded by default), a batch of jobs of `executor` on two threads or over
+/// processes: each design at the verification's softening, then (softening check) each ten
+/// times stiffer. Every process optimised the same way (NLopt's seed is fixed); a job carries
+/// the fingerprint of the run it is (design and softening), so a process that chose another
+/// design refuses it.
 /// The DEM decays run so far, by design and softening: a later round of the design loop
 /// reuses them (the same inputs give the same run) instead of running them again.
 using DecayRuns = std::map<std::string, VerifiedDecay>;
@@ -459,15 +452,17 @@ Verification verify_designs(const Case& c, const case_file::FillingRatioProblem&
   std::vector<std::size_t> to_run;
   for (std::size_t k = 0; k < jobs; ++k)
     if (!runs.contains(run_key(k))) to_run.push_back(k);
+  // A job's inputs are its run key: a process asked for a run checks that its own
+  // optimisation chose the same design.
   const auto ran = base::run_jobs<VerifiedDecay>(
       executor, to_run.size(), true,
       [&](std::size_t j) {
-        const std::size_t k = to_run[j];
+        const std::size_t k = to_run.at(j);
         const std::string label = designs[k % 2].first + (k < 2 ? "" : ", softening " + format_number(softening_of(k), 3));
         return verification_decay(c, p, verify, label, *designs[k % 2].second, modes[k % 2], softening_of(k), files[k],
                                   hooks);
       },
-      &v.mpi, [&](std::size_t j) { return design_fingerprint(*designs[to_run[j] % 2].second); },
+      &v.mpi, [&](std::size_t j) { return run_key(to_run.at(j)); },
       static_cast<std::size_t>(std::max(executor.concurrency(2), 1)));
   for (std::size_t j = 0; j < to_run.size(); ++j) runs[run_key(to_run[j])] = ran[j];
   std::vector<VerifiedDecay> decays;
@@ -532,12 +527,6 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
   FillingRatiosResult out;
   out.case_name = c.name;
   out.mass_budget_kg = task.mass_budget_kg;
-  out.problem = case_file::filling_ratio_problem(c);
-  // A task opens its jobs through the executor once per process (executor.hpp): over MPI
-  // ranks that is the first round's verification; the calibration (every rank needs the
-  // same beds to choose the same design) and the design loop's later rounds run on each
-  // process's own threads.
-  base::Executor& own_threads = executor.processes() > 1 ? static_cast<base::Executor&>(base::local_executor()) : executor;
   // The DEM verification: the task's verify block, or --verify with its defaults.
   std::optional<case_file::VerifySpec> verify = task.verify;
   if (!verify && o.force_verify) {
@@ -545,13 +534,20 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     verify->duration_s = task.decay.duration_s;
   }
   if (o.skip_verify) verify.reset();
+  const bool calibrated = o.calibrated.value_or(task.calibration.has_value());
+  // The DEM runs (the beds' calibration, each round's verification, the recalibrations) are
+  // the executor's batches, spread over its processes; every process optimises alike between
+  // them (NLopt's seed is fixed), on the same beds. Without DEM runs the task is the
+  // optimisation alone, on the primary process.
+  if (!verify && !calibrated) executor.primary_only();
+  out.problem = case_file::filling_ratio_problem(c);
   if (verify) {  // the first round: the chosen and the baseline design, at one or two softenings
     std::vector<double> softenings = {verify->stiffness_softening};
     if (verify->softening_check && !at_full_stiffness(c, *verify)) softenings.push_back(stiffer_softening(c, *verify));
     check_design_decays_cost(c, out.problem, verify->duration_s, softenings, 2, executor.concurrency(2),
                              "pdamp optimize --verify", "/task/verify/duration_s", hooks);
   }
-  if (o.calibrated.value_or(task.calibration.has_value())) {
+  if (calibrated) {
     case_file::CalibrationSpec spec;
     if (task.calibration) {
       spec = *task.calibration;
@@ -561,12 +557,12 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     }
     std::size_t beds = 0;  // every candidate bed, before the cache is read
     for (const auto& layer : out.problem.options.layers) beds += static_cast<std::size_t>(std::max(layer.max_slabs(), 0));
-    check_design_decays_cost(c, out.problem, spec.duration_s, {spec.stiffness_softening}, beds, own_threads.concurrency(2),
+    check_design_decays_cost(c, out.problem, spec.duration_s, {spec.stiffness_softening}, beds, executor.concurrency(2),
                              "the bed calibration", task.calibration ? "/task/calibration/duration_s" : "/task/verify/duration_s",
                              hooks);
     out.calibration = calibrate_beds(c, out.problem, spec,
                                      o.calibration_cache.empty() ? default_calibration_cache() : o.calibration_cache,
-                                     hooks, own_threads);
+                                     hooks, executor);
     out.problem.options.bed_models = out.calibration->models();
   }
 
@@ -592,8 +588,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     const int rounds = out.calibration ? verify->rounds : 1;
     DecayRuns runs;
     for (int round = 1;; ++round) {
-      out.verification = verify_designs(c, out.problem, out.optimum, *verify, o, hooks, round == 1 ? executor : own_threads,
-                                        out.checkpoints, runs);
+      out.verification = verify_designs(c, out.problem, out.optimum, *verify, o, hooks, executor, out.checkpoints, runs);
       out.rounds.push_back(round_summary(round, *out.verification));
       if (out.verification->passed) {
         out.loop_outcome = LoopOutcome::kAgreed;
@@ -613,7 +608,7 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
                                                               settling.frequency_hz);
       out.rounds.back().recalibrated =
           recalibrate_in_design(c, out.problem, *out.calibration, whole_slabs(chosen.design), design_damping,
-                                chosen.dem.threshold_m, hooks, own_threads);
+                                chosen.dem.threshold_m, hooks, executor);
       if (out.rounds.back().recalibrated.empty()) {
         out.loop_outcome = LoopOutcome::kNothingToRecalibrate;
         break;

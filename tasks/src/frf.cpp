@@ -708,6 +708,10 @@ DemFrfOptions default_dem_frf_options(const Case& c) {
 }
 
 FrfResult run_frf(const Case& c, const FrfOptions& options, base::RunHooks& hooks, base::Executor& executor) {
+  // Only the stepped sine's directions are spread: the harmonic balance and the linear sine
+  // sweep (one co-simulation) run on the primary process alone.
+  const bool stepped = options.method == FrfMethod::kCompare || (options.method == FrfMethod::kDem && !options.dem.linear_sweep);
+  if (!stepped) executor.primary_only();
   require_task(c, case_file::TaskKind::kFrf);
   FrfResult out;
   out.case_name = c.name;

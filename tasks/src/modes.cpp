@@ -26,7 +26,8 @@ constexpr double kNoMotionFraction = 1e-9;
 
 }  // namespace
 
-ModesResult run_modes(const case_file::Case& c, const ModesOptions& options) {
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, base::Executor& executor) {
+  executor.primary_only();  // no DEM: nothing to spread
   detail::Setup setup = detail::make_setup(c, options.method);
   const st::ModalModel& modal = setup.s.modal;
   const auto& dampers = setup.s.dampers;

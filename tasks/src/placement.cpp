@@ -12,7 +12,8 @@ namespace pdamp::tasks {
 namespace opt = optimizer;
 using nlohmann::json;
 
-PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options) {
+PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options, base::Executor& executor) {
+  executor.primary_only();  // the formulas or fields of a few sites: nothing to spread
   const case_file::PlacementTask& task = *c.task.placement;
   case_file::PlacementProblem p = case_file::placement_problem(c, options.method);
   opt::Options solver = opt::placement_solver_options();

@@ -161,6 +161,7 @@ SensitivityResult run_sensitivity(const case_file::Case& c, const SensitivityPla
   base::LabelledHooks labelled(hooks, plan.options.label);
   const auto result = surrogate::run_point_sweep(study.points, [&](std::size_t k) { return jobs(k); }, sweep,
                                                  dem ? labelled : base::silent_hooks());
+  jobs.end();  // the study is this process's alone (some runs from its log): the others' part ends
   SensitivityResult out = study_result(c, study, result, plan.options.source);
   out.sweep_report = result.summary.brief_report();
   out.mpi = jobs.balance();

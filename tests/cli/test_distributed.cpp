@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -188,8 +189,79 @@ TEST_CASE("the DEM verification of an optimisation on 2 ranks equals the serial 
     CHECK(a == b);
   }
   CHECK(spread["design"] == serial["design"]);
-  // A design each, at the judged softening and ten times stiffer.
-  CHECK(spread["verification"]["mpi"]["points"] == json::array({2, 2}));
+  // Four decays (each design at the judged softening and ten times stiffer), rank 1 taking
+  // the first (how many more it takes depends on the machine's load: rank 0 takes whichever
+  // job comes up while rank 1 is busy).
+  const auto& points = spread["verification"]["mpi"]["points"];
+  CHECK(points[0].get<int>() + points[1].get<int>() == 4);
+  CHECK(points[1].get<int>() >= 1);
+}
+
+namespace {
+
+/// Lines of `text` holding both `what` and `also`.
+std::size_t lines_with(const std::string& text, const std::string& what, const std::string& also) {
+  std::istringstream in(text);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);)
+    n += line.find(what) != std::string::npos && line.find(also) != std::string::npos ? 1 : 0;
+  return n;
+}
+
+/// `value` without the keys of wall times and paths, which differ between two runs.
+json without_times(json value) {
+  if (value.is_object()) {
+    for (const char* key : {"solve_time_s", "wall_time_s", "global_stage_s", "local_stage_s", "report", "file",
+                            "cache_dir", "outputs", "mpi"})
+      value.erase(key);
+  }
+  if (value.is_structured())
+    for (auto& item : value) item = without_times(item);
+  return value;
+}
+
+}  // namespace
+
+// The design loop on calibrated beds: the beds' calibration, each round's verification and
+// the recalibration are batches of the one executor, spread over the ranks; between them
+// every rank optimises on the beds rank 0 shares at each batch's end. Each bed's decay and
+// each verification decay is one deterministic DEM run from the same inputs, so the outcome
+// equals the serial run's to the bit. Short runs (1.5 s decays), and a tolerance no decay
+// meets, so that round 1 fails and the loop recalibrates (as the tasks test of the loop).
+TEST_CASE("a filling-ratio optimisation on calibrated beds on 2 ranks equals the serial one", "[mpi]") {
+  const TempDir dir("mpi_calibrated");
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  json edited = json::parse(in);
+  edited["task"]["calibration"] = {{"duration_s", 1.5}, {"stiffness_softening", 1e-3}};
+  edited["task"]["verify"] = {{"duration_s", 1.5}, {"stiffness_softening", 1e-3}, {"softening_check", false},
+                              {"tolerance_relative", 1e-6}, {"rounds", 2}};
+  const fs::path c = dir.path / "case.json";
+  std::ofstream(c) << edited.dump(2);
+  // A cache each: the second run would otherwise read every bed the first calibrated.
+  const auto optimize = [&](const std::string& out) {
+    return std::vector<std::string>{"optimize", c.string(), "--calibration-cache", (dir.path / (out + "_cache")).string(),
+                                    "-o", (dir.path / out).string(), "--json"};
+  };
+  const auto serial_run = run_pdamp(optimize("serial"));
+  const json serial = parse_result(serial_run);
+  const auto spread_run = run_mpi(2, optimize("mpi"));
+  const json spread = parse_result(spread_run);
+  for (const char* file : {"designs.csv", "verify_decay.csv", "decay_compare.csv"}) {
+    INFO(file);
+    CHECK(slurp(dir.path / "mpi" / file) == slurp(dir.path / "serial" / file));
+  }
+  REQUIRE(serial["design_loop"]["rounds"].size() == 2);
+  CHECK(spread["calibration"]["runs"] == serial["calibration"]["runs"]);  // 11 beds, 2 recalibrated
+  CHECK(without_times(spread) == without_times(serial));
+  // Each bed that runs notes its estimate where it runs: rank 1's are silent, so rank 0
+  // noted fewer than the serial run did (rank 1 calibrated some beds).
+  const auto bed_notes = [](const RunResult& r) {
+    return lines_with(r.err, "pdamp optimize: calibration (", "particle-steps");
+  };
+  const std::size_t serial_beds = bed_notes(serial_run), spread_beds = bed_notes(spread_run);
+  CHECK(serial_beds == serial["calibration"]["runs"].get<std::size_t>());
+  CHECK(spread_beds < serial_beds);
+  CHECK(spread_beds >= 1);
 }
 
 TEST_CASE("under mpirun, bad input is one error line and a command without a sweep runs once", "[mpi]") {

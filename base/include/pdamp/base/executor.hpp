@@ -1,11 +1,13 @@
 // Where a task's independent jobs run: in this process (one after the other or on
 // threads), or spread over processes (the command line's MPI executor). A task hands its
-// jobs to an Executor& and gets the results in order; a job's result crosses a process
-// boundary as CBOR of its JSON form (to_json/from_json), so doubles arrive bit for bit.
+// jobs to an Executor& in numbered batches and gets the results in order; a job's result
+// crosses a process boundary as CBOR of its JSON form (to_json/from_json), so doubles
+// arrive bit for bit. The task decides whether it is distributed (Executor::primary_only).
 #pragma once
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -13,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -20,30 +23,48 @@
 
 namespace pdamp::base {
 
-/// Thrown on a process that served a task's jobs to another (an MPI worker rank): it has no
-/// result of its own and must write and print nothing; the command line ends it with
-/// success (the primary process reports).
+/// Thrown on a process that served a task's jobs to another (an MPI worker rank) when the
+/// task ends there: a batch ended without results (a sweep), or the task runs on the primary
+/// process alone (Executor::primary_only). It has no result of its own and must write and
+/// print nothing; the command line ends it with success (the primary process reports).
 class JobsServedElsewhere : public std::exception {
  public:
   const char* what() const noexcept override { return "this process served its jobs to the primary process"; }
 };
 
-/// The jobs of one task while they run (Executor::open).
+/// FNV-1a (64 bits) of `text`: the fingerprint of a job from a text that names its inputs
+/// (a design's slabs and softening, a bed), the same on every process that set up the same work.
+std::uint64_t fingerprint(std::string_view text);
+
+/// One batch of a task's jobs while it runs (Executor::open).
 class JobChannel {
  public:
   virtual ~JobChannel() = default;
-  /// Runs job `index` in another process when one is free and returns its result bytes;
-  /// nothing when it should run here. `fingerprint` travels with the request: the other
-  /// process refuses a job whose fingerprint differs from its own (it set up other work).
-  /// Thread-safe.
-  virtual std::optional<std::string> run_elsewhere(std::size_t index, double fingerprint) = 0;
+  /// Runs job `index` of this batch in another process when one is free and returns its
+  /// result bytes; nothing when it should run here. `fingerprint` travels with the request:
+  /// the other process refuses a job whose fingerprint differs from its own (it set up other
+  /// work). Thread-safe.
+  virtual std::optional<std::string> run_elsewhere(std::size_t index, std::uint64_t fingerprint) = 0;
   /// Job `index` ran here, from `start` until now (for the balance). Thread-safe.
   virtual void ran_here(std::chrono::steady_clock::time_point /*start*/) {}
   /// How the jobs spread: {ranks, points[r], busy_fraction[r], wall_time_s}, or null when
   /// every job ran in this process.
   virtual nlohmann::json balance() const { return nullptr; }
+  /// The primary process, once every job of the batch has its result: the batch ends on every
+  /// process that served it. With `results` (the bytes of all its results, in order) each of
+  /// them returns them (shared_results) and goes on with the task, to the next batch; without
+  /// (a sweep: the primary alone has every result, some from its log) each ends its task
+  /// (JobsServedElsewhere) and serves no later batch, which then runs on the primary alone.
+  virtual void end(const std::optional<std::string>& /*results*/) {}
+  /// On a process that served the batch: the results the primary ended it with.
+  virtual std::optional<std::string> shared_results() const { return std::nullopt; }
 };
 
+/// Where a task's jobs run. A task opens its jobs in numbered batches (1, 2, ...: one at a
+/// time, never inside a job); every process of a run runs the same task on the same inputs,
+/// so it opens the same batches in the same order, and a request names its batch. The task
+/// decides whether it is distributed: one that is hands its jobs to the executor batch by
+/// batch; one that is not calls primary_only() at its start.
 class Executor {
  public:
   virtual ~Executor() = default;
@@ -51,12 +72,21 @@ class Executor {
   virtual int concurrency(int local_jobs) const = 0;
   /// Processes the jobs spread over (1: this one).
   virtual int processes() const { return 1; }
-  /// A job as another process asks for it: its index and the fingerprint the asker computed.
-  using EncodedJob = std::function<std::string(std::size_t index, double fingerprint)>;
-  /// Opens the jobs of one task; `encoded_job` computes a job and returns its result bytes
-  /// (called for jobs another process asks for). On a process that serves another (an MPI
-  /// worker) this serves until the primary is done and throws JobsServedElsewhere. One task
-  /// opens its jobs once per process.
+  /// This process runs the task for its results and writes them (false: a process that
+  /// computes the jobs another sends it, an MPI worker, which writes nothing).
+  virtual bool primary() const { return true; }
+  /// At the start of a task that runs on the primary process alone (one DEM run, closed
+  /// forms): on a process that serves another this throws JobsServedElsewhere; on the
+  /// primary the task goes on, and its batches, if any, run here.
+  virtual void primary_only() {}
+  /// A job as another process asks for it: its index in the batch and the fingerprint the
+  /// asker computed.
+  using EncodedJob = std::function<std::string(std::size_t index, std::uint64_t fingerprint)>;
+  /// Opens the task's next batch of jobs; `encoded_job` computes one of them and returns its
+  /// result bytes (called for the jobs another process asks for). On the primary this returns
+  /// the batch's channel. On a process that serves another (an MPI worker) this serves the
+  /// batch until the primary ends it, then returns a channel holding the results the primary
+  /// shared (JobChannel::shared_results), or throws JobsServedElsewhere when it shared none.
   virtual std::unique_ptr<JobChannel> open(EncodedJob encoded_job) = 0;
 };
 
@@ -80,23 +110,35 @@ T from_job_bytes(const std::string& bytes) {
   return nlohmann::json::from_cbor(bytes).get<T>();
 }
 
-/// The jobs of a task, run through an executor: job(index) here or in another process.
+/// One batch of a task's jobs, run through an executor: job(index) here or in another
+/// process. On a process that serves another the constructor serves the batch, then either
+/// holds the results the primary shared (shared_results) or throws JobsServedElsewhere.
 template <class T>
 class Jobs {
  public:
-  /// What identifies job `index`'s inputs beyond the index (a design's slabs), so that a
-  /// process that set up other work refuses it; none: 0 for every job.
-  using Fingerprint = std::function<double(std::size_t index)>;
-  /// On a process that serves another this serves and throws JobsServedElsewhere.
-  Jobs(Executor& executor, std::function<T(std::size_t)> job, Fingerprint fingerprint = {})
+  /// A text naming what job `index` is computed from beyond its index (a design's slabs and
+  /// softening, a bed); its fingerprint travels with the request, so that a process that set
+  /// up other work refuses the job. None: every job's fingerprint is 0.
+  using Inputs = std::function<std::string(std::size_t index)>;
+  Jobs(Executor& executor, std::function<T(std::size_t)> job, Inputs inputs = {})
       : job_(std::move(job)),
-        fingerprint_(std::move(fingerprint)),
-        channel_(executor.open([this](std::size_t index, double asked) {
+        inputs_(std::move(inputs)),
+        channel_(executor.open([this](std::size_t index, std::uint64_t asked) {
           if (fingerprint_of(index) != asked)
             throw std::runtime_error("job " + std::to_string(index) + " was set up differently here than by the primary "
                                      "process (another design or case): the processes differ");
           return to_job_bytes(job_(index));
         })) {}
+  Jobs(const Jobs&) = delete;
+  Jobs& operator=(const Jobs&) = delete;
+  /// A batch not ended (an exception on the way) ends without results.
+  ~Jobs() {
+    try {
+      end_once(std::nullopt);
+    } catch (...) {
+    }
+  }
+
   /// Job `index`'s result (thread-safe when the job is).
   T operator()(std::size_t index) {
     if (auto bytes = channel_->run_elsewhere(index, fingerprint_of(index))) return from_job_bytes<T>(*bytes);
@@ -105,14 +147,31 @@ class Jobs {
     channel_->ran_here(start);
     return result;
   }
+  /// The batch is complete, its results on this process alone (a sweep's): the processes that
+  /// served it end their task.
+  void end() { end_once(std::nullopt); }
+  /// The batch is complete: the processes that served it get `results` and go on.
+  void end(const std::vector<T>& results) { end_once(to_job_bytes(results)); }
+  /// On a process that served the batch: the results the primary ended it with.
+  std::optional<std::vector<T>> shared_results() const {
+    const auto bytes = channel_->shared_results();
+    if (!bytes) return std::nullopt;
+    return from_job_bytes<std::vector<T>>(*bytes);
+  }
   nlohmann::json balance() const { return channel_->balance(); }
 
  private:
-  double fingerprint_of(std::size_t index) const { return fingerprint_ ? fingerprint_(index) : 0.0; }
+  std::uint64_t fingerprint_of(std::size_t index) const { return inputs_ ? fingerprint(inputs_(index)) : 0; }
+  void end_once(const std::optional<std::string>& results) {
+    if (ended_) return;
+    ended_ = true;
+    channel_->end(results);
+  }
 
   std::function<T(std::size_t)> job_;
-  Fingerprint fingerprint_;
+  Inputs inputs_;
   std::unique_ptr<JobChannel> channel_;
+  bool ended_ = false;
 };
 
 /// Runs body(k) for k < count, when `parallel` on up to `max_threads` threads (a thread per
@@ -121,16 +180,26 @@ class Jobs {
 void for_each_concurrently(std::size_t count, bool parallel, const std::function<void(std::size_t)>& body,
                            std::size_t max_threads = std::numeric_limits<std::size_t>::max());
 
-/// Every job of a task, its results in order: jobs 0..count-1 through `executor`, at once
-/// (a thread each, at most `max_threads`) when `parallel`. `balance`, if given, receives
-/// Jobs::balance().
+/// Every job of a batch, its results in order: jobs 0..count-1 through `executor`, at once
+/// (a thread each, at most `max_threads`) when `parallel`. Every process gets the results: on
+/// one that served the batch to another they are the ones the primary computed, so the task
+/// goes on there as on the primary. `balance`, if given, receives Jobs::balance(); `inputs`:
+/// Jobs::Inputs.
 template <class T>
 std::vector<T> run_jobs(Executor& executor, std::size_t count, bool parallel, std::function<T(std::size_t)> job,
-                        nlohmann::json* balance = nullptr, typename Jobs<T>::Fingerprint fingerprint = {},
+                        nlohmann::json* balance = nullptr, typename Jobs<T>::Inputs inputs = {},
                         std::size_t max_threads = std::numeric_limits<std::size_t>::max()) {
-  Jobs<T> jobs(executor, std::move(job), std::move(fingerprint));
+  Jobs<T> jobs(executor, std::move(job), std::move(inputs));
+  if (auto shared = jobs.shared_results()) {
+    if (shared->size() != count)
+      throw std::runtime_error("the primary process ran " + std::to_string(shared->size()) + " jobs in a batch of " +
+                               std::to_string(count) + " here: the processes differ");
+    if (balance) *balance = jobs.balance();
+    return std::move(*shared);
+  }
   std::vector<T> results(count);
   for_each_concurrently(count, parallel, [&](std::size_t k) { results[k] = jobs(k); }, max_threads);
+  jobs.end(results);
   if (balance) *balance = jobs.balance();
   return results;
 }

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/executor.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
 
@@ -40,7 +41,8 @@ struct DamperDesignResult {
 /// The damper_design study of a case with one damper of one layer. A closed form that
 /// refuses the case's numbers, or a result that is not finite, is bad input of that case
 /// (base::InputError naming the file), so `pdamp validate` catches what `pdamp run` would.
-DamperDesignResult run_damper_design(const case_file::Case& c);
+/// It runs on the primary process alone (on another: base::JobsServedElsewhere).
+DamperDesignResult run_damper_design(const case_file::Case& c, base::Executor& executor = base::local_executor());
 /// The result keys (task, case, model, clearance_m, optimum, sizing, operating_point, buffer);
 /// "warnings" and "outputs" are the caller's.
 nlohmann::json to_json(const DamperDesignResult& result);

@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/executor.hpp"
 #include "pdamp/base/record.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
@@ -142,7 +143,9 @@ struct BareDecaySummary {
 BareDecaySummary without_beds_summary(const DecayResult& result);
 
 /// The decay study of a case whose task is kind decay (InputError naming /task otherwise).
-DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, base::RunHooks& hooks);
+/// One run: on the primary process alone (on another: base::JobsServedElsewhere).
+DecayResult run_decay(const case_file::Case& c, const DecayOptions& options, base::RunHooks& hooks,
+                      base::Executor& executor = base::local_executor());
 /// The result keys (task, case, method, file, settling_time_s, damping_ratio, decay, ...).
 nlohmann::json to_json(const DecayResult& result, const OutputFolder& folder);
 /// The co-simulation's energy ledger (docs/cosimulation.md §4) as JSON.

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/executor.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/tasks/checkpoint.hpp"
@@ -87,8 +88,10 @@ struct DemRunResult {
 /// Runs the plan: progress through `hooks`; with a checkpoint path, a checkpoint at period
 /// ends whenever the hooks say one is due, and base::Interrupted (after saving one)
 /// when they ask to stop; with file.resume, from the saved state (bit for bit the
-/// uninterrupted run). A DEM that goes unstable or fails: base::NumericalError.
-DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks);
+/// uninterrupted run). A DEM that goes unstable or fails: base::NumericalError. One run: on
+/// the primary process alone (on another: base::JobsServedElsewhere).
+DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks,
+                     base::Executor& executor = base::local_executor());
 
 /// The DEM's measures (eta_star, eta_star_stderr, apparent mass, energy, motion mode, run).
 nlohmann::json to_json(const dem_reference::DamperResult& result);

@@ -64,8 +64,10 @@ struct FieldResult {
 /// Runs the sweep: the points through `executor` (on a process that serves another:
 /// JobsServedElsewhere), progress through `hooks`.
 FieldResult run_field(const case_file::Case& c, const FieldPlan& plan, base::RunHooks& hooks, base::Executor& executor);
-/// A test rig's CSV on the case's grid spacing and damper (docs/effective_fields.md).
-FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv);
+/// A test rig's CSV on the case's grid spacing and damper (docs/effective_fields.md), read on
+/// the primary process alone (on another: base::JobsServedElsewhere).
+FieldResult import_measured_field(const case_file::Case& c, const std::filesystem::path& csv,
+                                  base::Executor& executor = base::local_executor());
 /// The shards' logs of one sweep joined into the field a single run gives; shards of another
 /// case, model version or grid are refused naming both files.
 FieldResult merge_field(const case_file::Case& c, const std::string& source, const std::vector<std::filesystem::path>& logs);

@@ -178,9 +178,11 @@ struct FillingRatiosResult {
   std::vector<std::string> warnings;
 };
 
-/// The filling-ratio study of a case whose task is kind filling_ratios. The verification's
-/// two DEM decays are jobs of `executor` (on a process that serves another:
-/// JobsServedElsewhere); their progress and checkpoints go through `hooks`.
+/// The filling-ratio study of a case whose task is kind filling_ratios. The beds'
+/// calibration, each round's verification and the recalibrations are batches of jobs of
+/// `executor`, whose results every process gets (each goes on alike to the next batch);
+/// without DEM runs the study runs on the primary process alone (on another:
+/// base::JobsServedElsewhere). The runs' progress and checkpoints go through `hooks`.
 FillingRatiosResult run_filling_ratios(const case_file::Case& c, const FillingRatiosOptions& options, base::RunHooks& hooks,
                                        base::Executor& executor);
 /// The result keys (task, case, method, design, designs, solver, verification, ...).

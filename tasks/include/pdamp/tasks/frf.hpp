@@ -133,8 +133,10 @@ struct FrfResult {
   std::vector<std::string> warnings;
 };
 
-/// The frf study of a case whose task is kind frf (InputError naming /task otherwise). On a
-/// process that serves another (an MPI worker) the stepped sine throws JobsServedElsewhere.
+/// The frf study of a case whose task is kind frf (InputError naming /task otherwise). The
+/// stepped sine's directions (--method dem, --compare) are a batch of jobs of `executor`,
+/// whose results every process gets; the other methods run on the primary process alone
+/// (on another: base::JobsServedElsewhere).
 FrfResult run_frf(const case_file::Case& c, const FrfOptions& options, base::RunHooks& hooks, base::Executor& executor);
 /// The result keys (task, case, method, file, peaks, branches, frf or compare, ...); "warnings"
 /// and "outputs" are the caller's.

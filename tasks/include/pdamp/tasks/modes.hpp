@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/executor.hpp"
 #include "pdamp/base/record.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
@@ -62,8 +63,10 @@ struct BackboneSummary {
 std::optional<BackboneSummary> backbone_summary(const ModesResult& result, Eigen::Index mode);
 
 /// The modes study of a format-2 case (any task kind: the backbone range is the modes
-/// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance).
-ModesResult run_modes(const case_file::Case& c, const ModesOptions& options);
+/// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance). It runs
+/// on the primary process alone (on another: base::JobsServedElsewhere).
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options,
+                      base::Executor& executor = base::local_executor());
 /// The result keys (task, case, method, file, modes, frequencies, backbone, outcome, ...).
 nlohmann::json to_json(const ModesResult& result, const OutputFolder& folder);
 

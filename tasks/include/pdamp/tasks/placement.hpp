@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/executor.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/optimizer/options.hpp"
@@ -31,8 +32,10 @@ struct PlacementStudy {
   std::vector<std::string> warnings;
 };
 
-/// The placement study of a case whose task is kind placement.
-PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options);
+/// The placement study of a case whose task is kind placement, on the primary process alone
+/// (on another: base::JobsServedElsewhere).
+PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options,
+                             base::Executor& executor = base::local_executor());
 /// The result keys (task, case, method, damper, objective, design, current, solver, ...).
 nlohmann::json to_json(const PlacementStudy& study);
 
