@@ -21,6 +21,41 @@
 
 namespace pdamp::dem_reference {
 
+const base::Fields<DamperResult>& DamperResult::fields() {
+  using R = DamperResult;
+  static const auto f =
+      base::Fields<R>()
+          .field("eta_star", &R::eta_star, "1", "reduced loss factor from the complex power")
+          .field("eta_star_stderr", &R::eta_star_stderr, "1", "standard error of the periods' mean")
+          .field("eta_star_energy_balance", &R::eta_star_energy_balance, "1", "eta* from the energy balance instead")
+          .field("e_diss_j", &R::e_diss_j, "J", "Re(P)/Omega")
+          .field("energy_per_cycle_j", &R::energy_per_cycle_j, "J", "2 pi E_diss")
+          .field("apparent_mass_kg", &R::apparent_mass_kg, "kg", "Im(F* conj V*)/(Omega |V*|^2)")
+          .derived("apparent_mass_fraction", [](const R& r) { return r.apparent_mass_kg / r.bed_mass_kg; }, "1",
+                   "apparent mass over bed mass")
+          .field("energy_balance_error", &R::energy_balance_error, "1", "the energy ledger's relative error")
+          .field("particle_steps_per_s", &R::particle_steps_per_s, "1/s", "particle steps per wall-clock second")
+          .field("motion_mode", &R::motion_mode, "", "the bed's motion mode")
+          .field("clearance_m", &R::clearance_m, "m", "h of the collected bed")
+          .field("bed_mass_kg", &R::bed_mass_kg, "kg", "particle mass")
+          .field("intensity", &R::intensity, "1", "X Omega^2 / g")
+          .field("velocity_amplitude_m_s", &R::velocity_amplitude_m_s, "m/s", "X Omega")
+          .field("time_step_s", &R::time_step_s, "s", "the integration step")
+          .field("steps_per_period", &R::steps_per_period, "", "steps per drive period")
+          .field("eta_star_per_period", &R::eta_star_per_period, "1", "eta* of each analysed period")
+          .field("energy", &R::energy, "", "the energy ledger over the analysed periods")
+          .field("motion_indicators", &R::indicators, "", "what the motion mode was read from")
+          .group("run", "the run",
+                 base::Fields<R>()
+                     .derived("outcome", [](const R& r) { return r.summary.outcome; }, "", "completed, unstable or failed")
+                     .derived("steps", [](const R& r) { return r.summary.steps; }, "", "integration steps")
+                     .derived("particles", [](const R& r) { return r.summary.particles; }, "", "spheres")
+                     .derived("wall_time_s", [](const R& r) { return r.summary.wall_time_s; }, "s", "wall time")
+                     .derived("neighbour_rebuilds", [](const R& r) { return r.summary.neighbour_rebuilds; }, "",
+                              "Verlet-list rebuilds"));
+  return f;
+}
+
 namespace {
 
 using detail::dot;

@@ -10,6 +10,28 @@
 
 namespace pdamp::dem_reference {
 
+const base::Fields<MotionIndicators>& MotionIndicators::fields() {
+  using M = MotionIndicators;
+  static const auto f =
+      base::Fields<M>()
+          .field("relative_stroke_over_clearance", &M::relative_stroke_over_clearance, "1",
+                 "peak-to-peak travel of the bed relative to the container over h")
+          .field("period_correlation", &M::period_correlation, "1", "correlation of consecutive periods' motion")
+          .field("eta_star_variation", &M::eta_star_variation, "1", "coefficient of variation of the periods' eta*")
+          .field("apparent_mass_fraction", &M::apparent_mass_fraction, "1", "apparent mass over bed mass")
+          .field("base_contact_fraction", &M::base_contact_fraction, "1", "particles on the wall gravity presses on")
+          .field("airborne_fraction", &M::airborne_fraction, "1", "particles touching nothing")
+          .field("spread_over_packed", &M::spread_over_packed, "1", "the bed's extent along the drive over its packed extent")
+          .field("phase_locked_stroke", &M::phase_locked_stroke, "1", "2 |x_r at Omega| / h")
+          .field("phase_coherence", &M::phase_coherence, "1", "how alike the periods' phase at Omega is, [0, 1]")
+          .field("phase_lag_deg", &M::phase_lag_deg, "deg", "lag of the bed's motion behind the container's")
+          .field("crossing_fraction", &M::crossing_fraction, "1", "crossings of the clearance per half period")
+          .field("settled_base_contact_fraction", &M::settled_base_contact_fraction, "1",
+                 "base contact of the settled bed before the drive")
+          .field("mobile_fraction", &M::mobile_fraction, "1", "spheres faster than V/2 relative to the bed");
+  return f;
+}
+
 namespace {
 
 using detail::dot;

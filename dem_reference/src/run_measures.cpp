@@ -10,6 +10,21 @@
 
 namespace pdamp::dem_reference {
 
+const base::Fields<EnergyBalance>& EnergyBalance::fields() {
+  using E = EnergyBalance;
+  static const auto f =
+      base::Fields<E>()
+          .field("container_work_j", &E::container_work_j, "J", "work W the container did on the bed")
+          .field("normal_damping_j", &E::normal_damping_j, "J", "dissipated by the contacts' normal damping")
+          .field("friction_j", &E::friction_j, "J", "dissipated by sliding friction")
+          .field("rolling_j", &E::rolling_j, "J", "dissipated by rolling resistance")
+          .field("delta_kinetic_j", &E::delta_kinetic_j, "J", "change of the bed's kinetic energy")
+          .field("delta_potential_j", &E::delta_potential_j, "J", "change of its potential energy")
+          .field("delta_elastic_j", &E::delta_elastic_j, "J", "change of the contacts' elastic energy")
+          .field("relative_error", &E::relative_error, "1", "|W - (D + dE)| / max(|W|, D)", base::kHidden);
+  return f;
+}
+
 EnergyBalance EnergyLedger::balance(const EnergyAccount& now) const {
   EnergyBalance eb;
   eb.container_work_j = now.container_work_j - opening_.container_work_j;

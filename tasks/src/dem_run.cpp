@@ -205,46 +205,8 @@ DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const Che
   return out;
 }
 
-json to_json(const dem_reference::DamperResult& r) {
-  const auto& e = r.energy;
-  const auto& m = r.indicators;
-  return {{"eta_star", r.eta_star},
-          {"eta_star_stderr", r.eta_star_stderr},
-          {"eta_star_energy_balance", r.eta_star_energy_balance},
-          {"e_diss_j", r.e_diss_j},
-          {"energy_per_cycle_j", r.energy_per_cycle_j},
-          {"apparent_mass_kg", r.apparent_mass_kg},
-          {"apparent_mass_fraction", r.apparent_mass_kg / r.bed_mass_kg},
-          {"energy_balance_error", r.energy_balance_error},
-          {"particle_steps_per_s", r.particle_steps_per_s},
-          {"motion_mode", dem_reference::to_string(r.motion_mode)},
-          {"clearance_m", r.clearance_m},
-          {"bed_mass_kg", r.bed_mass_kg},
-          {"intensity", r.intensity},
-          {"velocity_amplitude_m_s", r.velocity_amplitude_m_s},
-          {"time_step_s", r.time_step_s},
-          {"steps_per_period", r.steps_per_period},
-          {"eta_star_per_period", r.eta_star_per_period},
-          {"energy",
-           {{"container_work_j", e.container_work_j}, {"normal_damping_j", e.normal_damping_j},
-            {"friction_j", e.friction_j}, {"rolling_j", e.rolling_j}, {"delta_kinetic_j", e.delta_kinetic_j},
-            {"delta_potential_j", e.delta_potential_j}, {"delta_elastic_j", e.delta_elastic_j}}},
-          {"motion_indicators",
-           {{"relative_stroke_over_clearance", m.relative_stroke_over_clearance},
-            {"period_correlation", m.period_correlation}, {"eta_star_variation", m.eta_star_variation},
-            {"apparent_mass_fraction", m.apparent_mass_fraction}, {"base_contact_fraction", m.base_contact_fraction},
-            {"airborne_fraction", m.airborne_fraction}, {"spread_over_packed", m.spread_over_packed},
-            {"phase_locked_stroke", m.phase_locked_stroke}, {"phase_coherence", m.phase_coherence},
-            {"phase_lag_deg", m.phase_lag_deg}, {"crossing_fraction", m.crossing_fraction},
-            {"settled_base_contact_fraction", m.settled_base_contact_fraction}, {"mobile_fraction", m.mobile_fraction}}},
-          {"run",
-           {{"outcome", dem_reference::to_string(r.summary.outcome)}, {"steps", r.summary.steps},
-            {"particles", r.summary.particles}, {"wall_time_s", r.summary.wall_time_s},
-            {"neighbour_rebuilds", r.summary.neighbour_rebuilds}}}};
-}
-
 json to_json(const DemRunResult& r) {
-  json out = to_json(r.dem);
+  json out = base::to_json(r.dem);
   out.update({{"case", r.case_name}, {"amplitude_m", r.amplitude_m}, {"frequency_hz", r.frequency_hz}});
   if (r.approach_amplitude_m > 0.0)
     out["approach"] = {{"from_amplitude_m", r.approach_amplitude_m}, {"hold_periods", r.approach_hold_periods},

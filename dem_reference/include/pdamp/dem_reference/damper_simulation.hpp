@@ -112,6 +112,8 @@ struct DamperResult {
   /// (the run continues from it), or while the bed settled or approached, without one. The
   /// measures are unset.
   bool stopped = false;
+  /// The result's numbers (not its series, snapshots and warnings, which go to files).
+  static const base::Fields<DamperResult>& fields();
 };
 
 /// Where a harmonic run's checkpoints go (docs/dem.md "Checkpoints"): a file, memory. The

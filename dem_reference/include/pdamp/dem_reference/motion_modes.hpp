@@ -69,6 +69,7 @@ struct MotionIndicators {
   /// Spheres whose rms speed relative to the bed's mean velocity (over the analysed
   /// periods) exceeds V/2, fraction (0: the bed moves as a block; 1: a granular gas).
   double mobile_fraction = 0.0;
+  static const base::Fields<MotionIndicators>& fields();
 };
 
 /// The drive the indicators are read against.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/dem_reference/checkpoint.hpp"
 #include "pdamp/dem_reference/world.hpp"
 #include "pdamp/formulas/complex_power.hpp"
@@ -27,6 +28,7 @@ struct EnergyBalance {
   double dissipated_j() const { return normal_damping_j + friction_j + rolling_j; }
   /// ΔE = change of kinetic + potential + elastic energy, J.
   double delta_energy_j() const { return delta_kinetic_j + delta_potential_j + delta_elastic_j; }
+  static const base::Fields<EnergyBalance>& fields();
 };
 
 /// The energy balance over a window of any drive. The world keeps the cumulative

@@ -93,8 +93,6 @@ struct DemRunResult {
 DemRunResult run_dem(const case_file::Case& c, const DemRunPlan& plan, const CheckpointFile& checkpoint, base::RunHooks& hooks,
                      base::Executor& executor = base::local_executor());
 
-/// The DEM's measures (eta_star, eta_star_stderr, apparent mass, energy, motion mode, run).
-nlohmann::json to_json(const dem_reference::DamperResult& result);
 /// pdamp dem's result keys: the DEM's measures, case, amplitude, frequency, closed_form.
 nlohmann::json to_json(const DemRunResult& result);
 
