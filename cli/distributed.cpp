@@ -272,19 +272,6 @@ class RankChannel : public base::JobChannel {
   bool started_ = false;
 };
 
-/// A worker's batch: the results rank 0 ended it with.
-class SharedChannel : public base::JobChannel {
- public:
-  explicit SharedChannel(std::string results) : results_(std::move(results)) {}
-  std::optional<std::string> run_elsewhere(std::size_t, std::uint64_t) override {
-    throw std::logic_error("a batch served to rank 0 has no jobs left to run");
-  }
-  std::optional<std::string> shared_results() const override { return results_; }
-
- private:
-  std::string results_;
-};
-
 class MpiExecutor : public base::Executor {
  public:
   int concurrency(int local_jobs) const override { return spread() ? g_ranks : local_jobs; }
@@ -325,7 +312,7 @@ class MpiExecutor : public base::Executor {
       alone_ = true;
       throw base::JobsServedElsewhere();
     }
-    return std::make_unique<SharedChannel>(std::move(*end->results));
+    return std::make_unique<base::SharedResultsChannel>(std::move(*end->results));
   }
 
  private:

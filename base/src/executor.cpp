@@ -1,6 +1,8 @@
 // The local executor, the job fingerprint and the concurrency helper of executor.hpp.
 #include "pdamp/base/executor.hpp"
 
+#include "pdamp/base/fnv1a.hpp"
+
 #include <algorithm>
 #include <atomic>
 
@@ -15,14 +17,7 @@ class LocalChannel : public JobChannel {
 
 }  // namespace
 
-std::uint64_t fingerprint(std::string_view text) {
-  std::uint64_t hash = 14695981039346656037ULL;
-  for (const char c : text) {
-    hash ^= static_cast<unsigned char>(c);
-    hash *= 1099511628211ULL;
-  }
-  return hash;
-}
+std::uint64_t fingerprint(std::string_view text) { return fnv1a64(text); }
 
 std::unique_ptr<JobChannel> LocalExecutor::open(EncodedJob) {
   return std::make_unique<LocalChannel>();

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/fnv1a.hpp"
 #include "pdamp/base/input_file.hpp"
 #include "pdamp/base/strict_object.hpp"
 
@@ -161,15 +162,6 @@ void StateReader::finish() const {
     fail("end", std::to_string(remaining()) + " bytes are left over: a state of another layout");
 }
 
-std::uint64_t fnv1a64(std::string_view bytes) {
-  std::uint64_t hash = 14695981039346656037ULL;
-  for (const char c : bytes) {
-    hash ^= static_cast<unsigned char>(c);
-    hash *= 1099511628211ULL;
-  }
-  return hash;
-}
-
 std::string encode_checkpoint(const CheckpointHeader& header, std::string_view payload) {
   const nlohmann::json h = {{"kind", header.kind},
                             {"case_hash", header.case_hash},
@@ -178,7 +170,7 @@ std::string encode_checkpoint(const CheckpointHeader& header, std::string_view p
                             {"simulated_time_s", header.simulated_time_s},
                             {"end_time_s", header.end_time_s},
                             {"payload_bytes", payload.size()},
-                            {"payload_fnv1a64", hex(fnv1a64(payload))}};
+                            {"payload_fnv1a64", hex(base::fnv1a64(payload))}};
   std::string out(kMagic);
   out += h.dump();  // one line: dump() without indent has no newline
   out += '\n';
@@ -210,7 +202,7 @@ DecodedCheckpoint decode_checkpoint(std::string_view bytes, const std::string& f
     base::fail_at(file, "/payload_bytes",
                          "= " + std::to_string(size) + " but the file holds " + std::to_string(payload.size()) +
                              " payload bytes: the checkpoint is truncated or damaged");
-  if (hex(fnv1a64(payload)) != hash)
+  if (hex(base::fnv1a64(payload)) != hash)
     base::fail_at(file, "/payload_fnv1a64", "does not match the payload: the checkpoint is damaged");
   out.payload = std::string(payload);
   return out;

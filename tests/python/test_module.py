@@ -111,10 +111,10 @@ def test_structure_studies_return_dicts_of_arrays():
     assert modes["modes"][0]["frequency_hz"] > 0
 
 
-def test_keyboard_interrupt_stops_a_dem_run(tmp_path):
-    document = small_dem_case()
-    document["dem"]["analysed_periods"] = 2000  # minutes: only the interrupt ends it soon
-    path = tmp_path / "long.json"
+def interrupted_after_a_second(tmp_path, document, run):
+    """Runs run(case, progress) on the case `document`, sends SIGINT after a second and
+    expects KeyboardInterrupt; returns the progress reports seen."""
+    path = tmp_path / "case.json"
     path.write_text(json.dumps(document))
     case = pdamp.load_case(str(path))
     reports = []
@@ -122,9 +122,16 @@ def test_keyboard_interrupt_stops_a_dem_run(tmp_path):
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            pdamp.dem(case, progress=reports.append)
+            run(case, reports.append)
     finally:
         timer.cancel()
+    return reports
+
+
+def test_keyboard_interrupt_stops_a_dem_run(tmp_path):
+    document = small_dem_case()
+    document["dem"]["analysed_periods"] = 2000  # minutes: only the interrupt ends it soon
+    reports = interrupted_after_a_second(tmp_path, document, lambda case, progress: pdamp.dem(case, progress=progress))
     # Stopped where it was, not at its end: the last report is early in the 2000 periods.
     assert reports and reports[-1]["done"] < 0.5 * reports[-1]["total"]
 
@@ -134,17 +141,8 @@ def test_keyboard_interrupt_stops_a_dem_field_before_its_next_point(tmp_path):
     document["dem"]["analysed_periods"] = 20  # about a second a point: the interrupt lands mid-sweep
     document["field"] = {"axis0": {"min": 1.5, "max": 2.5, "count": 4}, "axis1": {"min": 0.015, "max": 0.07, "count": 4},
                          "threads": 1}
-    path = tmp_path / "field.json"
-    path.write_text(json.dumps(document))
-    case = pdamp.load_case(str(path))
-    reports = []
-    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            pdamp.field(case, source="dem", progress=reports.append)
-    finally:
-        timer.cancel()
+    reports = interrupted_after_a_second(tmp_path, document,
+                                         lambda case, progress: pdamp.field(case, source="dem", progress=progress))
     # The point in flight finished, no other started: the sweep ended well before its 16 points.
     assert reports and all(r["counts_points"] for r in reports)
     assert reports[-1]["done"] < reports[-1]["total"] == 16

@@ -73,22 +73,11 @@ class ServingExecutor : public base::Executor {
     if (next_ >= ended_.size() || !ended_[next_]) throw std::logic_error("a batch the primary did not end");
     const std::optional<std::string>& results = *ended_[next_++];
     if (!results) throw base::JobsServedElsewhere();
-    return std::make_unique<Shared>(*results);
+    return std::make_unique<base::SharedResultsChannel>(*results);
   }
   std::size_t batches() const { return next_; }
 
  private:
-  class Shared : public base::JobChannel {
-   public:
-    explicit Shared(std::string results) : results_(std::move(results)) {}
-    std::optional<std::string> run_elsewhere(std::size_t, std::uint64_t) override {
-      throw std::logic_error("a served batch has no jobs to run");
-    }
-    std::optional<std::string> shared_results() const override { return results_; }
-
-   private:
-    std::string results_;
-  };
   std::vector<std::optional<std::optional<std::string>>> ended_;
   std::size_t next_ = 0;
 };

@@ -17,6 +17,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -58,6 +59,20 @@ class JobChannel {
   virtual void end(const std::optional<std::string>& /*results*/) {}
   /// On a process that served the batch: the results the primary ended it with.
   virtual std::optional<std::string> shared_results() const { return std::nullopt; }
+};
+
+/// A batch this process served: it runs no job and holds the results the primary ended it
+/// with (what a distributed executor opens on every process but the primary).
+class SharedResultsChannel : public JobChannel {
+ public:
+  explicit SharedResultsChannel(std::string results) : results_(std::move(results)) {}
+  std::optional<std::string> run_elsewhere(std::size_t, std::uint64_t) override {
+    throw std::logic_error("a batch served to the primary process has no jobs left to run");
+  }
+  std::optional<std::string> shared_results() const override { return results_; }
+
+ private:
+  std::string results_;
 };
 
 /// Where a task's jobs run. A task opens its jobs in numbered batches (1, 2, ...: one at a

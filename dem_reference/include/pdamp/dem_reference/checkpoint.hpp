@@ -74,9 +74,6 @@ class StateReader {
   std::string what_;
 };
 
-/// FNV-1a 64-bit hash of bytes.
-std::uint64_t fnv1a64(std::string_view bytes);
-
 /// What a checkpoint says about itself (the JSON header line).
 struct CheckpointHeader {
   std::string kind;          ///< the run it continues ("decay_dem", ...): a resume of another kind is refused
