@@ -70,6 +70,16 @@ const tasks::DesignCheck* check_named(const tasks::Verification& v, std::string_
   return nullptr;
 }
 
+/// Which models the filling-ratio prediction came from, in words.
+std::string prediction_source(const tasks::FillingRatiosResult& r) {
+  if (const auto& cal = r.calibration)
+    return "The prediction comes from beds calibrated by the DEM (" + std::to_string(cal->beds.size()) + " beds, " +
+           std::to_string(cal->runs) + " run now, the others from the cache): " + std::string(cal->kWhat) + ".";
+  return "The prediction comes from the closed forms (each bed's collect-and-collide models), not from the DEM; on a "
+         "decay they can miss how a bed comes down from collect-and-collide, so trust it where the DEM check below "
+         "passes, or optimise on beds calibrated by the DEM (--method calibrated).";
+}
+
 Answer filling_ratios_answer(const tasks::FillingRatiosResult& r, const case_file::Case& c) {
   Answer a;
   const opt::FillingDesign& chosen = r.optimum.chosen;
@@ -110,6 +120,7 @@ Answer filling_ratios_answer(const tasks::FillingRatiosResult& r, const case_fil
       << three_digits(bare.objective) << " without particles. ";
   }
   a.paragraphs.push_back(p.str());
+  a.paragraphs.push_back(prediction_source(r));
   if (v) {
     std::ostringstream verdict;
     verdict << "DEM check: " << (v->passed ? "PASS" : "FAIL") << ". ";

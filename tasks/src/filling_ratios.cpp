@@ -547,6 +547,13 @@ FillingRatiosResult run_filling_ratios(const Case& c, const FillingRatiosOptions
     check_design_decays_cost(c, out.problem, verify->duration_s, softenings, 2, executor.concurrency(2),
                              "pdamp optimize --verify", "/task/verify/duration_s", hooks);
   }
+  // A verification of a design chosen on the closed forms often fails (they can miss how a
+  // bed comes down from collect-and-collide): say so once, when the runs' cost is accepted
+  // and before they start.
+  if (verify && !calibrated)
+    hooks.note("pdamp optimize: note: the DEM will check a design chosen on the closed forms, which it often does not "
+               "confirm; to choose on beds calibrated by the DEM add \"calibration\": {} to the task or run: pdamp "
+               "optimize " + c.path + " --method calibrated");
   if (calibrated) {
     case_file::CalibrationSpec spec;
     if (task.calibration) {

@@ -150,6 +150,13 @@ TEST_CASE("pdamp optimize --verify runs the DEM on the chosen and baseline desig
   // Progress of both DEM runs on stderr.
   CHECK(run.err.find("pdamp optimize --verify (chosen): decay") != std::string::npos);
   CHECK(run.err.find("pdamp optimize --verify (baseline): decay") != std::string::npos);
+  // Verified without calibration: one plain note before the runs, with the command that calibrates.
+  const std::string note = "a design chosen on the closed forms";
+  const auto note_at = run.err.find(note);
+  REQUIRE(note_at != std::string::npos);
+  CHECK(run.err.find(note, note_at + 1) == std::string::npos);
+  CHECK(note_at < run.err.find("pdamp optimize --verify (chosen): decay"));
+  CHECK(run.err.find(path + " --method calibrated") != std::string::npos);
   const json r = json::parse(slurp(dir.path / "out" / "optimize.json"));
   REQUIRE(r["verification"].is_object());
   const json& v = r["verification"];
@@ -202,8 +209,10 @@ TEST_CASE("the task's verification is skipped with --no-verify, and --verify wit
     c["task"]["verify"] = {{"duration_s", 0.7}, {"stiffness_softening", 1e-4}};
     c["task"].erase("calibration");
   });
-  const json r = run_json({"optimize", path, "--no-verify"});
-  CHECK(r["verification"].is_null());
+  const auto unverified = run_pdamp({"optimize", path, "--no-verify", "--json"});
+  REQUIRE(unverified.exit_code == 0);
+  CHECK(json::parse(unverified.out)["verification"].is_null());
+  CHECK(unverified.err.find("closed forms") == std::string::npos);  // nothing verified: no note
   CHECK(run_json({"run", path, "--no-verify"})["verification"].is_null());
   require_one_line_error(run_pdamp({"optimize", path, "--verify", "--no-verify"}), "--verify");
 }

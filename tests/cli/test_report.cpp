@@ -132,6 +132,23 @@ TEST_CASE("the report escapes hostile case text and embeds pictures as data URIs
   }
 }
 
+TEST_CASE("a filling-ratio answer names the models its prediction came from", "[cli][report]") {
+  pdamp::report::ReportInput in;
+  in.case_name = "link";
+  in.result = json::object();
+  pdamp::tasks::FillingRatiosResult design;
+  design.optimum.chosen.layers.resize(1);
+  in.typed = &design;
+  CHECK_THAT(pdamp::report::report_html(in), Catch::Contains("The prediction comes from the closed forms") &&
+                                                 Catch::Contains("--method calibrated"));
+  design.calibration.emplace();
+  design.calibration->beds.resize(7);
+  design.calibration->runs = 2;
+  CHECK_THAT(pdamp::report::report_html(in),
+             Catch::Contains("The prediction comes from beds calibrated by the DEM (7 beds, 2 run now") &&
+                 !Catch::Contains("The prediction comes from the closed forms"));
+}
+
 TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {
   const TempDir dir("report_run");
   const std::string path = (dir.path / "hostile.json").string();
