@@ -261,6 +261,12 @@ Answer placement_answer(const tasks::PlacementStudy& study) {
   else p << three_digits(gain) << " times that at the case's own site (" << three_digits(r.current ? r.current->objective : NAN) << ")";
   p << "; " << three_digits(static_cast<double>(r.scan.size())) << " positions tried.";
   a.paragraphs.push_back(p.str());
+  a.paragraphs.push_back(std::string("The damping ratios come from ") +
+                         (study.method == case_file::LossMethod::kField
+                              ? "each layer's effective field"
+                              : "the closed forms (each layer's collect-and-collide models)") +
+                         ", at the stroke each target mode gives the site, one mode at a time.");
+  a.verdict = "Not checked by the DEM in the loop (pdamp does not run one for a placement).";
   return a;
 }
 

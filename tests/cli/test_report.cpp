@@ -149,6 +149,19 @@ TEST_CASE("a filling-ratio answer names the models its prediction came from", "[
                  !Catch::Contains("The prediction comes from the closed forms"));
 }
 
+TEST_CASE("a placement answer names the models its damping ratios came from and that the DEM did not check them",
+          "[cli][report]") {
+  pdamp::report::ReportInput in;
+  in.case_name = "beam";
+  in.result = json::object();
+  pdamp::tasks::PlacementStudy placement;
+  in.typed = &placement;
+  CHECK_THAT(pdamp::report::report_html(in),
+             Catch::Contains("come from the closed forms") && Catch::Contains("Not checked by the DEM"));
+  placement.method = pdamp::case_file::LossMethod::kField;
+  CHECK_THAT(pdamp::report::report_html(in), Catch::Contains("come from each layer&#39;s effective field"));  // escaped
+}
+
 TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {
   const TempDir dir("report_run");
   const std::string path = (dir.path / "hostile.json").string();
