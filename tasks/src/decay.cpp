@@ -24,7 +24,6 @@ namespace pdamp::tasks {
 
 namespace st = structure;
 using case_file::Case;
-using detail::number_or_null;
 using nlohmann::json;
 using base::format_number;
 using base::InputError;

@@ -2,7 +2,6 @@
 // warnings kept once each, spaced values, JSON numbers that may be undefined.
 #pragma once
 
-#include <cmath>
 #include <optional>
 #include <set>
 #include <string>
@@ -39,10 +38,6 @@ class Warnings {
   std::vector<std::string> list_;
   std::set<std::string> seen_;
 };
-
-/// A number, or null where the study defines none (NaN: a half-power point outside the
-/// grid, a decay that did not settle).
-inline nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); }
 
 /// n values from lo to hi (both included), evenly spaced, or evenly in log when `log`.
 std::vector<double> spaced(double lo, double hi, int n, bool log);
