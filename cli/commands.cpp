@@ -196,9 +196,11 @@ int run_run(const ParsedArgs& args, CommandContext& context) {
   const Case c = case_file::load_case(args.positional().at(0));
   context.report = true;  // with -o DIR, the task also writes DIR/report.html
   const std::string kind(case_file::to_string(c.task.kind));
-  for (const char* flag : {"--no-verify", "--calibration-cache"})
-    if (args.has(flag) && c.task.kind != case_file::TaskKind::kFillingRatios)
-      throw InputError(flag, "", "applies to task kind filling_ratios; this case's task is " + kind);
+  if (args.has("--no-verify") && c.task.kind != case_file::TaskKind::kFillingRatios &&
+      c.task.kind != case_file::TaskKind::kClearance)
+    throw InputError("--no-verify", "", "applies to task kinds filling_ratios and clearance; this case's task is " + kind);
+  if (args.has("--calibration-cache") && c.task.kind != case_file::TaskKind::kFillingRatios)
+    throw InputError("--calibration-cache", "", "applies to task kind filling_ratios; this case's task is " + kind);
   if (c.task.kind != case_file::TaskKind::kFrf)
     refuse_flags(args, kDemSweepFlags, "applies to task kind frf (the DEM stepped sine); this case's task is " + kind);
   switch (c.task.kind) {
@@ -207,7 +209,8 @@ int run_run(const ParsedArgs& args, CommandContext& context) {
         throw InputError("--method", "", "applies to the structure tasks (modes, frf, decay); this case's task is damper_design");
       return run_damper_design(args, context, c);
     case case_file::TaskKind::kFillingRatios:
-    case case_file::TaskKind::kPlacement: return run_optimize_case(args, context, c);
+    case case_file::TaskKind::kPlacement:
+    case case_file::TaskKind::kClearance: return run_optimize_case(args, context, c);
     case case_file::TaskKind::kModes:
     case case_file::TaskKind::kFrf:
     case case_file::TaskKind::kDecay: return run_structure_case(args, context, c);

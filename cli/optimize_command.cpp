@@ -1,5 +1,6 @@
-// pdamp optimize (and pdamp run on task kinds filling_ratios and placement): the case's
-// design task (tasks/filling_ratios, tasks/placement), its files and its printout.
+// pdamp optimize (and pdamp run on task kinds filling_ratios, placement and clearance): the
+// case's design task (tasks/filling_ratios, tasks/placement, tasks/clearance), its files and
+// its printout.
 #include <iostream>
 #include <optional>
 
@@ -11,6 +12,7 @@
 #include "output.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/task_files.hpp"
+#include "pdamp/tasks/clearance.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/placement.hpp"
 #include "structure_commands.hpp"
@@ -216,16 +218,82 @@ int run_placement_case(const ParsedArgs& args, CommandContext& context, const Ca
   return finish(args, files.get(), out, warnings, rows, {"placement.json", &c, context.report}, &study);
 }
 
+std::string check_text(const tasks::ClearanceCheck& k) {
+  std::string line = "h = " + format_number(k.clearance_m * 1e3, 4) + " mm: predicted " +
+                     format_number(k.predicted_peak, 4) + " at " + format_number(k.predicted_frequency_hz, 4) + " Hz" +
+                     (k.predicted_peak > k.predicted_sweep_peak * 1.001
+                          ? " (an upper branch; sweeps reach " + format_number(k.predicted_sweep_peak, 4) + ")"
+                          : std::string()) +
+                     ", DEM " +
+                     format_number(k.dem_peak, 4) + " +- " + format_number(k.dem_peak_standard_error, 2) + " at " +
+                     format_number(k.dem_frequency_hz, 4) + " Hz (" + std::string(structure::to_string(k.dem_sweep)) + ")";
+  line += ", peak " + format_number(100.0 * k.peak_relative_difference, 3) + " %";
+  if (std::isfinite(k.band_centre_relative_difference))
+    line += ", band centre " + format_number(100.0 * k.band_centre_relative_difference, 3) + " %";
+  if (k.ranking != tasks::DemRanking::kChosen) line += ", " + std::string(tasks::to_string(k.ranking)) + " than chosen";
+  if (k.unconverged_points > 0) line += ", " + std::to_string(k.unconverged_points) + " point(s) not converged";
+  return line + ", " + format_number(k.wall_time_s, 3) + " s";
+}
+
+int run_clearance_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
+  if (const auto method = args.optional_text("--method"); method && *method != "formulas")
+    throw InputError("--method", "", "'" + *method + "': task kind clearance takes formulas (the layer's closed form)");
+  if (args.has("--calibration-cache"))
+    throw InputError("--calibration-cache", "", "applies to task kind filling_ratios; this case's task is clearance");
+  refuse_checkpoint_flags(args, "applies to task kind filling_ratios (the clearance's stepped sines are not checkpointed)");
+  tasks::ClearanceOptions options;
+  options.backend = backend_flag(args);
+  options.force_verify = args.has("--verify");
+  options.skip_verify = args.has("--no-verify");
+  auto files = output_dir(args, context);
+  CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
+  const tasks::ClearanceStudy study = tasks::run_clearance(c, options, hooks, context.executor);
+  std::vector<std::string> warnings = study.warnings;
+  if (files)
+    for (auto& w : report::write_files(*files, study)) warnings.push_back(w);
+  json out = tasks::to_json(study);
+  out["file"] = output_folder(files.get()).file("clearance.json");
+  const auto& r = study.sizing.response;
+  Rows rows = {{"case", c.name},
+               {"objective", std::string(opt::to_string(study.objective)) + " of |X/U| (mode " +
+                                 std::to_string(study.mode + 1) + ", U = " + format_number(study.base_amplitude_m * 1e3, 4) +
+                                 " mm)"},
+               {"chosen clearance", format_number(r.clearance_m * 1e3, 5) + " mm: peak |X/U| " +
+                                        format_number(r.peak_transmissibility, 4) + " at " +
+                                        format_number(r.peak_frequency_hz, 4) + " Hz, X = " +
+                                        format_number(r.damper_amplitude_m * 1e3, 4) + " mm" +
+                                        (r.held_at_onset ? " (held at the onset)" : "")},
+               {"closed form", format_number(study.sizing.estimate.clearance_m * 1e3, 5) + " mm"},
+               {"case clearance", format_number(study.current.clearance_m * 1e3, 5) + " mm: peak |X/U| " +
+                                      format_number(study.current.peak_transmissibility, 4)},
+               {"solver", study.sizing.summary.brief_report()}};
+  if (const auto& v = study.verification) {
+    for (const auto& k : v->checks) rows.push_back({k.factor == 1.0 ? "DEM check, chosen" : "DEM check, " +
+                                                        format_number(k.factor, 3) + " h", check_text(k)});
+    rows.push_back({"verification", std::string(v->passed ? "PASS" : "FAIL") + " (chosen within " +
+                                        format_number(100.0 * v->settings.tolerance_relative, 3) + " %: " +
+                                        (v->chosen_agrees ? "yes" : "no") + "; DEM contradicts no predicted ranking: " +
+                                        (v->ranking_agrees ? "yes" : "no") + "; every neighbour above it: " +
+                                        (v->ranking_resolved ? "yes" : "no") + "; neighbours within " +
+                                        format_number(100.0 * v->settings.tolerance_relative, 3) + " %: " +
+                                        (v->neighbours_agree ? "yes" : "no") + ")"});
+  }
+  rows.push_back({"time", format_number(study.sizing.solve_time_s, 4) + " s (sizing)"});
+  return finish(args, files.get(), out, warnings, rows, {"clearance.json", &c, context.report}, &study);
+}
+
 }  // namespace
 
 int run_optimize_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
   if (c.task.kind == case_file::TaskKind::kPlacement && c.task.placement) return run_placement_case(args, context, c);
+  if (c.task.kind == case_file::TaskKind::kClearance && c.task.clearance) return run_clearance_case(args, context, c);
   if (c.task.kind != case_file::TaskKind::kFillingRatios || !c.task.filling_ratios)
     throw InputError(c.path, "/task",
-                     "pdamp optimize needs a task of kind filling_ratios or placement (this case's task is '" +
+                     "pdamp optimize needs a task of kind filling_ratios, placement or clearance (this case's task is '" +
                          std::string(case_file::to_string(c.task.kind)) +
                          "'): give \"task\": {\"kind\": \"filling_ratios\", \"mass_budget_kg\", \"initial_state\", "
-                         "\"duration_s\"} or {\"kind\": \"placement\", \"targets\"} (docs/cases.md, Format 2)");
+                         "\"duration_s\"}, {\"kind\": \"placement\", \"targets\"} or {\"kind\": \"clearance\", \"mode\", ...} "
+                         "(docs/cases.md, Format 2)");
   return run_filling_ratios_case(args, context, c);
 }
 
@@ -236,7 +304,9 @@ Command optimize_command() {
            "neighbours, single-layer baseline; with the task's verify block or --verify, the\n"
            "DEM-in-the-loop check of the chosen and baseline designs. Kind placement: the site\n"
            "along a beam, or among named points, where the damper adds the most damping to the\n"
-           "target modes; docs/optimizer.md)",
+           "target modes. Kind clearance: the clearance of a single-layer damper for the lowest\n"
+           "resonant peak under a base motion; with verify, the DEM stepped sine at the chosen\n"
+           "clearance and its neighbours; docs/optimizer.md)",
            concat_flags({kBackendFlag,
             {"--method", "M", "each layer's eta*(f, X): placement formulas (the closed forms; default) or\n"
                               "                          field (its field_file); filling_ratios formulas or calibrated (each\n"
@@ -246,8 +316,11 @@ Command optimize_command() {
             {"-o", "DIR", "write optimize.json, designs.csv, decay_compare.csv, decay_compare.gp/png/svg,\n"
                           "                          case_resolved.json and with the verification verify_decay.csv,\n"
                           "                          verify_decay.gp/png/svg into DIR, atomically (placement:\n"
-                          "                          placement.json, placement.csv, placement.gp/png/svg; the verification's\n"
-                          "                          verify_chosen.checkpoint, verify_baseline.checkpoint while running)"},
+                          "                          placement.json, placement.csv, placement.gp/png/svg; clearance:\n"
+                          "                          clearance.json, clearance.csv, clearance.gp/png/svg and with the\n"
+                          "                          verification clearance_checks.csv, clearance_verify.csv/gp/png/svg;\n"
+                          "                          the verification's verify_chosen.checkpoint, verify_baseline.checkpoint\n"
+                          "                          while running)"},
             kJsonFlag}, kCheckpointFlags),
            1},
           [](const ParsedArgs& args, CommandContext& context) {

@@ -291,7 +291,8 @@ int run_structure_case(const ParsedArgs& args, CommandContext& context, const Ca
     case case_file::TaskKind::kDecay: return run_decay_case(args, context, c);
     case case_file::TaskKind::kDamperDesign:
     case case_file::TaskKind::kFillingRatios:
-    case case_file::TaskKind::kPlacement: break;
+    case case_file::TaskKind::kPlacement:
+    case case_file::TaskKind::kClearance: break;
   }
   throw std::logic_error("run_structure_case: not a structure task");
 }

@@ -15,7 +15,7 @@ std::vector<Command> structure_commands();
 
 /// The case's task of kind modes, frf or decay, exactly as the command of that name (pdamp run).
 int run_structure_case(const ParsedArgs& args, CommandContext& context, const case_file::Case& c);
-/// The case's task of kind filling_ratios or placement, exactly as pdamp optimize (pdamp run).
+/// The case's task of kind filling_ratios, placement or clearance, exactly as pdamp optimize (pdamp run).
 int run_optimize_case(const ParsedArgs& args, CommandContext& context, const case_file::Case& c);
 /// pdamp optimize.
 Command optimize_command();

@@ -30,6 +30,7 @@
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/frf.hpp"
 #include "pdamp/tasks/modes.hpp"
+#include "pdamp/tasks/clearance.hpp"
 #include "pdamp/tasks/placement.hpp"
 #include "pdamp/base/run_hooks.hpp"
 
@@ -354,6 +355,14 @@ PYBIND11_MODULE(pdamp, m) {
           tasks::PlacementOptions o;
           return to_python(tasks::to_json(run_study(hooks, [&] { return tasks::run_placement(c, o); })));
         }
+        if (c.task.kind == case_file::TaskKind::kClearance) {
+          tasks::ClearanceOptions o;
+          o.skip_verify = !verify;
+          const auto r = run_study(hooks, [&] { return tasks::run_clearance(c, o, hooks); });
+          json out = tasks::to_json(r);
+          out["warnings"] = r.warnings;
+          return to_python(out);
+        }
         tasks::FillingRatiosOptions o;
         o.skip_verify = !verify;
         const auto r = run_study(hooks, [&] { return tasks::run_filling_ratios(c, o, hooks, base::local_executor()); });
@@ -362,6 +371,6 @@ PYBIND11_MODULE(pdamp, m) {
         return to_python(out);
       },
       py::arg("case"), py::arg("verify") = true, py::arg("progress") = py::none(),
-      "`pdamp optimize` on a filling_ratios or placement case: the designs, the solver and, with\n"
-      "verify, the DEM verification.");
+      "`pdamp optimize` on a filling_ratios, placement or clearance case: the designs, the solver\n"
+      "and, with verify, the DEM verification.");
 }

@@ -1,4 +1,5 @@
-// Designs of a filling_ratios case as cases of their own (case.hpp, with_design).
+// Designs of a filling_ratios case and clearances of a clearance case as cases of their own
+// (case.hpp: with_design, with_clearance).
 #include <limits>
 #include <string>
 #include <vector>
@@ -40,6 +41,41 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
     const auto seed = static_cast<long long>(c.dem.simulation.world.seed);
     document["dem"]["seed"] = seed < std::numeric_limits<int>::max() ? seed + 1 : seed - 1;
   }
+  return load_case_document(document, c.path);
+}
+
+}  // namespace pdamp::case_file
+
+namespace pdamp::case_file {
+
+Case with_clearance(const Case& c, double clearance_m) {
+  if (!c.task.clearance || c.format_version != 2)
+    throw CaseError(c.path, "/task", "a clearance variant needs a format-2 case of task kind clearance");
+  const DamperSpec& damper = c.dampers.front();
+  const LayerSpec& layer = damper.layers.front();
+  const double change_m = clearance_m - layer.clearance_m;
+  json document = c.document;
+  json& layer_json = document["dampers"][0]["layers"][0];
+  json& container = layer_json["container"];
+  if (layer.container.shape == formulas::ContainerShape::kBox) {
+    json& size = container["inner_size_m"][static_cast<std::size_t>(damper.drive_axis)];
+    size = size.get<double>() + change_m;
+  } else if (layer.container.cylinder_axis == damper.drive_axis) {
+    container["inner_length_m"] = container["inner_length_m"].get<double>() + change_m;
+  } else {
+    throw CaseError(c.path, "/dampers/0/layers/0/container/axis",
+                    "a cylinder across the drive has no length to change: the clearance of task kind clearance "
+                    "needs a box, or a cylinder along the drive");
+  }
+  if (layer_json.contains("clearance_m")) layer_json["clearance_m"] = clearance_m;
+  const FrfTask& band = c.task.clearance->band;
+  document["task"] = json{{"kind", "frf"},
+                          {"min_frequency_hz", band.min_frequency_hz},
+                          {"max_frequency_hz", band.max_frequency_hz},
+                          {"points", band.points},
+                          {"excitation", {{"kind", "base"},
+                                          {"amplitude_m", band.base_amplitude_m},
+                                          {"direction", {band.direction[0], band.direction[1]}}}}};
   return load_case_document(document, c.path);
 }
 

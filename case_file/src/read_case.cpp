@@ -192,6 +192,7 @@ std::string_view to_string(TaskKind kind) {
     case TaskKind::kModes: return "modes";
     case TaskKind::kFillingRatios: return "filling_ratios";
     case TaskKind::kPlacement: return "placement";
+    case TaskKind::kClearance: return "clearance";
   }
   return "unknown";
 }

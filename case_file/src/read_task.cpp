@@ -216,9 +216,61 @@ PlacementTask read_placement(ObjectReader& r, const Case& c) {
   return t;
 }
 
+/// `verify` of task kind clearance (the DEM stepped sine at the chosen h and its neighbours).
+ClearanceVerifySpec read_clearance_verify(ObjectReader& r, const FrfTask& band) {
+  ClearanceVerifySpec v;
+  if (r.has("clearance_factors")) {
+    v.clearance_factors = r.number_array("clearance_factors", {0.1, 10.0}, "", 1);
+    if (v.clearance_factors.size() > 4)
+      r.fail("clearance_factors", "has " + std::to_string(v.clearance_factors.size()) +
+                                      " entries: at most 4 (each is a DEM stepped sine of its own)");
+    for (std::size_t i = 0; i < v.clearance_factors.size(); ++i)
+      if (std::abs(v.clearance_factors[i] - 1.0) < 1e-9)
+        r.fail("clearance_factors/" + std::to_string(i), "= 1: the chosen clearance is checked anyway");
+  }
+  v.dem_points = r.integer("dem_points", ClearanceVerifySpec{}.dem_points, 2, 1000);
+  v.dem_min_frequency_hz = r.number("dem_min_frequency_hz", band.min_frequency_hz, limits::kFrequency, " Hz");
+  v.dem_max_frequency_hz = r.number("dem_max_frequency_hz", band.max_frequency_hz, limits::kFrequency, " Hz");
+  if (!(v.dem_max_frequency_hz > v.dem_min_frequency_hz)) r.fail("dem_max_frequency_hz", "must be > dem_min_frequency_hz");
+  v.tolerance_relative = r.number("tolerance_relative", ClearanceVerifySpec{}.tolerance_relative, {0.0, 10.0, true});
+  v.dem_tolerance = r.number("dem_tolerance", ClearanceVerifySpec{}.dem_tolerance, {0.0, 0.99, true});
+  v.dem_max_periods = r.integer("dem_max_periods", ClearanceVerifySpec{}.dem_max_periods, 0, 100000);
+  v.require_ranking = r.boolean("require_ranking", ClearanceVerifySpec{}.require_ranking);
+  return v;
+}
+
+ClearanceTask read_clearance(ObjectReader& r, const Case& c) {
+  ClearanceTask t;
+  const DamperSpec& damper = c.dampers.front();
+  if (damper.layers.size() != 1)
+    throw CaseError(r.file(), "/dampers/0/layers",
+                    "has " + std::to_string(damper.layers.size()) +
+                        " layers: task kind clearance sizes the clearance of a single-layer first damper");
+  if (damper.model != formulas::DamperModel::kRolling && damper.model != formulas::DamperModel::kBouncing)
+    throw CaseError(r.file(), "/dampers/0/model",
+                    "= " + std::string(formulas::to_string(damper.model)) +
+                        ": task kind clearance needs rolling or bouncing (their design stroke is a fixed X/h)");
+  t.band = read_frf(r, c);
+  if (t.band.excitation != FrfTask::Excitation::kBase)
+    throw CaseError(r.file(), "/task/excitation/kind", "must be base for task kind clearance (the peak |X/U|)");
+  if (t.band.points < 5 || t.band.points > 10000) r.fail("points", "= " + std::to_string(t.band.points) + ": must be in [5, 10000]");
+  t.mode = r.integer("mode", std::nullopt, 1, available_modes(c)) - 1;  // counted from 1 in the case
+  t.objective = r.text("objective", std::string("lowest_peak"), {"lowest_peak", "design_stroke_at_resonance"}) ==
+                        "design_stroke_at_resonance"
+                    ? optimizer::ClearanceObjective::kDesignStrokeAtResonance
+                    : optimizer::ClearanceObjective::kLowestPeak;
+  t.min_clearance_m = r.optional_number("min_clearance_m", limits::kClearance, " m");
+  t.max_clearance_m = r.optional_number("max_clearance_m", limits::kClearance, " m");
+  if (t.min_clearance_m && t.max_clearance_m && !(*t.max_clearance_m > *t.min_clearance_m))
+    r.fail("max_clearance_m", "must be > min_clearance_m");
+  t.backend = r.text("backend", std::string("nlopt"), {"nlopt", "ipopt"});
+  r.object("verify", false, [&](ObjectReader& v) { t.verify = read_clearance_verify(v, t.band); });
+  return t;
+}
+
 void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
   const std::string kind = r.text("kind", std::string("damper_design"),
-                                  {"damper_design", "frf", "decay", "modes", "filling_ratios", "placement"});
+                                  {"damper_design", "frf", "decay", "modes", "filling_ratios", "placement", "clearance"});
   if (kind == "frf") {
     task.kind = TaskKind::kFrf;
     task.frf = read_frf(r, c);
@@ -234,6 +286,9 @@ void read_task_object(ObjectReader& r, const Case& c, TaskSpec& task) {
   } else if (kind == "placement") {
     task.kind = TaskKind::kPlacement;
     task.placement = read_placement(r, c);
+  } else if (kind == "clearance") {
+    task.kind = TaskKind::kClearance;
+    task.clearance = read_clearance(r, c);
   }
 }
 

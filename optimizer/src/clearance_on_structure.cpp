@@ -17,6 +17,40 @@
 #include "validation.hpp"
 
 namespace pdamp::optimizer {
+
+const base::Fields<ClearanceEstimate>& ClearanceEstimate::fields() {
+  using E = ClearanceEstimate;
+  static const auto f =
+      base::Fields<E>()
+          .field("clearance_m", &E::clearance_m, "m", "h of the single-mode closed form")
+          .field("transmissibility", &E::transmissibility, "1", "peak |X/U| of the closed form at that h")
+          .field("damper_amplitude_m", &E::damper_amplitude_m, "m", "the design stroke x_opt(h) at resonance")
+          .field("resonance_hz", &E::resonance_hz, "Hz", "the resonance with container and apparent bed mass")
+          .field("participation", &E::participation, "1", "effective base participation")
+          .field("structural_damping", &E::structural_damping, "1", "the structure's damping ratio, mass-scaled")
+          .field("added_damping", &E::added_damping, "1", "the damping ratio the bed adds at its design point")
+          .field("mass_ratio", &E::mass_ratio, "1", "bed mass in the mode over the mode's mass")
+          .field("eta_star_design", &E::eta_star_design, "1", "eta* at the design stroke")
+          .field("apparent_mass_fraction", &E::apparent_mass_fraction, "1", "m_app/m_bed at the design stroke")
+          .field("stroke_over_clearance", &E::stroke_over_clearance, "1", "x_opt/h of the model");
+  return f;
+}
+
+const base::Fields<ClearanceResponse>& ClearanceResponse::fields() {
+  using R = ClearanceResponse;
+  static const auto f =
+      base::Fields<R>()
+          .field("clearance_m", &R::clearance_m, "m", "h")
+          .field("peak_transmissibility", &R::peak_transmissibility, "1",
+                 "largest non-unstable or held |X/U| over the band")
+          .field("peak_frequency_hz", &R::peak_frequency_hz, "Hz", "where it is")
+          .field("damper_amplitude_m", &R::damper_amplitude_m, "m", "the site's amplitude along the drive there")
+          .field("onset_m", &R::onset_m, "m", "the onset stroke of collect-and-collide at h")
+          .field("design_stroke_m", &R::design_stroke_m, "m", "x_opt(h)")
+          .field("held_at_onset", &R::held_at_onset, "", "the peak is a state held at the onset (the jump)");
+  return f;
+}
+
 namespace {
 
 namespace fm = formulas;

@@ -270,6 +270,68 @@ Answer placement_answer(const tasks::PlacementStudy& study) {
   return a;
 }
 
+Answer clearance_answer(const tasks::ClearanceStudy& study) {
+  Answer a;
+  const auto& r = study.sizing.response;
+  std::ostringstream p;
+  p << "Make the clearance " << in_mm(r.clearance_m) << ": under a base motion of " << in_mm(study.base_amplitude_m)
+    << " the resonant peak of the damper's site is |X/U| = " << three_digits(r.peak_transmissibility) << " at "
+    << three_digits(r.peak_frequency_hz) << " Hz, with the damper at X = " << in_mm(r.damper_amplitude_m)
+    << (r.held_at_onset ? " (held at the onset of collect-and-collide)" : "") << ". The case's own clearance, "
+    << in_mm(study.current.clearance_m) << ", gives " << three_digits(study.current.peak_transmissibility) << ".";
+  a.paragraphs.push_back(p.str());
+  a.paragraphs.push_back("The peaks come from the harmonic balance of every kept mode with the layer's closed form "
+                         "(its collect-and-collide model at each clearance tried); the single-mode closed form gives " +
+                         in_mm(study.sizing.estimate.clearance_m) + ".");
+  const auto& v = study.verification;
+  if (!v) {
+    a.verdict = "Not checked by the DEM (run with the verification to check the prediction).";
+    return a;
+  }
+  const tasks::ClearanceCheck& chosen = v->checks.front();
+  std::ostringstream verdict;
+  verdict << "DEM check: " << (v->passed ? "PASS" : "FAIL") << ". At the chosen clearance the DEM stepped sine peaks at "
+          << three_digits(chosen.dem_peak) << " (predicted " << three_digits(chosen.predicted_sweep_peak) << ", "
+          << percent(chosen.peak_relative_difference) << "; band centre " << percent(chosen.band_centre_relative_difference)
+          << "); at";
+  for (std::size_t i = 1; i < v->checks.size(); ++i)
+    verdict << (i > 1 ? "," : "") << " " << in_mm(v->checks[i].clearance_m) << " it peaks at "
+            << three_digits(v->checks[i].dem_peak) << " (" << words(tasks::to_string(v->checks[i].ranking)) << ")";
+  verdict << ". ";
+  for (std::size_t i = 1; i < v->checks.size(); ++i)
+    if (v->checks[i].predicted_peak > v->checks[i].predicted_sweep_peak * 1.001)
+      verdict << "At " << in_mm(v->checks[i].clearance_m) << " the prediction's worst case, "
+              << three_digits(v->checks[i].predicted_peak) << " at " << three_digits(v->checks[i].predicted_frequency_hz)
+              << " Hz, lies on an upper branch that a sweep from the band's ends does not reach (predicted "
+              << three_digits(v->checks[i].predicted_sweep_peak)
+              << " for the sweeps); the DEM's stepped sines do not test it. ";
+  for (std::size_t i = 1; i < v->checks.size(); ++i)
+    if (std::abs(v->checks[i].peak_relative_difference) > v->settings.tolerance_relative)
+      verdict << "At " << in_mm(v->checks[i].clearance_m) << " the prediction for a sweep, "
+              << three_digits(v->checks[i].predicted_sweep_peak) << ", misses the DEM's "
+              << three_digits(v->checks[i].dem_peak) << ": the closed forms do not hold there. ";
+  if (v->passed && v->ranking_resolved)
+    verdict << "The DEM in the loop agrees with the prediction within the case's " << percent(v->settings.tolerance_relative)
+            << " and ranks the chosen clearance lowest: the prediction can be trusted for this design.";
+  else if (v->passed)
+    verdict << "The DEM in the loop agrees with the prediction at the chosen clearance within the case's "
+            << percent(v->settings.tolerance_relative)
+            << " and ranks no neighbour below it, but cannot tell every neighbour from it (within twice the standard "
+               "errors): the ranking there is the prediction's alone.";
+  else
+    verdict << "Do not build on the prediction: "
+            << (!v->chosen_agrees ? "the chosen clearance's peak differs from the DEM's by more than " +
+                                        percent(v->settings.tolerance_relative)
+                                  : std::string())
+            << (!v->chosen_agrees && !v->ranking_agrees ? "; " : "")
+            << (!v->ranking_agrees ? std::string("the DEM puts a neighbour's peak below the chosen clearance's")
+                                   : std::string())
+            << ". The DEM's numbers above are the better estimate.";
+  a.verdict = verdict.str();
+  a.passed = v->passed;
+  return a;
+}
+
 Answer modes_answer(const tasks::ModesResult& r) {
   Answer a;
   for (Eigen::Index j = 0; j < r.mode_count; ++j) {
@@ -296,6 +358,7 @@ Answer report_answer(const TaskResult& result, const case_file::Case& c) {
     Answer operator()(const tasks::DecayResult* r) const { return decay_answer(*r, c); }
     Answer operator()(const tasks::FrfResult* r) const { return frf_answer(*r); }
     Answer operator()(const tasks::PlacementStudy* r) const { return placement_answer(*r); }
+    Answer operator()(const tasks::ClearanceStudy* r) const { return clearance_answer(*r); }
     Answer operator()(const tasks::ModesResult* r) const { return modes_answer(*r); }
   };
   return std::visit(Visit{c}, result);

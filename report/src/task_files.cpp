@@ -436,4 +436,106 @@ Warnings write_files(OutputDir& out, const tasks::PlacementStudy& study) {
   return out.add_plot("placement.gp", gp.str(), {"placement.png", "placement.svg"});
 }
 
+namespace {
+
+/// The predicted curve of one clearance: per frequency the largest |X/U| that is not
+/// unstable, or the state held at a jump (what the sizing's objective takes).
+void predicted_curve(std::ostringstream& csv, const std::string& clearance_mm, const st::FrequencyResponse& r) {
+  for (const auto& p : r.points) {
+    double largest = -1.0;
+    for (const auto& root : p.roots)
+      if (root.stability != st::Stability::kUnstable && !root.outputs.empty())
+        largest = std::max(largest, std::abs(root.outputs.front()));
+    for (const auto& held : p.held_at_jump)
+      if (!held.outputs.empty()) largest = std::max(largest, std::abs(held.outputs.front()));
+    if (largest >= 0.0) csv << clearance_mm << ",formulas," << p.frequency_hz << ',' << largest << ",0,1\n";
+  }
+}
+
+Warnings clearance_verify_files(OutputDir& out, const tasks::ClearanceStudy& study, const tasks::ClearanceVerification& v) {
+  const base::CsvTable<tasks::ClearanceCheck> check_columns(
+      {"factor", "clearance_m", base::CsvColumn("predicted_peak").nan_as(""),
+       base::CsvColumn("predicted_frequency_hz").nan_as(""), base::CsvColumn("predicted_band_centre_hz").nan_as(""),
+       "dem_sweep", "dem_peak", base::CsvColumn("dem_peak_standard_error").nan_as("0"), "dem_frequency_hz",
+       "dem_band_centre_hz", base::CsvColumn("peak_relative_difference").nan_as(""),
+       base::CsvColumn("band_centre_relative_difference").nan_as(""), "unconverged_points", "solve_time_s",
+       "predicted_sweep_peak", "ranking"});
+  std::string checks = check_columns.header() + "\n";
+  for (const auto& k : v.checks) checks += check_columns.row(k) + "\n";
+  out.add("clearance_checks.csv", checks);
+
+  // Two gnuplot data sets per clearance (index 2i: the prediction, 2i+1: the DEM points).
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "clearance_mm,source,frequency_hz,magnitude,magnitude_spread,converged\n";
+  std::string titles;
+  for (std::size_t i = 0; i < v.checks.size(); ++i) {
+    const auto& k = v.checks[i];
+    const std::string mm = base::format_number(k.clearance_m * 1e3, 4);
+    titles += (titles.empty() ? "" : " ") + mm;
+    if (i > 0) csv << "\n\n";
+    predicted_curve(csv, mm, k.formulas.harmonic->response);
+    csv << "\n\n";
+    for (const auto& branch : k.dem.stepped->branches)
+      for (const st::SteppedSinePoint* p : st::stepped_sine_peak(branch).ascending)
+        csv << mm << ",dem_" << st::to_string(branch.sweep) << ',' << p->frequency_hz << ',' << p->magnitude.front() << ','
+            << (std::isfinite(p->spread) ? p->spread : 0.0) << ',' << (p->converged ? 1 : 0) << '\n';
+  }
+  out.add("clearance_verify.csv", csv.str());
+
+  std::ostringstream gp;
+  gp << "# the chosen clearance and its neighbours: the harmonic balance's largest stable |X/U| (lines)\n"
+     << "# and the DEM stepped sine up and down (points, error bars: spread over the analysed periods);\n"
+     << "# pdamp optimize, task clearance; run: gnuplot clearance_verify.gp\n"
+     << "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
+     << "set xlabel 'frequency f / Hz'\nset ylabel 'transmissibility |X/U|'\n"
+     << "set title " << gnuplot_string(study.case_name + ": clearance checked by the DEM in the loop") << " noenhanced\n"
+     << "h = '" << titles << "'\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,650 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'clearance_verify.svg' : 'clearance_verify.png'\n"
+     << "  plot for [i=1:words(h)] 'clearance_verify.csv' index 2*(i-1) using 3:4 with lines lw 2 lc i "
+        "title sprintf('h = %s mm, formulas', word(h, i)), \\\n"
+     << "       for [i=1:words(h)] '' index 2*i-1 using 3:4:5 with yerrorbars pt 7 ps 0.8 lc i "
+        "title sprintf('h = %s mm, DEM', word(h, i))\n"
+     << "}\n";
+  return out.add_plot("clearance_verify.gp", gp.str(), {"clearance_verify.png", "clearance_verify.svg"});
+}
+
+}  // namespace
+
+Warnings write_files(OutputDir& out, const tasks::ClearanceStudy& study) {
+  const base::CsvTable<opt::ClearanceResponse> columns({"clearance_m", "peak_transmissibility", "peak_frequency_hz",
+                                                        "damper_amplitude_m", "onset_m", "design_stroke_m",
+                                                        "held_at_onset"});
+  std::string csv = columns.header() + "\n";
+  for (const auto& r : study.scan) csv += columns.row(r) + "\n";
+  out.add("clearance.csv", csv);
+
+  const double chosen_mm = study.sizing.clearance_m * 1e3, case_mm = study.current.clearance_m * 1e3;
+  std::ostringstream gp;
+  gp << "# the resonant peak |X/U| against the clearance h (harmonic balance, closed form of the layer);\n"
+     << "# pdamp optimize, task clearance; run: gnuplot clearance.gp\n"
+     << "set datafile separator ','\nset logscale xy\nset grid\nset key top right\n"
+     << "set xlabel 'clearance h / mm'\nset ylabel 'peak transmissibility |X/U|'\n"
+     << "set title " << gnuplot_string(study.case_name + ": resonant peak against the clearance") << " noenhanced\n"
+     << "set arrow from " << chosen_mm << ", graph 0 to " << chosen_mm << ", graph 1 nohead lc rgb 'black' dt 2\n"
+     << "set label 'chosen' at " << chosen_mm << ", graph 0.97 left offset 0.5,0\n"
+     << "set arrow from " << case_mm << ", graph 0 to " << case_mm << ", graph 1 nohead lc rgb 'gray50' dt 3\n"
+     << "set label 'case' at " << case_mm << ", graph 0.91 left offset 0.5,0 tc rgb 'gray40'\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'clearance.svg' : 'clearance.png'\n"
+     << "  plot 'clearance.csv' using ($1*1000):2 every ::1 with linespoints lw 2 pt 7 ps 0.6 lc rgb 'black' "
+        "title 'formulas (harmonic balance)'";
+  if (study.verification)
+    gp << ", \\\n       'clearance_checks.csv' using ($2*1000):7:8 every ::1 with yerrorbars pt 5 ps 1.2 "
+          "lc rgb 'red' title 'DEM stepped sine (larger direction)'";
+  gp << "\n}\n";
+  Warnings warnings;
+  if (study.verification) append(warnings, clearance_verify_files(out, study, *study.verification));
+  append(warnings, out.add_plot("clearance.gp", gp.str(), {"clearance.png", "clearance.svg"}));
+  return warnings;
+}
+
 }  // namespace pdamp::report

@@ -35,7 +35,8 @@ void require_task(const case_file::Case& c, case_file::TaskKind kind) {
   const auto& t = c.task;
   const bool present = (kind == TaskKind::kFrf && t.frf) || (kind == TaskKind::kDecay && t.decay) ||
                        (kind == TaskKind::kModes && t.modes) || (kind == TaskKind::kFillingRatios && t.filling_ratios) ||
-                       (kind == TaskKind::kPlacement && t.placement) || kind == TaskKind::kDamperDesign;
+                       (kind == TaskKind::kPlacement && t.placement) || (kind == TaskKind::kClearance && t.clearance) ||
+                       kind == TaskKind::kDamperDesign;
   if (t.kind == kind && present) return;
   const std::string name(case_file::to_string(kind));
   const std::string needed = kind == TaskKind::kFrf     ? "\"min_frequency_hz\", \"max_frequency_hz\", \"excitation\""

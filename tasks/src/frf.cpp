@@ -206,6 +206,12 @@ SteppedSineFrf stepped_sine(const Case& c, detail::Setup& setup, const DemFrfOpt
   const st::SteadyStateRun options = dem_frf_options(c, modal, settling);
   SteppedSineFrf out;
   out.frequencies_hz = detail::spaced(o.min_frequency_hz, o.max_frequency_hz, o.points, false);
+  const double spacing = (o.max_frequency_hz - o.min_frequency_hz) / std::max(o.points - 1, 1);
+  for (const double f : o.extra_frequencies_hz) {
+    const bool near_grid = std::any_of(out.frequencies_hz.begin(), out.frequencies_hz.end(),
+                                       [&](double g) { return std::abs(g - f) < 0.25 * spacing; });
+    if (!near_grid) out.frequencies_hz.insert(std::upper_bound(out.frequencies_hz.begin(), out.frequencies_hz.end(), f), f);
+  }
   out.analysed_periods = options.analysed_periods;
   out.settling = settling;
   for (const double f : out.frequencies_hz) {  // every point's options checked before any runs

@@ -47,3 +47,27 @@ TEST_CASE("a design the reader refuses is the case's error naming the layer", "[
   }
   CHECK_THROWS_AS(case_file::with_design(c, {1, 1}), case_file::CaseError);
 }
+
+// Reference: the container is the bed plus h along the drive, so lengthening it by Δh
+// gives the reader's derived clearance h + Δh with the bed unchanged; the task becomes the
+// frf of the clearance task's band and base motion.
+TEST_CASE("a clearance variant is the case read again with its container changed along the drive", "[case_file]") {
+  const auto c = case_file::load_case(std::string(PDAMP_SOURCE_DIR) + "/cases/beam_clearance.json");
+  const auto& layer = c.dampers.front().layers.front();
+  REQUIRE(layer.clearance_m == Approx(0.030).epsilon(1e-9));
+  const auto v = case_file::with_clearance(c, 0.0112);
+  const auto& changed = v.dampers.front().layers.front();
+  CHECK(changed.clearance_m == Approx(0.0112).epsilon(1e-9));
+  CHECK(changed.container.inner_length(0) == Approx(layer.container.inner_length(0) - 0.0188).epsilon(1e-9));
+  CHECK(changed.bed_mass_kg == Approx(layer.bed_mass_kg));
+  REQUIRE(v.task.kind == case_file::TaskKind::kFrf);
+  CHECK(v.task.frf->min_frequency_hz == c.task.clearance->band.min_frequency_hz);
+  CHECK(v.task.frf->base_amplitude_m == c.task.clearance->band.base_amplitude_m);
+  // A clearance the bed does not fit into is the reader's error naming the container.
+  try {
+    (void)case_file::with_clearance(c, -0.01);
+    FAIL("no error");
+  } catch (const case_file::CaseError& e) {
+    CHECK_THAT(e.pointer(), Catch::StartsWith("/dampers/0/layers/0"));
+  }
+}

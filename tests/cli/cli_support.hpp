@@ -8,12 +8,40 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unistd.h>
 
 #include "support/run_pdamp.hpp"
 
 namespace pdamp::test {
 
 inline std::string case_path(const std::string& name) { return std::string(PDAMP_SOURCE_DIR) + "/cases/" + name; }
+
+/// Whether gnuplot is there to draw the pictures (without it the scripts are written alone).
+inline bool gnuplot_installed() {
+  for (const char* dir : {"/usr/bin", "/usr/local/bin", "/bin"})
+    if (::access((std::filesystem::path(dir) / "gnuplot").c_str(), X_OK) == 0) return true;
+  return false;
+}
+
+/// pdamp's --json output of a command that must succeed (exit 0, one JSON object on stdout).
+inline nlohmann::json run_json(std::vector<std::string> args) {
+  args.push_back("--json");
+  const auto r = run_pdamp(args);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return nlohmann::json::parse(r.out);
+}
+
+/// The shipped case `name` with one edit applied, written into `dir` as case.json.
+inline std::string edited_shipped_case(const std::filesystem::path& dir, const std::string& name,
+                                       const std::function<void(nlohmann::json&)>& edit) {
+  std::ifstream in(case_path(name));
+  nlohmann::json c = nlohmann::json::parse(in);
+  edit(c);
+  const std::filesystem::path path = dir / "case.json";
+  std::ofstream(path) << c.dump(2);
+  return path.string();
+}
 
 /// Writes a case built from the shipped low-intensity case with one edit applied.
 inline std::string edited_case(const std::string& name, const std::function<void(nlohmann::json&)>& edit) {

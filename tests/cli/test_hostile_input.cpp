@@ -30,12 +30,6 @@ using namespace pdamp::test;
 
 namespace {
 
-bool gnuplot_installed() {
-  for (const char* dir : {"/usr/bin", "/usr/local/bin", "/bin"})
-    if (::access((fs::path(dir) / "gnuplot").c_str(), X_OK) == 0) return true;
-  return false;
-}
-
 /// Shell and gnuplot payloads that would create `marker` if anything expanded them:
 /// backquotes (gnuplot and sh), $(...), quotes closing a string, gnuplot's system(),
 /// a newline starting a new gnuplot command, a macro.

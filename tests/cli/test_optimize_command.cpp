@@ -20,23 +20,9 @@ namespace {
 
 const std::string kCase = "manipulator_link_optimize.json";
 
-json run_json(const std::vector<std::string>& args) {
-  auto full = args;
-  full.push_back("--json");
-  const auto r = run_pdamp(full);
-  INFO(r.err);
-  REQUIRE(r.exit_code == 0);
-  return json::parse(r.out);
-}
-
 /// The optimisation case with one edit, written into `dir`.
 std::string edited(const TempDir& dir, const std::function<void(json&)>& edit) {
-  std::ifstream in(case_path(kCase));
-  json c = json::parse(in);
-  edit(c);
-  const fs::path path = dir.path / "case.json";
-  std::ofstream(path) << c.dump(2);
-  return path.string();
+  return edited_shipped_case(dir.path, kCase, edit);
 }
 
 }  // namespace

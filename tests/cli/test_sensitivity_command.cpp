@@ -16,15 +16,6 @@ using namespace pdamp::test;
 
 namespace {
 
-json run_json(const std::vector<std::string>& args) {
-  auto full = args;
-  full.push_back("--json");
-  const auto r = run_pdamp(full);
-  INFO(r.err);
-  REQUIRE(r.exit_code == 0);
-  return json::parse(r.out);
-}
-
 /// A quick DEM study: the shipped 36-sphere case, 1 transient and 1 analysed period.
 std::string quick_study(const TempDir& dir) {
   std::ifstream in(case_path("low_intensity_36_spheres.json"));

@@ -111,6 +111,15 @@ def test_structure_studies_return_dicts_of_arrays():
     assert modes["modes"][0]["frequency_hz"] > 0
 
 
+def test_optimize_sizes_a_clearance_as_pdamp_optimize():
+    beam = pdamp.load_case(case_file("beam_clearance.json"))
+    sized = pdamp.optimize(beam, verify=False)
+    expected = cli_json("optimize", case_file("beam_clearance.json"), "--no-verify")
+    assert sized["task"] == "clearance"
+    assert sized["design"]["clearance_m"] == expected["design"]["clearance_m"]
+    assert sized["verification"] is None
+
+
 def interrupted_after_a_second(tmp_path, document, run):
     """Runs run(case, progress) on the case `document`, sends SIGINT after a second and
     expects KeyboardInterrupt; returns the progress reports seen."""

@@ -18,6 +18,7 @@
 #include "pdamp/formulas/bed_packing.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/formulas/hertz_impact.hpp"
+#include "pdamp/optimizer/clearance_on_structure.hpp"
 #include "pdamp/optimizer/placement.hpp"
 #include "pdamp/structure/beam.hpp"
 #include "pdamp/structure/modal_model.hpp"
@@ -119,7 +120,7 @@ struct StructureSpec {
   std::vector<std::string> point_names;
 };
 
-enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes, kFillingRatios, kPlacement };
+enum class TaskKind { kDamperDesign, kFrf, kDecay, kModes, kFillingRatios, kPlacement, kClearance };
 
 /// `task` kind frf: the frequency response over a band.
 struct FrfTask {
@@ -237,6 +238,47 @@ struct PlacementTask {
   double rotation_warning_fraction = 0.1;     ///< (0, 10]: optimizer::PlacementOptions
 };
 
+/// `verify` of task kind clearance: the DEM-in-the-loop stepped sine (tasks/frf) at the
+/// chosen clearance and at its neighbours, each against the prediction at that clearance
+/// (docs/optimizer.md, "Clearance on a structure").
+struct ClearanceVerifySpec {
+  /// The neighbours checked besides the chosen h, as factors on it: each in [0.1, 10], not 1,
+  /// at most 4 (each is a stepped sine of its own).
+  std::vector<double> clearance_factors{0.7, 1.4};
+  int dem_points = 7;  ///< stepped-sine frequencies, linear over the DEM band, [2, 1000]
+  /// The DEM band, Hz: default the task's band (a DEM point costs seconds to minutes, so
+  /// the band is best spent near the resonance); max > min.
+  double dem_min_frequency_hz = 0.0;
+  double dem_max_frequency_hz = 0.0;
+  /// The chosen design passes when its DEM peak |X/U| and its 0.9-band centre lie within this
+  /// fraction of the predicted ones, dimensionless, (0, 10].
+  double tolerance_relative = 0.15;
+  /// A point's transient has converged when the site amplitude changes by at most this
+  /// fraction over the last 8 periods (pdamp frf --dem-tolerance), (0, 0.99].
+  double dem_tolerance = 0.1;
+  int dem_max_periods = 60;  ///< transient periods at most per point, [0, 100000]
+  /// true: the verification fails unless the DEM's lowest peak is the chosen clearance's,
+  /// as predicted.
+  bool require_ranking = true;
+};
+
+/// `task` kind clearance: the clearance h of the first damper's single layer that minimises
+/// the resonant peak |X/U| of the structure under a harmonic base motion over a band (or
+/// that runs the damper at its design stroke at the peak), solved on the harmonic balance
+/// with the layer's closed form (optimizer::size_clearance_on_structure).
+struct ClearanceTask {
+  /// The band, its points (the harmonic balance's grid, [5, 10000]) and the base motion
+  /// (kind base only), as task kind frf.
+  FrfTask band;
+  int mode = 0;  ///< the mode tuned, 0-based here (the case counts from 1)
+  optimizer::ClearanceObjective objective = optimizer::ClearanceObjective::kLowestPeak;
+  /// Search range of h, m; default the closed-form estimate /3 and ·3.
+  std::optional<double> min_clearance_m;
+  std::optional<double> max_clearance_m;
+  std::string backend = "nlopt";  ///< "nlopt" or "ipopt" (pdamp optimize --backend overrides)
+  std::optional<ClearanceVerifySpec> verify;
+};
+
 /// What `pdamp run` does; the settings of the kind given (format 1: damper_design only).
 struct TaskSpec {
   TaskKind kind = TaskKind::kDamperDesign;
@@ -245,6 +287,7 @@ struct TaskSpec {
   std::optional<ModesTask> modes;
   std::optional<FillingRatiosTask> filling_ratios;
   std::optional<PlacementTask> placement;
+  std::optional<ClearanceTask> clearance;
 };
 
 /// Most values of one sensitivity parameter: every value is a case of its own (a DEM run);
@@ -304,6 +347,13 @@ Case load_case_document(const nlohmann::json& document, const std::string& path)
 /// so that no verification repeats one of them).
 Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening = 1.0,
                  bool other_seed = false);
+
+/// The case of a clearance task with its first damper's layer at clearance `clearance_m`
+/// (the container longer or shorter along the drive by the change of h; an explicit
+/// `clearance_m` moved with it) and its task the frf over the task's band and base motion,
+/// read again by the case reader (CaseError naming the layer's key for a clearance the
+/// reader refuses).
+Case with_clearance(const Case& c, double clearance_m);
 
 /// One case of a sensitivity study: the parameter varied, its value, and the case with it.
 struct SensitivityVariant {

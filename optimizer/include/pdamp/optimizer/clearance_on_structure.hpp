@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include "pdamp/base/record.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/optimizer/summary.hpp"
@@ -92,6 +93,7 @@ struct ClearanceEstimate {
   double eta_star_design = 0.0;      ///< η*_opt
   double apparent_mass_fraction = 0.0;  ///< m_app/m_bed at the design point
   double stroke_over_clearance = 0.0;   ///< x_opt/h
+  static const base::Fields<ClearanceEstimate>& fields();
 };
 /// Throws std::invalid_argument for invalid options, an unknown site, a mode out of range,
 /// a model without base participation, or a site that does not move along n in the mode.
@@ -107,6 +109,7 @@ struct ClearanceResponse {
   double onset_m = 0.0;                ///< X_onset(h)
   double design_stroke_m = 0.0;        ///< x_opt(h)
   bool held_at_onset = false;          ///< the peak is a jump-held state (the onset cliff)
+  static const base::Fields<ClearanceResponse>& fields();
 };
 ClearanceResponse clearance_response(const structure::ModalModel& model, const ClearanceOnStructureOptions& options,
                                      double clearance_m);

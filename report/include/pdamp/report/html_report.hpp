@@ -15,6 +15,7 @@
 
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/report/output_dir.hpp"
+#include "pdamp/tasks/clearance.hpp"
 #include "pdamp/tasks/damper_design.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
@@ -28,7 +29,7 @@ namespace pdamp::report {
 /// its numbers only).
 using TaskResult = std::variant<std::monostate, const tasks::FillingRatiosResult*, const tasks::DamperDesignResult*,
                                 const tasks::DecayResult*, const tasks::FrfResult*, const tasks::PlacementStudy*,
-                                const tasks::ModesResult*>;
+                                const tasks::ModesResult*, const tasks::ClearanceStudy*>;
 
 /// Stages report.html built from the typed result (the answer and its evidence), the result
 /// JSON (every number, in the details), the warnings and the pictures already staged in

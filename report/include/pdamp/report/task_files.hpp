@@ -15,6 +15,7 @@
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/frf.hpp"
 #include "pdamp/tasks/modes.hpp"
+#include "pdamp/tasks/clearance.hpp"
 #include "pdamp/tasks/placement.hpp"
 #include "pdamp/tasks/sensitivity.hpp"
 
@@ -46,5 +47,9 @@ std::vector<std::string> write_files(OutputDir& out, const tasks::DecayResult& d
 std::vector<std::string> write_files(OutputDir& out, const tasks::FillingRatiosResult& result);
 /// placement.csv and its plot.
 std::vector<std::string> write_files(OutputDir& out, const tasks::PlacementStudy& study);
+/// clearance.csv (the peak against h) and its plot; with the verification
+/// clearance_checks.csv and clearance_verify.csv (each clearance's predicted curve and DEM
+/// points) and its plot.
+std::vector<std::string> write_files(OutputDir& out, const tasks::ClearanceStudy& study);
 
 }  // namespace pdamp::report

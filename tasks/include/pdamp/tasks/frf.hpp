@@ -27,6 +27,10 @@ enum class FrfMethod { kFormulas, kField, kDem, kCompare };
 /// The DEM's part of an frf study (--method dem and --compare).
 struct DemFrfOptions {
   int points = 9;                          ///< stepped sine: frequencies, linear over the band, [2, 1000]
+  /// Stepped sine: frequencies run besides the linear grid (where a prediction puts a narrow
+  /// peak between its points), merged in order; one within a quarter of the grid's spacing of
+  /// a grid frequency is left out (the grid's own point stands for it).
+  std::vector<double> extra_frequencies_hz;
   double min_frequency_hz = 0.0;           ///< the band, Hz (the task's by default), max > min > 0
   double max_frequency_hz = 0.0;
   /// The directions asked for, up first.
