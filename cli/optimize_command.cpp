@@ -190,15 +190,17 @@ std::string modes_text(const opt::PlacementPoint& p) {
 }
 
 int run_placement_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
-  if (args.has("--verify"))
-    throw InputError("--verify", "", "task kind placement has no DEM verification yet (filling_ratios has)");
   if (args.optional_text("--method").value_or("") == "dem")
     throw InputError("--method", "", "'dem': task kind placement takes formulas or field");
+  refuse_checkpoint_flags(args, "applies to task kind filling_ratios (a placement's DEM decays are not checkpointed)");
   tasks::PlacementOptions options;
   options.method = loss_method(args);
+  options.force_verify = args.has("--verify");
+  options.skip_verify = args.has("--no-verify");
   auto files = output_dir(args, context);
   options.backend = backend_flag(args);
-  const auto study = tasks::run_placement(c, options, context.executor);
+  CliHooks hooks(checkpoint_interval(args), args.has("--accept-long-run"));
+  const auto study = tasks::run_placement(c, options, hooks, context.executor);
   std::vector<std::string> warnings = study.warnings;
   if (files)
     for (auto& w : report::write_files(*files, study)) warnings.push_back(w);
@@ -214,6 +216,22 @@ int run_placement_case(const ParsedArgs& args, CommandContext& context, const Ca
     rows.push_back({"case site, per mode", modes_text(*r.current)});
   }
   rows.push_back({"solver", r.refined ? r.summary.brief_report() : std::string("every candidate point evaluated")});
+  if (const auto& v = study.verification) {
+    for (const auto& site : v->sites) {
+      std::string line = site_text(site.predicted) + ": objective predicted " +
+                         format_number(100.0 * site.predicted_objective, 4) + " %, DEM " +
+                         format_number(100.0 * site.dem_objective, 4) + " % (" +
+                         format_number(100.0 * site.relative_difference, 3) + " %)";
+      for (const auto& m : site.modes)
+        line += "; mode " + std::to_string(m.mode + 1) + ": " + format_number(100.0 * m.predicted_damping_ratio, 4) +
+                " % vs " + format_number(100.0 * m.dem_damping_ratio, 4) + " %, " + format_number(m.wall_time_s, 3) + " s";
+      rows.push_back({"DEM check, " + site.role, line});
+    }
+    rows.push_back({"verification", std::string(v->passed ? "PASS" : "FAIL") + " (chosen within " +
+                                        format_number(100.0 * v->settings.tolerance_relative, 3) + " %: " +
+                                        (v->chosen_agrees ? "yes" : "no") + "; DEM ranks the chosen site first: " +
+                                        (v->ranking_agrees ? "yes" : "no") + ")"});
+  }
   rows.push_back({"time", format_number(r.solve_time_s, 4) + " s, " + std::to_string(r.evaluations) + " sites"});
   return finish(args, files.get(), out, warnings, rows, {"placement.json", &c, context.report}, &study);
 }

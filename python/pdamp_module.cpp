@@ -353,7 +353,8 @@ PYBIND11_MODULE(pdamp, m) {
         PythonHooks hooks(progress);
         if (c.task.kind == case_file::TaskKind::kPlacement) {
           tasks::PlacementOptions o;
-          return to_python(tasks::to_json(run_study(hooks, [&] { return tasks::run_placement(c, o); })));
+          o.skip_verify = !verify;
+          return to_python(tasks::to_json(run_study(hooks, [&] { return tasks::run_placement(c, o, hooks); })));
         }
         if (c.task.kind == case_file::TaskKind::kClearance) {
           tasks::ClearanceOptions o;
@@ -372,5 +373,5 @@ PYBIND11_MODULE(pdamp, m) {
       },
       py::arg("case"), py::arg("verify") = true, py::arg("progress") = py::none(),
       "`pdamp optimize` on a filling_ratios, placement or clearance case: the designs, the solver\n"
-      "and, with verify, the DEM verification.");
+      "and, with verify, the DEM verification (the task's verify block).");
 }

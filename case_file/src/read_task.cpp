@@ -213,6 +213,26 @@ PlacementTask read_placement(ObjectReader& r, const Case& c) {
     r.fail("candidate_points", "required for modal data (its shapes are known at the named points only)");
   }
   t.rotation_warning_fraction = r.number("rotation_warning_fraction", PlacementTask{}.rotation_warning_fraction, {0.0, 10.0, true});
+  r.object("verify", false, [&](ObjectReader& v) {
+    PlacementVerifySpec spec;
+    spec.tolerance_relative = v.number("tolerance_relative", spec.tolerance_relative, {0.0, 10.0, true});
+    if (t.candidate_points.empty()) {
+      spec.other_position_m = v.optional_number("other_position_m", {t.min_position_m, t.max_position_m},
+                                                " m (along the beam, inside the search range)");
+    } else if (v.has("other_point")) {
+      spec.other_point = read_point_name(v, "other_point", c);
+      if (std::find(t.candidate_points.begin(), t.candidate_points.end(), spec.other_point) == t.candidate_points.end())
+        v.fail("other_point", "'" + spec.other_point + "' is not among candidate_points");
+    }
+    spec.periods = v.integer("periods", spec.periods, 4, 10000);
+    spec.amplitude_fraction = v.number("amplitude_fraction", spec.amplitude_fraction, {0.0, 1.0, true});
+    if (spec.amplitude_fraction >= 1.0) v.fail("amplitude_fraction", "must be < 1 (a fraction of the start)");
+    spec.require_ranking = v.boolean("require_ranking", spec.require_ranking);
+    if (c.dampers.size() != 1)
+      throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
+                                                " dampers: the verification of a placement takes a case of one damper");
+    t.verify = spec;
+  });
   return t;
 }
 

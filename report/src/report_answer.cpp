@@ -266,7 +266,34 @@ Answer placement_answer(const tasks::PlacementStudy& study) {
                               ? "each layer's effective field"
                               : "the closed forms (each layer's collect-and-collide models)") +
                          ", at the stroke each target mode gives the site, one mode at a time.");
-  a.verdict = "Not checked by the DEM in the loop (pdamp does not run one for a placement).";
+  const auto& v = study.verification;
+  if (!v || v->sites.size() < 2) {
+    a.verdict = "Not checked by the DEM in the loop (run with the verification to check the prediction).";
+    return a;
+  }
+  const tasks::PlacementSiteCheck& chosen = v->sites.front();
+  const tasks::PlacementSiteCheck& other = v->sites.back();
+  std::ostringstream verdict;
+  verdict << "DEM check: " << (v->passed ? "PASS" : "FAIL") << ". Each target mode decays alone from its stated "
+          << "amplitude; over its decay the beds add " << percent(chosen.predicted_objective) << " (the objective) at the "
+          << "chosen site by the " << (study.method == case_file::LossMethod::kField ? "fields" : "closed forms")
+          << " and " << percent(chosen.dem_objective) << " by the DEM in the loop; at "
+          << three_digits(other.predicted.position_m) << " m " << percent(other.predicted_objective) << " and "
+          << percent(other.dem_objective) << ". ";
+  if (v->passed)
+    verdict << "The DEM agrees with the prediction within the case's " << percent(v->settings.tolerance_relative)
+            << " and ranks the chosen site first: the prediction can be trusted for this placement.";
+  else
+    verdict << "Do not build on the predicted damping: "
+            << (!v->chosen_agrees ? "at the chosen site it differs from the DEM's by more than " +
+                                        percent(v->settings.tolerance_relative)
+                                  : std::string())
+            << (!v->chosen_agrees && !v->ranking_agrees ? "; " : "")
+            << (!v->ranking_agrees ? std::string("the DEM does not rank the chosen site first") : std::string())
+            << (v->ranking_agrees ? " (the DEM still ranks the chosen site first)" : "")
+            << ". The DEM's numbers are the better estimate.";
+  a.verdict = verdict.str();
+  a.passed = v->passed;
   return a;
 }
 

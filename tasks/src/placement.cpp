@@ -1,7 +1,14 @@
 // Task kind placement (placement.hpp).
 #include "pdamp/tasks/placement.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+
 #include "pdamp/case_file/placement_problem.hpp"
+#include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/structure/free_decay.hpp"
+#include "pdamp/tasks/decay.hpp"
 #include "pdamp/base/input_error.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/loss_model.hpp"
@@ -10,10 +17,225 @@
 namespace pdamp::tasks {
 
 namespace opt = optimizer;
+namespace st = structure;
 using nlohmann::json;
 
-PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options, base::Executor& executor) {
-  executor.primary_only();  // the formulas or fields of a few sites: nothing to spread
+const base::Fields<PlacementModeCheck>& PlacementModeCheck::fields() {
+  using M = PlacementModeCheck;
+  static const auto f =
+      base::Fields<M>()
+          .derived("mode", [](const M& m) { return m.mode + 1; }, "", "the mode, from 1")
+          .field("frequency_hz", &M::frequency_hz, "Hz", "its frequency with the damper (the periods' length)")
+          .field("predicted_damping_ratio", &M::predicted_damping_ratio, "1",
+                 "damping ratio the beds add over the decay, by the layers' loss models", base::kNullable)
+          .field("dem_damping_ratio", &M::dem_damping_ratio, "1", "the same by the DEM in the loop", base::kNullable)
+          .field("bare_damping_ratio", &M::bare_damping_ratio, "1", "the decay's with the containers empty (subtracted)",
+                 base::kNullable)
+          .field("relative_difference", &M::relative_difference, "1", "(predicted - DEM)/DEM", base::kNullable)
+          .field("dem_final_fraction", &M::dem_final_fraction, "1", "the DEM decay's last period over its first",
+                 base::kNullable)
+          .field("solve_time_s", &M::wall_time_s, "s", "wall time of the DEM decay");
+  return f;
+}
+
+const base::Fields<PlacementSiteCheck>& PlacementSiteCheck::fields() {
+  using S = PlacementSiteCheck;
+  static const auto f =
+      base::Fields<S>()
+          .field("role", &S::role, "", "chosen or other")
+          .derived("site", [](const S& s) { return s.predicted.site; }, "", "the point")
+          .derived("position_m", [](const S& s) { return s.predicted.position_m; }, "m", "along the beam (null: a point)",
+                   base::kNullable)
+          .derived("objective_at_amplitude", [](const S& s) { return s.predicted.objective; }, "1",
+                   "the placement's objective at the stated amplitudes")
+          .field("predicted_objective", &S::predicted_objective, "1", "the objective of the decays, predicted",
+                 base::kNullable)
+          .field("dem_objective", &S::dem_objective, "1", "the same by the DEM", base::kNullable)
+          .field("relative_difference", &S::relative_difference, "1", "(predicted - DEM)/DEM", base::kNullable)
+          .field("modes", &S::modes, "", "each target mode's decay");
+  return f;
+}
+
+const base::Fields<PlacementVerification>& PlacementVerification::fields() {
+  using V = PlacementVerification;
+  static const auto f =
+      base::Fields<V>()
+          .derived("tolerance_relative", [](const V& v) { return v.settings.tolerance_relative; }, "1",
+                   "the chosen site's objective must lie this close to the DEM's")
+          .derived("periods", [](const V& v) { return v.settings.periods; }, "", "each decay's length in periods")
+          .derived("amplitude_fraction", [](const V& v) { return v.settings.amplitude_fraction; }, "1",
+                   "the damping ratio is measured down to this fraction of the start")
+          .derived("require_ranking", [](const V& v) { return v.settings.require_ranking; }, "",
+                   "the DEM must rank the chosen site above the other")
+          .field("sites", &V::sites, "", "the chosen site, then the other")
+          .field("chosen_agrees", &V::chosen_agrees, "", "the chosen site's prediction within tolerance")
+          .field("ranking_agrees", &V::ranking_agrees, "", "the DEM ranks the chosen site above the other")
+          .field("passed", &V::passed, "", "the verification's verdict");
+  return f;
+}
+
+namespace {
+
+/// The largest |q| over each whole period of 1/frequency_hz from t = 0.
+std::vector<double> period_peaks(const std::vector<double>& time_s, const Eigen::VectorXd& q, double frequency_hz) {
+  std::vector<double> peaks;
+  std::size_t i = 0;
+  for (int k = 0; !time_s.empty(); ++k) {
+    const double end = (k + 1) / frequency_hz;
+    if (time_s.back() < end * (1.0 - 1e-9)) break;  // whole periods only
+    double peak = 0.0;
+    for (; i < time_s.size() && time_s[i] < end; ++i) peak = std::max(peak, std::abs(q[static_cast<Eigen::Index>(i)]));
+    peaks.push_back(peak);
+  }
+  return peaks;
+}
+
+}  // namespace
+
+double modal_decay_damping_ratio(const std::vector<double>& time_s, const Eigen::VectorXd& q, double frequency_hz,
+                                 double fraction) {
+  const std::vector<double> peaks = period_peaks(time_s, q, frequency_hz);
+  std::vector<double> t, log_amplitude;
+  for (std::size_t k = 0; k < peaks.size() && peaks[k] > 0.0 && peaks[k] >= fraction * peaks.front(); ++k) {
+    t.push_back(static_cast<double>(k) / frequency_hz);
+    log_amplitude.push_back(std::log(peaks[k]));
+  }
+  if (t.size() < 2) return NAN;
+  const double n = static_cast<double>(t.size());
+  const double t_mean = std::accumulate(t.begin(), t.end(), 0.0) / n;
+  const double y_mean = std::accumulate(log_amplitude.begin(), log_amplitude.end(), 0.0) / n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    sxy += (t[k] - t_mean) * (log_amplitude[k] - y_mean);
+    sxx += (t[k] - t_mean) * (t[k] - t_mean);
+  }
+  return -sxy / sxx / (2.0 * std::acos(-1.0) * frequency_hz);
+}
+
+namespace {
+
+/// ζ of mode `mode` in the averaged decay of `modal` with `damper` from q0 (its envelope a_j).
+double averaged_damping_ratio(const st::ModalModel& modal, const st::Damper& damper, const Eigen::VectorXd& q0,
+                              Eigen::Index mode, double frequency_hz, const case_file::PlacementVerifySpec& v) {
+  st::FreeDecayOptions o;
+  o.initial_modal_amplitudes = q0.cwiseAbs();
+  o.duration_s = v.periods / frequency_hz;
+  o.sample_times_s = st::uniform_sample_times(o.duration_s, 20 * v.periods + 1);
+  o.threshold_fraction = v.amplitude_fraction;
+  const st::FreeDecay d = st::free_decay(modal, {damper}, o);
+  std::vector<double> t;
+  Eigen::VectorXd a(static_cast<Eigen::Index>(d.samples.size()));
+  for (std::size_t k = 0; k < d.samples.size(); ++k) {
+    t.push_back(d.samples[k].time_s);
+    a[static_cast<Eigen::Index>(k)] = d.samples[k].modal_amplitudes[mode];
+  }
+  return modal_decay_damping_ratio(t, a, frequency_hz, v.amplitude_fraction);
+}
+
+/// One target mode's decays at the site `site` of `modal` (the placed damper's point there).
+PlacementModeCheck check_mode(const case_file::Case& c, std::size_t damper_index, const st::ModalModel& modal,
+                              st::Damper placed, const std::string& site, const opt::ModeAtSite& m,
+                              const case_file::PlacementVerifySpec& v, const std::string& label, base::RunHooks& hooks) {
+  PlacementModeCheck out;
+  out.mode = m.mode;
+  out.frequency_hz = m.natural_frequency_hz;
+  placed.point = site;
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(modal.mode_count()));
+  q0[m.mode] = m.modal_amplitude;
+  st::Damper empty = placed;
+  empty.layers.clear();
+  out.bare_damping_ratio = averaged_damping_ratio(modal, empty, q0, m.mode, out.frequency_hz, v);
+  out.predicted_damping_ratio =
+      averaged_damping_ratio(modal, placed, q0, m.mode, out.frequency_hz, v) - out.bare_damping_ratio;
+
+  st::CosimulationDamper bed = case_file::cosimulation_damper(c, damper_index);
+  bed.point = site;
+  case_file::DecayTask decay;
+  decay.initial_state = case_file::DecayTask::InitialState::kModalAmplitudes;
+  decay.modal_amplitudes.assign(q0.data(), q0.data() + q0.size());
+  decay.duration_s = v.periods / out.frequency_hz;
+  decay.settling_threshold = v.amplitude_fraction;
+  const auto started = std::chrono::steady_clock::now();
+  const DemDecay d = dem_decay(c, modal, {placed}, {bed}, q0, decay, label, "/task/verify/periods", {}, hooks);
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const auto& h = d.cosimulation.history;
+  const Eigen::VectorXd q = h.modal_displacements.col(m.mode);
+  out.dem_damping_ratio = modal_decay_damping_ratio(h.time_s, q, out.frequency_hz, v.amplitude_fraction) -
+                          out.bare_damping_ratio;
+  const std::vector<double> peaks = period_peaks(h.time_s, q, out.frequency_hz);
+  if (!peaks.empty() && peaks.front() > 0.0) out.dem_final_fraction = peaks.back() / peaks.front();
+  out.relative_difference = (out.predicted_damping_ratio - out.dem_damping_ratio) / out.dem_damping_ratio;
+  return out;
+}
+
+/// The objective of per-mode damping ratios, as the placement's (weighted mean or worst).
+double objective_of(const std::vector<PlacementModeCheck>& modes, const case_file::PlacementTask& task, bool dem) {
+  double sum = 0.0, weights = 0.0, worst = INFINITY;
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const double zeta = dem ? modes[k].dem_damping_ratio : modes[k].predicted_damping_ratio;
+    sum += task.targets[k].weight * zeta;
+    weights += task.targets[k].weight;
+    worst = std::min(worst, zeta);
+  }
+  return task.objective == opt::PlacementObjective::kWorstMode ? worst : sum / weights;
+}
+
+/// The site the verification compares with the chosen one: the task's, else the evaluated
+/// site nearest half the chosen objective (on a beam at least a quarter of the range away).
+opt::PlacementPoint other_site(const case_file::Case& c, const case_file::PlacementProblem& p,
+                               const opt::PlacementResult& r) {
+  const case_file::PlacementTask& task = *c.task.placement;
+  const auto& v = *task.verify;
+  if (p.beam && v.other_position_m) {
+    const st::ModalModel modal = opt::beam_model_with_site(*p.beam, *v.other_position_m, r.best.site);
+    opt::PlacementPoint point = opt::evaluate_placement(modal, r.best.site, p.options);
+    point.position_m = *v.other_position_m;
+    return point;
+  }
+  const opt::PlacementPoint* other = nullptr;
+  const double range = p.beam ? p.beam->max_position_m - p.beam->min_position_m : 0.0;
+  for (const auto& point : r.scan) {
+    const bool elsewhere = p.beam ? std::abs(point.position_m - r.best.position_m) >= 0.25 * range
+                                  : (v.other_point.empty() ? point.site != r.best.site : point.site == v.other_point);
+    if (!elsewhere) continue;
+    if (!other || std::abs(point.objective - 0.5 * r.best.objective) < std::abs(other->objective - 0.5 * r.best.objective))
+      other = &point;
+  }
+  if (!other) throw base::InputError(c.path, "/task/verify", "there is no other site to compare the chosen one with");
+  return *other;
+}
+
+PlacementVerification verify_placement(const case_file::Case& c, const case_file::PlacementProblem& p,
+                                       const opt::PlacementResult& r, base::RunHooks& hooks) {
+  const case_file::PlacementTask& task = *c.task.placement;
+  PlacementVerification out;
+  out.settings = *task.verify;
+  for (const auto& [role, point] : {std::pair{std::string("chosen"), r.best}, {std::string("other"), other_site(c, p, r)}}) {
+    PlacementSiteCheck site;
+    site.role = role;
+    site.predicted = point;
+    const st::ModalModel modal = p.beam ? opt::beam_model_with_site(*p.beam, point.position_m, point.site) : p.modal;
+    for (const auto& m : point.modes) {
+      const std::string label = "pdamp optimize --verify (" + role + " site, mode " + std::to_string(m.mode + 1) + ")";
+      site.modes.push_back(
+          check_mode(c, task.damper_index, modal, p.options.damper, point.site, m, out.settings, label, hooks));
+    }
+    site.predicted_objective = objective_of(site.modes, task, false);
+    site.dem_objective = objective_of(site.modes, task, true);
+    site.relative_difference = (site.predicted_objective - site.dem_objective) / site.dem_objective;
+    out.sites.push_back(std::move(site));
+  }
+  out.chosen_agrees = std::abs(out.sites[0].relative_difference) <= out.settings.tolerance_relative;
+  out.ranking_agrees = out.sites[0].dem_objective > out.sites[1].dem_objective;
+  out.passed = out.chosen_agrees && (out.ranking_agrees || !out.settings.require_ranking);
+  return out;
+}
+
+}  // namespace
+
+PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& options, base::RunHooks& hooks,
+                             base::Executor& executor) {
+  executor.primary_only();  // the formulas or fields of a few sites, a few DEM decays: nothing to spread
   const case_file::PlacementTask& task = *c.task.placement;
   case_file::PlacementProblem p = case_file::placement_problem(c, options.method);
   opt::Options solver = opt::placement_solver_options();
@@ -34,6 +256,14 @@ PlacementStudy run_placement(const case_file::Case& c, const PlacementOptions& o
   out.warnings.insert(out.warnings.end(), out.result.warnings.begin(), out.result.warnings.end());
   if (!std::isfinite(out.result.best.objective))
     throw base::NumericalError("pdamp optimize: the placement objective is not finite");
+  if (!options.skip_verify && (task.verify || options.force_verify)) {
+    case_file::Case checked = c;
+    if (!checked.task.placement->verify) checked.task.placement->verify = case_file::PlacementVerifySpec{};
+    if (checked.dampers.size() != 1)
+      throw base::InputError(c.path, "/dampers", "has " + std::to_string(c.dampers.size()) +
+                                                      " dampers: the verification of a placement takes a case of one damper");
+    out.verification = verify_placement(checked, p, out.result, hooks);
+  }
   return out;
 }
 
@@ -66,7 +296,7 @@ json to_json(const PlacementStudy& study) {
            r.current && r.current->objective > 0.0 ? json(r.best.objective / r.current->objective) : json(nullptr)},
           {"sites_evaluated", r.scan.size()},
           {"solver", solver_json},
-          {"verification", nullptr},
+          {"verification", study.verification ? base::to_json(*study.verification) : json(nullptr)},
           {"solve_time_s", r.solve_time_s}};
 }
 

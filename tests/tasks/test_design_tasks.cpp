@@ -313,3 +313,21 @@ TEST_CASE("the design loop recalibrates the chosen design's beds and stops after
   CHECK(j["design_loop"]["rounds"].size() == 2);
   CHECK(j["design_loop"]["outcome"] == "rounds_exhausted");
 }
+
+// Reference: q = e^(−ζω_n t) cos(ω_d t), sampled 100 times a period of f_d = f_n √(1 − ζ²),
+// each sample a millionth of a step after its instant so that the crests fall inside their
+// own periods: the period maxima are the crests e^(−ζω_n (kT_d + δ)) (cos ω_d δ ≈ 1 − 1e-15),
+// so the fit gives ζ ω_n / ω_d = ζ/√(1 − ζ²); the window stops at half the first crest.
+TEST_CASE("the damping ratio of a modal decay is the slope of its period maxima", "[tasks]") {
+  const double zeta = 0.02, fn = 10.0, fd = fn * std::sqrt(1.0 - zeta * zeta);
+  std::vector<double> t;
+  Eigen::VectorXd q(4001);
+  for (int i = 0; i <= 4000; ++i) {
+    t.push_back((i + 1e-6) / (100.0 * fd));
+    q[i] = std::exp(-zeta * 2.0 * M_PI * fn * t.back()) * std::cos(2.0 * M_PI * fd * t.back());
+  }
+  CHECK(tasks::modal_decay_damping_ratio(t, q, fd, 0.5) == Approx(zeta / std::sqrt(1.0 - zeta * zeta)).epsilon(1e-9));
+  CHECK(tasks::modal_decay_damping_ratio(t, q, fd, 0.0) == Approx(zeta / std::sqrt(1.0 - zeta * zeta)).epsilon(1e-9));
+  // Fewer than two whole periods: no ratio.
+  CHECK(std::isnan(tasks::modal_decay_damping_ratio({0.0, 0.05}, Eigen::Vector2d(1.0, 0.5), fd, 0.5)));
+}

@@ -220,6 +220,27 @@ struct FillingRatiosTask {
   std::vector<int> spheres_per_lane;  ///< of a slab, stacked across gravity in one lane (LatticeBed)
 };
 
+/// `verify` of task kind placement: the DEM-in-the-loop free decay of each target mode, alone,
+/// from its stated amplitude, with the damper at the chosen site and at one other, against
+/// the same decay by the layers' loss models (docs/optimizer.md, "Placement").
+struct PlacementVerifySpec {
+  /// A site passes when its objective by the DEM lies within this fraction of the predicted
+  /// one, dimensionless, (0, 10].
+  double tolerance_relative = 0.15;
+  /// The other site: a position along the beam, m (beam search), or a named point (points);
+  /// default the scanned site nearest half the chosen one's objective, at least a quarter of
+  /// the search range away from it (a beam), or the candidate point nearest it (points).
+  std::optional<double> other_position_m;
+  std::string other_point;
+  /// Each decay lasts this many periods of its mode, [4, 10000]; the damping ratio is
+  /// measured over its whole periods down to amplitude_fraction of the start.
+  int periods = 40;
+  double amplitude_fraction = 0.5;  ///< (0, 1)
+  /// true: the verification fails unless the DEM's objective at the chosen site exceeds the
+  /// other site's, as predicted.
+  bool require_ranking = true;
+};
+
 /// `task` kind placement: where one damper adds the most damping to chosen
 /// modes (docs/optimizer.md, "Placement"). On a beam the site moves continuously over
 /// [min_position_m, max_position_m]; on modal data (or with candidate_points on a beam) the
@@ -236,6 +257,9 @@ struct PlacementTask {
   int positions = 101;            ///< beam: positions of the scan, [3, 100000]
   std::vector<std::string> candidate_points;  ///< named points compared instead (required for modal data)
   double rotation_warning_fraction = 0.1;     ///< (0, 10]: optimizer::PlacementOptions
+  /// `verify`: present when the task asks for the DEM check (pdamp run and pdamp optimize run
+  /// it; `pdamp optimize --verify` runs it with these defaults when absent).
+  std::optional<PlacementVerifySpec> verify;
 };
 
 /// `verify` of task kind clearance: the DEM-in-the-loop stepped sine (tasks/frf) at the
