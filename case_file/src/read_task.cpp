@@ -274,6 +274,8 @@ ClearanceTask read_clearance(ObjectReader& r, const Case& c) {
   if (t.band.excitation != FrfTask::Excitation::kBase)
     throw CaseError(r.file(), "/task/excitation/kind", "must be base for task kind clearance (the peak |X/U|)");
   if (t.band.points < 5 || t.band.points > 10000) r.fail("points", "= " + std::to_string(t.band.points) + ": must be in [5, 10000]");
+  if (t.band.spacing != surrogate::AxisSpacing::kLinear)
+    r.fail("spacing", "must be linear for task kind clearance (the sizing's grid is evenly spaced)");
   t.mode = r.integer("mode", std::nullopt, 1, available_modes(c)) - 1;  // counted from 1 in the case
   t.objective = r.text("objective", std::string("lowest_peak"), {"lowest_peak", "design_stroke_at_resonance"}) ==
                         "design_stroke_at_resonance"

@@ -79,6 +79,7 @@ TEST_CASE("pdamp optimize exits 2 naming the key for a bad clearance task", "[cl
       {[](json& c) { c["task"].erase("mode"); }, "/task/mode"},
       {[](json& c) { c["task"]["mode"] = 4; }, "/task/mode"},
       {[](json& c) { c["task"]["points"] = 4; }, "/task/points"},
+      {[](json& c) { c["task"]["spacing"] = "log"; }, "/task/spacing"},
       {[](json& c) { c["task"]["excitation"] = {{"kind", "force"}, {"point", "tip"}, {"amplitude_n", 1.0}}; },
        "/task/excitation/kind"},
       {[](json& c) { c["task"]["objective"] = "fastest"; }, "/task/objective"},
