@@ -39,7 +39,8 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
   tasks::ModesOptions options;
   options.method = loss_method(args);
   auto files = output_dir(args, context);
-  const auto modes = tasks::run_modes(c, options, context.executor);
+  CliHooks hooks;
+  const auto modes = tasks::run_modes(c, options, hooks, context.executor);
   std::vector<std::string> warnings = modes.warnings;
   if (files)
     for (auto& w : report::write_files(*files, modes)) warnings.push_back(w);
@@ -54,6 +55,12 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
              format_number(backbone->max_added_damping_amplitude_m, 4) + " m";
     rows.push_back({"mode " + std::to_string(j + 1), row});
   }
+  for (const auto& check : modes.dem_checks)
+    rows.push_back({"DEM check, mode " + std::to_string(check.mode + 1),
+                    "X = " + format_number(check.damper_amplitude_m * 1e3, 4) + " mm: zeta_add predicted " +
+                        format_number(100.0 * check.predicted_damping_ratio, 4) + " %, DEM " +
+                        format_number(100.0 * check.dem_damping_ratio, 4) + " % (" +
+                        format_number(check.wall_time_s, 3) + " s)"});
   return finish(args, files.get(), result, warnings, rows, {"modes.json", &c, context.report}, &modes);
 }
 

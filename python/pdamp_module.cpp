@@ -283,13 +283,15 @@ PYBIND11_MODULE(pdamp, m) {
       "`pdamp field`: the effective field over the case's grid (source 'formulas' or 'dem'), as field.json.");
   m.def(
       "modes",
-      [](const case_file::Case& c, const std::string& method) {
+      [](const case_file::Case& c, const std::string& method, py::object progress) {
+        PythonHooks hooks(progress);
         tasks::ModesOptions o;
         o.method = method == "field" ? case_file::LossMethod::kField : case_file::LossMethod::kFormulas;
-        json out = tasks::to_json(tasks::run_modes(c, o), tasks::OutputFolder{});
+        json out = tasks::to_json(run_study(hooks, [&] { return tasks::run_modes(c, o, hooks); }), tasks::OutputFolder{});
         return to_python(out);
       },
-      py::arg("case"), py::arg("method") = "formulas", "`pdamp modes`: natural frequencies, shapes and backbones.");
+      py::arg("case"), py::arg("method") = "formulas", py::arg("progress") = py::none(),
+      "`pdamp modes`: natural frequencies, shapes and backbones (and the task's dem_check).");
   m.def(
       "frf",
       [](const case_file::Case& c, const std::string& method, py::object progress) {

@@ -69,6 +69,29 @@ ModesTask read_modes(ObjectReader& r, const Case& c) {
   if (!(t.backbone_max_amplitude_m > t.backbone_min_amplitude_m))
     r.fail("backbone_max_amplitude_m", "must be > backbone_min_amplitude_m");
   t.backbone_points = r.integer("backbone_points", ModesTask{}.backbone_points, 2, 10000);
+  r.object("dem_check", false, [&](ObjectReader& d) {
+    ModesDemCheck check;
+    const auto modes = d.number_array("modes", {1.0, static_cast<double>(t.mode_count)}, "", 1);
+    for (std::size_t i = 0; i < modes.size(); ++i) {
+      if (modes[i] != std::floor(modes[i])) d.fail("modes/" + std::to_string(i), "must be a whole mode number");
+      const int mode = static_cast<int>(modes[i]) - 1;  // counted from 1 in the case
+      if (std::find(check.modes.begin(), check.modes.end(), mode) != check.modes.end())
+        d.fail("modes/" + std::to_string(i), "= " + std::to_string(mode + 1) + ": given twice");
+      check.modes.push_back(mode);
+    }
+    check.amplitudes_m = d.number_array("amplitudes_m", limits::kStroke, " m", 1);
+    if (check.amplitudes_m.size() > 20)
+      d.fail("amplitudes_m", "has " + std::to_string(check.amplitudes_m.size()) + " entries: at most 20 (each is a DEM decay)");
+    if (!std::is_sorted(check.amplitudes_m.begin(), check.amplitudes_m.end()))
+      d.fail("amplitudes_m", "must be ascending");
+    check.periods = d.integer("periods", check.periods, 4, 10000);
+    check.amplitude_fraction = d.number("amplitude_fraction", check.amplitude_fraction, {0.0, 1.0, true});
+    if (check.amplitude_fraction >= 1.0) d.fail("amplitude_fraction", "must be < 1 (a fraction of the start)");
+    if (c.dampers.size() != 1)
+      throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
+                                                " dampers: the DEM check of task kind modes takes a case of one damper");
+    t.dem_check = check;
+  });
   return t;
 }
 

@@ -52,7 +52,8 @@ void write_modes_table(OutputDir& out, const ModeTable& t) {
 }
 
 std::vector<std::string> write_backbone_files(OutputDir& out, const std::vector<st::Backbone>& backbones,
-                                              const std::vector<std::string>& layer_names, const std::string& title) {
+                                              const std::vector<std::string>& layer_names, const std::string& title,
+                                              const std::string& dem_check_file) {
   std::vector<std::string> files;
   for (const auto& b : backbones) {
     std::ostringstream csv;
@@ -92,7 +93,11 @@ std::vector<std::string> write_backbone_files(OutputDir& out, const std::vector<
      << "  set multiplot layout 2,1 title " << gnuplot_string(title) << " noenhanced\n"
      << "  set xlabel 'damper amplitude X / m'\n"
      << "  set ylabel 'added damping ratio {/Symbol z}_{add}'\n"
-     << curves(5)
+     << (dem_check_file.empty()
+             ? curves(5)
+             : curves(5).substr(0, curves(5).size() - 1) + ", \\\n       '" + dem_check_file +
+                   "' using 3:4 every ::1 with points pt 6 ps 1.3 lc rgb 'black' title 'decay, loss models', \\\n"
+                   "       '' using 3:5 every ::1 with points pt 7 ps 1.3 lc rgb 'red' title 'decay, DEM in the loop'\n")
      << "  set ylabel 'damped natural frequency f / Hz'\n"
      << (backbones.size() > 1 ? "  set logscale y\n" : "")
      << curves(4)

@@ -169,8 +169,18 @@ Warnings write_files(OutputDir& out, const tasks::ModesResult& m) {
   table.mass_ratio = m.mass_ratio;
   table.points = m.modal.points;
   write_modes_table(out, table);
+  if (!m.dem_checks.empty()) {
+    const base::CsvTable<tasks::ModeDecayCheck> columns(
+        {"mode", "frequency_hz", "damper_amplitude_m", base::CsvColumn("predicted_damping_ratio").nan_as(""),
+         base::CsvColumn("dem_damping_ratio").nan_as(""), base::CsvColumn("bare_damping_ratio").nan_as(""),
+         base::CsvColumn("dem_final_fraction").nan_as(""), "solve_time_s"});
+    std::string csv = columns.header() + "\n";
+    for (const auto& check : m.dem_checks) csv += columns.row(check) + "\n";
+    out.add("dem_check.csv", csv);
+  }
   return write_backbone_files(out, m.backbones, m.layer_names,
-                              m.case_name + ": backbones (" + std::string(case_file::to_string(m.method)) + ")");
+                              m.case_name + ": backbones (" + std::string(case_file::to_string(m.method)) + ")",
+                              m.dem_checks.empty() ? "" : "dem_check.csv");
 }
 
 namespace {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "pdamp/base/input_error.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
@@ -26,8 +27,9 @@ constexpr double kNoMotionFraction = 1e-9;
 
 }  // namespace
 
-ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, base::Executor& executor) {
-  executor.primary_only();  // no DEM: nothing to spread
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, base::RunHooks& hooks,
+                      base::Executor& executor) {
+  executor.primary_only();  // a few DEM decays at most, one after the other: nothing to spread
   detail::Setup setup = detail::make_setup(c, options.method);
   const st::ModalModel& modal = setup.s.modal;
   const auto& dampers = setup.s.dampers;
@@ -103,6 +105,26 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
     if (!std::isfinite(out.frequencies_with_containers_hz[j]) || !std::isfinite(modal.natural_frequencies_hz[j]))
       throw base::NumericalError("pdamp modes: the natural frequency of mode " + std::to_string(j + 1) + " is not finite");
   if (!out.converged) setup.warnings.add("some backbone points did not converge (converged = 0 in backbone_mode<j>.csv)");
+  if (from_task && c.task.modes->dem_check) {
+    const case_file::ModesDemCheck& check = *c.task.modes->dem_check;
+    const ModeDecayWindow window{check.periods, check.amplitude_fraction};
+    for (const int j : check.modes) {
+      const double b = std::abs(coupled.drive_shapes(j, 0));
+      if (!(b > kNoMotionFraction * largest_drive))
+        throw base::InputError(c.path, "/task/dem_check/modes",
+                               "mode " + std::to_string(j + 1) + " does not move damper " + dampers.front().name +
+                                   " along its drive: nothing to check");
+      for (const double amplitude : check.amplitudes_m) {
+        // The periods are the mode's with the empty containers: the beds' apparent mass moves
+        // the frequency by a few per cent at most (backbone_mode<j>.csv), a fraction of a period over the decay.
+        const std::string label = "pdamp modes (dem_check, mode " + std::to_string(j + 1) + ", X = " +
+                                  base::format_number(amplitude * 1e3, 4) + " mm)";
+        out.dem_checks.push_back(mode_decay_check(c, 0, modal, dampers.front(), dampers.front().point, j, amplitude / b,
+                                                  out.frequencies_with_containers_hz[j], window, label,
+                                                  "/task/dem_check/periods", hooks));
+      }
+    }
+  }
   out.modal = modal;
   out.warnings = setup.warnings.list();
   return out;
@@ -187,6 +209,11 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
                         {"spacing", "log"},
                         {"plot", folder.file("backbone.png")}};
   result["outcome"] = r.converged ? "converged" : "not_converged";
+  result["dem_check"] = nullptr;
+  if (!r.dem_checks.empty()) {
+    result["dem_check"] = json::array();
+    for (const auto& check : r.dem_checks) result["dem_check"].push_back(base::to_json(check));
+  }
   return result;
 }
 

@@ -589,3 +589,41 @@ TEST_CASE("shipped link: decay by averaging on the DEM fields agrees with the DE
   CHECK(std::abs(t_field - t_dem) < 0.25 * t_dem);
   CHECK(t_formulas > t_dem);
 }
+
+// The plumbing of a modes task's dem_check (its physics: the placement's DEM check in
+// tests/cli/test_placement_command.cpp, and docs/optimizer.md): one mode, one amplitude and
+// 4 periods of the 141 Hz mode (a 28 ms decay of the DEM) give one check with both damping
+// ratios, its CSV and the points on the backbone plot; bad dem_check blocks are exit 2.
+TEST_CASE("pdamp modes runs the task's dem_check: each mode's decay by the loss models and the DEM", "[cli][structure]") {
+  const TempDir dir("modes_dem_check");
+  const std::string path = edited_shipped_case(dir.path, "free_free_beam_damping.json", [](json& c) {
+    c["task"]["dem_check"] = {{"modes", {4}}, {"amplitudes_m", {0.0015}}, {"periods", 4}};
+  });
+  const json r = run_json("modes " + path + " -o " + (dir.path / "out").string());
+  REQUIRE(r["dem_check"].size() == 1);
+  const json& check = r["dem_check"][0];
+  CHECK(check["mode"] == 4);
+  CHECK(check["damper_amplitude_m"].get<double>() == Approx(0.0015).epsilon(1e-9));
+  CHECK(check["predicted_damping_ratio"].get<double>() > 0.0);
+  CHECK(check["dem_damping_ratio"].is_number());
+  std::ifstream csv(dir.path / "out" / "dem_check.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header.rfind("mode,frequency_hz,damper_amplitude_m,predicted_damping_ratio,dem_damping_ratio", 0) == 0);
+  std::ifstream gp(dir.path / "out" / "backbone.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  CHECK(script.find("dem_check.csv") != std::string::npos);
+
+  const std::vector<std::pair<std::function<void(json&)>, std::string>> bad = {
+      {[](json& c) { c["task"]["dem_check"]["modes"] = {0}; }, "/task/dem_check/modes"},
+      {[](json& c) { c["task"]["dem_check"]["modes"] = {3, 3}; }, "/task/dem_check/modes/1"},
+      {[](json& c) { c["task"]["dem_check"]["modes"] = {5}; }, "/task/dem_check/modes"},
+      {[](json& c) { c["task"]["dem_check"]["amplitudes_m"] = {0.002, 0.001}; }, "/task/dem_check/amplitudes_m"},
+      {[](json& c) { c["task"]["dem_check"].erase("amplitudes_m"); }, "/task/dem_check/amplitudes_m"},
+      {[](json& c) { c["task"]["dem_check"]["periods"] = 2; }, "/task/dem_check/periods"},
+  };
+  for (const auto& [edit, key] : bad) {
+    INFO(key);
+    require_one_line_error(run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_damping.json", edit)}), key);
+  }
+}

@@ -147,12 +147,22 @@ struct DecayTask {
   double settling_threshold = 0.05;       ///< settled below this fraction of the initial amplitude, (0, 1)
 };
 
+/// `dem_check` of task kind modes: the damping each mode gets against amplitude, by the DEM in
+/// the loop at a few amplitudes of the first damper, beside the backbones (tasks/mode_decay.hpp).
+struct ModesDemCheck {
+  std::vector<int> modes;            ///< 0-based here (the case counts from 1), each once
+  std::vector<double> amplitudes_m;  ///< the first damper's stroke at each decay's start, m, ascending
+  int periods = 40;                  ///< each decay's length in periods of its mode, [4, 10000]
+  double amplitude_fraction = 0.5;   ///< measured down to this fraction of the start, (0, 1)
+};
+
 /// `task` kind modes: natural frequencies, shapes and backbones.
 struct ModesTask {
   int mode_count = 0;                       ///< modes reported, [1, the structure's mode_count]
   double backbone_min_amplitude_m = 0.0;    ///< lowest amplitude at the damper site, m
   double backbone_max_amplitude_m = 0.0;    ///< highest, m (> min)
   int backbone_points = 50;                 ///< [2, 10000]
+  std::optional<ModesDemCheck> dem_check;   ///< `dem_check`: absent, none
 };
 
 /// `verify` of task kind filling_ratios: the DEM-in-the-loop free decay

@@ -28,9 +28,13 @@ void write_modes_table(OutputDir& out, const ModeTable& table);
 
 /// backbone_mode<j>.csv for every backbone (j = mode + 1) and backbone.gp/png/svg:
 /// ζ_add(X) and the damped natural frequency f(X) per mode, X on a log axis.
-/// `layer_names` label the η* columns. Returns warnings (gnuplot missing or failing).
+/// `layer_names` label the η* columns. `dem_check_file` (a CSV of mode, frequency_hz,
+/// damper_amplitude_m, predicted_damping_ratio, dem_damping_ratio, ... with a header; empty:
+/// none) adds its decays' ζ_add to the damping panel as points. Returns warnings (gnuplot
+/// missing or failing).
 std::vector<std::string> write_backbone_files(OutputDir& out, const std::vector<structure::Backbone>& backbones,
-                                              const std::vector<std::string>& layer_names, const std::string& title);
+                                              const std::vector<std::string>& layer_names, const std::string& title,
+                                              const std::string& dem_check_file = "");
 
 /// frf.csv (one row per frequency: the linear response without beds, then every root and
 /// every state held at a jump), frf_branches.csv (one row per root, grouped by branch,

@@ -17,6 +17,8 @@
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/modal_model.hpp"
+#include "pdamp/base/run_hooks.hpp"
+#include "pdamp/tasks/mode_decay.hpp"
 #include "pdamp/tasks/output_folder.hpp"
 
 namespace pdamp::tasks {
@@ -42,6 +44,9 @@ struct ModesResult {
   bool backbone_from_task = false;                 ///< the task's range, else the default
   int rigid_modes_dropped = 0;
   bool converged = true;                           ///< every backbone point converged
+  /// The task's dem_check: each mode's decay from each amplitude, by the loss models and the
+  /// DEM in the loop (mode by mode, amplitudes ascending); empty without one.
+  std::vector<ModeDecayCheck> dem_checks;
   std::vector<std::string> warnings;
   /// Mode j's μ_j summed over the dampers, in their order.
   double modal_mass_ratio(Eigen::Index mode) const {
@@ -63,9 +68,10 @@ struct BackboneSummary {
 std::optional<BackboneSummary> backbone_summary(const ModesResult& result, Eigen::Index mode);
 
 /// The modes study of a format-2 case (any task kind: the backbone range is the modes
-/// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance). It runs
-/// on the primary process alone (on another: base::JobsServedElsewhere).
-ModesResult run_modes(const case_file::Case& c, const ModesOptions& options,
+/// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance), with the
+/// task's dem_check (its DEM decays report through `hooks`). It runs on the primary process
+/// alone (on another: base::JobsServedElsewhere).
+ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, base::RunHooks& hooks = base::silent_hooks(),
                       base::Executor& executor = base::local_executor());
 /// The result keys (task, case, method, file, modes, frequencies, backbone, outcome, ...).
 nlohmann::json to_json(const ModesResult& result, const OutputFolder& folder);

@@ -19,6 +19,7 @@
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/optimizer/options.hpp"
 #include "pdamp/optimizer/placement.hpp"
+#include "pdamp/tasks/mode_decay.hpp"
 
 namespace pdamp::tasks {
 
@@ -29,26 +30,10 @@ struct PlacementOptions {
   bool force_verify = false;  ///< verify with the defaults when the task has no verify block
 };
 
-/// One target mode's free decay at one site, alone from its stated amplitude: the damping
-/// ratio the beds add, by the layers' loss models (the averaged decay, structure::free_decay)
-/// and by the DEM in the loop, each measured the same way (modal_decay_damping_ratio) and
-/// less the same decay with the containers empty.
-struct PlacementModeCheck {
-  int mode = 0;                        ///< 0-based
-  double frequency_hz = 0.0;           ///< the backbone frequency at the site (the periods' length)
-  double predicted_damping_ratio = NAN;  ///< ζ_add of the averaged decay
-  double dem_damping_ratio = NAN;        ///< ζ_add of the DEM decay
-  double bare_damping_ratio = NAN;       ///< ζ of the decay with the containers empty (subtracted)
-  double relative_difference = NAN;      ///< (predicted − DEM)/DEM
-  double dem_final_fraction = NAN;       ///< the DEM decay's last period over its first (1: no decay)
-  double wall_time_s = 0.0;
-  static const base::Fields<PlacementModeCheck>& fields();
-};
-
 struct PlacementSiteCheck {
   std::string role;                    ///< "chosen" or "other"
   optimizer::PlacementPoint predicted; ///< the placement's evaluation of the site (ζ_add at the stated amplitude)
-  std::vector<PlacementModeCheck> modes;  ///< in the order of the targets
+  std::vector<ModeDecayCheck> modes;  ///< in the order of the targets
   double predicted_objective = NAN;    ///< the objective of the modes' decay ζ_add, predicted
   double dem_objective = NAN;          ///< the same by the DEM
   double relative_difference = NAN;    ///< (predicted − DEM)/DEM of the objective
@@ -63,12 +48,6 @@ struct PlacementVerification {
   bool passed = false;          ///< chosen_agrees, and ranking_agrees where require_ranking
   static const base::Fields<PlacementVerification>& fields();
 };
-
-/// The damping ratio of one mode's decay: the per-period largest |q| of the mode (periods of
-/// 1/frequency_hz from t = 0) while it stays at or above `fraction` of the first, fitted as
-/// ln|q| = a − ζ·2πf·t (least squares); NaN with fewer than two periods.
-double modal_decay_damping_ratio(const std::vector<double>& time_s, const Eigen::VectorXd& q, double frequency_hz,
-                                 double fraction);
 
 struct PlacementStudy {
   std::string case_name;
