@@ -36,6 +36,14 @@ std::string words(std::string_view name) {
 }
 std::string percent(double fraction) { return three_digits(100.0 * fraction) + " %"; }
 
+/// The verdict of a failed DEM check: "Do not build on the prediction: a; b. The DEM's
+/// numbers above are the better estimate."
+std::string do_not_build(const std::vector<std::string>& reasons) {
+  std::string text = "Do not build on the prediction: ";
+  for (std::size_t i = 0; i < reasons.size(); ++i) text += (i ? "; " : "") + reasons[i];
+  return text + ". The DEM's numbers above are the better estimate.";
+}
+
 /// "X times faster" of a settling time t against a reference t_ref (both finite).
 std::string times_faster(double t, double t_ref) {
   if (!(t > 0.0) || !(t_ref > 0.0)) return "";
@@ -143,9 +151,7 @@ Answer filling_ratios_answer(const tasks::FillingRatiosResult& r, const case_fil
               << (d && d->softening_check ? ", and gives the same with stiffer contacts" : "")
               << ": the prediction can be trusted for this design.";
     } else {
-      verdict << "Do not build on the prediction: ";
-      for (std::size_t i = 0; i < failed.size(); ++i) verdict << (i ? "; " : "") << failed[i];
-      verdict << ". The DEM's numbers above are the better estimate.";
+      verdict << do_not_build(failed);
     }
     a.verdict = verdict.str();
     a.passed = v->passed;
@@ -283,15 +289,15 @@ Answer placement_answer(const tasks::PlacementStudy& study) {
   if (v->passed)
     verdict << "The DEM agrees with the prediction within the case's " << percent(v->settings.tolerance_relative)
             << " and ranks the chosen site first: the prediction can be trusted for this placement.";
-  else
-    verdict << "Do not build on the predicted damping: "
-            << (!v->chosen_agrees ? "at the chosen site it differs from the DEM's by more than " +
-                                        percent(v->settings.tolerance_relative)
-                                  : std::string())
-            << (!v->chosen_agrees && !v->ranking_agrees ? "; " : "")
-            << (!v->ranking_agrees ? std::string("the DEM does not rank the chosen site first") : std::string())
-            << (v->ranking_agrees ? " (the DEM still ranks the chosen site first)" : "")
-            << ". The DEM's numbers are the better estimate.";
+  else {
+    std::vector<std::string> failed;
+    if (!v->chosen_agrees)
+      failed.push_back("at the chosen site the damping differs from the DEM's by more than " +
+                       percent(v->settings.tolerance_relative) +
+                       (v->ranking_agrees ? " (the DEM still ranks the chosen site first)" : ""));
+    if (!v->ranking_agrees) failed.push_back("the DEM does not rank the chosen site first");
+    verdict << do_not_build(failed);
+  }
   a.verdict = verdict.str();
   a.passed = v->passed;
   return a;
@@ -345,15 +351,14 @@ Answer clearance_answer(const tasks::ClearanceStudy& study) {
             << percent(v->settings.tolerance_relative)
             << " and ranks no neighbour below it, but cannot tell every neighbour from it (within twice the standard "
                "errors): the ranking there is the prediction's alone.";
-  else
-    verdict << "Do not build on the prediction: "
-            << (!v->chosen_agrees ? "the chosen clearance's peak differs from the DEM's by more than " +
-                                        percent(v->settings.tolerance_relative)
-                                  : std::string())
-            << (!v->chosen_agrees && !v->ranking_agrees ? "; " : "")
-            << (!v->ranking_agrees ? std::string("the DEM puts a neighbour's peak below the chosen clearance's")
-                                   : std::string())
-            << ". The DEM's numbers above are the better estimate.";
+  else {
+    std::vector<std::string> failed;
+    if (!v->chosen_agrees)
+      failed.push_back("the chosen clearance's peak differs from the DEM's by more than " +
+                       percent(v->settings.tolerance_relative));
+    if (!v->ranking_agrees) failed.push_back("the DEM puts a neighbour's peak below the chosen clearance's");
+    verdict << do_not_build(failed);
+  }
   a.verdict = verdict.str();
   a.passed = v->passed;
   return a;

@@ -162,6 +162,37 @@ TEST_CASE("a placement answer names the models its damping ratios came from and 
   CHECK_THAT(pdamp::report::report_html(in), Catch::Contains("come from each layer&#39;s effective field"));  // escaped
 }
 
+// The verdicts of the placement's and the clearance's DEM checks, from typed results built here.
+TEST_CASE("a placement or clearance answer gives the DEM check's verdict and why it failed", "[cli][report]") {
+  pdamp::report::ReportInput in;
+  in.case_name = "beam";
+  in.result = json::object();
+  pdamp::tasks::PlacementStudy placement;
+  placement.verification.emplace();
+  auto& v = *placement.verification;
+  v.settings.tolerance_relative = 0.15;
+  v.sites.resize(2);
+  v.sites[0].predicted_objective = 0.0153, v.sites[0].dem_objective = 0.00128;
+  v.sites[1].predicted.position_m = 1.71, v.sites[1].predicted_objective = 0.0016, v.sites[1].dem_objective = 0.00045;
+  v.ranking_agrees = true;
+  in.typed = &placement;
+  CHECK_THAT(pdamp::report::report_html(in),
+             Catch::Contains("DEM check: FAIL") && Catch::Contains("Do not build on the prediction") &&
+                 Catch::Contains("the DEM still ranks the chosen site first"));
+
+  pdamp::tasks::ClearanceStudy clearance;
+  clearance.verification.emplace();
+  auto& c = *clearance.verification;
+  c.settings.tolerance_relative = 0.15;
+  c.checks.resize(2);
+  c.checks[1].ranking = pdamp::tasks::DemRanking::kIndistinguishable;
+  c.chosen_agrees = c.ranking_agrees = c.passed = true;
+  in.typed = &clearance;
+  CHECK_THAT(pdamp::report::report_html(in),
+             Catch::Contains("DEM check: PASS") && Catch::Contains("indistinguishable") &&
+                 Catch::Contains("the ranking there is the prediction&#39;s alone"));
+}
+
 TEST_CASE("pdamp run -o DIR writes report.html with the case's plots, and other commands write none", "[cli][report]") {
   const TempDir dir("report_run");
   const std::string path = (dir.path / "hostile.json").string();
