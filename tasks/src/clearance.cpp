@@ -130,10 +130,10 @@ opt::ClearanceOnStructureOptions sizing_options(const case_file::Case& c) {
   return o;
 }
 
-/// The prediction and the DEM stepped sine of the case at clearance `predicted.clearance_m`
-/// (factor·h): the peak and its frequency are the sizing's objective there, the band centre
-/// the harmonic balance's peak of the case at that clearance.
-ClearanceCheck check_clearance(const case_file::Case& c, const case_file::ClearanceVerifySpec& v, double factor,
+/// The prediction and the DEM stepped sine of `variant`, the case at clearance
+/// `predicted.clearance_m` (factor·h): the peak and its frequency are the sizing's objective
+/// there, the band centre the harmonic balance's peak of the variant.
+ClearanceCheck check_clearance(const case_file::Case& variant, const case_file::ClearanceVerifySpec& v, double factor,
                                const opt::ClearanceResponse& predicted, base::RunHooks& hooks,
                                std::vector<std::string>& warnings) {
   ClearanceCheck out;
@@ -141,7 +141,6 @@ ClearanceCheck check_clearance(const case_file::Case& c, const case_file::Cleara
   out.clearance_m = predicted.clearance_m;
   out.predicted_peak = predicted.peak_transmissibility;
   out.predicted_frequency_hz = predicted.peak_frequency_hz;
-  const case_file::Case variant = case_file::with_clearance(c, out.clearance_m);
   const std::string label = "h = " + base::format_number(out.clearance_m * 1e3, 4) + " mm";
   out.formulas = run_frf(variant, FrfOptions{FrfMethod::kFormulas, {}}, hooks, base::local_executor());
   if (const st::ResponsePeak* peak = first_output_peak(out.formulas.harmonic->response))
@@ -181,9 +180,12 @@ ClearanceVerification verify_clearance(const case_file::Case& c, const case_file
   out.settings = v;
   std::vector<double> factors{1.0};
   factors.insert(factors.end(), v.clearance_factors.begin(), v.clearance_factors.end());
-  for (const double factor : factors)
-    out.checks.push_back(
-        check_clearance(c, v, factor, opt::clearance_response(modal, o, factor * chosen_m), hooks, warnings));
+  // Every clearance read as a case before any DEM runs: one the reader refuses stops nothing half-way.
+  std::vector<case_file::Case> variants;
+  for (const double factor : factors) variants.push_back(case_file::with_clearance(c, factor * chosen_m));
+  for (std::size_t k = 0; k < factors.size(); ++k)
+    out.checks.push_back(check_clearance(variants[k], v, factors[k],
+                                         opt::clearance_response(modal, o, factors[k] * chosen_m), hooks, warnings));
   const ClearanceCheck& chosen = out.checks.front();
   out.chosen_agrees = std::abs(chosen.peak_relative_difference) <= v.tolerance_relative &&
                       std::abs(chosen.band_centre_relative_difference) <= v.tolerance_relative;
