@@ -284,6 +284,9 @@ ClearanceVerifySpec read_clearance_verify(ObjectReader& r, const FrfTask& band) 
 
 ClearanceTask read_clearance(ObjectReader& r, const Case& c) {
   ClearanceTask t;
+  if (c.dampers.size() != 1)
+    throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
+                                              " dampers: task kind clearance sizes one damper on the structure");
   const DamperSpec& damper = c.dampers.front();
   if (damper.layers.size() != 1)
     throw CaseError(r.file(), "/dampers/0/layers",

@@ -94,6 +94,11 @@ TEST_CASE("pdamp optimize exits 2 naming the key for a bad clearance task", "[cl
       {[](json& c) { c["task"]["verify"]["rounds"] = 2; }, "rounds"},
       {[](json& c) { c["dampers"][0]["model"] = "auto"; }, "/dampers/0/model"},
       {[](json& c) { c["dampers"][0]["layers"].push_back(c["dampers"][0]["layers"][0]); }, "/dampers/0/layers"},
+      {[](json& c) {
+         c["dampers"].push_back(c["dampers"][0]);
+         c["dampers"][1]["name"] = "second";
+       },
+       "/dampers"},
   };
   for (const auto& [edit, key] : cases) {
     INFO(key);
