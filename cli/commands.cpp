@@ -58,7 +58,7 @@ fm::ModelOptions model_options(const ParsedArgs& args, fm::DamperModel model) {
     options.bed_restitution = *e_b;
   if (const auto law = args.optional_text("--below-onset")) {
     const auto below = fm::below_onset_model_from_string(*law);
-    if (!below) throw InputError("--below-onset", "", "'" + *law + "' is not allowed (one of: scattered_fit impact_map)");
+    if (!below) throw InputError("--below-onset", "", "'" + *law + "' is not allowed (one of: scattered_fit impact_map rolling_tail)");
     options.below_onset = *below;
   }
   if (const auto file = args.optional_text("--scattered-fit")) {
@@ -625,7 +625,9 @@ const std::vector<Command>& commands() {
          {"--bed-mass", "KG", "bed mass for e_diss_j and energy_per_cycle_j, kg (default 1)"},
          {"--scattered-fit", "FILE", "fitted scattered-state coefficients (scattered_fit.json of\n"
                                      "                          pdamp field --source dem); default: provisional"},
-         {"--below-onset", "LAW", "scattered_fit (default) or impact_map (the plastic block's map)"},
+         {"--below-onset", "LAW",
+          "scattered_fit (default), impact_map (the plastic block's map) or rolling_tail (a rolling bed come down "
+          "from collect-and-collide)"},
          kModelOverrides[0], kModelOverrides[1], kModelOverrides[2], kModelOverrides[3], kOutFlag, kJsonFlag}},
        run_loss},
       {{"buffer",

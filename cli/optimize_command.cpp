@@ -133,8 +133,9 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
                {"objective", std::string(opt::to_string(p.options.objective)) + " (" + unit + ")"},
                {"mass budget", format_number(result.mass_budget_kg * 1e3, 5) + " g"},
                {"relaxed optimum", design_row(r.relaxed, false)},
-               {"rounded neighbours", std::to_string(r.neighbours_feasible) + " feasible of " +
-                                          std::to_string(r.neighbours_total) + " evaluated"},
+               {r.enumerated ? "whole-slab designs" : "rounded neighbours",
+                std::to_string(r.neighbours_feasible) + " feasible of " + std::to_string(r.neighbours_total) +
+                    ", the feasible evaluated"},
                {"chosen", design_row(r.chosen, true)},
                {"baseline (" + r.baseline_layer + ")", design_row(r.baseline, true)},
                {"same mass, one compartment", format_number(r.same_mass.total_mass_kg * 1e3, 4) + " g at h = " +

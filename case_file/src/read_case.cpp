@@ -224,6 +224,12 @@ dem_reference::DamperSimulationOptions dem_options(const Case& c, std::size_t da
 formulas::ModelOptions layer_model_options(const DamperSpec& damper, const LayerSpec& layer) {
   formulas::ModelOptions options = damper.model_options;
   options.nested_bed = layer.bed.settled_upper_spheres > 0;
+  // The settled bed's rows along the drive: its extent over one diameter (the lattice's
+  // slabs, plus what settling spreads onto the base).
+  const auto& bed = layer.bed;
+  if (bed.slabs > 0 && bed.bed_extent_m > 0.0)
+    options.rows_along_drive =
+        std::round((bed.bed_extent_m + bed.clearance_m - bed.settled_clearance_m) / (bed.bed_extent_m / bed.slabs));
   return options;
 }
 

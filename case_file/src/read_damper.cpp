@@ -17,13 +17,14 @@ namespace {
 
 /// ModelOptions::validate() owns the constants' ranges: its line "rolling_calibration =
 /// 3: must be in (0, 2]" (or "scattered.s_max = ...") becomes the case's error at
-/// model_options/rolling_calibration. base_friction is no key of model_options: it is
-/// the DEM's friction (checked there).
+/// model_options/rolling_calibration. base_friction and rolling_resistance are no keys of
+/// model_options: they are the DEM contact's friction and rolling friction (checked there).
 void check_model_options(const ObjectReader& r, const fm::ModelOptions& options) {
   for (const auto& line : options.validate()) {
     const auto cut = line.find(" = ");
     std::string field = line.substr(0, cut);
-    if (field == "base_friction" || field == "particle_restitution") continue;  // the DEM contact's, checked there
+    if (field == "base_friction" || field == "particle_restitution" || field == "rolling_resistance")
+      continue;  // the DEM contact's, checked there
     for (auto& ch : field)
       if (ch == '.') ch = '/';
     r.fail("model_options/" + field, line.substr(cut + 1));
@@ -49,9 +50,12 @@ void read_model_options(ObjectReader& r, fm::ModelOptions& options) {
   // The rebounding bed and the law below the onset (docs/theory.md §3.1, §4.2): read only
   // when given, so that a case without them keeps its resolved form and physics hash.
   if (const auto e_b = r.optional_number("bed_restitution", Range{})) options.bed_restitution = *e_b;
+  const std::vector<std::string> below_onset_laws = {"scattered_fit", "impact_map", "rolling_tail"};
   if (r.has("below_onset"))
-    options.below_onset =
-        *fm::below_onset_model_from_string(r.text("below_onset", std::nullopt, {"scattered_fit", "impact_map"}));
+    options.below_onset = *fm::below_onset_model_from_string(r.text("below_onset", std::nullopt, below_onset_laws));
+  if (r.has("below_onset_from_above"))
+    options.below_onset_from_above =
+        *fm::below_onset_model_from_string(r.text("below_onset_from_above", std::nullopt, below_onset_laws));
   if (!r.has("scattered")) {
     auto& s = r.resolved()["scattered"];
     s["jump_fraction"] = defaults.scattered.jump_fraction;

@@ -35,29 +35,25 @@ void read_contact_pair(ObjectReader& r, dr::ContactPairOptions& pair) {
   pair.rolling_friction = r.number("rolling_friction", defaults.rolling_friction, {0.0, dr::limits::kMaxRollingFriction});
 }
 
-/// The closed forms' base friction (where auto leaves rolling) is the DEM's friction of
-/// the first layer's spheres on its walls: one number for both models.
-double base_friction(const dr::WorldOptions& world, const LayerSpec& layer) {
+/// The DEM contact of the first layer's spheres on its walls. The closed forms take its
+/// friction as their base friction (where auto leaves rolling) and its rolling friction as
+/// the rolling tail's resistance: one number each for both models.
+const dr::ContactPairOptions& wall_contact(const dr::WorldOptions& world, const LayerSpec& layer) {
   const int particles = layer.compartment.particles.front().material;
   const int wall = layer.compartment.wall_material;
-  double mu = world.default_pair.friction;
+  const dr::ContactPairOptions* contact = &world.default_pair;
   for (const auto& pair : world.pairs)
     if ((pair.material_a == particles && pair.material_b == wall) || (pair.material_b == particles && pair.material_a == wall))
-      mu = pair.friction;
-  return mu;
+      contact = &pair;
+  return *contact;
 }
 
 /// ε of the spheres on the walls of a layer when it is a constant (a table or a law: NaN),
 /// for the one-sphere bound of the closed forms' bed_restitution (docs/theory.md §3.1).
-double particle_restitution(const dr::WorldOptions& world, const LayerSpec& layer) {
-  const int particles = layer.compartment.particles.front().material;
-  const int wall = layer.compartment.wall_material;
-  const dr::RestitutionOptions* restitution = &world.default_pair.restitution;
-  for (const auto& pair : world.pairs)
-    if ((pair.material_a == particles && pair.material_b == wall) || (pair.material_b == particles && pair.material_a == wall))
-      restitution = &pair.restitution;
-  if (restitution->model || !restitution->table_values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  return restitution->constant;
+double particle_restitution(const dr::ContactPairOptions& contact) {
+  const dr::RestitutionOptions& restitution = contact.restitution;
+  if (restitution.model || !restitution.table_values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return restitution.constant;
 }
 
 }  // namespace
@@ -146,8 +142,10 @@ void read_dem(ObjectReader& r, Case& c) {
   });
   for (std::size_t i = 0; i < c.dampers.size(); ++i) {
     auto& damper = c.dampers[i];
-    damper.model_options.base_friction = base_friction(world, damper.layers.front());
-    damper.model_options.particle_restitution = particle_restitution(world, damper.layers.front());
+    const dr::ContactPairOptions& contact = wall_contact(world, damper.layers.front());
+    damper.model_options.base_friction = contact.friction;
+    damper.model_options.rolling_resistance = contact.rolling_friction;
+    damper.model_options.particle_restitution = particle_restitution(contact);
     auto& resolved_damper = c.format_version == 1 ? c.resolved["damper"] : c.resolved["dampers"][i];
     resolved_damper["derived"]["base_friction"] = damper.model_options.base_friction;
   }

@@ -376,10 +376,10 @@ double impact_map_reduced_loss_factor_slope(double xi) {
 
 // ---- Coulomb block ----------------------------------------------------------------------
 
-CoulombBlock coulomb_block(double friction, double intensity, double clearance_over_stroke) {
-  require(friction >= 0.0 && std::isfinite(friction), "friction", friction, ">= 0 and finite");
-  require_positive("intensity", intensity);
-  require_positive("clearance_over_stroke", clearance_over_stroke);
+namespace {
+
+/// coulomb_block for checked inputs; h = +inf: no wall is ever reached (the wall-free slide).
+CoulombBlock block_orbit(double friction, double intensity, double clearance_over_stroke) {
   CoulombBlock block;
   const double r = friction / intensity;
   if (r >= 1.0) return block;  // the base holds it: carried, η* = 0, m_app = m_bed
@@ -432,6 +432,44 @@ CoulombBlock coulomb_block(double friction, double intensity, double clearance_o
   // m_app/m_bed = 1 + Re(û)/V (the bed moves at v_c + u, docs/theory.md §1).
   block.apparent_mass_fraction = 1.0 + 2.0 / kPi * harmonic.real();
   return block;
+}
+
+}  // namespace
+
+CoulombBlock coulomb_block(double friction, double intensity, double clearance_over_stroke) {
+  require(friction >= 0.0 && std::isfinite(friction), "friction", friction, ">= 0 and finite");
+  require_positive("intensity", intensity);
+  require_positive("clearance_over_stroke", clearance_over_stroke);
+  return block_orbit(friction, intensity, clearance_over_stroke);
+}
+
+CoulombBlock coulomb_slide_without_walls(double friction, double intensity) {
+  require(friction >= 0.0 && std::isfinite(friction), "friction", friction, ">= 0 and finite");
+  require_positive("intensity", intensity);
+  return block_orbit(friction, intensity, std::numeric_limits<double>::infinity());
+}
+
+RollingTail rolling_tail(double inertia_factor, double rolling_resistance, double intensity) {
+  require(inertia_factor > 0.0 && inertia_factor <= 1.0, "inertia_factor", inertia_factor, "in (0, 1]");
+  // U = (1+κ)u slides as the Coulomb block of friction μ_r; the force on the bed is
+  // (κ m a_c + F_block)/(1+κ), F_block = m(a_c + U̇) the block's friction force
+  // (docs/theory.md §3.4), so η* and the block's part of m_app are divided by 1+κ.
+  require(rolling_resistance >= 0.0 && std::isfinite(rolling_resistance), "rolling_resistance", rolling_resistance,
+          ">= 0 and finite");
+  require_positive("intensity", intensity);
+  RollingTail tail;
+  const double scale = 1.0 + inertia_factor;
+  if (rolling_resistance == 0.0) {
+    // The frictionless block's wall-free orbit u = −V sin... carries no force: η* = 0, m_block = 0
+    // (the general path gives the same to rounding; this one is exact and allocation-free).
+    tail.apparent_mass_fraction = inertia_factor / scale;
+    return tail;
+  }
+  const CoulombBlock block = coulomb_slide_without_walls(rolling_resistance, intensity);
+  tail.regime = block.regime == MotionRegime::kStuck ? MotionRegime::kStuck : MotionRegime::kRollingTail;
+  tail.eta_star = block.eta_star / scale;
+  tail.apparent_mass_fraction = (inertia_factor + block.apparent_mass_fraction) / scale;
+  return tail;
 }
 
 }  // namespace pdamp::formulas

@@ -188,6 +188,7 @@ std::string_view to_string(MotionRegime regime) {
     case MotionRegime::kScattered: return "scattered";
     case MotionRegime::kStuck: return "stuck";
     case MotionRegime::kSliding: return "sliding";
+    case MotionRegime::kRollingTail: return "rolling_tail";
   }
   return "unknown";
 }
@@ -196,6 +197,7 @@ std::string_view to_string(BelowOnsetModel model) {
   switch (model) {
     case BelowOnsetModel::kScatteredFit: return "scattered_fit";
     case BelowOnsetModel::kImpactMap: return "impact_map";
+    case BelowOnsetModel::kRollingTail: return "rolling_tail";
   }
   return "unknown";
 }
@@ -203,6 +205,7 @@ std::string_view to_string(BelowOnsetModel model) {
 std::optional<BelowOnsetModel> below_onset_model_from_string(std::string_view name) {
   if (name == "scattered_fit") return BelowOnsetModel::kScatteredFit;
   if (name == "impact_map") return BelowOnsetModel::kImpactMap;
+  if (name == "rolling_tail") return BelowOnsetModel::kRollingTail;
   return std::nullopt;
 }
 
@@ -231,6 +234,10 @@ std::vector<std::string> ModelOptions::validate() const {
                     bouncing_calibration > 0.0 && bouncing_calibration <= 2.0, "in (0, 2]");
   append_range_rule(problems, "base_friction", base_friction, base_friction >= 0.0 && base_friction <= 10.0,
                     "in [0, 10]");
+  append_range_rule(problems, "rows_along_drive", rows_along_drive,
+                    rows_along_drive >= 0.0 && std::isfinite(rows_along_drive), ">= 0 and finite");
+  append_range_rule(problems, "rolling_resistance", rolling_resistance,
+                    rolling_resistance >= 0.0 && rolling_resistance <= 1.0, "in [0, 1]");
   append_range_rule(problems, "bed_restitution", bed_restitution,
                     bed_restitution >= 0.0 && bed_restitution <= kMaxBedRestitution, "in [0, 0.9]");
   append_range_rule(problems, "particle_restitution", particle_restitution,
@@ -506,6 +513,14 @@ LossResult loss_factor(DamperModel model, double clearance_m, double stroke_m, d
     result.regime = orbit.regime;
     result.eta_star = orbit.eta_star;
     result.impact_phase_rad = orbit.impact_phase_rad;
+  } else if (options.below_onset == BelowOnsetModel::kRollingTail && model != DamperModel::kScattered && rolling &&
+             rolls && (options.rows_along_drive == 0.0 || options.rows_along_drive >= kMinRollingTailRows)) {
+    // Come down from collect-and-collide, the bed rolls about its mean position: the onset's
+    // relative travel 2X/(1+κ) < 0.54 h keeps it off the walls (docs/theory.md §3.4).
+    const RollingTail tail = rolling_tail(inertia_factor, options.rolling_resistance, result.intensity);
+    result.regime = tail.regime;
+    result.eta_star = tail.eta_star;
+    result.impact_phase_rad = kNaN;
   } else if (impact_map) {
     // The plastic block's map in ξ = cX/h, c = 1/(1+κ) (docs/theory.md §4.2): η* = c·η*_map(ξ).
     const double c = 1.0 / (1.0 + inertia_factor);

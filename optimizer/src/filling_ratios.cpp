@@ -148,6 +148,9 @@ std::vector<std::string> FillingRatioOptions::validate() const {
     problems.push_back("mass_budget_kg = " + format_number(mass_budget_kg, 10) + ": must be >= the lightest slab, " +
                        format_number(lightest, 10) + " kg (no layer could hold a whole slab)");
   if (max_total_slabs < 0) problems.push_back("max_total_slabs = " + std::to_string(max_total_slabs) + ": must be >= 0");
+  if (max_enumerated_designs < 0 || max_enumerated_designs > kMaxEnumeratedDesigns)
+    problems.push_back("max_enumerated_designs = " + std::to_string(max_enumerated_designs) + ": must be in [0, " +
+                       std::to_string(kMaxEnumeratedDesigns) + "]");
   if (mass_budget_kg == 0.0 && max_total_slabs == 0)
     problems.push_back("mass_budget_kg = 0 and max_total_slabs = 0: give at least one constraint");
   if (integral_samples < 10 || integral_samples > 100000)
@@ -192,8 +195,9 @@ structure::Damper filling_damper(const FillingRatioOptions& options, std::span<c
     layer.name = l.name;
     layer.bed_mass_kg = n * l.slab_mass_kg();
     if (options.bed_models.empty()) {
-      layer.loss_model =
-          std::make_shared<surrogate::ClosedFormLossModel>(options.model, l.clearance_m(n), options.model_options);
+      formulas::ModelOptions model_options = options.model_options;
+      model_options.rows_along_drive = n * l.spheres_per_lane;  // the settled bed's rows (the tail needs 3)
+      layer.loss_model = std::make_shared<surrogate::ClosedFormLossModel>(options.model, l.clearance_m(n), model_options);
     } else {
       if (std::abs(n - std::round(n)) > kWholeTolerance)
         throw std::invalid_argument("filling_damper: layer '" + l.name + "': slabs = " + format_number(n, 10) +
@@ -351,12 +355,14 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
     out.warnings.push_back("the starting design (the case's particle counts) exceeds the budget: the search starts "
                            "inside the bounds instead");
 
-  if (!options.bed_models.empty()) {
-    // Calibrated beds exist at whole slabs only: every feasible whole-slab design (an
-    // odometer over the layers' counts), the best chosen.
+  // Every feasible whole-slab design (an odometer over the layers' counts), the best chosen:
+  // calibrated beds exist at whole slabs only, and on the closed forms a small design space
+  // is cheaper to enumerate than to trust the rounding across the objective's jumps.
+  const auto enumerate_whole_slab_designs = [&] {
     std::vector<double> n(n_layers, 0.0);
     double best = std::numeric_limits<double>::infinity();
     for (;;) {
+      ++out.neighbours_total;
       if (feasible(options, n)) {
         out.neighbours.push_back(evaluate(n));
         if (out.neighbours.back().objective < best) best = out.neighbours.back().objective, out.chosen = out.neighbours.back();
@@ -366,7 +372,15 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
       if (k == n_layers) break;
       n[k] += 1.0;
     }
-    out.neighbours_total = out.neighbours_feasible = static_cast<int>(out.neighbours.size());
+    out.enumerated = true;
+    out.neighbours_feasible = static_cast<int>(out.neighbours.size());
+  };
+  long designs = 1;
+  for (const auto& l : options.layers)
+    designs = std::min(designs * (std::max(l.max_slabs(), 0) + 1L), FillingRatioOptions::kMaxEnumeratedDesigns + 1L);
+
+  if (!options.bed_models.empty()) {
+    enumerate_whole_slab_designs();
     out.relaxed = out.chosen;
     out.summary.outcome = Outcome::kConverged;
     out.summary.evaluations = out.decay_evaluations;
@@ -401,7 +415,11 @@ FillingRatioResult optimize_filling_ratios(const structure::ModalModel& model, c
     }
     out.summary = solve(problem, solver);
     out.relaxed = evaluate(out.summary.x);
-
+  }
+  if (options.bed_models.empty() && designs <= options.max_enumerated_designs) {
+    // 2. Every whole-slab design (the relaxed optimum stays the continuous reference).
+    enumerate_whole_slab_designs();
+  } else if (options.bed_models.empty()) {
     // 2. Every rounded neighbour of the relaxed optimum (floor/ceil per fractional n_k).
     std::vector<double> base(n_layers);
     std::vector<std::size_t> fractional;

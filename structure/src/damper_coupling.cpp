@@ -123,7 +123,8 @@ std::vector<std::string> CouplingOptions::validate() const {
 
 LayerImpedance layer_impedance(const DamperLayer& layer, double frequency_hz, double stroke_m,
                                const CouplingOptions& options) {
-  const surrogate::DamperResponse response = layer.loss_model->evaluate(frequency_hz, stroke_m);
+  const surrogate::DamperResponse response = layer.from_above ? layer.loss_model->evaluate_from_above(frequency_hz, stroke_m)
+                                                              : layer.loss_model->evaluate(frequency_hz, stroke_m);
   LayerImpedance impedance;
   impedance.loss_warnings = response.warnings;
   impedance.eta_star = response.eta_star;

@@ -112,6 +112,24 @@ class EnvelopeSystem {
   Eigen::VectorXd rates_, layer_power_, k1_, k2_, k3_, k4_, stage_;
 };
 
+/// A bed released above its onset comes down from collect-and-collide and keeps that history
+/// below the onset (docs/theory.md §3.4); one released below it starts as from rest. The
+/// release stroke is the damper's envelope bound Σ_j |b_dj| a_j(0); the onset is taken at the
+/// natural frequency of the mode that moves the damper most.
+void mark_beds_from_above(CoupledModel& coupled, const ModalModel& model, const Eigen::VectorXd& initial) {
+  for (std::size_t d = 0; d < coupled.dampers.size(); ++d) {
+    const Eigen::VectorXd share = coupled.drive_shapes.col(static_cast<Eigen::Index>(d)).cwiseAbs().cwiseProduct(initial);
+    Eigen::Index largest = 0;
+    const double release_m = share.size() > 0 ? share.sum() : 0.0;
+    if (share.size() > 0) share.maxCoeff(&largest);
+    const double frequency_hz = model.natural_frequencies_hz[largest];
+    for (auto& layer : coupled.dampers[d].layers) {
+      const auto jumps = layer.loss_model->discontinuities_stroke_m(frequency_hz);
+      layer.from_above = !jumps.empty() && release_m >= jumps.front();
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> FreeDecayOptions::validate(Eigen::Index modes) const {
@@ -165,8 +183,9 @@ FreeDecay free_decay(const ModalModel& model, const std::vector<Damper>& dampers
     for (const auto& p : problems) message += "\n  " + p;
     throw std::invalid_argument(message);
   }
-  const CoupledModel coupled = couple(model, dampers, options.coupling);
+  CoupledModel coupled = couple(model, dampers, options.coupling);
   const Eigen::Index modes = model.mode_count();
+  mark_beds_from_above(coupled, model, options.initial_modal_amplitudes);
   // Weights of the settling measure: |e·φ_j(p)|.
   Eigen::VectorXd weights(modes);
   if (options.threshold_point.empty()) {

@@ -69,6 +69,10 @@ BlockSlopes rebounding_slopes(double psi, double k) {
 
 std::vector<double> LossModel::discontinuities_stroke_m(double /*frequency_hz*/) const { return {}; }
 
+DamperResponse LossModel::evaluate_from_above(double frequency_hz, double stroke_m) const {
+  return evaluate(frequency_hz, stroke_m);
+}
+
 std::vector<std::string> LossModel::warning_messages(double frequency_hz, double stroke_m) const {
   return describe_loss_warnings(evaluate(frequency_hz, stroke_m).warnings);
 }
@@ -90,7 +94,8 @@ std::vector<std::string> describe_loss_warnings(std::uint32_t warnings) {
 
 ClosedFormLossModel::ClosedFormLossModel(formulas::DamperModel model, double clearance_m,
                                          formulas::ModelOptions options)
-    : model_(model), clearance_m_(clearance_m), options_(std::move(options)) {
+    : model_(model), clearance_m_(clearance_m), options_(std::move(options)), from_above_options_(options_) {
+  from_above_options_.below_onset = options_.below_onset_from_above;
   if (!(clearance_m > 0.0 && std::isfinite(clearance_m)))
     throw std::invalid_argument("ClosedFormLossModel: clearance_m = " + std::to_string(clearance_m) +
                                 ": must be > 0 and finite");
@@ -99,21 +104,31 @@ ClosedFormLossModel::ClosedFormLossModel(formulas::DamperModel model, double cle
 }
 
 DamperResponse ClosedFormLossModel::evaluate(double frequency_hz, double stroke_m) const {
-  // options_ were validated by the constructor; only the number of warnings is used here
+  return respond(options_, frequency_hz, stroke_m);
+}
+
+DamperResponse ClosedFormLossModel::evaluate_from_above(double frequency_hz, double stroke_m) const {
+  return respond(from_above_options_, frequency_hz, stroke_m);
+}
+
+DamperResponse ClosedFormLossModel::respond(const formulas::ModelOptions& options, double frequency_hz,
+                                            double stroke_m) const {
+  // The options were validated by the constructor; only the number of warnings is used here
   // (warning_messages writes the sentences).
-  const auto loss = formulas::reduced_loss_factor_counted(model_, clearance_m_, stroke_m, frequency_hz, options_);
+  const auto loss = formulas::reduced_loss_factor_counted(model_, clearance_m_, stroke_m, frequency_hz, options);
   DamperResponse response;
   response.eta_star = loss.eta_star;
   response.regime = formulas::to_string(loss.regime);
   const double kappa = loss.inertia_factor;
   const double scale = 1.0 + kappa;
   const double d_kappa = d_inertia_factor_d_stroke(model_, options_, loss.intensity, stroke_m);
-  if (loss.regime == formulas::MotionRegime::kStuck || loss.regime == formulas::MotionRegime::kSliding)
-    return coulomb_response(loss, frequency_hz, stroke_m);
+  if (loss.model_used == formulas::DamperModel::kCoulombBlock) return coulomb_response(loss, frequency_hz, stroke_m);
+  if (loss.regime == formulas::MotionRegime::kRollingTail || loss.regime == formulas::MotionRegime::kStuck)
+    return tail_response(loss, frequency_hz, stroke_m);
   const bool scattered = loss.regime == formulas::MotionRegime::kScattered;
   const bool explicit_family =
       model_ == formulas::DamperModel::kRolling || model_ == formulas::DamperModel::kBouncing;
-  if (scattered && options_.below_onset == formulas::BelowOnsetModel::kImpactMap &&
+  if (scattered && options.below_onset == formulas::BelowOnsetModel::kImpactMap &&
       model_ != formulas::DamperModel::kScattered) {
     // η* = c·E(ξ), ξ = cX/h, c = 1/(1+κ) (docs/theory.md §4.2); dc/dX = −c² dκ/dX.
     const double c = 1.0 / scale;
@@ -189,6 +204,33 @@ DamperResponse ClosedFormLossModel::rebounding_response(const formulas::LossResu
   response.d_eta_star_d_stroke_1_m =
       tail ? -loss.eta_star / stroke_m : block.d_eta_d_r * dr / scale - loss.eta_star * d_kappa / scale;
   if (tail) response.warnings |= kLossApparentMassAssumed;
+  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
+  return response;
+}
+
+DamperResponse ClosedFormLossModel::tail_response(const formulas::LossResult& loss, double frequency_hz,
+                                                  double stroke_m) const {
+  // The rolling tail (docs/theory.md §3.4): κ is fixed there (the bed rolls, Γ <= Γ_slip), and
+  // without rolling resistance η* = 0 and m_app/m_bed = κ/(1+κ) do not depend on X; with it,
+  // central differences as for the Coulomb block (smooth inside each regime).
+  DamperResponse response;
+  response.eta_star = loss.eta_star;
+  response.regime = formulas::to_string(loss.regime);
+  const double kappa = loss.inertia_factor;
+  const double mu_r = options_.rolling_resistance;
+  const double omega = 2.0 * kPi * frequency_hz;
+  const auto tail_at = [&](double x) {
+    return formulas::rolling_tail(kappa, mu_r, x * omega * omega / formulas::kStandardGravity);
+  };
+  response.apparent_mass_fraction = tail_at(stroke_m).apparent_mass_fraction;
+  if (mu_r > 0.0 && loss.regime == formulas::MotionRegime::kRollingTail) {
+    const double step = 1e-6 * stroke_m;
+    const auto up = tail_at(stroke_m + step);
+    const auto down = tail_at(stroke_m - step);
+    response.d_eta_star_d_stroke_1_m = (up.eta_star - down.eta_star) / (2.0 * step);
+    response.d_apparent_mass_fraction_d_stroke_1_m =
+        (up.apparent_mass_fraction - down.apparent_mass_fraction) / (2.0 * step);
+  }
   if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
   return response;
 }

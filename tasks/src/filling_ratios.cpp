@@ -684,8 +684,10 @@ json to_json(const FillingRatiosResult& res) {
                       {"same_mass", "the chosen design's particle mass in one compartment at its own best clearance"}}},
       {"baseline_layer", r.baseline_layer},
       {"baseline_evaluations", r.baseline_evaluations},
-      {"rounding", {{"rule", "each relaxed n_k floored and ceiled (one value when within 1e-6 of a whole number); "
-                             "every feasible point evaluated, the best chosen"},
+      {"rounding", {{"rule", r.enumerated ? "every whole-slab design, the feasible ones evaluated, the best chosen"
+                                          : "each relaxed n_k floored and ceiled (one value when within 1e-6 of a whole "
+                                            "number); every feasible point evaluated, the best chosen"},
+                    {"enumerated", r.enumerated},
                     {"neighbours_total", r.neighbours_total},
                     {"neighbours_feasible", r.neighbours_feasible},
                     {"neighbours", neighbours}}},

@@ -93,18 +93,33 @@ TEST_CASE("the bed models' keys reach each layer's model options; absent, they k
   const auto& options = plain.dampers.front().model_options;
   CHECK(options.bed_restitution == 0.0);
   CHECK(options.below_onset == pdamp::formulas::BelowOnsetModel::kScatteredFit);
+  CHECK(options.below_onset_from_above == pdamp::formulas::BelowOnsetModel::kRollingTail);
+  CHECK(options.rolling_resistance == plain.dem.simulation.world.default_pair.rolling_friction);
   CHECK_FALSE(plain.resolved["damper"]["model_options"].contains("bed_restitution"));
   // The DEM contact's constant restitution, for the one-sphere bound's warning.
   CHECK(options.particle_restitution == plain.dem.simulation.world.default_pair.restitution.constant);
-  // One sphere high: not nested.
-  CHECK_FALSE(pdamp::case_file::layer_model_options(plain.dampers.front(), plain.dampers.front().layers.front()).nested_bed);
+  // One sphere high: not nested; its rows along the drive are the lattice's slabs.
+  const auto plain_layer = pdamp::case_file::layer_model_options(plain.dampers.front(), plain.dampers.front().layers.front());
+  CHECK_FALSE(plain_layer.nested_bed);
+  CHECK(plain_layer.rows_along_drive == plain.dampers.front().layers.front().bed.slabs);
+  // Two high across gravity, a slab settles into two rows (docs/theory.md §9): the link's
+  // starting layers of two slabs lie in four rows.
+  const Case link = load_case(shipped("manipulator_link_optimize.json"));
+  for (const auto& layer : link.dampers.front().layers) {
+    CAPTURE(layer.name);
+    CHECK(pdamp::case_file::layer_model_options(link.dampers.front(), layer).rows_along_drive == 2.0 * layer.bed.slabs);
+  }
   const Case c = load_case(edited(dir, [](json& j) {
-    j["damper"]["model_options"] = {{"bed_restitution", 0.2}, {"below_onset", "impact_map"}};
+    j["damper"]["model_options"] = {
+        {"bed_restitution", 0.2}, {"below_onset", "impact_map"}, {"below_onset_from_above", "scattered_fit"}};
+    j["dem"]["contact"]["rolling_friction"] = 0.05;  // the rolling tail's resistance (docs/theory.md §3.4)
   }));
   const auto& d = c.dampers.front();
   const auto layer = pdamp::case_file::layer_model_options(d, d.layers.front());
   CHECK(layer.bed_restitution == 0.2);
   CHECK(layer.below_onset == pdamp::formulas::BelowOnsetModel::kImpactMap);
+  CHECK(layer.below_onset_from_above == pdamp::formulas::BelowOnsetModel::kScatteredFit);
+  CHECK(layer.rolling_resistance == 0.05);
   CHECK(c.resolved["damper"]["model_options"]["bed_restitution"] == 0.2);
   CHECK(c.resolved["damper"]["model_options"]["below_onset"] == "impact_map");
   CHECK(pdamp::case_file::physics_hash(c, "formulas") != pdamp::case_file::physics_hash(plain, "formulas"));
@@ -209,6 +224,8 @@ TEST_CASE("ranges owned by an option struct come from its validate()", "[case_fi
                   "/damper/model_options/bed_restitution", "= -0.1: must be in [0, 0.9]");
   require_refused(edited(dir, [](json& c) { c["damper"]["model_options"] = {{"below_onset", "map"}}; }),
                   "/damper/model_options/below_onset", "impact_map");
+  require_refused(edited(dir, [](json& c) { c["damper"]["model_options"] = {{"below_onset_from_above", "tail"}}; }),
+                  "/damper/model_options/below_onset_from_above", "rolling_tail");
   // dem_reference's validate(): a pin of the case, named by its pointer under /dem.
   require_refused(edited(dir, [](json& c) { c["dem"]["restitution_typo"] = 1; }), "/dem/restitution_typo",
                      "unknown key");

@@ -370,7 +370,7 @@ TEST_CASE("the closed-form commands take the bed models' flags and refuse bad va
                          "--bed-restitution: '1.2': must be a finite number >= 0 and <= 0.9");
   require_one_line_error(
       run_pdamp("loss --model rolling --clearance 0.01 --amplitude 0.003 --frequency 3 --below-onset map"),
-      "--below-onset: 'map' is not allowed (one of: scattered_fit impact_map)");
+      "--below-onset: 'map' is not allowed (one of: scattered_fit impact_map rolling_tail)");
   const auto held = run_pdamp("loss --model coulomb_block --clearance 0.003 --amplitude 0.001 --frequency 3.6 "
                               "--friction 0.2 --json");
   REQUIRE(held.exit_code == 0);

@@ -557,3 +557,131 @@ TEST_CASE("the plastic block's impact map matches a separate event-driven simula
   CHECK_FALSE(fm::below_onset_model_from_string("map").has_value());
 }
 
+
+// ---- Below the onset after collect-and-collide: the rolling tail ---------------------------
+
+// A sphere (m = 1, r = 1, I = κ) rolling without slip on a base that moves as x_c = sin φ,
+// a resisting torque ρ = μ_r/Γ against its spin (units X, V = XΩ, 1/Ω), stepped in φ
+// (2e-5 rad) from its own equations, not from the block: m v̇ = F, κ ω̇ = F − ρ sgn ω,
+// v + ω = v_c, so F = (κ a_c + ρ sgn ω)/(1+κ) while it spins; with ω = 0 it is held (v = v_c)
+// while |a_c| <= ρ. Started off the walls without drift (v = κ/(1+κ)·v_c), warmed up, then
+// η* = (energy the torque takes)/(π·cycles) and m_app/m_bed = Re(v̂)/V from the first harmonic
+// of its velocity.
+namespace {
+
+struct TailMeasure {
+  double eta_star = 0.0;
+  double apparent_mass_fraction = 0.0;
+};
+TailMeasure simulate_rolling_sphere(double kappa, double rho, int warm_up_cycles, int cycles) {
+  const double step = 2e-5;
+  const long per_cycle = std::lround(kTwoPi / step);
+  const double dphi = kTwoPi / static_cast<double>(per_cycle);
+  double v = kappa / (1.0 + kappa), omega = 1.0 - v;  // v + ω = v_c(0) = 1
+  double dissipated = 0.0, re = 0.0;
+  for (long i = 0; i < static_cast<long>(warm_up_cycles + cycles) * per_cycle; ++i) {
+    const double phi = (static_cast<double>(i) + 0.5) * dphi;  // midpoint of the step
+    const double a_c = -std::sin(phi);
+    const bool measuring = i >= static_cast<long>(warm_up_cycles) * per_cycle;
+    double a_v = a_c, d_omega = 0.0;
+    if (omega != 0.0 || std::abs(a_c) > rho) {
+      // Spinning, or released: the spin's sign is that of the current spin, else of the
+      // drive that starts it (F − ρ sgn ω > 0 with F ≈ a_c).
+      const double sign = omega != 0.0 ? (omega > 0.0 ? 1.0 : -1.0) : (a_c > 0.0 ? 1.0 : -1.0);
+      const double force = (kappa * a_c + rho * sign) / (1.0 + kappa);
+      d_omega = (force - rho * sign) / kappa * dphi;
+      a_v = force;
+      if (omega != 0.0 && (omega + d_omega) * omega < 0.0) d_omega = -omega;  // stops inside the step
+    }
+    if (measuring) {
+      dissipated += rho * std::abs(omega + 0.5 * d_omega) * dphi;
+      re += (v + 0.5 * a_v * dphi) * std::cos(phi) * dphi;
+    }
+    v += a_v * dphi;
+    omega += d_omega;
+    if (d_omega == 0.0 && omega == 0.0) v = std::cos(phi + 0.5 * dphi);  // held: v = v_c
+  }
+  return {dissipated / (kPi * cycles), re / (kPi * cycles)};
+}
+
+}  // namespace
+
+// Den Hartog's slide (ρ = 0.1, 0.3, 0.45), stick-slip (0.7, 0.9) and held (1.3) for solid and
+// hollow spheres: the stepped sphere agrees with formulas::rolling_tail to 1e-7 (η*) and
+// 1.5e-5 (m_app, the stepping error at the stick and release instants): tolerances 1e-5 and
+// 1e-4, far below the differences between the regimes (η* 0.02-0.29, m_app 0.30-1).
+TEST_CASE("the rolling tail's eta* and m_app match a stepped rolling sphere with rolling resistance", "[formulas]") {
+  for (const double kappa : {0.4, 2.0 / 3.0}) {
+    for (const double rho : {0.1, 0.3, 0.45, 0.7, 0.9, 1.3}) {
+      CAPTURE(kappa, rho);
+      const auto tail = fm::rolling_tail(kappa, rho, 1.0);  // μ_r = ρ at Γ = 1
+      CHECK(tail.regime == (rho >= 1.0 ? fm::MotionRegime::kStuck : fm::MotionRegime::kRollingTail));
+      const TailMeasure m = simulate_rolling_sphere(kappa, rho, 4, 4);
+      CHECK(m.eta_star == Approx(tail.eta_star).margin(1e-5));
+      CHECK(m.apparent_mass_fraction == Approx(tail.apparent_mass_fraction).margin(1e-4));
+    }
+  }
+  // Without rolling resistance: no loss, κ/(1+κ) of the bed (2/7 for solid spheres), exactly;
+  // the stepped sphere gives the same.
+  const auto free = fm::rolling_tail(0.4, 0.0, 0.3);
+  CHECK(free.eta_star == 0.0);
+  CHECK(free.apparent_mass_fraction == Approx(2.0 / 7.0).epsilon(1e-15));
+  const TailMeasure m = simulate_rolling_sphere(0.4, 0.0, 1, 2);
+  CHECK(m.eta_star == 0.0);
+  CHECK(m.apparent_mass_fraction == Approx(2.0 / 7.0).margin(1e-4));
+  CHECK_THROWS_AS(fm::rolling_tail(0.0, 0.1, 1.0), std::invalid_argument);
+  CHECK_THROWS_AS(fm::rolling_tail(0.4, -0.1, 1.0), std::invalid_argument);
+  CHECK_THROWS_AS(fm::rolling_tail(0.4, 0.1, 0.0), std::invalid_argument);
+}
+
+TEST_CASE("below the onset the rolling tail answers for a rolling bed only; above it nothing changes",
+          "[formulas]") {
+  fm::ModelOptions tail;
+  tail.below_onset = fm::BelowOnsetModel::kRollingTail;
+  const fm::ModelOptions rest;  // the scattered fit
+  const double h = 0.01, f = 3.0;
+  const double onset = fm::onset_stroke_m(0.4, h);
+  for (const auto model : {fm::DamperModel::kRolling, fm::DamperModel::kAuto}) {
+    const auto below = fm::reduced_loss_factor(model, h, 0.5 * onset, f, tail);
+    CHECK(below.regime == fm::MotionRegime::kRollingTail);
+    CHECK(below.eta_star == 0.0);
+    CHECK(below.warnings.empty());  // a modelled state, not the missing orbit
+    CHECK(fm::reduced_loss_factor(model, h, 0.5 * onset, f, rest).regime == fm::MotionRegime::kScattered);
+    for (const double x : {onset, 1.3 * onset, 3.0 * onset})
+      CHECK(fm::reduced_loss_factor(model, h, x, f, tail).eta_star == fm::reduced_loss_factor(model, h, x, f, rest).eta_star);
+  }
+  // A bed of two rows along the drive keeps the law from rest (the DEM's two-row beds still
+  // reach the walls below the onset); three rows or more, or an unknown count, roll off them.
+  fm::ModelOptions two_rows = tail;
+  two_rows.rows_along_drive = 2.0;
+  CHECK(fm::reduced_loss_factor(fm::DamperModel::kRolling, h, 0.5 * onset, f, two_rows).regime ==
+        fm::MotionRegime::kScattered);
+  two_rows.rows_along_drive = fm::kMinRollingTailRows;
+  CHECK(fm::reduced_loss_factor(fm::DamperModel::kRolling, h, 0.5 * onset, f, two_rows).regime ==
+        fm::MotionRegime::kRollingTail);
+  // With rolling resistance: the block of friction μ_r at the bed's Γ.
+  fm::ModelOptions resisted = tail;
+  resisted.rolling_resistance = 0.02;
+  const auto r = fm::reduced_loss_factor(fm::DamperModel::kRolling, h, 0.5 * onset, f, resisted);
+  CHECK(r.eta_star == fm::rolling_tail(0.4, 0.02, r.intensity).eta_star);
+  CHECK(r.eta_star > 0.0);
+  // No base to roll on, a bouncing bed, or spheres that slide (Γ above Γ_slip): the scattered fit.
+  fm::ModelOptions weightless = tail;
+  weightless.gravity_across_drive = false;
+  CHECK(fm::reduced_loss_factor(fm::DamperModel::kAuto, h, 0.5 * onset, f, weightless).regime ==
+        fm::MotionRegime::kScattered);
+  CHECK(fm::reduced_loss_factor(fm::DamperModel::kBouncing, h, 0.5 * fm::onset_stroke_m(0.0, h), f, tail).regime ==
+        fm::MotionRegime::kScattered);
+  fm::ModelOptions slippery = tail;
+  slippery.base_friction = 0.01;  // Γ_slip = 0.035
+  const double x_slip = 0.5 * onset;
+  REQUIRE(x_slip * std::pow(kTwoPi * f, 2) / fm::kStandardGravity > 0.035);
+  CHECK(fm::reduced_loss_factor(fm::DamperModel::kRolling, h, x_slip, f, slippery).regime ==
+        fm::MotionRegime::kScattered);
+  CHECK(fm::below_onset_model_from_string("rolling_tail") == fm::BelowOnsetModel::kRollingTail);
+  CHECK(fm::to_string(fm::BelowOnsetModel::kRollingTail) == "rolling_tail");
+  fm::ModelOptions bad;
+  bad.rolling_resistance = 2.0;
+  REQUIRE(bad.validate().size() == 1);
+  CHECK(bad.validate().front().find("rolling_resistance") == 0);
+}

@@ -314,3 +314,44 @@ TEST_CASE("the bed models' responses: rebounding orbit, impact map and Coulomb b
   CHECK(ClosedFormLossModel(fm::DamperModel::kRolling, h, rebounding).discontinuities_stroke_m(2.0).at(0) ==
         fm::onset_stroke_m(0.4, h, 0.2));
 }
+
+TEST_CASE("come down from above, a rolling bed below the onset answers with the rolling tail", "[surrogate]") {
+  // evaluate (from rest) keeps the scattered fit; evaluate_from_above takes the rolling tail:
+  // no loss and m_app/m_bed = κ/(1+κ) without rolling resistance, the block of friction μ_r
+  // with it (formulas::rolling_tail, tested against a stepped sphere), and the same response
+  // as evaluate above the onset.
+  const double h = 0.01, f = 3.0;
+  const double onset = fm::onset_stroke_m(0.4, h);
+  const ClosedFormLossModel model(fm::DamperModel::kRolling, h);
+  const auto rest = model.evaluate(f, 0.5 * onset);
+  const auto above = model.evaluate_from_above(f, 0.5 * onset);
+  CHECK(rest.regime == "scattered");
+  CHECK(rest.eta_star > 0.0);
+  CHECK(above.regime == "rolling_tail");
+  CHECK(above.eta_star == 0.0);
+  CHECK(above.apparent_mass_fraction == Approx(2.0 / 7.0).epsilon(1e-15));
+  CHECK(above.d_eta_star_d_stroke_1_m == 0.0);
+  CHECK(above.warnings == 0u);
+  for (const double x : {onset, 2.0 * onset}) {
+    CHECK(model.evaluate_from_above(f, x).eta_star == model.evaluate(f, x).eta_star);
+    CHECK(model.evaluate_from_above(f, x).apparent_mass_fraction == model.evaluate(f, x).apparent_mass_fraction);
+  }
+  // With rolling resistance: η* > 0 and its slope is the difference quotient's (the central
+  // difference inside the model against one over 1e-4 X here: 1e-5 relative).
+  fm::ModelOptions resisted;
+  resisted.rolling_resistance = 0.02;
+  const ClosedFormLossModel rolling(fm::DamperModel::kRolling, h, resisted);
+  const double x = 0.5 * onset, dx = 1e-4 * x;
+  const auto r = rolling.evaluate_from_above(f, x);
+  const double gamma = x * std::pow(2.0 * fm::kPi * f, 2) / fm::kStandardGravity;
+  // (Γ computed here in another order: round-off only.)
+  CHECK(r.eta_star == Approx(fm::rolling_tail(0.4, 0.02, gamma).eta_star).epsilon(1e-12));
+  CHECK(r.apparent_mass_fraction == Approx(fm::rolling_tail(0.4, 0.02, gamma).apparent_mass_fraction).epsilon(1e-12));
+  const double slope = (rolling.evaluate_from_above(f, x + dx).eta_star - rolling.evaluate_from_above(f, x - dx).eta_star) / (2.0 * dx);
+  CHECK(r.d_eta_star_d_stroke_1_m == Approx(slope).epsilon(1e-5));
+  // The option below_onset_from_above = scattered_fit restores the law from rest.
+  fm::ModelOptions as_rest;
+  as_rest.below_onset_from_above = fm::BelowOnsetModel::kScatteredFit;
+  const ClosedFormLossModel old(fm::DamperModel::kRolling, h, as_rest);
+  CHECK(old.evaluate_from_above(f, 0.5 * onset).eta_star == rest.eta_star);
+}

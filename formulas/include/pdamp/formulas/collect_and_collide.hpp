@@ -40,6 +40,7 @@ enum class MotionRegime {
   kScattered,          ///< X < X_onset: no synchronous orbit: the scattered fit or the impact map (§4)
   kStuck,              ///< Coulomb block (nested bed) at Γ <= μ: carried by the base, η* = 0 (§3.3)
   kSliding,            ///< Coulomb block at Γ > μ: slides on its base, stick-slip or wall to wall (§3.3)
+  kRollingTail,        ///< X < X_onset after collect-and-collide: rolls about its mean position, no impacts (§3.4)
 };
 std::string_view to_string(MotionRegime regime);
 
@@ -73,10 +74,18 @@ struct ScatteredFit {
 enum class BelowOnsetModel {
   kScatteredFit,  ///< the empirical law of ScatteredFit (§4.1): the default
   kImpactMap,     ///< the plastic block's deterministic impact map, tabulated in cX/h (§4.2)
+  /// A rolling bed that has come down from collect-and-collide (§3.4): it rolls about its
+  /// mean position without reaching the walls (rolling_tail); beds that do not roll on a
+  /// base, or have fewer than kMinRollingTailRows rows along the drive, keep the scattered fit.
+  kRollingTail,
 };
 std::string_view to_string(BelowOnsetModel model);
-/// "scattered_fit", "impact_map"; std::nullopt for anything else.
+/// "scattered_fit", "impact_map", "rolling_tail"; std::nullopt for anything else.
 std::optional<BelowOnsetModel> below_onset_model_from_string(std::string_view name);
+
+/// Fewest rows along the drive for the rolling tail (ModelOptions::rows_along_drive): the DEM
+/// shows two rows still reaching the walls below the onset, four rows rolling off them.
+inline constexpr double kMinRollingTailRows = 3.0;
 
 /// Largest collective bed restitution accepted: K = (1+e_b)/(1−e_b) = 19 there, an onset at
 /// 0.017 (1+κ)h; no bed of the DEM comes near it (one sphere: e_b <= (ε − κ)/(1+κ) < 0.72).
@@ -119,8 +128,22 @@ struct ModelOptions {
   /// takes the Coulomb block (docs/theory.md §3.3) and `rolling` warns. false: a bed one
   /// sphere high (after settling), which rolls.
   bool nested_bed = false;
-  /// Below the onset: the scattered fit (default) or the plastic block's impact map.
+  /// Below the onset, for a bed driven there from rest (a steady state, a field, a forced
+  /// response): the scattered fit (default), the plastic block's impact map or the rolling tail.
   BelowOnsetModel below_onset = BelowOnsetModel::kScatteredFit;
+  /// Below the onset, for a bed that has come down from collect-and-collide (a free decay
+  /// released above the onset, surrogate::LossModel::evaluate_from_above): the rolling tail
+  /// (default, docs/theory.md §3.4) or the law of a bed driven from rest.
+  BelowOnsetModel below_onset_from_above = BelowOnsetModel::kRollingTail;
+  /// Spheres one after another along the drive in a lane of the settled bed, > 0, or 0
+  /// (default: unknown, a long bed). The rolling tail answers for kMinRollingTailRows or more:
+  /// the DEM's beds of two rows still reach the walls below the onset (η* 0.03-0.2, docs/
+  /// theory.md §3.4) and keep the law of a bed from rest.
+  double rows_along_drive = 0.0;
+  /// Rolling resistance μ_r of the spheres on the base, dimensionless, in [0, 1] (default 0:
+  /// none, the DEM's default; a case takes its DEM contact's rolling_friction). The rolling
+  /// tail's only loss: a resisting torque μ_r r m g.
+  double rolling_resistance = 0.0;
   /// One line per violated rule ("rolling_inertia_factor = 1.5: must be in (0, 1]"),
   /// the fit's lines prefixed "scattered."; empty if valid.
   std::vector<std::string> validate() const;
@@ -340,6 +363,25 @@ struct CoulombBlock {
 };
 /// μ >= 0, Γ > 0, h/X > 0, all finite (std::invalid_argument otherwise).
 CoulombBlock coulomb_block(double friction, double intensity, double clearance_over_stroke);
+/// The block's periodic slide far from both walls: the orbit of a block that has left them
+/// with no drift, stuck (r >= 1), stick-slip (r > r_c) or Den Hartog's (r <= r_c), never
+/// wall to wall. Same ranges as coulomb_block.
+CoulombBlock coulomb_slide_without_walls(double friction, double intensity);
+
+// ---- Below the onset after collect-and-collide: the rolling tail (docs/theory.md §3.4) ----
+/// A rolling bed (κ > 0) that has left the walls rolls about its mean position. Its
+/// relative motion u obeys (1+κ)u̇ = −a_c − μ_r g sgn u (a resisting torque μ_r r m g at the
+/// base), the Coulomb block of friction μ_r in U = (1+κ)u, so
+///   η* = η*_block/(1+κ),   m_app/m_bed = (κ + m_block/m)/(1+κ),
+/// the block's wall-free slide at r = μ_r/Γ; μ_r = 0: η* = 0, m_app/m_bed = κ/(1+κ) (2/7 for
+/// solid spheres). kRollingTail, or kStuck for μ_r >= Γ (carried by the base).
+struct RollingTail {
+  MotionRegime regime = MotionRegime::kRollingTail;
+  double eta_star = 0.0;
+  double apparent_mass_fraction = 0.0;
+};
+/// κ in (0, 1], μ_r >= 0, Γ > 0, all finite (std::invalid_argument otherwise).
+RollingTail rolling_tail(double inertia_factor, double rolling_resistance, double intensity);
 
 /// η* for clearance h (> 0), stroke X (> 0), frequency f (> 0), all finite
 /// (std::invalid_argument naming the quantity otherwise, and for invalid options).

@@ -82,6 +82,12 @@ struct FillingRatioOptions {
   std::vector<std::vector<std::shared_ptr<const surrogate::LossModel>>> bed_models;
   /// Largest number of whole-slab designs enumerated with bed_models (Π(max_slabs + 1)).
   static constexpr long kMaxEnumeratedDesigns = 100000;
+  /// On the closed forms, every whole-slab design is evaluated when there are at most this
+  /// many (Π(max_slabs + 1)), in [0, kMaxEnumeratedDesigns]: the objective jumps where a layer's
+  /// onset crosses the release, so rounding the relaxed optimum can miss the best one. Above
+  /// it, the rounded neighbours of the relaxed optimum only. Default 2000 (about 5 s of
+  /// decays at 2.3 ms each).
+  long max_enumerated_designs = 2000;
   /// One line per violated rule, naming the field ("layers[1].slab_length_m = 0: must be > 0"),
   /// including a budget below the lightest slab ("mass_budget_kg = ...").
   std::vector<std::string> validate() const;
@@ -117,10 +123,13 @@ struct FillingDesign {
 struct FillingRatioResult {
   FillingDesign initial;   ///< the starting design (LayerCandidate::initial_slabs)
   FillingDesign relaxed;   ///< continuous optimum of optimizer::solve (n_k real)
-  /// The integer points around the relaxed optimum (each n_k floored or ceiled; one value
-  /// where n_k is within 1e-6 of a whole number), feasible ones evaluated, in order.
+  /// The whole-slab designs evaluated, in order: every feasible one when they are
+  /// enumerated (calibrated beds, or at most max_enumerated_designs), else the integer points
+  /// around the relaxed optimum (each n_k floored or ceiled; one value where n_k is within
+  /// 1e-6 of a whole number).
   std::vector<FillingDesign> neighbours;
-  int neighbours_total = 0;      ///< 2^(number of fractional n_k)
+  bool enumerated = false;       ///< neighbours holds every feasible whole-slab design
+  int neighbours_total = 0;      ///< designs considered (enumerated, or 2^(number of fractional n_k))
   int neighbours_feasible = 0;   ///< of those, within the constraints (evaluated)
   FillingDesign chosen;          ///< best evaluated neighbour
   /// Best single-layer design with the same budget: all mass in one layer, best over the

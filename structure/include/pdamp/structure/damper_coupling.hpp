@@ -21,6 +21,9 @@ struct DamperLayer {
   std::string name;                                          ///< label for reports
   double bed_mass_kg = 0.0;                                  ///< m_bed, kg, > 0
   std::shared_ptr<const surrogate::LossModel> loss_model;    ///< η*(f, X), m_app/m_bed(f, X); required
+  /// The bed has come down from above its loss model's onset (free_decay sets it for a
+  /// release above the onset): the coupling then asks loss_model->evaluate_from_above.
+  bool from_above = false;
 };
 
 /// A particle damper at a named point of a ModalModel.

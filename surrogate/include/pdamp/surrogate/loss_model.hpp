@@ -55,6 +55,10 @@ class LossModel {
   /// The response at (f, X); f > 0 and X > 0 finite. No allocation where the response has
   /// no warning (implementations state their exceptions).
   virtual DamperResponse evaluate(double frequency_hz, double stroke_m) const = 0;
+  /// The response of a bed that has come down from above the onset (a free decay released
+  /// above it, docs/theory.md §3.4): below the onset it may differ from a bed driven there
+  /// from rest. Default: evaluate (a field or a model without that history).
+  virtual DamperResponse evaluate_from_above(double frequency_hz, double stroke_m) const;
   /// Strokes at which the response jumps at frequency f (the onset cliff of
   /// collect-and-collide), ascending, m. Default: none (a continuous model).
   virtual std::vector<double> discontinuities_stroke_m(double frequency_hz) const;
@@ -80,7 +84,9 @@ std::vector<std::string> describe_loss_warnings(std::uint32_t warnings);
 /// Rolling spheres (κ > 0) move as v_c + u_block/(1+κ):  m_app/m_bed = (κ + m_block)/(1+κ).
 /// Below the onset (no orbit, scattered fit for η*) the assumption is the no-impact
 /// limit κ/(1+κ) (2/7 for rolling solid spheres, docs/theory.md §3; 0 for a free block),
-/// flagged kLossApparentMassAssumed. Derivatives in X are analytic (chain rule through the
+/// flagged kLossApparentMassAssumed. Come down from above (evaluate_from_above, options'
+/// below_onset_from_above: the rolling tail by default), a rolling bed below the onset
+/// rolls without impacts: η* and m_app/m_bed of formulas::rolling_tail. Derivatives in X are analytic (chain rule through the
 /// impact phase and, for auto's friction-limited sliding, through κ_eff(Γ)). They diverge
 /// like 1/√(X − X_onset) just above the onset (a saddle-node, docs §3): the onset is a jump
 /// listed by discontinuities_stroke_m().
@@ -93,6 +99,7 @@ class ClosedFormLossModel final : public LossModel {
   /// Throws std::invalid_argument for clearance_m not > 0 and finite or invalid options.
   ClosedFormLossModel(formulas::DamperModel model, double clearance_m, formulas::ModelOptions options = {});
   DamperResponse evaluate(double frequency_hz, double stroke_m) const override;
+  DamperResponse evaluate_from_above(double frequency_hz, double stroke_m) const override;
   /// The onset stroke of the block that answers at f (kRolling/kBouncing: (1+κ)h/√(π²+4);
   /// kAuto: the fixed point X = (1+κ_eff(Γ(X)))h/√(π²+4)); none for kScattered.
   std::vector<double> discontinuities_stroke_m(double frequency_hz) const override;
@@ -102,11 +109,15 @@ class ClosedFormLossModel final : public LossModel {
   double clearance_m() const { return clearance_m_; }
 
  private:
+  DamperResponse respond(const formulas::ModelOptions& options, double frequency_hz, double stroke_m) const;
   DamperResponse rebounding_response(const formulas::LossResult& loss, double stroke_m, double d_kappa) const;
   DamperResponse coulomb_response(const formulas::LossResult& loss, double frequency_hz, double stroke_m) const;
+  DamperResponse tail_response(const formulas::LossResult& loss, double frequency_hz, double stroke_m) const;
   formulas::DamperModel model_;
   double clearance_m_;
   formulas::ModelOptions options_;
+  /// options_ with below_onset = below_onset_from_above.
+  formulas::ModelOptions from_above_options_;
 };
 
 /// LossModel from an effective field (DEM, formulas or measured): η* and the apparent-mass
