@@ -102,6 +102,8 @@ int run_filling_ratios_case(const ParsedArgs& args, CommandContext& context, con
   const bool calibrated = options.calibrated.value_or(c.task.filling_ratios->calibration.has_value());
   if (const auto cache = args.optional_text("--calibration-cache")) {
     if (!calibrated) throw InputError("--calibration-cache", "", "applies to calibrated beds (--method calibrated)");
+    if (const std::string problem = tasks::prepare_calibration_cache(*cache); !problem.empty())
+      throw InputError("--calibration-cache", "", problem);
     options.calibration_cache = *cache;
   }
   options.backend = backend_flag(args);
@@ -319,8 +321,8 @@ int run_optimize_case(const ParsedArgs& args, CommandContext& context, const Cas
 Command optimize_command() {
   return {{"optimize", "pdamp optimize CASE.json [--backend nlopt|ipopt] [--method formulas|field|calibrated] [--calibration-cache DIR] [--verify|--no-verify] [--resume] [-o DIR] [--json]",
            "optimise the case's task (kind filling_ratios: whole slabs per layer of the first damper\n"
-           "for the fastest free decay under a particle-mass budget; relaxed solve, rounded\n"
-           "neighbours, single-layer baseline; with the task's verify block or --verify, the\n"
+           "for the fastest free decay under a particle-mass budget; relaxed solve, every\n"
+           "whole-slab design, single-layer baseline; with the task's verify block or --verify, the\n"
            "DEM-in-the-loop check of the chosen and baseline designs. Kind placement: the site\n"
            "along a beam, or among named points, where the damper adds the most damping to the\n"
            "target modes. Kind clearance: the clearance of a single-layer damper for the lowest\n"

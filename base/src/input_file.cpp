@@ -251,4 +251,17 @@ nlohmann::json parse_json_document(const std::string& text, const std::string& p
   }
 }
 
+std::string safe_file_name(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                      c == '-' || c == '_' || c == '+';
+    out += keep ? c : '_';
+  }
+  if (out.size() > 100) out.resize(100);
+  if (out.empty()) out = "case";
+  if (out[0] == '.' || out[0] == '-') out[0] = '_';
+  return out;
+}
+
 }  // namespace pdamp::base

@@ -1,4 +1,4 @@
-// Filling ratios of a multi-layer damper: relaxed solve, rounded neighbours, baseline.
+// Filling ratios of a multi-layer damper: relaxed solve, whole-slab designs, baseline.
 #include "pdamp/optimizer/filling_ratios.hpp"
 
 #include "pdamp/structure/sampled_decay.hpp"

@@ -5,8 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <numbers>
 
+#include <unistd.h>
+
+#include "pdamp/base/input_error.hpp"
 #include "pdamp/base/input_file.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/output_file.hpp"
@@ -28,21 +32,6 @@ constexpr const char* kCacheFormat = "pdamp.bed_calibration";
 /// Raised whenever what a cache file holds or how it is computed from the DEM changes
 /// (structure::bed_response_per_period, surrogate::decay_field): it is part of every key.
 constexpr int kCacheFormatVersion = 3;  // 3: the bed's force the mean over each sample interval, centred
-
-/// The physics a bed's calibration depends on: the design case's structure, dampers,
-/// materials and DEM settings (the softening included), the release, the duration, the
-/// binning and the DEM's model version; not names, descriptions or the budget.
-std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec, double extra_damping_ratio) {
-  const json& r = design.resolved;
-  json identity = {{"structure", r.value("structure", json())},   {"dampers", r.value("dampers", json())},
-                   {"materials", r.value("materials", json())},   {"dem", r.value("dem", json())},
-                   {"initial_state", r.at("task").value("initial_state", json())},
-                   {"duration_s", spec.duration_s},              {"strokes_per_decade", spec.strokes_per_decade},
-                   {"dem_model_version", surrogate::dem_model_version()},
-                   {"calibration_version", kCacheFormatVersion},
-                   {"extra_damping_ratio", extra_damping_ratio}};
-  return surrogate::case_hash(identity);
-}
 
 json period_rows(const std::vector<surrogate::DecayPeriodResponse>& periods) {
   json rows = json::array();
@@ -138,6 +127,56 @@ json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const
 
 }  // namespace
 
+// The physics a bed's calibration depends on: the design case's structure, dampers,
+// materials and DEM settings (the softening included), the release, the duration, the
+// binning and the DEM's model version; not names, descriptions or the budget.
+std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec, double extra_damping_ratio) {
+  const json& r = design.resolved;
+  // The dampers' and layers' names label the bed; they are no part of what it does.
+  json dampers = r.value("dampers", json());
+  for (auto& damper : dampers) {
+    if (!damper.is_object()) continue;
+    damper.erase("name");
+    if (damper.contains("layers"))
+      for (auto& layer : damper["layers"])
+        if (layer.is_object()) layer.erase("name");
+  }
+  json identity = {{"structure", r.value("structure", json())},   {"dampers", dampers},
+                   {"materials", r.value("materials", json())},   {"dem", r.value("dem", json())},
+                   {"initial_state", r.at("task").value("initial_state", json())},
+                   {"duration_s", spec.duration_s},              {"strokes_per_decade", spec.strokes_per_decade},
+                   {"dem_model_version", surrogate::dem_model_version()},
+                   {"calibration_version", kCacheFormatVersion},
+                   {"extra_damping_ratio", extra_damping_ratio}};
+  return surrogate::case_hash(identity);
+}
+
+std::filesystem::path calibration_cache_file(const std::filesystem::path& cache_dir, const std::string& layer, int slabs,
+                                             const std::string& key) {
+  // The layer's name only as a safe label: a case's name must not steer the path (the key
+  // makes the file unique).
+  return cache_dir / (base::safe_file_name(layer) + "_" + std::to_string(slabs) + "_" + key + ".json");
+}
+
+std::string prepare_calibration_cache(const std::filesystem::path& cache_dir) {
+  if (cache_dir.empty()) return "must name a folder";
+  std::error_code error;
+  if (std::filesystem::exists(cache_dir, error) && !std::filesystem::is_directory(cache_dir, error))
+    return "'" + base::printable(cache_dir.string()) + "' exists and is not a folder";
+  std::filesystem::create_directories(cache_dir, error);
+  if (error) return "cannot create '" + base::printable(cache_dir.string()) + "': " + error.message();
+  // The beds are written atomically beside their final name: try one such file now.
+  const auto probe = cache_dir / (".pdamp-write-probe-" + std::to_string(::getpid()));
+  bool written = false;
+  {
+    std::ofstream out(probe);
+    written = static_cast<bool>(out << "probe") && static_cast<bool>(out.flush());
+  }
+  std::filesystem::remove(probe, error);
+  if (!written) return "'" + base::printable(cache_dir.string()) + "' is not writable";
+  return "";
+}
+
 std::filesystem::path default_calibration_cache() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
     return std::filesystem::path(xdg) / "pdamp" / "bed_calibration";
@@ -173,11 +212,8 @@ std::string bed_inputs(const CalibratedBed& bed) {
 int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
                 const std::filesystem::path& cache_dir, std::vector<CalibratedBed>& beds, base::RunHooks& hooks,
                 base::Executor& executor) {
-  std::error_code error;
-  std::filesystem::create_directories(cache_dir, error);
-  if (error)
-    throw std::runtime_error("pdamp optimize: cannot create the calibration cache " + cache_dir.string() + ": " +
-                             error.message());
+  if (const std::string problem = prepare_calibration_cache(cache_dir); !problem.empty())
+    throw base::InputError(cache_dir.string(), "", "the calibration cache " + problem);
   std::vector<std::size_t> to_run;
   for (std::size_t b = 0; b < beds.size(); ++b) {
     CalibratedBed& bed = beds[b];
@@ -185,7 +221,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
     slabs[static_cast<std::size_t>(bed.layer_index)] = bed.slabs;
     bed.key = calibration_key(case_file::with_design(c, slabs, spec.stiffness_softening, true), spec,
                               bed.extra_damping_ratio);
-    bed.file = cache_dir / (bed.layer + "_" + std::to_string(bed.slabs) + "_" + bed.key + ".json");
+    bed.file = calibration_cache_file(cache_dir, bed.layer, bed.slabs, bed.key);
     std::string why;
     if (!read_cached(bed, why)) {
       if (!why.empty()) hooks.note("pdamp: warning: " + bed.file.string() + " is not used (" + why + "): it runs again");

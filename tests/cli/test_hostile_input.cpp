@@ -892,3 +892,21 @@ TEST_CASE("every structure and modal-data number has a range, and validate build
   require_one_line_error(out_of_scale, "/task/initial_state");
   CHECK_THAT(out_of_scale.err, Catch::Contains("site 'tip'") && Catch::Contains("modal masses and shapes"));
 }
+
+// Reference: a calibration cache that cannot hold the beds is refused before any DEM work,
+// naming the flag (once: exit 1 after the whole calibration, or the default cache silently
+// used for an empty value).
+TEST_CASE("a calibration cache that is a file, empty or not writable is refused before any DEM work", "[cli]") {
+  TempDir tmp("calibration_cache_faults");
+  const std::string link = case_path("manipulator_link_optimize.json");
+  const fs::path file = tmp.path / "a_file";
+  { std::ofstream(file) << "x"; }
+  require_one_line_error(run_pdamp({"optimize", link, "--calibration-cache", file.string()}),
+                         "--calibration-cache: '" + file.string() + "' exists and is not a folder");
+  require_one_line_error(run_pdamp({"optimize", link, "--calibration-cache="}), "--calibration-cache: must name a folder");
+  require_one_line_error(run_pdamp({"optimize", link, "--calibration-cache", (file / "below").string()}),
+                         "--calibration-cache: cannot create");
+  // A folder nobody can write in, root included: /proc (a file cannot be created there).
+  require_one_line_error(run_pdamp({"optimize", link, "--calibration-cache", "/proc"}),
+                         "--calibration-cache: '/proc' is not writable");
+}

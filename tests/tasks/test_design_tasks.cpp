@@ -7,8 +7,10 @@
 #include <fstream>
 
 #include "cli/cli_support.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/case_file/case.hpp"
 #include "pdamp/case_file/structure_setup.hpp"
+#include "pdamp/tasks/bed_calibration.hpp"
 #include "pdamp/tasks/filling_ratios.hpp"
 #include "pdamp/tasks/placement.hpp"
 #include "support/temp_dir.hpp"
@@ -330,4 +332,43 @@ TEST_CASE("the damping ratio of a modal decay is the slope of its period maxima"
   CHECK(tasks::modal_decay_damping_ratio(t, q, fd, 0.0) == Approx(zeta / std::sqrt(1.0 - zeta * zeta)).epsilon(1e-9));
   // Fewer than two whole periods: no ratio.
   CHECK(std::isnan(tasks::modal_decay_damping_ratio({0.0, 0.05}, Eigen::Vector2d(1.0, 0.5), fd, 0.5)));
+}
+
+// A layer's name is a label: it neither leads the bed's cache file out of the cache folder
+// (once "../../x" wrote outside it, "/abs" into an absolute folder, a NUL cut the name so that
+// beds overwrote one file, 300 bytes failed with "File name too long") nor changes the key.
+TEST_CASE("a layer's name cannot lead its calibration file out of the cache folder nor change its key", "[tasks]") {
+  const std::filesystem::path dir = std::filesystem::path("cache") / "beds";
+  const std::string key = "0123456789abcdef";
+  for (const std::string& name : {std::string("../../x"), std::string("/abs/olute"), std::string("lo\0w", 4),
+                                  std::string("lo\0v", 4), std::string(300, 'a'), std::string("sub/dir"),
+                                  std::string(".hidden"), std::string("-rf"), std::string("..")}) {
+    CAPTURE(base::printable(name));
+    const auto file = tasks::calibration_cache_file(dir, name, 3, key);
+    CHECK(file.parent_path() == dir);
+    const std::string leaf = file.filename().string();
+    CHECK(leaf.size() <= 130);  // 100 for the name, then "_3_" + 16 + ".json"
+    CHECK(leaf.front() != '.');
+    CHECK(leaf.find('\0') == std::string::npos);
+    CHECK(leaf.substr(leaf.size() - 24) == "_3_" + key + ".json");
+  }
+  // Two names cut at the same NUL are two files (their keys differ in the bed's physics, and
+  // the names stay apart after the NUL).
+  CHECK(tasks::calibration_cache_file(dir, std::string("lo\0w", 4), 1, key) !=
+        tasks::calibration_cache_file(dir, std::string("lo\0v", 4), 1, key));
+
+  std::ifstream in(case_path("manipulator_link_optimize.json"));
+  const nlohmann::json document = nlohmann::json::parse(in);
+  nlohmann::json renamed = document;
+  renamed["dampers"][0]["name"] = "another damper";
+  for (auto& layer : renamed["dampers"][0]["layers"]) layer["name"] = "../" + layer["name"].get<std::string>();
+  nlohmann::json heavier = document;
+  heavier["dampers"][0]["container_mass_kg"] = 0.3;
+  const auto key_of = [](const nlohmann::json& j) {
+    const auto c = case_file::load_case_document(j, "key.json");
+    const auto spec = c.task.filling_ratios->calibration.value();
+    return tasks::calibration_key(case_file::with_design(c, {1, 0, 0}, spec.stiffness_softening, true), spec, 0.0);
+  };
+  CHECK(key_of(renamed) == key_of(document));
+  CHECK(key_of(heavier) != key_of(document));
 }

@@ -42,4 +42,10 @@ bool valid_utf8(const std::string& text);
 /// input stays one line and is not cut at a NUL byte.
 std::string printable(const std::string& text);
 
+/// `name` as a safe single file-name component: letters, digits, '.', '-', '_' and
+/// '+' are kept, every other byte (a '/', "..", a NUL, a quote, a space) becomes '_', a
+/// leading '.' or '-' is replaced and the length is capped at 100 bytes, so a name cannot
+/// steer a path out of its folder nor exceed a file system's name length.
+std::string safe_file_name(const std::string& name);
+
 }  // namespace pdamp::base

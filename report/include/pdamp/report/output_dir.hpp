@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/base/number_text.hpp"
 
 namespace pdamp::report {
@@ -90,10 +91,7 @@ bool gnuplot_available();
 /// that ^ _ { } @ & show as typed.
 std::string gnuplot_string(const std::string& text);
 
-/// `name` as a safe single file-name component: letters, digits, '.', '-', '_' and
-/// '+' are kept, every other byte (a '/', "..", a quote, a space) becomes '_', and a
-/// leading '.' or '-' is replaced, so a name cannot steer a path out of its folder.
-std::string safe_file_name(const std::string& name);
+using base::safe_file_name;
 
 /// Numbers in titles and labels (base::format_number).
 using base::format_number;

@@ -66,10 +66,27 @@ struct BedCalibration {
 /// $HOME/.cache/pdamp/bed_calibration, else ./.pdamp-cache/bed_calibration.
 std::filesystem::path default_calibration_cache();
 
+/// A bed's key, 16 hex digits of the physics its calibration depends on: the design case's
+/// structure, dampers (without their names), materials and DEM settings (the softening
+/// included), the release, the duration, the binning, the DEM's model version and the cache
+/// format; not names, descriptions or the budget.
+std::string calibration_key(const case_file::Case& design, const case_file::CalibrationSpec& spec,
+                            double extra_damping_ratio);
+/// A bed's cache file, `<layer>_<slabs>_<key>.json` in cache_dir, the layer's name made a
+/// safe file-name component (base::safe_file_name): no name leads it out of the folder.
+std::filesystem::path calibration_cache_file(const std::filesystem::path& cache_dir, const std::string& layer, int slabs,
+                                             const std::string& key);
+
+/// Makes the cache folder (with its parents) and checks that a file can be written there:
+/// "" when it can, else why not ("… exists and is not a folder", "cannot create it: …", "is
+/// not writable: …"), so that a calibration is refused before its DEM work rather than after.
+std::string prepare_calibration_cache(const std::filesystem::path& cache_dir);
+
 /// Calibrates every candidate bed of the case's filling-ratio problem: cached beds are read,
 /// the others run as jobs of `executor` (each writes its cache file atomically when done, so
 /// an interrupted calibration keeps what finished). A cache file that cannot be read or holds
-/// another key is run again, with a note. InputError for refused DEM options, NumericalError
+/// another key is run again, with a note. InputError for a cache folder that cannot be
+/// written (prepare_calibration_cache) or refused DEM options, NumericalError
 /// for a decay the DEM cannot run or a bed whose decay gives no field.
 BedCalibration calibrate_beds(const case_file::Case& c, const case_file::FillingRatioProblem& p,
                               const case_file::CalibrationSpec& spec, const std::filesystem::path& cache_dir,

@@ -1,6 +1,6 @@
 // Task kind filling_ratios (pdamp optimize, pdamp run): how many whole slabs each layer of
 // the first damper holds for the fastest free decay under a particle-mass budget (NLopt or
-// Ipopt on the closed forms), the rounded neighbours and the best single layer, the decays
+// Ipopt on the closed forms), the whole-slab designs and the best single layer, the decays
 // that compare them, and the DEM verification of the chosen design against the baseline.
 #pragma once
 
