@@ -31,7 +31,7 @@ namespace {
 constexpr const char* kCacheFormat = "pdamp.bed_calibration";
 /// Raised whenever what a cache file holds or how it is computed from the DEM changes
 /// (structure::bed_response_per_period, surrogate::decay_field): it is part of every key.
-constexpr int kCacheFormatVersion = 3;  // 3: the bed's force the mean over each sample interval, centred
+constexpr int kCacheFormatVersion = 4;  // 3: the bed's force the mean over each sample interval, centred; 4: a digest
 
 json period_rows(const std::vector<surrogate::DecayPeriodResponse>& periods) {
   json rows = json::array();
@@ -40,23 +40,75 @@ json period_rows(const std::vector<surrogate::DecayPeriodResponse>& periods) {
   return rows;
 }
 
-json cache_document(const CalibratedBed& bed) {
-  return {{"format", kCacheFormat},          {"format_version", kCacheFormatVersion},
-          {"key", bed.key},                  {"layer", bed.layer},
-          {"slabs", bed.slabs},              {"extra_damping_ratio", bed.extra_damping_ratio},
-          {"steps", bed.steps},
-          {"energy_error", bed.energy_error}, {"wall_time_s", bed.wall_time_s},
-          {"periods", period_rows(bed.periods)}, {"field", surrogate::to_json(bed.field)}};
+/// The digest of a cache document: a hash of everything in it but the digest itself (and
+/// the "cached" flag the processes of a distributed run add), so that an edited file (an η*
+/// multiplied by 50) is not trusted.
+std::string document_digest(json d) {
+  d.erase("digest");
+  d.erase("cached");
+  return surrogate::case_hash(d);
 }
 
-/// The bed from a cache document, or false (with the reason in `why`) when it is not one of
-/// this bed's key.
-bool bed_from_document(const json& d, CalibratedBed& bed, std::string& why) {
+json cache_document(const CalibratedBed& bed) {
+  json d = {{"format", kCacheFormat},          {"format_version", kCacheFormatVersion},
+            {"key", bed.key},                  {"layer", bed.layer},
+            {"slabs", bed.slabs},              {"extra_damping_ratio", bed.extra_damping_ratio},
+            {"steps", bed.steps},
+            {"energy_error", bed.energy_error}, {"wall_time_s", bed.wall_time_s},
+            {"periods", period_rows(bed.periods)}, {"field", surrogate::to_json(bed.field)}};
+  d["digest"] = document_digest(d);
+  return d;
+}
+
+/// What a bed is for, which its document must say of itself.
+struct BedIdentity {
+  double bed_mass_kg = 0.0;  ///< slabs · the layer's slab mass
+  double clearance_m = 0.0;  ///< the layer's settled clearance at those slabs
+  double duration_s = 0.0;   ///< the calibration's decay
+};
+
+BedIdentity identity_of(const case_file::FillingRatioProblem& p, const case_file::CalibrationSpec& spec,
+                        const CalibratedBed& bed) {
+  const auto& layer = p.options.layers.at(static_cast<std::size_t>(bed.layer_index));
+  return {bed.slabs * layer.slab_mass_kg(), layer.clearance_m(bed.slabs), spec.duration_s};
+}
+
+/// "" when the document is this bed's (layer, slabs, extra damping, key, digest, bed mass,
+/// clearance) and every number in it is in its range, else the first rule broken.
+std::string document_problem(const json& d, const CalibratedBed& bed, const BedIdentity& id) {
+  const auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
+  if (d.at("format") != kCacheFormat || d.at("format_version") != kCacheFormatVersion || d.at("key") != bed.key)
+    return "it holds another calibration";
+  if (!d.contains("digest") || d.at("digest") != document_digest(d)) return "its content does not match its digest";
+  if (d.at("layer") != bed.layer || d.at("slabs") != bed.slabs ||
+      !same(d.at("extra_damping_ratio").get<double>(), bed.extra_damping_ratio))
+    return "it is the calibration of another bed";
+  const json& field = d.at("field");
+  if (!same(field.at("bed_mass_kg").get<double>(), id.bed_mass_kg) ||
+      !same(field.at("clearance_m").get<double>(), id.clearance_m))
+    return "its bed mass or clearance is not this bed's";
+  if (d.at("steps").get<std::int64_t>() < 0) return "steps < 0";
+  const double energy_error = d.at("energy_error").get<double>(), wall = d.at("wall_time_s").get<double>();
+  if (!(energy_error >= 0.0 && energy_error <= 1.0)) return "energy_error outside [0, 1]";
+  if (!(wall >= 0.0 && std::isfinite(wall))) return "wall_time_s not >= 0 and finite";
+  for (const auto& row : d.at("periods")) {
+    const double t = row.at(0).get<double>(), f = row.at(1).get<double>(), x = row.at(2).get<double>();
+    // The periods of a decay of duration_s at the case's frequencies (<= 1e4 Hz) and strokes
+    // (the clearance's range, <= 100 m); η* and m_app/m_bed in the fields' ranges.
+    if (!(t >= 0.0 && t <= id.duration_s * (1.0 + 1e-9)) || !(f > 0.0 && f <= 1e4) || !(x > 0.0 && x <= 100.0))
+      return "a period row outside [0, duration] s, (0, 1e4] Hz, (0, 100] m";
+    if (const std::string problem = surrogate::field_value_problem(row.at(3).get<double>(), row.at(4).get<double>());
+        !problem.empty())
+      return "a period row's " + problem;
+  }
+  return "";
+}
+
+/// The bed from a cache document, or false (with the reason in `why`) when it is not this
+/// bed's (document_problem).
+bool bed_from_document(const json& d, CalibratedBed& bed, const BedIdentity& id, std::string& why) {
   try {
-    if (d.at("format") != kCacheFormat || d.at("format_version") != kCacheFormatVersion || d.at("key") != bed.key) {
-      why = "it holds another calibration";
-      return false;
-    }
+    if (why = document_problem(d, bed, id); !why.empty()) return false;
     bed.field = surrogate::effective_field_from_json(d.at("field"), bed.file.string());
     bed.periods.clear();
     for (const auto& row : d.at("periods"))
@@ -74,11 +126,11 @@ bool bed_from_document(const json& d, CalibratedBed& bed, std::string& why) {
 
 /// The cached bed, or false (with the reason in `why`) when the file is absent, unreadable
 /// or of another key.
-bool read_cached(CalibratedBed& bed, std::string& why) {
+bool read_cached(CalibratedBed& bed, const BedIdentity& id, std::string& why) {
   if (!std::filesystem::exists(bed.file)) return false;
   try {
     const json d = base::parse_json_document(base::read_input_file(bed.file.string()), bed.file.string());
-    return bed.cached = bed_from_document(d, bed, why);
+    return bed.cached = bed_from_document(d, bed, id, why);
   } catch (const std::exception& e) {
     why = e.what();
     return false;
@@ -223,7 +275,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
                               bed.extra_damping_ratio);
     bed.file = calibration_cache_file(cache_dir, bed.layer, bed.slabs, bed.key);
     std::string why;
-    if (!read_cached(bed, why)) {
+    if (!read_cached(bed, identity_of(p, spec, bed), why)) {
       if (!why.empty()) hooks.note("pdamp: warning: " + bed.file.string() + " is not used (" + why + "): it runs again");
       to_run.push_back(b);
     }
@@ -241,7 +293,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
       CalibratedBed& bed = beds[to_run[j]];
       std::string why;
       // What the job returned is what it wrote to the cache (on this process or another).
-      if (!bed_from_document(ran[j], bed, why))
+      if (!bed_from_document(ran[j], bed, identity_of(p, spec, bed), why))
         throw base::NumericalError("pdamp optimize: the calibration of " + bed.layer + " with " +
                                    std::to_string(bed.slabs) + " slabs came back unreadable (" + why + ")");
     }
@@ -258,7 +310,7 @@ int read_or_run(const Case& c, const case_file::FillingRatioProblem& p, const ca
   for (std::size_t b = 0; b < beds.size(); ++b) {
     CalibratedBed& bed = beds[b];
     std::string why;
-    if (!bed_from_document((*shared)[b], bed, why))
+    if (!bed_from_document((*shared)[b], bed, identity_of(p, spec, bed), why))
       throw std::runtime_error("the primary process's calibration of " + bed.layer + " with " +
                                std::to_string(bed.slabs) + " slabs is not this process's (" + why + ")");
     bed.cached = (*shared)[b].at("cached").get<bool>();

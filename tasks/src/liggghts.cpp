@@ -9,7 +9,9 @@
 #include <numbers>
 #include <sstream>
 
+#include "pdamp/case_file/ranges.hpp"
 #include "pdamp/dem_reference/world.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/formulas/cor_models.hpp"
 #include "pdamp/base/input_error.hpp"
 #include "pdamp/base/input_file.hpp"
@@ -444,9 +446,11 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
 namespace {
 
 /// The rows of one LIGGGHTS output file: its title line must name this export; every
-/// other line not starting with '#' holds `columns` finite numbers, the first the step.
+/// other line not starting with '#' holds `columns` finite numbers, the first the step. A
+/// file of more than `max_rows` rows is refused at the first row too many (the export's run
+/// writes a known number: a huge file costs no more than its text).
 std::vector<std::vector<double>> read_output_file(const std::filesystem::path& path, const std::string& export_id,
-                                                  std::size_t columns) {
+                                                  std::size_t columns, std::size_t max_rows) {
   const std::string file = path.string();
   if (!std::filesystem::exists(path))
     throw InputError(file, "", "missing: run LIGGGHTS on the deck in this folder first (README.txt)");
@@ -469,6 +473,9 @@ std::vector<std::vector<double>> read_output_file(const std::filesystem::path& p
       continue;
     }
     if (line.empty() || line[0] == '#') continue;
+    if (rows.size() == max_rows)
+      throw InputError(file, "",
+                       where + "holds more than the " + std::to_string(max_rows) + " samples of this export's run");
     std::vector<double> row;
     const char* at = line.data();
     const char* end = line.data() + line.size();
@@ -514,10 +521,17 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   out.record = document;
   const std::string id = r.string("export_id");
   out.case_name = r.string("case");
-  out.frequency_hz = r.number("frequency_hz", true, "Hz");
-  out.amplitude_m = r.number("amplitude_m", true, "m");
-  out.bed_mass_kg = r.number("bed_mass_kg", true, "kg");
-  out.time_step_s = r.number("time_step_s", true, "s");
+  // The case's own ranges (docs/bad_inputs.md): a record edited to 1e300 m or 1e-320 kg is
+  // refused here rather than turned into a NaN or a silent 0 further on.
+  const auto ranged = [&](std::string_view key, const case_file::Range& range, std::string_view unit) {
+    const double value = r.number(key, false, unit);
+    if (!range.contains(value)) r.fail(key, "= " + format_number(value, 10) + ": " + range.text() + " " + std::string(unit));
+    return value;
+  };
+  out.frequency_hz = ranged("frequency_hz", case_file::limits::kFrequency, "Hz");
+  out.amplitude_m = ranged("amplitude_m", case_file::limits::kStroke, "m");
+  out.bed_mass_kg = ranged("bed_mass_kg", {1e-9, 1e6}, "kg");
+  out.time_step_s = ranged("time_step_s", {dr::limits::kMinTimeStep_s, dr::limits::kMaxTimeStep_s}, "s");
   const int transient = static_cast<int>(r.integer("transient_periods", 0, dr::limits::kMaxPeriods));
   out.analysed_periods = static_cast<int>(r.integer("analysed_periods", 1, dr::limits::kMaxPeriods));
   out.samples_per_period = static_cast<int>(r.integer("samples_per_period", 3, dr::limits::kMaxSamplesPerPeriod));
@@ -540,9 +554,23 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
     if (!value->is_array() || value->size() != 3) r.fail(key, "must be 3 numbers");
     for (int k = 0; k < 3; ++k) (*into)[k] = r.number_value((*value)[k], r.pointer(key) + "/" + std::to_string(k), false);
   }
-  for (const char* informative : {"pdamp_version", "velocity_amplitude_m_s", "intensity", "sample_interval_s", "settling_steps",
-                                  "particles", "clearance_m", "stiffness_softening", "contacts", "closed_form"})
-    (void)r.optional(informative);
+  for (int k = 0; k < 3; ++k)
+    if (!case_file::limits::kGravity.contains(g[k]))
+      r.fail("gravity_m_s2", "= " + format_number(g[k], 10) + " in component " + std::to_string(k) + ": " +
+                                 case_file::limits::kGravity.text() + " m/s^2");
+  // The export writes the unit vector of its drive axis; another is an edited record whose
+  // force would be measured along the wrong axis or scaled.
+  for (int k = 0; k < 3; ++k)
+    if (d[k] != (k == axis ? 1.0 : 0.0))
+      r.fail("drive_direction", "must be the unit vector of drive_axis " + axis_name);
+  // Informative keys are not used, but a wrong type is still a wrong record.
+  for (const char* text : {"pdamp_version"})
+    if (const auto* v = r.optional(text); v && !v->is_string()) r.fail(text, std::string("must be a string, got ") + v->type_name());
+  for (const char* number : {"velocity_amplitude_m_s", "intensity", "sample_interval_s", "settling_steps", "particles",
+                             "clearance_m", "stiffness_softening"})
+    if (const auto* v = r.optional(number); v && !v->is_number())
+      r.fail(number, std::string("must be a number, got ") + v->type_name());
+  for (const char* informative : {"contacts", "closed_form"}) (void)r.optional(informative);
   r.finish();
 
   const double omega = 2.0 * std::numbers::pi * out.frequency_hz;
@@ -552,15 +580,11 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
 
   // Force: sample m ends at step m·B and is the mean over steps m·B − B + 1 ... m·B.
   const auto force_path = dir / kLiggghtsForceFile;
-  const auto force_rows = read_output_file(force_path, id, 4);
+  const auto force_rows = read_output_file(force_path, id, 4, static_cast<std::size_t>(last));
   if (static_cast<std::int64_t>(force_rows.size()) < last)
     throw InputError(force_path.string(), "",
                      "holds " + std::to_string(force_rows.size()) + " samples of the " + std::to_string(last) +
                          " the run writes: the LIGGGHTS run has not finished (see its log)");
-  if (static_cast<std::int64_t>(force_rows.size()) > last)
-    throw InputError(force_path.string(), "",
-                     "holds " + std::to_string(force_rows.size()) + " samples, more than the " + std::to_string(last) +
-                         " of this export's run");
   dr::DriveBinMeasure bin(samples, out.frequency_hz, out.bed_mass_kg);
   for (std::int64_t m = 1; m <= last; ++m) {
     const auto& row = force_rows[static_cast<std::size_t>(m - 1)];
@@ -569,6 +593,13 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
                        "sample " + std::to_string(m) + " is at step " + format_number(row[0], 12) + ", expected " +
                            std::to_string(m * per_sample) + " (a step every " + std::to_string(per_sample) +
                            " from the drive's start)");
+    // A bed of at most 1e6 kg (the case's mass range) at 1e5 m/s² pushes with 1e11 N: a force
+    // beyond 1e12 N is no bed's, and would overflow the measure's sums.
+    for (int k = 1; k <= 3; ++k)
+      if (std::abs(row[static_cast<std::size_t>(k)]) > 1e12)
+        throw InputError(force_path.string(), "",
+                         "its forces give sample " + std::to_string(m) + " a force of " +
+                             format_number(row[static_cast<std::size_t>(k)], 6) + " N, beyond any bed's (1e12 N)");
     if (m < first) continue;
     // The force of the container on the bed is minus the force of the bed on the walls.
     const double force = -(row[1] * d[0] + row[2] * d[1] + row[3] * d[2]);
@@ -583,11 +614,26 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
     const double t_start = (static_cast<double>((m - 1) * per_sample) + 0.5) * dt;
     out.container_work_j += force * x * (std::sin(omega * t_end) - std::sin(omega * t_start));
   }
-  out.measures = bin.result();
+  // Forces of 1e300 N pass the row check but overflow the sums: the file's fault, named.
+  try {
+    out.measures = bin.result();
+  } catch (const std::exception& e) {
+    throw InputError(force_path.string(), "", std::string("its forces give no measure: ") + e.what());
+  }
+  if (!std::isfinite(out.measures.eta_star) || !std::isfinite(out.measures.e_diss_j) ||
+      !std::isfinite(out.measures.apparent_mass_kg) || !std::isfinite(out.container_work_j))
+    throw InputError(force_path.string(), "", "its forces give a non-finite eta*, E_diss, apparent mass or work "
+                                              "(forces far beyond any bed's): not the output of this run");
+  // The fields' ranges (η* in [−1, 100], m_app/m_bed within ±10): beyond them no bed.
+  if (const std::string problem =
+          surrogate::field_value_problem(out.measures.eta_star, out.measures.apparent_mass_kg / out.bed_mass_kg);
+      !problem.empty())
+    throw InputError(force_path.string(), "", "its forces give " + problem + ": not the output of this run");
 
   // Energy at the analysis' two ends (instantaneous values at sample ends).
   const auto energy_path = dir / kLiggghtsEnergyFile;
-  const auto energy_rows = read_output_file(energy_path, id, 6);
+  // One row at each sample's end, the drive's start (step 0) included.
+  const auto energy_rows = read_output_file(energy_path, id, 6, static_cast<std::size_t>(last) + 1);
   const auto at_step = [&](std::int64_t step) -> const std::vector<double>& {
     for (const auto& row : energy_rows)
       if (row[0] == static_cast<double>(step)) return row;
@@ -600,6 +646,10 @@ LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   out.delta_kinetic_j = (end[1] + end[2]) - (start[1] + start[2]);
   out.delta_potential_j = 0.0;
   for (int k = 0; k < 3; ++k) out.delta_potential_j -= out.bed_mass_kg * g[k] * (end[3 + k] - start[3 + k]);
+  if (!std::isfinite(out.delta_kinetic_j) || !std::isfinite(out.delta_potential_j) ||
+      !std::isfinite(out.container_work_j - out.delta_kinetic_j - out.delta_potential_j))
+    throw InputError(energy_path.string(), "", "its energies give a non-finite energy balance (values near 1e308): "
+                                               "not the output of this run");
 
   // The drive bin weighs a sample as a force held over it (sinc(π/M)); a sample's mean of
   // a harmonic force is that force times sinc(π/M) already, so η* is low by 1 − sinc²(π/M).

@@ -3,6 +3,7 @@
 // LIGGGHTS is installed, [long]) a real LIGGGHTS run of the shipped case against pdamp dem.
 // pdamp and LIGGGHTS run through argument vectors (support/run_pdamp.hpp), never a shell.
 #include <catch2/catch.hpp>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -154,6 +155,12 @@ TEST_CASE("pdamp import liggghts refuses a missing or garbled output with one li
   const std::string half = good.substr(0, good.rfind('\n', good.size() / 2) + 1);
   require_one_line_error(with_force(half), "force.txt: holds");
   CHECK_THAT(with_force(half).err, Catch::Contains("has not finished"));
+  // A file of far more rows than the run writes (once 30 M rows took 2.5 GB before they were
+  // refused): refused at the first row too many, naming its line.
+  std::string doubled = good;
+  const std::string body = good.substr(good.find('\n', good.find('\n') + 1) + 1);  // after title and header
+  for (int k = 0; k < 3; ++k) doubled += body;
+  require_one_line_error(with_force(doubled), "samples of this export's run");
   // The output of an earlier deck (another export's title).
   require_one_line_error(with_force("# pdamp export 0123456789abcdef\n" + good.substr(good.find('\n') + 1)),
                          "force.txt: line 1:");
@@ -240,5 +247,58 @@ TEST_CASE("a LIGGGHTS run of the exported deck gives pdamp dem's eta*", "[cli][l
   // samples in the time domain; 1e-13 measured, 1e-6 allowed for the 6-digit samples).
   CHECK(l["energy"]["container_work_j"].get<double>() ==
         Approx(periods * l["energy_per_cycle_j"].get<double>()).epsilon(1e-6));
+  fs::remove_all(dir);
+}
+
+// Reference: the case's own ranges and the export's own form for what pdamp_export.json
+// says, and finite results or the input file named (once: η* silently 0 or doubled, a force
+// measured along another axis, `null` in the JSON with exit 0, or a raw library message).
+TEST_CASE("pdamp import liggghts refuses an edited record and outputs that overflow, naming the file", "[cli][liggghts]") {
+  const fs::path dir = fresh_dir("ranges");
+  const json record = export_deck(dir, 2);
+  write_synthetic_output(dir, record, 0.3, 0.0);
+  const std::string good_record = slurp(dir / "pdamp_export.json");
+  const auto with_record = [&](const std::function<void(json&)>& edit) {
+    json r = json::parse(good_record);
+    edit(r);
+    std::ofstream(dir / "pdamp_export.json") << r.dump(2);
+    return run_pdamp({"import", "liggghts", dir.string()});
+  };
+  REQUIRE(with_record([](json&) {}).exit_code == 0);
+  require_one_line_error(with_record([](json& r) { r["amplitude_m"] = 1e300; }), "pdamp_export.json: /amplitude_m: = 1e+300");
+  require_one_line_error(with_record([](json& r) { r["bed_mass_kg"] = 1e-320; }), "/bed_mass_kg: = ");
+  require_one_line_error(with_record([](json& r) { r["gravity_m_s2"] = {0.0, 0.0, -1e300}; }), "/gravity_m_s2: = -1e+300");
+  for (const json& direction : {json{0.0, 0.0, 0.0}, json{2.0, 0.0, 0.0}, json{0.0, 1.0, 0.0}})
+    require_one_line_error(with_record([&](json& r) { r["drive_direction"] = direction; }),
+                           "/drive_direction: must be the unit vector of drive_axis x");
+  require_one_line_error(with_record([](json& r) { r["settling_steps"] = "x"; }), "/settling_steps: must be a number, got string");
+  std::ofstream(dir / "pdamp_export.json") << good_record;
+
+  // Energies near the largest double: their balance overflows.
+  const std::string good_energy = slurp(dir / "energy.txt");
+  std::string huge = good_energy;
+  for (std::size_t at = huge.find(" 0.01 0.001 "); at != std::string::npos; at = huge.find(" 0.01 0.001 ", at + 1))
+    huge.replace(at, 12, " 1.7e308 1.7e308 ");  // kinetic + rotational: +inf at both ends
+  std::ofstream(dir / "energy.txt") << huge;
+  require_one_line_error(run_pdamp({"import", "liggghts", dir.string()}), "energy.txt: its energies give a non-finite");
+  std::ofstream(dir / "energy.txt") << good_energy;
+  // A force of 1e11 N in one sample (η* far beyond any bed's), and forces of 1.7e308 N that
+  // would overflow the sums: named by their file, not by the library that overflowed.
+  const std::string good_forces = slurp(dir / "force.txt");
+  std::string forces = good_forces;
+  const std::size_t line = forces.rfind('\n', forces.size() - 2) + 1;  // the last sample (analysed)
+  const std::size_t value = forces.find(' ', line) + 1;
+  forces.replace(value, forces.find(' ', value) - value, "1e11");
+  std::ofstream(dir / "force.txt") << forces;
+  require_one_line_error(run_pdamp({"import", "liggghts", dir.string()}), "force.txt: its forces give eta_star = ");
+  std::string overflowing = good_forces;
+  // Every sample's force component along x becomes 1.7e308 (each line "step fx 0 0").
+  for (std::size_t at = overflowing.find(" 0 0\n"); at != std::string::npos;) {
+    const std::size_t start = overflowing.rfind(' ', at - 1) + 1;
+    overflowing.replace(start, at - start, "1.7e308");
+    at = overflowing.find(" 0 0\n", start + 7 + 5);  // past this line
+  }
+  std::ofstream(dir / "force.txt") << overflowing;
+  require_one_line_error(run_pdamp({"import", "liggghts", dir.string()}), "beyond any bed's (1e12 N)");
   fs::remove_all(dir);
 }
