@@ -56,6 +56,18 @@ std::string layer_key(const case_file::Case& c, const std::string& key) {
   return c.format_version == 1 ? "/dem/" + key : "/dampers/0/layers/0/" + key;
 }
 
+/// `run N` as LIGGGHTS takes it: N in pieces of at most 2^31 − 1 steps (its run command's
+/// bound); consecutive runs continue the same simulation (timestep, fixes, files).
+template <class Line>
+void run_lines(const Line& line, std::int64_t steps) {
+  constexpr std::int64_t kMaxRunSteps = 2147483647;
+  while (steps > 0) {
+    const std::int64_t piece = std::min(steps, kMaxRunSteps);
+    line("run " + std::to_string(piece));
+    steps -= piece;
+  }
+}
+
 const dr::ContactPairOptions& pair_of(const dr::WorldOptions& world, int a, int b) {
   for (const auto& p : world.pairs)
     if ((p.material_a == a && p.material_b == b) || (p.material_a == b && p.material_b == a)) return p;
@@ -224,10 +236,15 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   LiggghtsDeck deck;
   deck.warnings = estimate.warnings;
 
-  // Materials: LIGGGHTS atom type k + 1 is the case's material k (its Young's modulus
-  // already multiplied by /dem/stiffness_softening, as pdamp's DEM takes it).
-  const int types = static_cast<int>(world_options.materials.size());
-  const int wall_type = compartment.wall_material + 1;
+  // Materials: LIGGGHTS atom type 1 is the spheres' material, type 2 the walls' when it is
+  // another (LIGGGHTS refuses types that do not start from 1, so materials the deck does not
+  // use get no type); Young's moduli already multiplied by /dem/stiffness_softening, as
+  // pdamp's DEM takes them.
+  std::vector<int> used = {compartment.particles.front().material};
+  if (compartment.wall_material != used.front()) used.push_back(compartment.wall_material);
+  const int types = static_cast<int>(used.size());
+  const int particle_type = 1;
+  const int wall_type = types;
   double max_radius = 0.0, min_radius = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
     max_radius = std::max(max_radius, world.radius(i));
@@ -256,7 +273,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
     const auto p = world.position(i);
     const double r = world.radius(i);
     const double density = world.mass(i) / (4.0 / 3.0 * std::numbers::pi * r * r * r);
-    data << i + 1 << ' ' << compartment.particles.front().material + 1 << ' ' << 2.0 * r << ' '
+    data << i + 1 << ' ' << particle_type << ' ' << 2.0 * r << ' '
          << density << ' ' << p[0] << ' ' << p[1] << ' ' << p[2] << "\n";
   }
 
@@ -266,11 +283,16 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
       cylinder ? mantle_segments(container.cylinder_inner_radius_m, min_radius) : 0);
 
   bool rolling = false;
+  // The contact of deck types a and b (0-based) is that of the materials they stand for.
+  const auto pair_of_types = [&](int a, int b) -> const dr::ContactPairOptions& {
+    return pair_of(world_options, used[static_cast<std::size_t>(a)], used[static_cast<std::size_t>(b)]);
+  };
+  const auto material_of_type = [&](int a) -> const auto& { return world_options.materials[used[static_cast<std::size_t>(a)]]; };
   for (int a = 0; a < types; ++a)
-    for (int b = 0; b < types; ++b) rolling = rolling || pair_of(world_options, a, b).rolling_friction > 0.0;
+    for (int b = 0; b < types; ++b) rolling = rolling || pair_of_types(a, b).rolling_friction > 0.0;
   const auto per_type = [&](auto value) {
     std::string s;
-    for (int a = 0; a < types; ++a) s += " " + format_number(value(world_options.materials[a].material), kDeckDigits);
+    for (int a = 0; a < types; ++a) s += " " + format_number(value(material_of_type(a).material), kDeckDigits);
     return s;
   };
   const auto per_pair = [&](auto value) {
@@ -279,7 +301,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
     for (int a = 0; a < types; ++a)
       for (int b = 0; b < types; ++b) {
         s += ' ';
-        s += format_number(value(pair_of(world_options, a, b)), kDeckDigits);
+        s += format_number(value(pair_of_types(a, b)), kDeckDigits);
       }
     return s;
   };
@@ -315,8 +337,8 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("neigh_modify delay 0");
   line("");
   std::string names;
-  for (int a = 0; a < types; ++a) names += (a ? ", " : "") + std::to_string(a + 1) + " " + world_options.materials[a].name;
-  line("# Atom types = the case's materials (" + base::printable(names) + "); the walls are type " +
+  for (int a = 0; a < types; ++a) names += (a ? ", " : "") + std::to_string(a + 1) + " " + material_of_type(a).name;
+  line("# Atom types = the materials in use (" + base::printable(names) + "): the spheres are type 1, the walls type " +
        std::to_string(wall_type) + ".");
   line("# Young's moduli include /dem/stiffness_softening = " + format_number(c.dem.stiffness_softening, kDeckDigits) +
        " as in pdamp's DEM.");
@@ -354,7 +376,7 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   if (estimate.settling_steps > 0) {
     line("# 1. Settling with the container at rest, as pdamp's run (" +
          format_number(estimate.settling_steps * estimate.time_step_s, kDeckDigits) + " s).");
-    line("run " + std::to_string(estimate.settling_steps));
+    run_lines(line, estimate.settling_steps);
     line("");
   }
   line("# 2. The drive. Step numbers restart at 0, so that sample k ends at step k x " + std::to_string(steps_per_sample) +
@@ -381,8 +403,9 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   line("# Kinetic energy (translational, rotational, J) and centre of mass (m) at each sample's end.");
   line("fix pdamp_energy all ave/time " + std::to_string(steps_per_sample) + " 1 " + std::to_string(steps_per_sample) +
        " c_pdamp_ke c_pdamp_rke c_pdamp_com[1] c_pdamp_com[2] c_pdamp_com[3] file " + kLiggghtsEnergyFile + " " + title);
-  line("# One run: the mesh's phase runs on from the fix's creation through transient and analysis.");
-  line("run " + std::to_string(drive_steps));
+  line("# One run (in pieces of at most 2^31 - 1 steps, LIGGGHTS' limit): the mesh's phase runs on from the");
+  line("# fix's creation through transient and analysis.");
+  run_lines(line, drive_steps);
 
   // The identity covers the deck's physics (input with a placeholder id, spheres, walls).
   std::string input = in.str();
@@ -396,10 +419,10 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
   json contacts = json::array();
   for (int a = 0; a < types; ++a)
     for (int b = a; b < types; ++b) {
-      const auto& p = pair_of(world_options, a, b);
+      const auto& p = pair_of_types(a, b);
       const double e = p.restitution.constant;
-      contacts.push_back({{"material_a", world_options.materials[a].name},
-                          {"material_b", world_options.materials[b].name},
+      contacts.push_back({{"material_a", material_of_type(a).name},
+                          {"material_b", material_of_type(b).name},
                           {"restitution", e},
                           {"liggghts_realised_restitution", e >= 1.0 ? 1.0 : fm::realised_restitution(liggghts_damping_coefficient(e))},
                           {"friction", p.friction},

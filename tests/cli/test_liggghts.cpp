@@ -4,6 +4,7 @@
 // pdamp and LIGGGHTS run through argument vectors (support/run_pdamp.hpp), never a shell.
 #include <catch2/catch.hpp>
 #include <functional>
+#include <sstream>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -300,5 +301,64 @@ TEST_CASE("pdamp import liggghts refuses an edited record and outputs that overf
   }
   std::ofstream(dir / "force.txt") << overflowing;
   require_one_line_error(run_pdamp({"import", "liggghts", dir.string()}), "beyond any bed's (1e12 N)");
+  fs::remove_all(dir);
+}
+
+// Reference: LIGGGHTS' own limits (its run command takes at most 2^31 − 1 steps; atom types
+// must start from 1). A drive of 7.4e9 steps is written as consecutive runs of at most
+// 2^31 − 1 that add up to it (once: `run 7384805604`, which LIGGGHTS refuses).
+TEST_CASE("pdamp export liggghts splits a run beyond LIGGGHTS' 2^31 - 1 steps", "[cli][liggghts]") {
+  const auto long_case = edited_case("pdamp_liggghts_long.json", [](json& c) { c["dem"]["samples_per_period"] = 16; });
+  const fs::path dir = fresh_dir("long_run");
+  const auto r = run_pdamp({"export", "liggghts", long_case, "-o", dir.string(), "--periods", "50000", "--json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json record = json::parse(r.out);
+  const long long drive = record["steps_per_period"].get<long long>() *
+                          (record["transient_periods"].get<long long>() + record["analysed_periods"].get<long long>());
+  REQUIRE(drive > 2147483647LL);
+  const std::string deck = slurp(dir / "in.pdamp");
+  // The drive's runs follow reset_timestep 0; the settling run comes before it.
+  std::istringstream lines(deck.substr(deck.find("reset_timestep 0")));
+  long long total = 0;
+  int runs = 0;
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("run ", 0) == 0) {
+      const long long steps = std::stoll(line.substr(4));
+      CHECK(steps >= 1);
+      CHECK(steps <= 2147483647LL);
+      total += steps;
+      ++runs;
+    }
+  CHECK(runs == 4);
+  CHECK(total == drive);
+  fs::remove_all(dir);
+}
+
+// A bed of another material than the built-in steel walls (tungsten sorts after steel): the
+// deck's types are the materials in use, the spheres type 1 (once the spheres were type 2
+// and LIGGGHTS stopped: "Atom types must start from 1"). LIGGGHTS runs one period of it.
+TEST_CASE("LIGGGHTS runs the deck of a tungsten bed in steel walls", "[cli][liggghts][long]") {
+  const auto tungsten = edited_case("pdamp_liggghts_tungsten.json", [](json& c) {
+    c["materials"] = {{"tungsten", {{"density_kg_m3", 19250}, {"youngs_modulus_pa", 411e9}, {"poisson_ratio", 0.28}}},
+                      {"unused", {{"density_kg_m3", 1000}, {"youngs_modulus_pa", 1e9}, {"poisson_ratio", 0.3}}}};
+    c["damper"]["particles"]["material"] = "tungsten";
+    c["dem"]["transient_periods"] = 0;
+  });
+  const fs::path dir = fresh_dir("tungsten");
+  const auto r = run_pdamp({"export", "liggghts", tungsten, "-o", dir.string(), "--periods", "1"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(slurp(dir / "particles.data"), Catch::Contains("2 atom types"));
+  if (!fs::exists(kLiggghts)) {
+    WARN("SKIP: " << kLiggghts << " is not installed (Debian package liggghts); the deck did not run");
+    return;
+  }
+  const auto liggghts = run_program({kLiggghts, "-in", "in.pdamp"}, RunOptions{dir, 600.0, {}, {}, 0});
+  INFO(liggghts.out.substr(liggghts.out.size() > 2000 ? liggghts.out.size() - 2000 : 0) << liggghts.err);
+  REQUIRE(liggghts.exit_code == 0);
+  const auto imported = run_pdamp({"import", "liggghts", dir.string(), "--json"});
+  INFO(imported.err);
+  CHECK(imported.exit_code == 0);
   fs::remove_all(dir);
 }
