@@ -44,9 +44,9 @@ ParsedArgs::ParsedArgs(const CommandSpec& spec, const std::vector<std::string>& 
       continue;
     }
     if (arg.size() > 1 && arg[0] == '-' && !parse_number(arg)) {
-      // "--flag=value" as well as "--flag value" (GNU style); only for long flags, and the
-      // value is everything after the first '=' (it may hold '=' itself).
-      const std::size_t equals = arg.rfind("--", 0) == 0 ? arg.find('=') : std::string::npos;
+      // "--flag=value" as well as "--flag value" (GNU style), "-o=DIR" too; the value is
+      // everything after the first '=' (it may hold '=' itself).
+      const std::size_t equals = arg.find('=');
       const std::string name = arg.substr(0, equals);
       const FlagSpec* flag = nullptr;
       for (const auto& f : spec.flags)

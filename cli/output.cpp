@@ -16,7 +16,10 @@ std::string key_value_table(const Rows& rows) {
   std::size_t width = 0;
   for (const auto& row : rows) width = std::max(width, row.first.size());
   std::ostringstream out;
-  for (const auto& [key, value] : rows) out << key << std::string(width + 2 - key.size(), ' ') << value << "\n";
+  // A value may quote a user's text (a case's name): made printable, so that a newline or a
+  // terminal escape in it cannot forge lines or drive the terminal.
+  for (const auto& [key, value] : rows)
+    out << key << std::string(width + 2 - key.size(), ' ') << base::printable(value) << "\n";
   return out.str();
 }
 

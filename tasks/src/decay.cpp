@@ -284,6 +284,17 @@ CoupledRunEstimate check_coupled_decay(const Case& c, const st::ModalModel& moda
                                          const std::vector<st::CosimulationDamper>& dampers,
                                          const st::DecayRun& options, const std::string& label,
                                          const std::string& duration_pointer, base::RunHooks& hooks) {
+  // A decay shorter than one period of the fastest mode it releases gives no history to
+  // measure (once: exit 3 "the co-simulation returned no history" for 1e-6 s).
+  double fastest_hz = 0.0;
+  for (Eigen::Index j = 0; j < modal.mode_count(); ++j)
+    if (j < options.initial_modal_displacements.size() && options.initial_modal_displacements[j] != 0.0)
+      fastest_hz = std::max(fastest_hz, modal.natural_frequencies_hz[j]);
+  if (fastest_hz > 0.0 && options.duration_s < 1.0 / fastest_hz)
+    throw InputError(c.path, duration_pointer,
+                     "= " + format_number(options.duration_s, 6) + " s: shorter than one period of the released mode at " +
+                         format_number(fastest_hz, 6) + " Hz: at least " + format_number(1.0 / fastest_hz, 6) +
+                         " s (a decay is measured over several)");
   const CoupledRunEstimate e = estimate_coupled_decay(c, modal, dampers, options);
   if (const double available = available_memory_bytes(); e.memory_bytes > available)
     throw InputError(c.path, "/dem",

@@ -165,7 +165,7 @@ int mantle_segments(double cylinder_radius_m, double smallest_particle_radius_m)
 
 std::string readme_text(const json& r, bool cylinder) {
   std::ostringstream out;
-  out << "LIGGGHTS deck of pdamp dem's run of case '" << r["case"].get<std::string>() << "'\n"
+  out << "LIGGGHTS deck of pdamp dem's run of case '" << base::printable(r["case"].get<std::string>()) << "'\n"
       << "written by pdamp " << r["pdamp_version"].get<std::string>() << " (export "
       << r["export_id"].get<std::string>() << "); docs/liggghts.md of pdamp explains every command.\n\n"
       << "The run: " << r["particles"].get<int>() << " spheres (" << format_number(r["bed_mass_kg"].get<double>(), 4)
@@ -468,6 +468,15 @@ LiggghtsDeck export_liggghts(const case_file::Case& c, const DemRunOptions& opti
 
 namespace {
 
+/// Whether `path` exists; InputError naming it when the file system cannot tell (a loop of
+/// symbolic links, a folder without permission) rather than a raw filesystem_error.
+bool exists_or_refuse(const std::filesystem::path& path) {
+  std::error_code error;
+  const bool found = std::filesystem::exists(path, error);
+  if (error) throw InputError(path.string(), "", "cannot be read: " + error.message());
+  return found;
+}
+
 /// The rows of one LIGGGHTS output file: its title line must name this export; every
 /// other line not starting with '#' holds `columns` finite numbers, the first the step. A
 /// file of more than `max_rows` rows is refused at the first row too many (the export's run
@@ -475,7 +484,7 @@ namespace {
 std::vector<std::vector<double>> read_output_file(const std::filesystem::path& path, const std::string& export_id,
                                                   std::size_t columns, std::size_t max_rows) {
   const std::string file = path.string();
-  if (!std::filesystem::exists(path))
+  if (!exists_or_refuse(path))
     throw InputError(file, "", "missing: run LIGGGHTS on the deck in this folder first (README.txt)");
   const std::string text = base::read_input_file(file);
   std::vector<std::vector<double>> rows;
@@ -531,9 +540,10 @@ std::vector<std::vector<double>> read_output_file(const std::filesystem::path& p
 LiggghtsImport import_liggghts(const std::filesystem::path& dir) {
   const std::filesystem::path record_path = dir / kLiggghtsExportRecord;
   const std::string record_file = record_path.string();
-  if (!std::filesystem::is_directory(dir))
+  std::error_code error;
+  if (!exists_or_refuse(dir) || !std::filesystem::is_directory(dir, error))
     throw InputError(dir.string(), "", "is not a folder (the folder pdamp export liggghts wrote)");
-  if (!std::filesystem::exists(record_path))
+  if (!exists_or_refuse(record_path))
     throw InputError(record_file, "", "missing: the folder holds no deck of pdamp export liggghts");
   const json document = base::parse_json_document(base::read_input_file(record_file), record_file);
   base::StrictObject r(document, "", record_file);

@@ -910,3 +910,17 @@ TEST_CASE("a calibration cache that is a file, empty or not writable is refused 
   require_one_line_error(run_pdamp({"optimize", link, "--calibration-cache", "/proc"}),
                          "--calibration-cache: '/proc' is not writable");
 }
+
+// Reference: a DEM decay shorter than one period of the fastest mode it releases is refused
+// naming the key and the shortest duration (once: exit 3 "the co-simulation returned no
+// history" for a verification of 1e-6 s).
+TEST_CASE("a DEM decay shorter than a period of the released modes is refused naming its key", "[cli]") {
+  TempDir tmp("short_verify");
+  std::ifstream in(case_path("cantilever_two_layer_optimize.json"));
+  json c = json::parse(in);
+  c["task"]["verify"]["duration_s"] = 1e-6;
+  c["task"].erase("calibration");
+  const fs::path path = tmp.path / "short_verify.json";
+  std::ofstream(path) << c.dump(2);
+  require_one_line_error(run_pdamp({"optimize", path.string()}), "/task/verify/duration_s: = 1e-06 s: shorter than one period");
+}

@@ -362,3 +362,31 @@ TEST_CASE("LIGGGHTS runs the deck of a tungsten bed in steel walls", "[cli][ligg
   CHECK(imported.exit_code == 0);
   fs::remove_all(dir);
 }
+
+// Reference: what a folder, a flag or a case's name can do to the export and the import
+// (once: exit 1 with a raw "filesystem error" for a loop of symbolic links, `-o=DIR` refused
+// although long flags take '=', a newline and a terminal escape of the case's name printed
+// raw to stdout and README.txt).
+TEST_CASE("pdamp export and import liggghts take -o=DIR, refuse symlink loops and print a name escaped", "[cli][liggghts]") {
+  const fs::path dir = fresh_dir("links");
+  fs::create_directories(dir);
+  const auto named = edited_case("pdamp_liggghts_named.json", [](json& c) { c["name"] = "two\nlines\x1b[31m"; });
+  const auto r = run_pdamp({"export", "liggghts", named, "-o=" + (dir / "deck").string(), "--periods", "1"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(fs::is_regular_file(dir / "deck" / "in.pdamp"));
+  CHECK(r.out.find('\x1b') == std::string::npos);
+  CHECK_THAT(r.out, Catch::Contains("two\\nlines\\x1b[31m"));
+  const std::string readme = slurp(dir / "deck" / "README.txt");
+  CHECK(readme.find('\x1b') == std::string::npos);
+  CHECK_THAT(readme, Catch::Contains("two\\nlines"));
+  // A loop of symbolic links at force.txt, and at the folder itself.
+  fs::create_symlink("loop_b", dir / "deck" / "force.txt");
+  fs::create_symlink("force.txt", dir / "deck" / "loop_b");
+  require_one_line_error(run_pdamp({"import", "liggghts", (dir / "deck").string()}),
+                         "force.txt: cannot be read: Too many levels of symbolic links");
+  fs::create_symlink("b", dir / "a");
+  fs::create_symlink("a", dir / "b");
+  require_one_line_error(run_pdamp({"import", "liggghts", (dir / "a").string()}), "cannot be read");
+  fs::remove_all(dir);
+}
