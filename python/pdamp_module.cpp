@@ -14,12 +14,16 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <initializer_list>
 #include <optional>
 #include <string>
 
 #include "pdamp/case_file/case.hpp"
+#include "pdamp/case_file/ranges.hpp"
 #include "pdamp/formulas/collect_and_collide.hpp"
 #include "pdamp/base/input_error.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/tasks/closed_forms.hpp"
@@ -72,10 +76,44 @@ py::object to_python(const json& v) {
 }
 
 /// A Python dict (or list, number, ...) as JSON, through the json module: what json.dumps
-/// accepts is a case document.
+/// accepts is a case document. What it refuses (a set, bytes keys, NaN, nesting beyond
+/// Python's recursion limit) is a ValueError naming the cause; the text is then parsed as a
+/// case file is (base::parse_json_document: no nesting deeper than a case needs).
 json from_python(const py::handle& object) {
-  const auto text = py::module_::import("json").attr("dumps")(object, py::arg("allow_nan") = false).cast<std::string>();
-  return json::parse(text);
+  std::string text;
+  // numpy arrays and scalars (what Case.resolved and the studies return) as lists and numbers.
+  const py::cpp_function plain([](const py::object& o) -> py::object {
+    if (py::hasattr(o, "tolist")) return o.attr("tolist")();
+    throw py::type_error("Object of type " + py::str(o.get_type().attr("__name__")).cast<std::string>() +
+                         " is not JSON serializable");
+  });
+  try {
+    text = py::module_::import("json").attr("dumps")(object, py::arg("allow_nan") = false, py::arg("default") = plain)
+               .cast<std::string>();
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_TypeError) && !e.matches(PyExc_ValueError) && !e.matches(PyExc_RecursionError)) throw;
+    throw py::value_error("the case dict is not a JSON document: " + py::str(e.type().attr("__name__")).cast<std::string>() +
+                          ": " + py::str(e.value()).cast<std::string>());
+  }
+  return base::parse_json_document(text, "<dict>");
+}
+
+/// `value` if it lies in `range` (the command line's flag ranges, pdamp/case_file/ranges.hpp:
+/// one source of truth), else ValueError "name = value: must be ...".
+double in_range(const char* name, double value, const case_file::Range& range) {
+  if (!range.contains(value)) throw py::value_error(std::string(name) + " = " + base::format_number(value, 10) + ": " + range.text());
+  return value;
+}
+
+/// `value` if it is one of `allowed`, else ValueError naming the argument and the choices (a
+/// misspelt method once ran another one silently).
+const std::string& choice(const std::string& argument, const std::string& value, std::initializer_list<const char*> allowed) {
+  std::string list;
+  for (const char* a : allowed) {
+    if (value == a) return value;
+    list += (list.empty() ? "" : ", ") + std::string(a);
+  }
+  throw py::value_error(argument + " = '" + value + "': must be one of " + list);
 }
 
 /// The hooks of a run started from Python: progress to the callback (with the GIL), a
@@ -145,7 +183,11 @@ auto run_study(PythonHooks& hooks, Study&& study) {
 
 case_file::Case load_case(const py::object& source, const std::string& path) {
   if (py::isinstance<py::dict>(source)) return case_file::load_case_document(from_python(source), path.empty() ? "<dict>" : path);
-  return case_file::load_case(py::str(source).cast<std::string>());
+  // A path: str or os.PathLike, nothing else (42 once read as the file "42").
+  if (!py::isinstance<py::str>(source) && !py::hasattr(source, "__fspath__"))
+    throw py::type_error("load_case: source must be a path (str or os.PathLike) or a dict, got " +
+                         py::str(source.get_type().attr("__name__")).cast<std::string>());
+  return case_file::load_case(py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>());
 }
 
 formulas::DamperModel model_of(const std::string& name) {
@@ -198,9 +240,20 @@ PYBIND11_MODULE(pdamp, m) {
         const auto options = model_options(rolling_inertia_factor, base_friction, bed_restitution);
         if (const auto problems = options.validate(); !problems.empty()) throw py::value_error(problems.front());
         auto eta = [&](double h, double x, double f) {
-          return formulas::reduced_loss_factor_counted(kind, h, x, f, options).eta_star;
+          return formulas::reduced_loss_factor_counted(kind, in_range("clearance_m", h, case_file::limits::kClearance),
+                                                       in_range("stroke_m", x, case_file::limits::kStroke),
+                                                       in_range("frequency_hz", f, case_file::limits::kFrequency), options)
+              .eta_star;
         };
-        return py::vectorize(eta)(clearance_m, stroke_m, frequency_hz);
+        try {
+          return py::vectorize(eta)(clearance_m, stroke_m, frequency_hz);
+        } catch (const py::error_already_set&) {
+          throw;
+        } catch (const std::runtime_error& e) {
+          // pybind11's broadcasting failure ("incompatible size/dimension of inputs") is the
+          // caller's arrays: a ValueError, as numpy says it.
+          throw py::value_error(std::string("clearance_m, stroke_m and frequency_hz do not broadcast: ") + e.what());
+        }
       },
       py::arg("model"), py::arg("clearance_m"), py::arg("stroke_m"), py::arg("frequency_hz"),
       py::arg("rolling_inertia_factor") = 0.4, py::arg("base_friction") = 0.3, py::arg("bed_restitution") = 0.0,
@@ -213,9 +266,9 @@ PYBIND11_MODULE(pdamp, m) {
          bool curve) {
         tasks::LossOptions o;
         o.model = model_of(model);
-        o.clearance_m = clearance_m;
-        o.amplitude_m = stroke_m;
-        o.frequency_hz = frequency_hz;
+        o.clearance_m = in_range("clearance_m", clearance_m, case_file::limits::kClearance);
+        o.amplitude_m = in_range("stroke_m", stroke_m, case_file::limits::kStroke);
+        o.frequency_hz = in_range("frequency_hz", frequency_hz, case_file::limits::kFrequency);
         o.bed_mass_kg = bed_mass_kg;
         o.with_curve = curve;
         const auto study = tasks::run_loss(o);
@@ -270,7 +323,7 @@ PYBIND11_MODULE(pdamp, m) {
       "field",
       [](const case_file::Case& c, const std::string& source, py::object progress) {
         tasks::FieldOptions o;
-        o.source = source;
+        o.source = choice("source", source, {"formulas", "dem"});
         auto& executor = base::local_executor();
         const auto plan = tasks::plan_field(c, o, executor);
         PythonHooks hooks(progress);
@@ -286,7 +339,8 @@ PYBIND11_MODULE(pdamp, m) {
       [](const case_file::Case& c, const std::string& method, py::object progress) {
         PythonHooks hooks(progress);
         tasks::ModesOptions o;
-        o.method = method == "field" ? case_file::LossMethod::kField : case_file::LossMethod::kFormulas;
+        o.method = choice("method", method, {"formulas", "field"}) == "field" ? case_file::LossMethod::kField
+                                                                               : case_file::LossMethod::kFormulas;
         json out = tasks::to_json(run_study(hooks, [&] { return tasks::run_modes(c, o, hooks); }), tasks::OutputFolder{});
         return to_python(out);
       },
@@ -296,7 +350,7 @@ PYBIND11_MODULE(pdamp, m) {
       "frf",
       [](const case_file::Case& c, const std::string& method, py::object progress) {
         tasks::FrfOptions o;
-        if (method == "dem") {
+        if (choice("method", method, {"formulas", "field", "dem"}) == "dem") {
           o.method = tasks::FrfMethod::kDem;
           o.dem = tasks::default_dem_frf_options(c);
         } else {
@@ -334,7 +388,7 @@ PYBIND11_MODULE(pdamp, m) {
       "decay",
       [](const case_file::Case& c, const std::string& method, py::object progress) {
         tasks::DecayOptions o;
-        o.method = method == "dem" ? tasks::DecayMethod::kDem
+        o.method = choice("method", method, {"formulas", "field", "dem"}) == "dem" ? tasks::DecayMethod::kDem
                    : method == "field" ? tasks::DecayMethod::kField
                                        : tasks::DecayMethod::kFormulas;
         PythonHooks hooks(progress);
