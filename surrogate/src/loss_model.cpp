@@ -65,6 +65,29 @@ BlockSlopes rebounding_slopes(double psi, double k) {
           -4.0 * k * std::cos(2.0 * psi) / kPi * d_psi_d_r};
 }
 
+/// A friction-limited bed's response (the nested bed's Coulomb block, the rolling tail with
+/// rolling resistance): η* from `loss`, m_app/m_bed from `at(X)`, and where the bed `moves`
+/// both stroke derivatives by central differences (η* and m_app are smooth in X inside each
+/// regime; 1e-6 X keeps the truncation error near 1e-12 and the rounding error near 1e-10
+/// relative).
+template <class At>
+DamperResponse friction_response(const formulas::LossResult& loss, double stroke_m, bool moves, const At& at) {
+  DamperResponse response;
+  response.eta_star = loss.eta_star;
+  response.regime = formulas::to_string(loss.regime);
+  response.apparent_mass_fraction = at(stroke_m).apparent_mass_fraction;
+  if (moves) {
+    const double step = 1e-6 * stroke_m;
+    const auto up = at(stroke_m + step);
+    const auto down = at(stroke_m - step);
+    response.d_eta_star_d_stroke_1_m = (up.eta_star - down.eta_star) / (2.0 * step);
+    response.d_apparent_mass_fraction_d_stroke_1_m =
+        (up.apparent_mass_fraction - down.apparent_mass_fraction) / (2.0 * step);
+  }
+  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
+  return response;
+}
+
 }  // namespace
 
 std::vector<double> LossModel::discontinuities_stroke_m(double /*frequency_hz*/) const { return {}; }
@@ -211,56 +234,25 @@ DamperResponse ClosedFormLossModel::rebounding_response(const formulas::LossResu
 DamperResponse ClosedFormLossModel::tail_response(const formulas::LossResult& loss, double frequency_hz,
                                                   double stroke_m) const {
   // The rolling tail (docs/theory.md §3.4): κ is fixed there (the bed rolls, Γ <= Γ_slip), and
-  // without rolling resistance η* = 0 and m_app/m_bed = κ/(1+κ) do not depend on X; with it,
-  // central differences as for the Coulomb block (smooth inside each regime).
-  DamperResponse response;
-  response.eta_star = loss.eta_star;
-  response.regime = formulas::to_string(loss.regime);
+  // without rolling resistance η* = 0 and m_app/m_bed = κ/(1+κ) do not depend on X.
   const double kappa = loss.inertia_factor;
   const double mu_r = options_.rolling_resistance;
   const double omega = 2.0 * kPi * frequency_hz;
-  const auto tail_at = [&](double x) {
-    return formulas::rolling_tail(kappa, mu_r, x * omega * omega / formulas::kStandardGravity);
-  };
-  response.apparent_mass_fraction = tail_at(stroke_m).apparent_mass_fraction;
-  if (mu_r > 0.0 && loss.regime == formulas::MotionRegime::kRollingTail) {
-    const double step = 1e-6 * stroke_m;
-    const auto up = tail_at(stroke_m + step);
-    const auto down = tail_at(stroke_m - step);
-    response.d_eta_star_d_stroke_1_m = (up.eta_star - down.eta_star) / (2.0 * step);
-    response.d_apparent_mass_fraction_d_stroke_1_m =
-        (up.apparent_mass_fraction - down.apparent_mass_fraction) / (2.0 * step);
-  }
-  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
-  return response;
+  return friction_response(loss, stroke_m, mu_r > 0.0 && loss.regime == formulas::MotionRegime::kRollingTail,
+                           [&](double x) {
+                             return formulas::rolling_tail(kappa, mu_r, x * omega * omega / formulas::kStandardGravity);
+                           });
 }
 
 DamperResponse ClosedFormLossModel::coulomb_response(const formulas::LossResult& loss, double frequency_hz,
                                                      double stroke_m) const {
   // The nested bed as a Coulomb block (docs/theory.md §3.3): η* and m_app from
-  // formulas::coulomb_block; the stroke derivatives by central differences (the block's
-  // η* and m_app are smooth in X inside each of its regimes; 1e-6 X keeps the truncation
-  // error near 1e-12 and the rounding error near 1e-10 relative).
-  DamperResponse response;
-  response.eta_star = loss.eta_star;
-  response.regime = formulas::to_string(loss.regime);
+  // formulas::coulomb_block.
   const double omega = 2.0 * kPi * frequency_hz;
   const double mu = options_.base_friction;
-  const auto block_at = [&](double x) {
+  return friction_response(loss, stroke_m, loss.regime == formulas::MotionRegime::kSliding, [&](double x) {
     return formulas::coulomb_block(mu, x * omega * omega / formulas::kStandardGravity, clearance_m_ / x);
-  };
-  const auto here = block_at(stroke_m);
-  response.apparent_mass_fraction = here.apparent_mass_fraction;
-  if (loss.regime == formulas::MotionRegime::kSliding) {
-    const double step = 1e-6 * stroke_m;
-    const auto up = block_at(stroke_m + step);
-    const auto down = block_at(stroke_m - step);
-    response.d_eta_star_d_stroke_1_m = (up.eta_star - down.eta_star) / (2.0 * step);
-    response.d_apparent_mass_fraction_d_stroke_1_m =
-        (up.apparent_mass_fraction - down.apparent_mass_fraction) / (2.0 * step);
-  }
-  if (loss.warning_count > 0) response.warnings |= kLossOutsideClosedForm;
-  return response;
+  });
 }
 
 std::vector<double> ClosedFormLossModel::discontinuities_stroke_m(double frequency_hz) const {
