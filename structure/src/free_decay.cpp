@@ -120,8 +120,8 @@ void mark_beds_from_above(CoupledModel& coupled, const ModalModel& model, const 
   for (std::size_t d = 0; d < coupled.dampers.size(); ++d) {
     const Eigen::VectorXd share = coupled.drive_shapes.col(static_cast<Eigen::Index>(d)).cwiseAbs().cwiseProduct(initial);
     Eigen::Index largest = 0;
-    const double release_m = share.size() > 0 ? share.sum() : 0.0;
-    if (share.size() > 0) share.maxCoeff(&largest);
+    share.maxCoeff(&largest);
+    const double release_m = share.sum();
     const double frequency_hz = model.natural_frequencies_hz[largest];
     for (auto& layer : coupled.dampers[d].layers) {
       const auto jumps = layer.loss_model->discontinuities_stroke_m(frequency_hz);

@@ -130,6 +130,33 @@ TEST_CASE("the chosen integer design of two and three layers is the best of an e
   }
 }
 
+TEST_CASE("above the enumeration limit the chosen design is the best rounded neighbour of the relaxed optimum",
+          "[optimizer]") {
+  // The same three layers with max_enumerated_designs = 0: only the floors and ceilings of
+  // the relaxed optimum are evaluated (2^F for F fractional counts), the best of them chosen;
+  // it is never better than the exhaustive enumeration's best, and the result says which rule
+  // chose it.
+  const auto model = one_mode();
+  auto o = layered({0.07, 0.04, 0.028}, 5.0);
+  o.max_enumerated_designs = 0;
+  opt::Options solver;
+  solver.global_evaluations = 300;
+  solver.max_evaluations = 1000;
+  const auto result = opt::optimize_filling_ratios(model, o, solver);
+  CHECK_FALSE(result.enumerated);
+  int fractional = 0;
+  for (std::size_t k = 0; k < o.layers.size(); ++k) {
+    const double x = result.relaxed.layers[k].slabs;
+    if (std::abs(x - std::round(x)) > 1e-6) ++fractional;
+    CHECK(std::abs(result.chosen.layers[k].slabs - x) < 1.0);
+  }
+  CHECK(result.neighbours_total == (1 << fractional));
+  for (const auto& n : result.neighbours) CHECK(result.chosen.objective <= n.objective);
+  CHECK(result.chosen.objective >= enumerate(model, o).objective);
+  o.max_enumerated_designs = opt::FillingRatioOptions::kMaxEnumeratedDesigns + 1;
+  CHECK_FALSE(o.validate().empty());
+}
+
 TEST_CASE("NLopt and the Ipopt hybrid choose the same integer design", "[optimizer]") {
   const auto model = one_mode();
   const auto o = layered({0.07, 0.04, 0.028}, 5.0);
