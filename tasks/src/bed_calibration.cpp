@@ -179,9 +179,6 @@ json calibrate_bed(const Case& c, const case_file::FillingRatioProblem& p, const
 
 }  // namespace
 
-// The physics a bed's calibration depends on: the design case's structure, dampers,
-// materials and DEM settings (the softening included), the release, the duration, the
-// binning and the DEM's model version; not names, descriptions or the budget.
 std::string calibration_key(const Case& design, const case_file::CalibrationSpec& spec, double extra_damping_ratio) {
   const json& r = design.resolved;
   // The dampers' and layers' names label the bed; they are no part of what it does.
