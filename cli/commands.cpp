@@ -199,8 +199,9 @@ int run_run(const ParsedArgs& args, CommandContext& context) {
   if (args.has("--no-verify") && c.task.kind != case_file::TaskKind::kFillingRatios &&
       c.task.kind != case_file::TaskKind::kClearance)
     throw InputError("--no-verify", "", "applies to task kinds filling_ratios and clearance; this case's task is " + kind);
-  if (args.has("--calibration-cache") && c.task.kind != case_file::TaskKind::kFillingRatios)
-    throw InputError("--calibration-cache", "", "applies to task kind filling_ratios; this case's task is " + kind);
+  if (args.has("--calibration-cache") && c.task.kind != case_file::TaskKind::kFillingRatios &&
+      c.task.kind != case_file::TaskKind::kModes)
+    throw InputError("--calibration-cache", "", "applies to task kinds filling_ratios and modes; this case's task is " + kind);
   if (c.task.kind != case_file::TaskKind::kFrf)
     refuse_flags(args, kDemSweepFlags, "applies to task kind frf (the DEM stepped sine); this case's task is " + kind);
   switch (c.task.kind) {

@@ -59,8 +59,8 @@ const FlagSpec kNoVerifyFlag{"--no-verify", "",
                              "skip the DEM verification the task's verify block asks for (the optimisation only)"};
 
 const FlagSpec kCalibrationCacheFlag{"--calibration-cache", "DIR",
-                                     "filling_ratios on calibrated beds: the folder of the beds' cache files\n"
-                                     "                          (default ~/.cache/pdamp/bed_calibration)"};
+                                     "calibrated beds (filling_ratios) and modes: the folder of their cache\n"
+                                     "                          files (default ~/.cache/pdamp/bed_calibration)"};
 
 case_file::LossMethod loss_method(const ParsedArgs& args, const std::string& command) {
   const std::string name = args.optional_text("--method").value_or("formulas");

@@ -13,6 +13,7 @@
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/task_files.hpp"
+#include "pdamp/tasks/bed_calibration.hpp"
 #include "pdamp/tasks/case_checks.hpp"
 #include "pdamp/tasks/decay.hpp"
 #include "pdamp/tasks/frf.hpp"
@@ -37,7 +38,20 @@ std::string optional_number(double value, int digits, const std::string& otherwi
 
 int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& c) {
   tasks::ModesOptions options;
-  options.method = loss_method(args);
+  if (args.optional_text("--method") == "calibrated") {
+    options.calibrated = true;
+  } else {
+    options.method = loss_method(args);
+    if (args.has("--method")) options.calibrated = false;
+  }
+  if (const auto cache = args.optional_text("--calibration-cache")) {
+    const bool task_calibrates = c.task.kind == case_file::TaskKind::kModes && c.task.modes && c.task.modes->calibration;
+    if (!options.calibrated.value_or(task_calibrates))
+      throw InputError("--calibration-cache", "", "applies to calibrated modes (--method calibrated, or the task's calibration)");
+    if (const std::string problem = tasks::prepare_calibration_cache(*cache); !problem.empty())
+      throw InputError("--calibration-cache", "", problem);
+    options.calibration_cache = *cache;
+  }
   auto files = output_dir(args, context);
   CliHooks hooks;
   const auto modes = tasks::run_modes(c, options, hooks, context.executor);
@@ -46,6 +60,11 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
     for (auto& w : report::write_files(*files, modes)) warnings.push_back(w);
   json result = tasks::to_json(modes, output_folder(files.get()));
   Rows rows = {{"case", c.name}, {"method", std::string(case_file::to_string(options.method))}};
+  for (const auto& m : modes.calibrations)
+    rows.push_back({"calibration, mode " + std::to_string(m.mode + 1),
+                    std::to_string(2 * m.amplitude_points) + " DEM points, " +
+                        (m.cached ? "cached" : "run in " + format_number(m.wall_time_s, 3) + " s") + ": " +
+                        m.file.string()});
   for (Eigen::Index j = 0; j < modes.mode_count; ++j) {
     std::string row = format_number(modes.frequencies_with_containers_hz[j], 6) + " Hz (bare " +
                       format_number(modes.modal.natural_frequencies_hz[j], 6) + " Hz), mu = " +
@@ -59,8 +78,12 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
     rows.push_back({"DEM check, mode " + std::to_string(check.mode + 1),
                     "X = " + format_number(check.damper_amplitude_m * 1e3, 4) + " mm: zeta_add predicted " +
                         format_number(100.0 * check.predicted_damping_ratio, 4) + " %, DEM " +
-                        format_number(100.0 * check.dem_damping_ratio, 4) + " % (" +
+                        format_number(100.0 * check.dem_damping_ratio, 4) + " %; whole zeta differs by " +
+                        format_number(100.0 * check.whole_relative_difference(), 3) + " % (" +
                         format_number(check.wall_time_s, 3) + " s)"});
+  if (!modes.dem_checks.empty())
+    rows.push_back({"DEM check", std::string(modes.dem_checks_passed() ? "passed" : "failed") + " (whole damping ratios within " +
+                                     format_number(100.0 * modes.dem_check_tolerance, 3) + " %)"});
   return finish(args, files.get(), result, warnings, rows, {"modes.json", &c, context.report}, &modes);
 }
 
@@ -306,10 +329,17 @@ int run_structure_case(const ParsedArgs& args, CommandContext& context, const Ca
 
 std::vector<Command> structure_commands() {
   return {
-      {{"modes", "pdamp modes CASE.json [--method formulas|field] [-o DIR] [--json]",
+      {{"modes", "pdamp modes CASE.json [--method formulas|field|calibrated] [--calibration-cache DIR] [-o DIR] [--json]",
         "natural frequencies (with the empty containers attached, and bare), mode shapes at the\n"
         "named points, modal mass ratio per damper and backbones f(X), zeta_add(X) per mode",
-        {kMethodFlag, {"-o", "DIR", "write modes.csv, backbone_mode<j>.csv, backbone.gp/png/svg, modes.json\n"
+        {{"--method", "M",
+          "source of each layer's eta*(f, X) and apparent mass: formulas (the closed\n"
+          "                          forms of its model and clearance), field (the layer's field_file, made\n"
+          "                          by pdamp field) or calibrated (the task's calibrated modes, its\n"
+          "                          calibration's or else its dem_check's, from a DEM field of the bed;\n"
+          "                          the others by formulas); default calibrated when the task has a\n"
+          "                          calibration, else formulas"},
+         kCalibrationCacheFlag, {"-o", "DIR", "write modes.csv, backbone_mode<j>.csv, backbone.gp/png/svg, modes.json\n"
                                     "                          and case_resolved.json into DIR, atomically"},
          kJsonFlag}, 1},
        run_modes, true},

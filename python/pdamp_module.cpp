@@ -336,16 +336,20 @@ PYBIND11_MODULE(pdamp, m) {
       "`pdamp field`: the effective field over the case's grid (source 'formulas' or 'dem'), as field.json.");
   m.def(
       "modes",
-      [](const case_file::Case& c, const std::string& method, py::object progress) {
+      [](const case_file::Case& c, const std::optional<std::string>& method, py::object progress) {
         PythonHooks hooks(progress);
         tasks::ModesOptions o;
-        o.method = choice("method", method, {"formulas", "field"}) == "field" ? case_file::LossMethod::kField
-                                                                               : case_file::LossMethod::kFormulas;
+        if (method) {
+          const std::string name = choice("method", *method, {"formulas", "field", "calibrated"});
+          o.calibrated = name == "calibrated";
+          if (name == "field") o.method = case_file::LossMethod::kField;
+        }
         json out = tasks::to_json(run_study(hooks, [&] { return tasks::run_modes(c, o, hooks); }), tasks::OutputFolder{});
         return to_python(out);
       },
-      py::arg("case"), py::arg("method") = "formulas", py::arg("progress") = py::none(),
-      "`pdamp modes`: natural frequencies, shapes and backbones (and the task's dem_check).");
+      py::arg("case"), py::arg("method") = py::none(), py::arg("progress") = py::none(),
+      "`pdamp modes`: natural frequencies, shapes and backbones (and the task's calibration and dem_check); "
+      "method None: calibrated when the task has a calibration, else formulas.");
   m.def(
       "frf",
       [](const case_file::Case& c, const std::string& method, py::object progress) {

@@ -1,5 +1,5 @@
-// Designs of a filling_ratios case and clearances of a clearance case as cases of their own
-// (case.hpp: with_design, with_clearance).
+// Designs of a filling_ratios case, clearances of a clearance case and patched documents as
+// cases of their own (case.hpp: with_design, with_clearance, with_merge_patch).
 #include <limits>
 #include <string>
 #include <vector>
@@ -9,6 +9,17 @@
 namespace pdamp::case_file {
 
 using nlohmann::json;
+
+long long other_seed(const Case& c) {
+  const auto seed = static_cast<long long>(c.dem.simulation.world.seed);
+  return seed < std::numeric_limits<int>::max() ? seed + 1 : seed - 1;
+}
+
+Case with_merge_patch(const Case& c, const json& patch) {
+  json document = c.document;
+  document.merge_patch(patch);
+  return load_case_document(document, c.path);
+}
 
 Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness_softening, bool other_seed) {
   if (!c.task.filling_ratios || c.format_version != 2)
@@ -38,8 +49,7 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
   }
   if (other_seed) {
     if (!document["dem"].is_object()) document["dem"] = json::object();
-    const auto seed = static_cast<long long>(c.dem.simulation.world.seed);
-    document["dem"]["seed"] = seed < std::numeric_limits<int>::max() ? seed + 1 : seed - 1;
+    document["dem"]["seed"] = case_file::other_seed(c);
   }
   return load_case_document(document, c.path);
 }

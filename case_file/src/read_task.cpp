@@ -60,6 +60,28 @@ DecayTask read_decay(ObjectReader& r, const Case& c) {
   return t;
 }
 
+/// `modes`: whole mode numbers from 1 to mode_count, each once; 0-based in the result.
+std::vector<int> read_mode_list(ObjectReader& r, int mode_count) {
+  std::vector<int> out;
+  const auto modes = r.number_array("modes", {1.0, static_cast<double>(mode_count)}, "", 1);
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    if (modes[i] != std::floor(modes[i])) r.fail("modes/" + std::to_string(i), "must be a whole mode number");
+    const int mode = static_cast<int>(modes[i]) - 1;  // counted from 1 in the case
+    if (std::find(out.begin(), out.end(), mode) != out.end())
+      r.fail("modes/" + std::to_string(i), "= " + std::to_string(mode + 1) + ": given twice");
+    out.push_back(mode);
+  }
+  return out;
+}
+
+ModesCalibrationSpec read_modes_calibration(ObjectReader& b, const ModesTask& t) {
+  ModesCalibrationSpec spec;
+  spec.modes = b.has("modes") || !t.dem_check ? read_mode_list(b, t.mode_count) : t.dem_check->modes;
+  spec.strokes_per_decade = b.integer("strokes_per_decade", spec.strokes_per_decade, 1, 100);
+  spec.stiffness_softening = b.number("stiffness_softening", spec.stiffness_softening, {1e-6, 1.0});
+  return spec;
+}
+
 ModesTask read_modes(ObjectReader& r, const Case& c) {
   ModesTask t;
   const int available = available_modes(c);
@@ -71,14 +93,7 @@ ModesTask read_modes(ObjectReader& r, const Case& c) {
   t.backbone_points = r.integer("backbone_points", ModesTask{}.backbone_points, 2, 10000);
   r.object("dem_check", false, [&](ObjectReader& d) {
     ModesDemCheck check;
-    const auto modes = d.number_array("modes", {1.0, static_cast<double>(t.mode_count)}, "", 1);
-    for (std::size_t i = 0; i < modes.size(); ++i) {
-      if (modes[i] != std::floor(modes[i])) d.fail("modes/" + std::to_string(i), "must be a whole mode number");
-      const int mode = static_cast<int>(modes[i]) - 1;  // counted from 1 in the case
-      if (std::find(check.modes.begin(), check.modes.end(), mode) != check.modes.end())
-        d.fail("modes/" + std::to_string(i), "= " + std::to_string(mode + 1) + ": given twice");
-      check.modes.push_back(mode);
-    }
+    check.modes = read_mode_list(d, t.mode_count);
     check.amplitudes_m = d.number_array("amplitudes_m", limits::kStroke, " m", 1);
     if (check.amplitudes_m.size() > 20)
       d.fail("amplitudes_m", "has " + std::to_string(check.amplitudes_m.size()) + " entries: at most 20 (each is a DEM decay)");
@@ -87,11 +102,13 @@ ModesTask read_modes(ObjectReader& r, const Case& c) {
     check.periods = d.integer("periods", check.periods, 4, 10000);
     check.amplitude_fraction = d.number("amplitude_fraction", check.amplitude_fraction, {0.0, 1.0, true});
     if (check.amplitude_fraction >= 1.0) d.fail("amplitude_fraction", "must be < 1 (a fraction of the start)");
+    check.tolerance_relative = d.number("tolerance_relative", check.tolerance_relative, {0.0, 10.0, true});
     if (c.dampers.size() != 1)
       throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
                                                 " dampers: the DEM check of task kind modes takes a case of one damper");
     t.dem_check = check;
   });
+  r.object("calibration", false, [&](ObjectReader& b) { t.calibration = read_modes_calibration(b, t); });
   return t;
 }
 

@@ -372,10 +372,33 @@ Answer modes_answer(const tasks::ModesResult& r) {
       << " Hz with the empty containers (" << three_digits(r.modal.natural_frequencies_hz[j]) << " Hz without them)";
     if (const auto backbone = tasks::backbone_summary(r, j); backbone && number(backbone->max_added_damping_ratio))
       p << "; the particles add up to ζ = " << three_digits(backbone->max_added_damping_ratio)
-        << " at a damper amplitude of " << in_mm(backbone->max_added_damping_amplitude_m);
+        << " at a damper amplitude of " << in_mm(backbone->max_added_damping_amplitude_m)
+        << (r.calibration_of(j) != nullptr ? " (the DEM-calibrated bed)" : " (" + std::string(case_file::to_string(r.method)) + ")");
     p << ".";
     a.paragraphs.push_back(p.str());
   }
+  if (r.dem_checks.empty()) return a;
+  std::ostringstream verdict;
+  std::vector<std::string> missed;
+  for (std::size_t k = 0; k < r.dem_checks.size(); ++k) {
+    const auto& check = r.dem_checks[k];
+    if (!r.dem_check_passed(k))
+      missed.push_back("mode " + std::to_string(check.mode + 1) + " from " + in_mm(check.damper_amplitude_m) + " (" +
+                       percent(check.whole_relative_difference()) + ")");
+  }
+  verdict << "The DEM in the loop decayed " << r.dem_checks.size() << " modes and strokes; ";
+  if (missed.empty()) {
+    verdict << "each mode's damping ratio by the prediction lies within the case's " << percent(r.dem_check_tolerance)
+            << " of the DEM's: the damping against amplitude can be trusted at the strokes checked.";
+  } else {
+    verdict << "the prediction misses the DEM's damping ratio by more than the case's " << percent(r.dem_check_tolerance)
+            << " at ";
+    for (std::size_t k = 0; k < missed.size(); ++k) verdict << (k == 0 ? "" : ", ") << missed[k];
+    verdict << ": there the damping ratio is the DEM's"
+            << (r.calibrations.empty() ? "; a calibration of the task's modes takes the bed from the DEM." : ".");
+  }
+  a.verdict = verdict.str();
+  a.passed = missed.empty();
   return a;
 }
 

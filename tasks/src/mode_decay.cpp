@@ -26,6 +26,8 @@ const base::Fields<ModeDecayCheck>& ModeDecayCheck::fields() {
           .field("bare_damping_ratio", &M::bare_damping_ratio, "1", "the decay's with the containers empty (subtracted)",
                  base::kNullable)
           .field("relative_difference", &M::relative_difference, "1", "(predicted - DEM)/DEM", base::kNullable)
+          .derived("whole_relative_difference", [](const M& m) { return m.whole_relative_difference(); }, "1",
+                   "the same of the mode's whole damping ratio, the bare decay's plus the added", base::kNullable)
           .field("dem_final_fraction", &M::dem_final_fraction, "1", "the DEM decay's last period over its first",
                  base::kNullable)
           .field("solve_time_s", &M::wall_time_s, "s", "wall time of the DEM decay");

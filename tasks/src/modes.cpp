@@ -7,6 +7,9 @@
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
 #include "pdamp/structure/damper_coupling.hpp"
+#include "mode_calibration.hpp"
+#include "pdamp/surrogate/loss_model.hpp"
+#include "pdamp/tasks/bed_calibration.hpp"
 #include "structure_support.hpp"
 
 namespace pdamp::tasks {
@@ -24,6 +27,27 @@ constexpr double kDefaultBackboneMaxOverClearance = 2.0;
 /// A mode in which the reference damper moves less than this fraction of its largest
 /// drive shape gets no backbone (its amplitude there would be meaningless).
 constexpr double kNoMotionFraction = 1e-9;
+
+/// The calibration the run takes (ModesOptions::calibrated), if any: the task's, else
+/// the defaults on the dem_check's modes.
+std::optional<case_file::ModesCalibrationSpec> modes_calibration(const case_file::Case& c, const ModesOptions& options) {
+  const case_file::ModesTask* task =
+      c.task.kind == case_file::TaskKind::kModes && c.task.modes ? &*c.task.modes : nullptr;
+  if (!options.calibrated.value_or(task != nullptr && task->calibration)) return std::nullopt;
+  if (task == nullptr || (!task->calibration && !task->dem_check))
+    throw base::InputError(c.path, "/task",
+                           "a calibration needs task kind modes with a calibration or a dem_check (whose modes it calibrates)");
+  // The DEM field is of one bed: the first damper's, of one layer.
+  if (c.dampers.size() != 1 || c.dampers.front().layers.size() != 1)
+    throw base::InputError(c.path, "/dampers",
+                           "has " + std::to_string(c.dampers.size()) + " dampers, the first with " +
+                               std::to_string(c.dampers.front().layers.size()) +
+                               " layers: the calibration of task kind modes takes one damper of one layer");
+  if (task->calibration) return task->calibration;
+  case_file::ModesCalibrationSpec spec;
+  spec.modes = task->dem_check->modes;
+  return spec;
+}
 
 }  // namespace
 
@@ -79,9 +103,41 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
   }
 
   const double largest_drive = coupled.drive_shapes.col(0).cwiseAbs().maxCoeff();
+  const auto moves_damper = [&](Eigen::Index j) {
+    return std::abs(coupled.drive_shapes(j, 0)) > kNoMotionFraction * largest_drive;
+  };
+
+  // The calibrated modes: the first damper's bed as the DEM sees it around each one, between
+  // the mode's frequency with the bed carried whole and with the containers empty.
+  std::map<Eigen::Index, std::vector<st::Damper>> calibrated_dampers;
+  if (const auto calibration = modes_calibration(c, options)) {
+    out.calibration_cache = options.calibration_cache.empty() ? default_calibration_cache() : options.calibration_cache;
+    if (const std::string problem = prepare_calibration_cache(out.calibration_cache); !problem.empty())
+      throw base::InputError(c.path, "/task/calibration", "the calibration cache " + problem);
+    std::vector<st::Damper> carried = containers;
+    for (std::size_t d = 0; d < carried.size(); ++d)
+      for (const auto& l : dampers[d].layers) carried[d].container_mass_kg += l.bed_mass_kg;
+    const Eigen::VectorXd carried_hz = st::natural_frequencies_with_containers_hz(
+        detail::call_solver(c, "/dampers", [&] { return st::couple(modal, carried); }));
+    for (const int j : calibration->modes) {
+      if (!moves_damper(j))
+        throw base::InputError(c.path, "/task/calibration/modes",
+                               "mode " + std::to_string(j + 1) + " does not move damper " + dampers.front().name +
+                                   " along its drive: nothing to calibrate");
+      const detail::ModeCalibrationRange range{j, carried_hz[j], out.frequencies_with_containers_hz[j], lo, hi};
+      out.calibrations.push_back(detail::calibrate_mode(c, *calibration, range, out.calibration_cache, hooks));
+      auto& calibrated = calibrated_dampers[j] = dampers;
+      calibrated.front().layers.front().loss_model =
+          std::make_shared<surrogate::EffectiveFieldLossModel>(out.calibrations.back().field);
+    }
+  }
+  const auto dampers_of = [&](Eigen::Index j) -> const std::vector<st::Damper>& {
+    const auto it = calibrated_dampers.find(j);
+    return it == calibrated_dampers.end() ? dampers : it->second;
+  };
   std::map<std::string, std::vector<Eigen::Index>> backbone_warnings;  // sentence -> modes (1-based)
   for (Eigen::Index j = 0; j < mode_count; ++j) {
-    if (!(std::abs(coupled.drive_shapes(j, 0)) > kNoMotionFraction * largest_drive)) {
+    if (!moves_damper(j)) {
       setup.warnings.add("mode " + std::to_string(j + 1) + ": damper " + dampers.front().name +
                          " does not move along its drive in this mode: no backbone");
       continue;
@@ -90,7 +146,7 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
     backbone.mode = static_cast<int>(j);
     backbone.reference_damper = 0;
     backbone.damper_amplitudes_m = amplitudes;
-    auto b = detail::call_solver(c, "/task", [&] { return st::backbone(modal, dampers, backbone); });
+    auto b = detail::call_solver(c, "/task", [&] { return st::backbone(modal, dampers_of(j), backbone); });
     for (const auto& p : b.points) out.converged = out.converged && p.converged;
     for (const auto& w : b.warnings) backbone_warnings[w].push_back(j + 1);
     out.backbone_of_mode[j] = out.backbones.size();
@@ -108,9 +164,10 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
   if (from_task && c.task.modes->dem_check) {
     const case_file::ModesDemCheck& check = *c.task.modes->dem_check;
     const ModeDecayWindow window{check.periods, check.amplitude_fraction};
+    out.dem_check_tolerance = check.tolerance_relative;
     for (const int j : check.modes) {
       const double b = std::abs(coupled.drive_shapes(j, 0));
-      if (!(b > kNoMotionFraction * largest_drive))
+      if (!moves_damper(j))
         throw base::InputError(c.path, "/task/dem_check/modes",
                                "mode " + std::to_string(j + 1) + " does not move damper " + dampers.front().name +
                                    " along its drive: nothing to check");
@@ -119,7 +176,7 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
         // the frequency by a few per cent at most (backbone_mode<j>.csv), a fraction of a period over the decay.
         const std::string label = "pdamp modes (dem_check, mode " + std::to_string(j + 1) + ", X = " +
                                   base::format_number(amplitude * 1e3, 4) + " mm)";
-        out.dem_checks.push_back(mode_decay_check(c, 0, modal, dampers.front(), dampers.front().point, j, amplitude / b,
+        out.dem_checks.push_back(mode_decay_check(c, 0, modal, dampers_of(j).front(), dampers.front().point, j, amplitude / b,
                                                   out.frequencies_with_containers_hz[j], window, label,
                                                   "/task/dem_check/periods", hooks));
       }
@@ -128,6 +185,39 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
   out.modal = modal;
   out.warnings = setup.warnings.list();
   return out;
+}
+
+bool ModesResult::dem_check_passed(std::size_t k) const {
+  return std::abs(dem_checks.at(k).whole_relative_difference()) <= dem_check_tolerance;
+}
+
+bool ModesResult::dem_checks_passed() const {
+  for (std::size_t k = 0; k < dem_checks.size(); ++k)
+    if (!dem_check_passed(k)) return false;
+  return !dem_checks.empty();
+}
+
+const ModeCalibration* ModesResult::calibration_of(Eigen::Index mode) const {
+  for (const auto& m : calibrations)
+    if (m.mode == mode) return &m;
+  return nullptr;
+}
+
+const base::Fields<ModeCalibration>& ModeCalibration::fields() {
+  using M = ModeCalibration;
+  static const auto f =
+      base::Fields<M>()
+          .derived("mode", [](const M& m) { return m.mode + 1; }, "", "the mode, from 1")
+          .field("min_frequency_hz", &M::min_frequency_hz, "Hz", "the field's lower frequency: the bed carried whole")
+          .field("max_frequency_hz", &M::max_frequency_hz, "Hz", "its upper: the containers empty")
+          .field("min_amplitude_m", &M::min_amplitude_m, "m", "the smallest stroke of its points")
+          .field("max_amplitude_m", &M::max_amplitude_m, "m", "the largest, from which the others are approached")
+          .field("amplitude_points", &M::amplitude_points, "", "strokes per frequency (log-spaced)")
+          .field("key", &M::key, "", "16 hex digits of the physics it depends on")
+          .derived("file", [](const M& m) { return m.file.string(); }, "", "its cache file")
+          .field("cached", &M::cached, "", "read from the cache (not run now)")
+          .field("wall_time_s", &M::wall_time_s, "s", "of its DEM points (0 when cached)");
+  return f;
 }
 
 const base::Fields<BackboneSummary>& BackboneSummary::fields() {
@@ -187,7 +277,8 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
                  {"modal_mass_ratio_per_damper", ratio_per_damper},
                  {"drive_shape_per_damper", drive},
                  {"shapes", shapes},
-                 {"backbone", nullptr}};
+                 {"backbone", nullptr},
+                 {"loss_model", r.calibration_of(j) != nullptr ? "calibrated" : case_file::to_string(r.method)}};
     if (const auto backbone = backbone_summary(r, j)) {
       mode["backbone"] = base::to_json(*backbone);
       mode["backbone"]["file"] = folder.file("backbone_mode" + std::to_string(j + 1) + ".csv");
@@ -209,10 +300,22 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
                         {"spacing", "log"},
                         {"plot", folder.file("backbone.png")}};
   result["outcome"] = r.converged ? "converged" : "not_converged";
+  result["calibration"] = nullptr;
+  if (!r.calibrations.empty()) {
+    result["calibration"] = {{"cache", r.calibration_cache.string()}, {"what", ModeCalibration::kWhat}, {"modes", json::array()}};
+    for (const auto& m : r.calibrations) result["calibration"]["modes"].push_back(base::to_json(m));
+  }
   result["dem_check"] = nullptr;
+  result["dem_check_outcome"] = nullptr;
   if (!r.dem_checks.empty()) {
     result["dem_check"] = json::array();
-    for (const auto& check : r.dem_checks) result["dem_check"].push_back(base::to_json(check));
+    for (std::size_t k = 0; k < r.dem_checks.size(); ++k) {
+      json check = base::to_json(r.dem_checks[k]);
+      check["passed"] = r.dem_check_passed(k);
+      result["dem_check"].push_back(std::move(check));
+    }
+    result["dem_check_outcome"] = r.dem_checks_passed() ? "passed" : "failed";
+    result["dem_check_tolerance_relative"] = r.dem_check_tolerance;
   }
   return result;
 }

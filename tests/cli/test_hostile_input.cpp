@@ -543,7 +543,7 @@ TEST_CASE("the DEM stepped sine's flags are refused where they would do nothing"
   require_one_line_error(run_pdamp({"frf", beam, "--dem-points", "5"}), "--dem-points: applies to --method dem");
   require_one_line_error(run_pdamp({"frf", beam, "--method", "field", "--dem-tolerance", "0.01"}), "--dem-tolerance");
   require_one_line_error(run_pdamp({"run", link, "--dem-points", "5"}), "--dem-points: applies to task kind frf");
-  require_one_line_error(run_pdamp({"run", link, "--calibration-cache", "x"}), "--calibration-cache: applies to task kind filling_ratios");
+  require_one_line_error(run_pdamp({"run", link, "--calibration-cache", "x"}), "--calibration-cache: applies to task kinds filling_ratios and modes");
 }
 
 // Reference: the field file's value ranges (surrogate::field_value_problem: η* in [−1, 100],

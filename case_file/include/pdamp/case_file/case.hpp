@@ -154,6 +154,18 @@ struct ModesDemCheck {
   std::vector<double> amplitudes_m;  ///< the first damper's stroke at each decay's start, m, ascending
   int periods = 40;                  ///< each decay's length in periods of its mode, [4, 10000]
   double amplitude_fraction = 0.5;   ///< measured down to this fraction of the start, (0, 1)
+  /// A decay passes when |predicted − DEM| <= tolerance·DEM for ζ_add, dimensionless, (0, 10].
+  double tolerance_relative = 0.15;
+};
+
+/// `calibration` of task kind modes (docs/optimizer.md, "Damping against amplitude"): for each
+/// listed mode, the first damper's bed as the DEM sees it: an effective field from DEM steady
+/// states at the mode's frequency over the backbone's amplitudes, used in place of the loss
+/// model for that mode's backbone and its dem_check prediction.
+struct ModesCalibrationSpec {
+  std::vector<int> modes;            ///< 0-based here (the case counts from 1); default the dem_check's
+  int strokes_per_decade = 8;        ///< field nodes per decade of amplitude, [1, 100]
+  double stiffness_softening = 1.0;  ///< factor on every Young's modulus of its runs, on top of /dem's, (0, 1]
 };
 
 /// `task` kind modes: natural frequencies, shapes and backbones.
@@ -163,6 +175,7 @@ struct ModesTask {
   double backbone_max_amplitude_m = 0.0;    ///< highest, m (> min)
   int backbone_points = 50;                 ///< [2, 10000]
   std::optional<ModesDemCheck> dem_check;   ///< `dem_check`: absent, none
+  std::optional<ModesCalibrationSpec> calibration;  ///< `calibration`: absent, the loss models alone
 };
 
 /// `verify` of task kind filling_ratios: the DEM-in-the-loop free decay
@@ -388,6 +401,14 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
 /// read again by the case reader (CaseError naming the layer's key for a clearance the
 /// reader refuses).
 Case with_clearance(const Case& c, double clearance_m);
+
+/// The case with `patch` merged into its document (RFC 7396: objects merge key by key, null
+/// removes a key, anything else replaces), read again by the case reader (a CaseError names
+/// the key the patch made wrong).
+Case with_merge_patch(const Case& c, const nlohmann::json& patch);
+/// The DEM's seed one further (the one below when the seed is the largest allowed): another
+/// realisation of the ball lot, for calibration runs that no check may repeat.
+long long other_seed(const Case& c);
 
 /// One case of a sensitivity study: the parameter varied, its value, and the case with it.
 struct SensitivityVariant {

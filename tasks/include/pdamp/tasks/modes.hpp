@@ -3,9 +3,11 @@
 // zeta_add(X) of each mode with the dampers' loss models.
 #pragma once
 
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -17,6 +19,7 @@
 #include "pdamp/case_file/structure_setup.hpp"
 #include "pdamp/structure/backbone.hpp"
 #include "pdamp/structure/modal_model.hpp"
+#include "pdamp/surrogate/effective_field.hpp"
 #include "pdamp/base/run_hooks.hpp"
 #include "pdamp/tasks/mode_decay.hpp"
 #include "pdamp/tasks/output_folder.hpp"
@@ -25,6 +28,33 @@ namespace pdamp::tasks {
 
 struct ModesOptions {
   case_file::LossMethod method = case_file::LossMethod::kFormulas;  ///< formulas or field
+  /// The calibrated modes take the DEM's bed (the task's `calibration`, or its defaults):
+  /// std::nullopt: when the task has a `calibration`.
+  std::optional<bool> calibrated;
+  std::filesystem::path calibration_cache;  ///< empty: default_calibration_cache()
+};
+
+/// One mode's calibrated bed (case_file::ModesCalibrationSpec): the first damper's bed as a
+/// DEM effective field over two frequencies, the mode's with the bed carried whole (m_app =
+/// m_bed) and with the containers empty (m_app = 0), each widened by 1 %, and the backbone's
+/// amplitudes (log-spaced); each point below the largest comes down from it (the descending
+/// branch a decay follows, docs/dem.md "Approach"). Cached like the filling-ratio beds, in a
+/// field file of its own under a key of the physics it depends on.
+struct ModeCalibration {
+  int mode = 0;  ///< 0-based
+  double min_frequency_hz = 0.0, max_frequency_hz = 0.0;
+  double min_amplitude_m = 0.0, max_amplitude_m = 0.0;
+  int amplitude_points = 0;
+  std::string key;               ///< 16 hex digits of the physics the field depends on
+  std::filesystem::path file;    ///< its cache file
+  bool cached = false;           ///< read from the cache (not run now)
+  double wall_time_s = 0.0;      ///< of its DEM points (when they ran)
+  surrogate::EffectiveField field;
+  static constexpr std::string_view kWhat =
+      "for each calibrated mode, the first damper's bed as a DEM effective field from steady states between the mode's "
+      "frequency with the bed carried whole and with the containers empty, over the backbone's strokes, each below the "
+      "largest approached from it; that mode's backbone and dem_check prediction use it";
+  static const base::Fields<ModeCalibration>& fields();
 };
 
 struct ModesResult {
@@ -47,7 +77,19 @@ struct ModesResult {
   /// The task's dem_check: each mode's decay from each amplitude, by the loss models and the
   /// DEM in the loop (mode by mode, amplitudes ascending); empty without one.
   std::vector<ModeDecayCheck> dem_checks;
+  /// Each check passes when its mode's whole damping ratio (structural plus added) by the
+  /// prediction lies within this fraction of the DEM's (the task's tolerance_relative).
+  double dem_check_tolerance = 0.15;
+  /// The calibrated modes' beds (in the calibration's order); empty without a calibration.
+  std::vector<ModeCalibration> calibrations;
+  std::filesystem::path calibration_cache;  ///< where they are cached (with calibrations)
   std::vector<std::string> warnings;
+  /// The prediction of check k within dem_check_tolerance of the DEM (whole damping ratios).
+  bool dem_check_passed(std::size_t k) const;
+  /// Every check passed (false without checks).
+  bool dem_checks_passed() const;
+  /// Mode j's calibration, if it has one.
+  const ModeCalibration* calibration_of(Eigen::Index mode) const;
   /// Mode j's μ_j summed over the dampers, in their order.
   double modal_mass_ratio(Eigen::Index mode) const {
     double total = 0.0;
@@ -69,8 +111,10 @@ std::optional<BackboneSummary> backbone_summary(const ModesResult& result, Eigen
 
 /// The modes study of a format-2 case (any task kind: the backbone range is the modes
 /// task's, else 40 log-spaced amplitudes from 1 mm to twice the largest clearance), with the
-/// task's dem_check (its DEM decays report through `hooks`). It runs on the primary process
-/// alone (on another: base::JobsServedElsewhere).
+/// task's calibration (calibrated modes: their backbones and dem_check predictions from the
+/// calibrated bed) and dem_check (the DEM runs report through `hooks`). It runs on the primary
+/// process alone (on another: base::JobsServedElsewhere). InputError for a calibration asked
+/// of a case without a modes task or modes to calibrate, or a cache folder that cannot be written.
 ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, base::RunHooks& hooks = base::silent_hooks(),
                       base::Executor& executor = base::local_executor());
 /// The result keys (task, case, method, file, modes, frequencies, backbone, outcome, ...).

@@ -1,0 +1,116 @@
+// Calibrated modes of task kind modes (modes.hpp, ModeCalibration): the first damper's bed as
+// a DEM effective field around each mode's frequency, cached in the calibration folder.
+#include <cmath>
+#include <filesystem>
+
+#include "mode_calibration.hpp"
+#include "pdamp/base/input_file.hpp"
+#include "pdamp/base/number_text.hpp"
+#include "pdamp/base/run_errors.hpp"
+#include "pdamp/surrogate/dem_evaluator.hpp"
+#include "pdamp/tasks/bed_calibration.hpp"
+#include "pdamp/tasks/field.hpp"
+
+namespace pdamp::tasks::detail {
+
+namespace {
+
+using nlohmann::json;
+
+/// Raised whenever what a calibration field holds or how it is run changes: part of every key.
+constexpr int kModeCalibrationVersion = 1;
+/// The frequency nodes lie this fraction beyond the bed carried whole and the containers
+/// empty, so that an apparent mass measured a little outside [0, m_bed] stays in the field.
+constexpr double kFrequencyMargin = 0.01;
+
+/// The field's grid as the case's `field` section writes it (docs/cases.md).
+json calibration_grid(const ModeCalibration& m, int threads) {
+  return {{"axes", "frequency_amplitude"},
+          {"axis0", {{"min", m.min_frequency_hz}, {"max", m.max_frequency_hz}, {"count", 2}, {"spacing", "linear"}}},
+          {"axis1",
+           {{"min", m.min_amplitude_m}, {"max", m.max_amplitude_m}, {"count", m.amplitude_points}, {"spacing", "log"}}},
+          {"threads", threads}};
+}
+
+/// Why a cached field is not this calibration's ("" when it is).
+std::string cache_problem(const surrogate::EffectiveField& field, const ModeCalibration& m,
+                          const surrogate::Grid& grid) {
+  if (field.provenance.source != surrogate::FieldSource::kDem) return "it is not a DEM field";
+  if (field.provenance.case_hash != m.key) return "it holds key " + field.provenance.case_hash;
+  if (field.provenance.model_version != surrogate::dem_model_version())
+    return "it was made by DEM model version " + std::to_string(field.provenance.model_version);
+  if (!(field.grid == grid)) return "its grid is not the calibration's";
+  for (const auto& p : field.points)
+    if (p.status != surrogate::PointStatus::kOk) return "a point of it is not ok";
+  return "";
+}
+
+}  // namespace
+
+ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesCalibrationSpec& spec,
+                               const ModeCalibrationRange& range, const std::filesystem::path& cache_dir,
+                               base::RunHooks& hooks) {
+  ModeCalibration m;
+  m.mode = range.mode;
+  m.min_frequency_hz = range.carried_frequency_hz * (1.0 - kFrequencyMargin);
+  m.max_frequency_hz = range.empty_frequency_hz * (1.0 + kFrequencyMargin);
+  m.min_amplitude_m = range.min_amplitude_m;
+  m.max_amplitude_m = range.max_amplitude_m;
+  const double decades = std::log10(range.max_amplitude_m / range.min_amplitude_m);
+  m.amplitude_points = std::max(2, static_cast<int>(std::ceil(decades * spec.strokes_per_decade - 1e-9)) + 1);
+
+  // The calibration's case: the grid, the softening, another seed, and each point below the
+  // largest stroke approached from it (the descending branch a decay follows); its
+  // excitation only has to lie below the approach.
+  json grid = calibration_grid(m, c.field.threads);
+  const case_file::Case fc = case_file::with_merge_patch(
+      c, {{"field", grid},
+          {"dem",
+           {{"stiffness_softening", c.dem.stiffness_softening * spec.stiffness_softening},
+            {"seed", case_file::other_seed(c)},
+            {"approach", {{"amplitude_m", m.max_amplitude_m}}}}},
+          {"excitation", {{"frequency_hz", m.max_frequency_hz}, {"amplitude_m", m.min_amplitude_m}}}});
+  grid.erase("threads");  // how many points run at once changes no point
+  m.key = surrogate::case_hash({{"physics", case_file::physics_hash(fc, "dem")},
+                                {"grid", grid},
+                                {"approach", fc.resolved.at("dem").value("approach", json())},
+                                {"dem_model_version", surrogate::dem_model_version()},
+                                {"calibration_version", kModeCalibrationVersion}});
+  const std::string stem = base::safe_file_name(c.dampers.front().name) + "_mode" + std::to_string(m.mode + 1) + "_" + m.key;
+  m.file = cache_dir / (stem + ".json");
+  const std::string label = "pdamp modes (calibration, mode " + std::to_string(m.mode + 1) + ")";
+
+  FieldOptions options;
+  options.source = "dem";
+  options.results_log = cache_dir / (stem + ".jsonl");  // an interrupted calibration resumes its points
+  options.label = label;
+  FieldPlan plan = plan_field(fc, options, base::local_executor());
+  if (std::filesystem::exists(m.file)) {
+    std::string problem;
+    try {
+      m.field = surrogate::read_effective_field(m.file);
+      problem = cache_problem(m.field, m, plan.grid);
+    } catch (const std::exception& e) {
+      problem = e.what();
+    }
+    if (problem.empty()) {
+      m.cached = true;
+      return m;
+    }
+    hooks.note(label + ": the cached field " + base::printable(m.file.string()) + " is run again: " + problem);
+  }
+  plan.sweep.case_hash = m.key;  // the field's provenance names the calibration it belongs to
+  FieldResult result = run_field(fc, plan, hooks, base::local_executor());
+  m.wall_time_s = result.summary.wall_time_s;
+  if (result.summary.points_failed > 0)
+    throw base::NumericalError(label + ": " + std::to_string(result.summary.points_failed) + " of the field's " +
+                               std::to_string(plan.grid.size()) + " DEM points failed (" + result.sweep_report +
+                               "); the log " + base::printable(options.results_log.string()) + " names them");
+  m.field = std::move(result.field);
+  surrogate::write_effective_field(m.field, m.file);
+  std::error_code ignored;
+  std::filesystem::remove(options.results_log, ignored);  // the field holds every point now
+  return m;
+}
+
+}  // namespace pdamp::tasks::detail
