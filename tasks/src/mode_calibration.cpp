@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "mode_calibration.hpp"
+#include "pdamp/base/input_error.hpp"
 #include "pdamp/base/input_file.hpp"
 #include "pdamp/base/number_text.hpp"
 #include "pdamp/base/run_errors.hpp"
@@ -84,7 +85,13 @@ ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesC
   options.source = "dem";
   options.results_log = cache_dir / (stem + ".jsonl");  // an interrupted calibration resumes its points
   options.label = label;
-  FieldPlan plan = plan_field(fc, options, base::local_executor());
+  FieldPlan plan;
+  try {
+    plan = plan_field(fc, options, base::local_executor());
+  } catch (const base::InputError& e) {  // the field's keys are the calibration's, not the user's
+    throw base::InputError(c.path, "/task/calibration", "its DEM field of mode " + std::to_string(m.mode + 1) +
+                                                            " is refused: " + e.what());
+  }
   if (std::filesystem::exists(m.file)) {
     std::string problem;
     try {

@@ -700,12 +700,15 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
       {[](json& c) { c["task"].erase("dem_check"); }, "/task/calibration/modes"},
       {[](json& c) { c["task"]["dem_check"]["tolerance_relative"] = 0; }, "/task/dem_check/tolerance_relative"},
   };
-  for (const auto& [change, key] : bad) {
-    INFO(key);
-    require_one_line_error(run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_damping.json",
-                                                                   [&](json& c) { edit(c); change(c); }),
-                                      cache_flag}),
-                           key);
+  for (const auto& entry : bad) {
+    INFO(entry.second);
+    const auto edited = [&](json& c) {
+      edit(c);
+      entry.first(c);
+    };
+    require_one_line_error(
+        run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_damping.json", edited), cache_flag}),
+        entry.second);
   }
 }
 

@@ -82,6 +82,9 @@ def test_a_misspelt_choice_is_refused_not_replaced():
     for study in (pdamp.modes, pdamp.frf, pdamp.decay):
         with pytest.raises(ValueError, match="method = 'bogus': must be one of"):
             study(decay, method="bogus")
+    # A calibration needs a modes task: the frf case has none.
+    with pytest.raises(pdamp.InputError, match="a calibration needs task kind modes"):
+        pdamp.modes(pdamp.load_case(case_file("beam_base_excited.json")), method="calibrated")
     layer = pdamp.load_case(case_file("low_intensity_36_spheres.json"))
     with pytest.raises(ValueError, match="source = 'bogus'"):
         pdamp.field(layer, source="bogus")
