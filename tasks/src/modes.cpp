@@ -179,6 +179,14 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
         out.dem_checks.push_back(mode_decay_check(c, 0, modal, dampers_of(j).front(), dampers.front().point, j, amplitude / b,
                                                   out.frequencies_with_containers_hz[j], window, label,
                                                   "/task/dem_check/periods", hooks));
+        // A decay cut short of its measure is fitted over fewer, earlier periods than the
+        // check means (and the prediction alike): said, so that it is lengthened.
+        if (const double left = out.dem_checks.back().dem_final_fraction; left > check.amplitude_fraction)
+          setup.warnings.add(label + ": the DEM decay ended at " + base::format_number(left, 3) +
+                             " of its start, above the " + base::format_number(check.amplitude_fraction, 3) +
+                             " it is measured down to: its damping ratio is that of its first " +
+                             std::to_string(check.periods) + " periods (a larger /task/dem_check/periods measures "
+                             "it as meant)");
       }
     }
   }
