@@ -67,10 +67,28 @@ std::string decay_settings(const Case& c, const st::DecayRun& o, double dt, cons
 /// ends it keeping nothing (base::Interrupted).
 st::CosimulationResult cosimulate_case(const Case& c, const st::ModalModel& modal,
                                        const std::vector<st::CosimulationDamper>& dampers, const st::DecayRun& options,
-                                       const std::string& label, base::RunHooks& hooks) {
+                                       const std::string& label, base::RunHooks& hooks, const DecayStop* stop) {
   detail::check_cosimulation(c, modal, dampers, options);
   base::LabelledHooks labelled(hooks, label);
-  auto r = detail::call_dem(c, [&] { return st::cosimulate(modal, dampers, options, labelled); });
+  auto r = detail::call_dem(c, [&] {
+    if (stop == nullptr) return st::cosimulate(modal, dampers, options, labelled);
+    // Segments of a twentieth of a period give the bits of the whole run (Cosimulation).
+    st::Cosimulation run(modal, dampers, options, labelled);
+    const double steps_per_period = 1.0 / (stop->frequency_hz * run.time_step_s());
+    double first = 0.0, peak = 0.0;
+    for (std::int64_t sample = 1; !run.finished(); ++sample) {
+      const auto target = std::llround(steps_per_period * static_cast<double>(sample) / DecayStop::kSamplesPerPeriod);
+      run.advance(std::max<std::int64_t>(1, target - run.steps_done()));
+      if (run.stop_signal() != 0)
+        throw base::Interrupted(run.stop_signal(), "the co-simulation stopped; it had no checkpoint, so nothing was kept");
+      peak = std::max(peak, std::abs(run.state().modal_displacements[stop->mode]));
+      if (sample % DecayStop::kSamplesPerPeriod != 0) continue;
+      if (sample == DecayStop::kSamplesPerPeriod) first = peak;
+      else if (peak < stop->below * first) break;
+      peak = 0.0;
+    }
+    return std::move(run).result();
+  });
   detail::check_outcome(r.outcome, r.message, label);
   return r;
 }
@@ -316,7 +334,8 @@ std::string estimate_text(const CoupledRunEstimate& e) {
 DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::Damper> containers,
                    const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
-                   const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots) {
+                   const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots,
+                   const DecayStop* stop) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -337,7 +356,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   DemDecay out;
   if (checkpoint.file.path.empty()) {
     hooks.note(estimate);
-    out.cosimulation = cosimulate_case(c, modal, dampers, options, label, hooks);
+    out.cosimulation = cosimulate_case(c, modal, dampers, options, label, hooks, stop);
   } else {
     out.cosimulation = checkpointed_decay(c, modal, dampers, options, label, estimate, checkpoint, hooks);
   }

@@ -607,6 +607,11 @@ TEST_CASE("pdamp modes runs the task's dem_check: each mode's decay by the loss 
   CHECK(check["damper_amplitude_m"].get<double>() == Approx(0.0015).epsilon(1e-9));
   CHECK(check["predicted_damping_ratio"].get<double>() > 0.0);
   CHECK(check["dem_damping_ratio"].is_number());
+  CHECK(check["whole_relative_difference"].is_number());
+  CHECK(check["passed"].is_boolean());
+  CHECK(r["dem_check_outcome"].is_string());
+  // 4 periods of a mode that loses a few per cent a period end far above half: said.
+  CHECK_THAT(r["warnings"].dump(), Catch::Contains("above the 0.5 it is measured down to"));
   std::ifstream csv(dir.path / "out" / "dem_check.csv");
   std::string header;
   std::getline(csv, header);
@@ -622,6 +627,7 @@ TEST_CASE("pdamp modes runs the task's dem_check: each mode's decay by the loss 
       {[](json& c) { c["task"]["dem_check"]["amplitudes_m"] = {0.002, 0.001}; }, "/task/dem_check/amplitudes_m"},
       {[](json& c) { c["task"]["dem_check"].erase("amplitudes_m"); }, "/task/dem_check/amplitudes_m"},
       {[](json& c) { c["task"]["dem_check"]["periods"] = 2; }, "/task/dem_check/periods"},
+      {[](json& c) { c["task"]["dem_check"]["tolerance_relative"] = 0; }, "/task/dem_check/tolerance_relative"},
   };
   for (const auto& [edit, key] : bad) {
     INFO(key);
@@ -632,7 +638,7 @@ TEST_CASE("pdamp modes runs the task's dem_check: each mode's decay by the loss 
 // The plumbing of a modes task's calibration (its physics against the DEM decays: the
 // [long] test below and docs/optimizer.md): mode 4's bed as a field of 2 strokes x 2
 // frequencies (contacts softened 100 times, 1 + 2 periods a point, an approach of one
-// ramp period), then one 4-period DEM decay. The field is cached under its key: a second run
+// ramp period). The field is cached under its key: a second run
 // reads it and gives the same backbone; a file whose key is edited is run again; the other
 // modes keep the closed forms; --method formulas takes none.
 TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady states, cached under a key",
@@ -643,8 +649,8 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
     c["task"]["backbone_min_amplitude_m"] = 0.001;
     c["task"]["backbone_max_amplitude_m"] = 0.002;
     c["task"]["backbone_points"] = 5;
-    c["task"]["dem_check"] = {{"modes", {4}}, {"amplitudes_m", {0.0015}}, {"periods", 4}};
-    c["task"]["calibration"] = {{"strokes_per_decade", 1}, {"stiffness_softening", 0.01}};
+    c["task"].erase("dem_check");  // its decays: the test above and the [long] one below
+    c["task"]["calibration"] = {{"modes", {4}}, {"strokes_per_decade", 1}, {"stiffness_softening", 0.01}};
     c["dem"] = {{"transient_periods", 1},
                 {"analysed_periods", 2},
                 {"approach", {{"amplitude_m", 0.002}, {"hold_periods", 0}, {"ramp_periods", 1}}}};
@@ -664,10 +670,6 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
   CHECK(std::filesystem::exists(bed["file"].get<std::string>()));
   CHECK(first["modes"][3]["loss_model"] == "calibrated");
   CHECK(first["modes"][2]["loss_model"] == "formulas");
-  REQUIRE(first["dem_check"].size() == 1);
-  CHECK(first["dem_check"][0]["passed"].is_boolean());
-  CHECK(first["dem_check"][0]["whole_relative_difference"].is_number());
-  CHECK(first["dem_check_outcome"].is_string());
 
   const auto backbone = [&](const std::string& out) {
     std::ifstream in(dir.path / out / "backbone_mode4.csv");
@@ -677,7 +679,6 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
   CHECK(second["calibration"]["modes"][0]["cached"] == true);
   CHECK(second["calibration"]["modes"][0]["key"] == bed["key"]);
   CHECK(backbone("second") == backbone("first"));
-  CHECK(second["dem_check"][0]["predicted_damping_ratio"] == first["dem_check"][0]["predicted_damping_ratio"]);
 
   {  // a field under this key's name that holds another key is run again, with a note
     const std::string file = bed["file"].get<std::string>();
@@ -697,8 +698,7 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
       {[](json& c) { c["task"]["calibration"]["modes"] = {0}; }, "/task/calibration/modes"},
       {[](json& c) { c["task"]["calibration"]["strokes_per_decade"] = 0; }, "/task/calibration/strokes_per_decade"},
       {[](json& c) { c["task"]["calibration"]["stiffness_softening"] = 2; }, "/task/calibration/stiffness_softening"},
-      {[](json& c) { c["task"].erase("dem_check"); }, "/task/calibration/modes"},
-      {[](json& c) { c["task"]["dem_check"]["tolerance_relative"] = 0; }, "/task/dem_check/tolerance_relative"},
+      {[](json& c) { c["task"]["calibration"].erase("modes"); }, "/task/calibration/modes"},  // no dem_check either
   };
   for (const auto& entry : bad) {
     INFO(entry.second);

@@ -37,7 +37,9 @@ struct ModeDecayCheck {
   double dem_damping_ratio = NAN;        ///< ζ_add of the DEM decay
   double bare_damping_ratio = NAN;       ///< ζ of the decay with the containers empty (subtracted)
   double relative_difference = NAN;      ///< (predicted − DEM)/DEM
-  double dem_final_fraction = NAN;       ///< the DEM decay's last period over its first (1: no decay)
+  /// The DEM decay's last whole period over its first (1: no decay). The decay ends early, at
+  /// the first period below 0.9 of the measure's fraction (nothing later enters the measure).
+  double dem_final_fraction = NAN;
   double wall_time_s = 0.0;              ///< of the DEM decay
   /// (predicted − DEM)/DEM of the mode's whole damping ratio, bare plus added: what a design
   /// gets (an added ratio far below the structure's own is small in both, and its relative
