@@ -33,14 +33,16 @@ json calibration_grid(const ModeCalibration& m, int threads) {
           {"threads", threads}};
 }
 
-/// Why a cached field is not this calibration's ("" when it is).
-std::string cache_problem(const surrogate::EffectiveField& field, const ModeCalibration& m,
-                          const surrogate::Grid& grid) {
+/// Why a cached field is not this calibration's ("" when it is): the identity its sweep
+/// stamps (the bed's physics hash, model version, approach) and the grid.
+std::string cache_problem(const surrogate::EffectiveField& field, const FieldPlan& plan) {
   if (field.provenance.source != surrogate::FieldSource::kDem) return "it is not a DEM field";
-  if (field.provenance.case_hash != m.key) return "it holds key " + field.provenance.case_hash;
-  if (field.provenance.model_version != surrogate::dem_model_version())
+  if (field.provenance.case_hash != plan.sweep.case_hash)
+    return "it belongs to another bed (case hash " + field.provenance.case_hash + ")";
+  if (field.provenance.model_version != plan.sweep.model_version)
     return "it was made by DEM model version " + std::to_string(field.provenance.model_version);
-  if (!(field.grid == grid)) return "its grid is not the calibration's";
+  if (field.provenance.approach_amplitude_m != plan.sweep.approach_amplitude_m) return "its points were approached otherwise";
+  if (!(field.grid == plan.grid)) return "its grid is not the calibration's";
   for (const auto& p : field.points)
     if (p.status != surrogate::PointStatus::kOk) return "a point of it is not ok";
   return "";
@@ -86,7 +88,7 @@ ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesC
   options.results_log = cache_dir / (stem + ".jsonl");  // an interrupted calibration resumes its points
   options.label = label;
   FieldPlan plan;
-  try {
+  try {  // also refuses a results log of another sweep
     plan = plan_field(fc, options, base::local_executor());
   } catch (const base::InputError& e) {  // the field's keys are the calibration's, not the user's
     throw base::InputError(c.path, "/task/calibration", "its DEM field of mode " + std::to_string(m.mode + 1) +
@@ -96,7 +98,7 @@ ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesC
     std::string problem;
     try {
       m.field = surrogate::read_effective_field(m.file);
-      problem = cache_problem(m.field, m, plan.grid);
+      problem = cache_problem(m.field, plan);
     } catch (const std::exception& e) {
       problem = e.what();
     }
@@ -106,7 +108,6 @@ ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesC
     }
     hooks.note(label + ": the cached field " + base::printable(m.file.string()) + " is run again: " + problem);
   }
-  plan.sweep.case_hash = m.key;  // the field's provenance names the calibration it belongs to
   FieldResult result = run_field(fc, plan, hooks, base::local_executor());
   m.wall_time_s = result.summary.wall_time_s;
   if (result.summary.points_failed > 0)

@@ -639,7 +639,7 @@ TEST_CASE("pdamp modes runs the task's dem_check: each mode's decay by the loss 
 // [long] test below and docs/optimizer.md): mode 4's bed as a field of 2 strokes x 2
 // frequencies (contacts softened 100 times, 1 + 2 periods a point, an approach of one
 // ramp period). The field is cached under its key: a second run
-// reads it and gives the same backbone; a file whose key is edited is run again; the other
+// reads it and gives the same backbone; a file of another bed is run again; the other
 // modes keep the closed forms; --method formulas takes none.
 TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady states, cached under a key",
           "[cli][structure]") {
@@ -680,7 +680,7 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
   CHECK(second["calibration"]["modes"][0]["key"] == bed["key"]);
   CHECK(backbone("second") == backbone("first"));
 
-  {  // a field under this key's name that holds another key is run again, with a note
+  {  // a field under this key's name that is another bed's is run again, with a note
     const std::string file = bed["file"].get<std::string>();
     std::ifstream in(file);
     json field = json::parse(in);
@@ -690,7 +690,7 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
   const auto again = run_pdamp({"modes", path, cache_flag, "--json"});
   REQUIRE(again.exit_code == 0);
   CHECK(json::parse(again.out)["calibration"]["modes"][0]["cached"] == false);
-  CHECK_THAT(again.err, Catch::Contains("is run again: it holds key 0123456789abcdef"));
+  CHECK_THAT(again.err, Catch::Contains("is run again: it belongs to another bed (case hash 0123456789abcdef)"));
 
   CHECK(run_json({"modes", path, "--method", "formulas"})["calibration"].is_null());
   require_one_line_error(run_pdamp({"modes", path, "--method", "formulas", cache_flag}), "--calibration-cache");
