@@ -10,6 +10,7 @@
 #include "errors.hpp"
 #include "flags.hpp"
 #include "output.hpp"
+#include "pdamp/base/input_file.hpp"
 #include "pdamp/dem_reference/damper_simulation.hpp"
 #include "pdamp/report/external_program.hpp"
 #include "pdamp/report/task_files.hpp"
@@ -64,7 +65,7 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
     rows.push_back({"calibration, mode " + std::to_string(m.mode + 1),
                     std::to_string(2 * m.amplitude_points) + " DEM points, " +
                         (m.cached ? "cached" : "run in " + format_number(m.wall_time_s, 3) + " s") + ": " +
-                        m.file.string()});
+                        base::printable(m.file.string())});
   for (Eigen::Index j = 0; j < modes.mode_count; ++j) {
     std::string row = format_number(modes.frequencies_with_containers_hz[j], 6) + " Hz (bare " +
                       format_number(modes.modal.natural_frequencies_hz[j], 6) + " Hz), mu = " +

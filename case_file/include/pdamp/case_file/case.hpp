@@ -154,7 +154,8 @@ struct ModesDemCheck {
   std::vector<double> amplitudes_m;  ///< the first damper's stroke at each decay's start, m, ascending
   int periods = 40;                  ///< each decay's length in periods of its mode, [4, 10000]
   double amplitude_fraction = 0.5;   ///< measured down to this fraction of the start, (0, 1)
-  /// A decay passes when |predicted − DEM| <= tolerance·DEM for ζ_add, dimensionless, (0, 10].
+  /// A decay passes when the mode's whole damping ratio (bare plus added) by the prediction
+  /// lies within this fraction of the DEM's, dimensionless, (0, 10].
   double tolerance_relative = 0.15;
 };
 
