@@ -45,6 +45,17 @@ struct DemDecay {
   std::vector<std::string> warnings;   ///< the co-simulation's, not settled, energy ledger above 1%
 };
 
+/// Ends a DEM decay at the end of the first whole period (of frequency_hz, from the release)
+/// in which the largest |q_mode|, sampled kSamplesPerPeriod times, is below `below` times the
+/// first period's: a measure over the periods above a larger fraction then has all its
+/// periods (a sampled sine's peak is at least cos(π/20) = 0.988 of the true one).
+struct DecayStop {
+  Eigen::Index mode = 0;
+  double frequency_hz = 0.0;
+  double below = 0.0;
+  static constexpr int kSamplesPerPeriod = 20;
+};
+
 /// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds) from
 /// rest at q0 over task.duration_s and measures its settling against
 /// task.settling_threshold (structure::sampled_settling). With a checkpoint file the run
@@ -59,23 +70,11 @@ struct DemDecay {
 /// base::NumericalError for a World that stops.
 /// `stop` (without a checkpoint file only) ends the decay early once it is below what a
 /// measure of it uses.
-struct DecayStop;
 DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal, std::vector<structure::Damper> containers,
                    const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
                    const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots = 0,
                    const DecayStop* stop = nullptr);
-
-/// Ends a DEM decay at the end of the first whole period (of frequency_hz, from the release)
-/// in which the largest |q_mode|, sampled kSamplesPerPeriod times, is below `below` times the
-/// first period's: a measure over the periods above a larger fraction then has all its
-/// periods (a sampled sine's peak is at least cos(π/20) = 0.988 of the true one).
-struct DecayStop {
-  Eigen::Index mode = 0;
-  double frequency_hz = 0.0;
-  double below = 0.0;
-  static constexpr int kSamplesPerPeriod = 20;
-};
 
 /// The cost of a DEM-in-the-loop run before it starts, computed without building its
 /// worlds: the coupled step, the steps, every bed's particles, and the memory of its worlds
