@@ -70,6 +70,7 @@ CaseError dem_case_error(const Case& c, std::size_t damper_index, const std::str
       {std::regex(R"(^wall_material$)"), "{geometry}/wall_material"},
       {std::regex(R"(^offset_m.*$)"), "{geometry}/offset_m"},
       {std::regex(R"(^lattice_counts.*$)"), "{bed}/particles/lattice"},
+      {std::regex(R"(^staggered_lattice.*$)"), "{bed}/particles/lattice"},
   };
   // Internal names of the world options and the case keys they come from (read_dem).
   static const std::vector<std::pair<std::regex, std::string>> kKeys = {

@@ -125,7 +125,7 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
       }
       packing.lattice_counts = n;
     } else {
-      p.text("lattice", std::string("auto"), {"auto"});
+      packing.staggered = p.text("lattice", std::string("auto"), {"auto", "staggered"}) == "staggered";
     }
   });
   packing.drive_axis = d.drive_axis;
@@ -197,6 +197,7 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
   compartment.collect_side = packing.collect_side;
   compartment.lane_gap_m = packing.lane_gap_m;
   compartment.lane_gap_auto = packing.lane_gap_auto;
+  compartment.staggered_lattice = packing.staggered;
   if (packing.lattice_counts) compartment.lattice_counts.assign(packing.lattice_counts->begin(), packing.lattice_counts->end());
   dem_reference::ParticleGroupOptions group;
   group.count = layer.particle_count;

@@ -48,6 +48,7 @@ formulas::LatticePacking packing_of(const CompartmentOptions& c, const Vec3& gra
   }
   packing.lane_gap_m = c.lane_gap_m;
   packing.lane_gap_auto = c.lane_gap_auto;
+  packing.staggered = c.staggered_lattice;
   return packing;
 }
 

@@ -271,7 +271,11 @@ void validate_compartment(Violations& v, const CompartmentOptions& c, const std:
     v.check(c.lane_gap_m == 0.0 || !std::isfinite(c.lane_gap_m), at + ".lane_gap_m", c.lane_gap_m,
             "must be 0 in a cylinder (lane gaps are for box containers)");
     v.check(!c.lane_gap_auto, at + ".lane_gap_auto", "true", "must be false in a cylinder (lane gaps are for box containers)");
+  } else {
+    v.check(!c.staggered_lattice, at + ".staggered_lattice", "true", "must be false in a box (staggered slabs are for cylinders)");
   }
+  v.check(!c.staggered_lattice || c.lattice_counts.empty(), at + ".staggered_lattice", "true",
+          "must be false with lattice_counts (the staggered lattice takes the automatic sites)");
   for (std::size_t k = 0; k < c.plates.size(); ++k) {
     const auto& p = c.plates[k];
     const std::string pk = index(at + ".plates", k);

@@ -1,4 +1,5 @@
-// Collected simple-cubic bed in a box or cylinder: sphere centres and the clearance h.
+// Collected bed in a box or cylinder (simple cubic; staggered in a cylinder): sphere centres
+// and the clearance h.
 #include "pdamp/formulas/bed_packing.hpp"
 
 #include "pdamp/base/checks.hpp"
@@ -141,12 +142,18 @@ std::vector<Vec3> disk_lattice(double r, double disk_radius_m, const CrossSectio
   return sites;
 }
 
-std::vector<Vec3> cylinder_sites_auto(double r, double disk_radius_m, const CrossSection& cs) {
-  std::vector<Vec3> best;
+/// The registration of the square lattice (pitch 2r) whose disk holds the most sites: the
+/// first of (0,0), (r,0), (0,r), (r,r) on ties.
+std::pair<double, double> best_registration(double r, double disk_radius_m, const CrossSection& cs) {
+  std::pair<double, double> best{0.0, 0.0};
+  std::size_t most = 0;
   for (const auto& [o_a, o_b] :
        {std::pair{0.0, 0.0}, std::pair{r, 0.0}, std::pair{0.0, r}, std::pair{r, r}}) {
-    auto sites = disk_lattice(r, disk_radius_m, cs, o_a, o_b);
-    if (sites.size() > best.size()) best = std::move(sites);
+    const std::size_t n = disk_lattice(r, disk_radius_m, cs, o_a, o_b).size();
+    if (n > most) {
+      most = n;
+      best = {o_a, o_b};
+    }
   }
   return best;
 }
@@ -208,6 +215,10 @@ std::vector<std::string> packing_problems(const Container& container, int count,
                        (packing.lane_gap_auto ? std::string("auto") : format_number(packing.lane_gap_m, 12)) +
                        ": lane gaps are supported in a box only (must be 0 for a cylinder)");
   }
+  if (packing.staggered && container.shape != ContainerShape::kCylinder)
+    problems.push_back("packing.staggered: supported in a cylinder only (a box takes the simple cubic lattice)");
+  if (packing.staggered && packing.lattice_counts)
+    problems.push_back("packing.staggered: takes the automatic sites (no lattice_counts)");
   if (packing.lattice_counts) {
     for (int i = 0; i < 3; ++i) {
       const int n = (*packing.lattice_counts)[i];
@@ -318,7 +329,7 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
              format_number(per_slab, 12) + " lattice sites of radius_m = " + format_number(r, 12) + " (more than " +
              format_number(kMaxSlabSites, 12) + "): give lattice_counts (the lanes the bed really has)");
   };
-  std::vector<Vec3> sites;
+  std::vector<Vec3> sites, shifted_sites;  // shifted: the staggered lattice's odd slabs
   if (packing.lattice_counts) {
     const auto& n = *packing.lattice_counts;
     refuse_huge(static_cast<double>(n[cs.axis_a]) * n[cs.axis_b]);
@@ -356,7 +367,14 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
     }
   } else if (cylinder) {
     refuse_huge(3.14159265358979323846 * std::pow(container.cylinder_inner_radius_m / (2.0 * r), 2));
-    sites = cylinder_sites_auto(r, container.cylinder_inner_radius_m, cs);
+    const auto [o_a, o_b] = best_registration(r, container.cylinder_inner_radius_m, cs);
+    sites = disk_lattice(r, container.cylinder_inner_radius_m, cs, o_a, o_b);
+    if (packing.staggered) {
+      shifted_sites = disk_lattice(r, container.cylinder_inner_radius_m, cs, o_a + r, o_b + r);
+      if (shifted_sites.empty())
+        reject("staggered: no shifted site fits in inner_radius_m = " + format_number(container.cylinder_inner_radius_m, 12) +
+               " for radius_m = " + format_number(r, 12) + " (needs inner_radius_m >= (1 + sqrt 2)·radius_m)");
+    }
   } else {
     const auto lanes = [&](int axis) {
       const double inner = container.box_inner_size_m[axis];
@@ -378,28 +396,43 @@ LatticeBed collected_lattice(const Container& container, int count, double radiu
   const auto height = [&](const Vec3& p) {
     return cs.gravity_axis < 0 ? 0.0 : -cs.gravity_sign * p[cs.gravity_axis];
   };
-  std::sort(sites.begin(), sites.end(), [&](const Vec3& p, const Vec3& q) {
-    return std::tuple(height(p), p[0], p[1], p[2]) < std::tuple(height(q), q[0], q[1], q[2]);
-  });
+  const auto lowest_first = [&](std::vector<Vec3>& list) {
+    std::sort(list.begin(), list.end(), [&](const Vec3& p, const Vec3& q) {
+      return std::tuple(height(p), p[0], p[1], p[2]) < std::tuple(height(q), q[0], q[1], q[2]);
+    });
+  };
+  lowest_first(sites);
+  lowest_first(shifted_sites);
 
-  const int per_slab = static_cast<int>(sites.size());
+  // Slab j's sites: the shifted set on odd slabs when staggered. The shifted slab sits in the
+  // hollows of its neighbours: its centres are r off along both transverse axes, so touching
+  // needs (r√2)² + p² = (2r)², p = r√2.
+  const auto slab_sites = [&](int slab) -> const std::vector<Vec3>& {
+    return packing.staggered && slab % 2 == 1 ? shifted_sites : sites;
+  };
+  const double pitch = packing.staggered ? std::sqrt(2.0) * r : 2.0 * r;
   LatticeBed bed;
-  bed.slabs = static_cast<int>((static_cast<long long>(count) + per_slab - 1) / per_slab);
-  bed.bed_extent_m = bed.slabs * 2.0 * r;
+  for (int placed = 0; placed < count; bed.slabs++) placed += static_cast<int>(slab_sites(bed.slabs).size());
+  const int per_slab = static_cast<int>(sites.size());
+  bed.bed_extent_m = packing.staggered ? (bed.slabs - 1) * pitch + 2.0 * r : bed.slabs * 2.0 * r;
   bed.clearance_m = length - bed.bed_extent_m;
   if (!(bed.clearance_m > 0.0)) {
     reject("count = " + std::to_string(count) + " spheres of radius_m = " + format_number(r, 12) + " fill " +
-           std::to_string(bed.slabs) + " slabs of " + std::to_string(per_slab) + " sites, extent " +
-           format_number(bed.bed_extent_m, 12) + " m along axis " + std::to_string(drive) + " of inner length " +
-           format_number(length, 12) + " m: clearance_m = " + format_number(bed.clearance_m, 12) + " must be > 0");
+           std::to_string(bed.slabs) + " slabs of " + std::to_string(per_slab) + " sites" +
+           (packing.staggered ? " (staggered)" : "") + ", extent " + format_number(bed.bed_extent_m, 12) +
+           " m along axis " + std::to_string(drive) + " of inner length " + format_number(length, 12) +
+           " m: clearance_m = " + format_number(bed.clearance_m, 12) + " must be > 0");
   }
 
   bed.centres_m.reserve(static_cast<std::size_t>(count));
-  for (int placed = 0; placed < count; ++placed) {
-    const int slab = placed / per_slab;
-    Vec3 centre = sites[static_cast<std::size_t>(placed % per_slab)];
-    centre[drive] = packing.collect_side * (0.5 * length - r - 2.0 * r * slab);
-    bed.centres_m.push_back(centre);
+  for (int slab = 0, placed = 0; placed < count; ++slab) {
+    for (const Vec3& site : slab_sites(slab)) {
+      if (placed == count) break;
+      Vec3 centre = site;
+      centre[drive] = packing.collect_side * (0.5 * length - r - pitch * slab);
+      bed.centres_m.push_back(centre);
+      ++placed;
+    }
   }
   settle(bed, cs, cylinder, length, r, per_slab);
   return bed;

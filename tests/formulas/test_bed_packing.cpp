@@ -341,3 +341,44 @@ TEST_CASE("containers report their inner lengths and their invalid sizes", "[for
   CHECK_THROWS_WITH(fm::collected_lattice(bad_box, 1, 0.005, fm::LatticePacking{}),
                     Catch::Contains("container.box_inner_size_m[1] = -0.06"));
 }
+
+TEST_CASE("a staggered cylinder bed stacks shifted slabs in the hollows at pitch r√2", "[formulas]") {
+  const double r = 0.0025;
+  // The shipped free-free beam's cylinder: R = 5r. Hand count of |offset| <= 4r: the
+  // axis-registered lattice (0, ±2r, ±4r)² holds 1 + 4 + 4 + 4 = 13 sites ((±2r, ±2r) at
+  // 2.83r; (±4r, 0) and (0, ±4r) on the wall), the shifted one (±r, ±3r)² 4 + 8 = 12
+  // ((±3r, ±3r) at 4.24r do not fit). 260 spheres: 10 pairs of 25 and 10 in slab 21.
+  const fm::Container cyl = cylinder(5.0 * r, 0.090, 0);
+  fm::LatticePacking packing = along_x_gravity_down();
+  packing.staggered = true;
+  const fm::LatticeBed bed = fm::collected_lattice(cyl, 260, r, packing);
+  CHECK(bed.slabs == 21);
+  CHECK(bed.bed_extent_m == Approx(20.0 * std::sqrt(2.0) * r + 2.0 * r).margin(kGeometry));
+  CHECK(bed.clearance_m == Approx(0.090 - bed.bed_extent_m).margin(kGeometry));
+  CHECK(bed.settled_clearance_m == bed.clearance_m);
+  check_inside_cylinder(cyl, bed.centres_m, r);
+  // Touching (every shifted sphere rests on four of each neighbouring slab), nowhere closer.
+  CHECK(min_pair_distance(bed.centres_m) == Approx(2.0 * r).margin(kGeometry));
+  const auto slabs = count_by(bed.centres_m, 0);
+  REQUIRE(slabs.size() == 21);
+  int slab = 0;
+  for (auto it = slabs.begin(); it != slabs.end(); ++it, ++slab) {  // from the collect wall at −L/2
+    CHECK(it->second == (slab == 20 ? 10 : slab % 2 == 0 ? 13 : 12));
+  }
+  // The simple cubic lattice of the same bed needs 20 slabs of 13, 100 mm: not in 90 mm.
+  CHECK_THROWS_WITH(fm::collected_lattice(cyl, 260, r, along_x_gravity_down()), Catch::Contains("fill 20 slabs of 13 sites"));
+
+  SECTION("refusals") {
+    CHECK_THROWS_WITH(fm::collected_lattice(level2_box(), 36, 0.005, [] {
+      fm::LatticePacking p;
+      p.staggered = true;
+      return p;
+    }()),
+                      Catch::Contains("staggered: supported in a cylinder only"));
+    packing.lattice_counts = std::array{2, 2, 2};
+    CHECK_THROWS_WITH(fm::collected_lattice(cyl, 8, r, packing), Catch::Contains("no lattice_counts"));
+    packing.lattice_counts.reset();
+    CHECK_THROWS_WITH(fm::collected_lattice(cylinder(1.5 * r, 0.1, 0), 8, r, packing),
+                      Catch::Contains("no shifted site fits"));
+  }
+}

@@ -175,6 +175,9 @@ struct CompartmentOptions {
   /// equally, g = (L − n·2r)/n: each lane owns L/n, the side walls keep g/2 (shipped
   /// 61 mm box, 6 lanes of 10 mm: g = 0.167 mm). Box containers only.
   bool lane_gap_auto = false;
+  /// Face-centred stacking of the automatic slabs, cylinder only (formulas::LatticePacking::
+  /// staggered): slab pitch r√2, denser than the simple cubic lattice.
+  bool staggered_lattice = false;
   std::vector<PlateOptions> plates;
   std::vector<PinOptions> pins;
   WallLayerOptions layer;
