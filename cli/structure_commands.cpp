@@ -47,8 +47,10 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
   }
   if (const auto cache = args.optional_text("--calibration-cache")) {
     const bool task_calibrates = c.task.kind == case_file::TaskKind::kModes && c.task.modes && c.task.modes->calibration;
-    if (!options.calibrated.value_or(task_calibrates))
-      throw InputError("--calibration-cache", "", "applies to calibrated modes (--method calibrated, or the task's calibration)");
+    const bool task_searches = c.task.kind == case_file::TaskKind::kModes && c.task.modes && c.task.modes->clearance_search;
+    if (!options.calibrated.value_or(task_calibrates) && !task_searches)
+      throw InputError("--calibration-cache", "",
+                       "applies to calibrated modes (--method calibrated, the task's calibration or clearance_search)");
     if (const std::string problem = tasks::prepare_calibration_cache(*cache); !problem.empty())
       throw InputError("--calibration-cache", "", problem);
     options.calibration_cache = *cache;
@@ -85,6 +87,22 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
   if (!modes.dem_checks.empty())
     rows.push_back({"DEM check", std::string(modes.dem_checks_passed() ? "passed" : "failed") + " (whole damping ratios within " +
                                      format_number(100.0 * modes.dem_check_tolerance, 3) + " %)"});
+  if (const auto& search = modes.clearance_search) {
+    for (std::size_t k = 0; k < search->candidates.size(); ++k) {
+      const auto& candidate = search->candidates[k];
+      std::string row = "zeta_add " + (std::isfinite(candidate.objective) ? format_number(100.0 * candidate.objective, 4) + " %" : "-") +
+                        " (inner length " + format_number(candidate.inner_length_m * 1e3, 5) + " mm; calibration " +
+                        (candidate.calibration.cached ? "cached" : format_number(candidate.calibration.wall_time_s, 3) + " s") + ")";
+      if (!candidate.checks.empty())
+        row += "; checked decays: calibrated " + format_number(100.0 * candidate.predicted_check_mean, 4) + " %, DEM " +
+               format_number(100.0 * candidate.dem_check_mean, 4) + " %" + (candidate.checks_passed ? "" : " (a decay missed)");
+      rows.push_back({"h = " + format_number(candidate.clearance_m * 1e3, 4) + " mm" + (k == search->chosen ? " (chosen)" : ""), row});
+    }
+    if (search->verified)
+      rows.push_back({"clearance search", std::string(search->passed ? "passed" : "failed") + ": chosen " +
+                                              (search->chosen_agrees ? "agrees" : "misses") + ", ranking " +
+                                              (search->ranking_agrees ? "not contradicted" : "contradicted") + " by the DEM"});
+  }
   return finish(args, files.get(), result, warnings, rows, {"modes.json", &c, context.report}, &modes);
 }
 

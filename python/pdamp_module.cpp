@@ -348,7 +348,7 @@ PYBIND11_MODULE(pdamp, m) {
         return to_python(out);
       },
       py::arg("case"), py::arg("method") = py::none(), py::arg("progress") = py::none(),
-      "`pdamp modes`: natural frequencies, shapes and backbones (and the task's calibration and dem_check); "
+      "`pdamp modes`: natural frequencies, shapes and backbones (and the task's calibration, dem_check and clearance_search); "
       "method None: calibrated when the task has a calibration, else formulas.");
   m.def(
       "frf",

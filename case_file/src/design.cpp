@@ -58,14 +58,12 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
 
 namespace pdamp::case_file {
 
-Case with_clearance(const Case& c, double clearance_m) {
-  if (!c.task.clearance || c.format_version != 2)
-    throw CaseError(c.path, "/task", "a clearance variant needs a format-2 case of task kind clearance");
+nlohmann::json clearance_patch(const Case& c, double clearance_m) {
   const DamperSpec& damper = c.dampers.front();
   const LayerSpec& layer = damper.layers.front();
   const double change_m = clearance_m - layer.clearance_m;
-  json document = c.document;
-  json& layer_json = document["dampers"][0]["layers"][0];
+  json dampers = c.document.at("dampers");
+  json& layer_json = dampers[0]["layers"][0];
   json& container = layer_json["container"];
   if (layer.container.shape == formulas::ContainerShape::kBox) {
     json& size = container["inner_size_m"][static_cast<std::size_t>(damper.drive_axis)];
@@ -74,10 +72,18 @@ Case with_clearance(const Case& c, double clearance_m) {
     container["inner_length_m"] = container["inner_length_m"].get<double>() + change_m;
   } else {
     throw CaseError(c.path, "/dampers/0/layers/0/container/axis",
-                    "a cylinder across the drive has no length to change: the clearance of task kind clearance "
-                    "needs a box, or a cylinder along the drive");
+                    "a cylinder across the drive has no length to change: a clearance variant needs a box, or a "
+                    "cylinder along the drive");
   }
   if (layer_json.contains("clearance_m")) layer_json["clearance_m"] = clearance_m;
+  return {{"dampers", dampers}};  // a merge patch replaces arrays whole
+}
+
+Case with_clearance(const Case& c, double clearance_m) {
+  if (!c.task.clearance || c.format_version != 2)
+    throw CaseError(c.path, "/task", "a clearance variant needs a format-2 case of task kind clearance");
+  json document = c.document;
+  document.merge_patch(clearance_patch(c, clearance_m));
   const FrfTask& band = c.task.clearance->band;
   document["task"] = json{{"kind", "frf"},
                           {"min_frequency_hz", band.min_frequency_hz},

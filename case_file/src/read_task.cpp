@@ -1,6 +1,7 @@
 // Format 2 `task`: what `pdamp run` does, with the settings of its kind.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 #include "readers.hpp"
@@ -74,12 +75,88 @@ std::vector<int> read_mode_list(ObjectReader& r, int mode_count) {
   return out;
 }
 
+/// A calibration's settings (its modes are the caller's).
+void read_calibration_settings(ObjectReader& b, ModesCalibrationSpec& spec) {
+  spec.strokes_per_decade = b.integer("strokes_per_decade", spec.strokes_per_decade, 1, 100);
+  spec.stiffness_softening = b.number("stiffness_softening", spec.stiffness_softening, {1e-6, 1.0});
+}
+
 ModesCalibrationSpec read_modes_calibration(ObjectReader& b, const ModesTask& t) {
   ModesCalibrationSpec spec;
   spec.modes = b.has("modes") || !t.dem_check ? read_mode_list(b, t.mode_count) : t.dem_check->modes;
-  spec.strokes_per_decade = b.integer("strokes_per_decade", spec.strokes_per_decade, 1, 100);
-  spec.stiffness_softening = b.number("stiffness_softening", spec.stiffness_softening, {1e-6, 1.0});
+  read_calibration_settings(b, spec);
   return spec;
+}
+
+/// The DEM decays of `dem_check` (of `modes`) and of clearance_search's `verify`.
+ModesDemCheck read_mode_decays(ObjectReader& d, const Case& c, std::vector<int> modes) {
+  ModesDemCheck check;
+  check.modes = std::move(modes);
+  check.amplitudes_m = d.number_array("amplitudes_m", limits::kStroke, " m", 1);
+  if (check.amplitudes_m.size() > 20)
+    d.fail("amplitudes_m", "has " + std::to_string(check.amplitudes_m.size()) + " entries: at most 20 (each is a DEM decay)");
+  if (!std::is_sorted(check.amplitudes_m.begin(), check.amplitudes_m.end())) d.fail("amplitudes_m", "must be ascending");
+  check.periods = d.integer("periods", check.periods, 4, 10000);
+  check.amplitude_fraction = d.number("amplitude_fraction", check.amplitude_fraction, {0.0, 1.0, true});
+  if (check.amplitude_fraction >= 1.0) d.fail("amplitude_fraction", "must be < 1 (a fraction of the start)");
+  check.tolerance_relative = d.number("tolerance_relative", check.tolerance_relative, {0.0, 10.0, true});
+  check.forced_start_periods = d.integer("forced_start_periods", check.forced_start_periods, 0, 10000);
+  if (c.dampers.size() != 1)
+    throw CaseError(d.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
+                                              " dampers: the DEM check of task kind modes takes a case of one damper");
+  return check;
+}
+
+ModesClearanceSearch read_clearance_search(ObjectReader& r, const Case& c, const ModesTask& t) {
+  ModesClearanceSearch s;
+  const auto mode = r.number("mode", std::nullopt, {1.0, static_cast<double>(t.mode_count)}, "");
+  if (mode != std::floor(mode)) r.fail("mode", "must be a whole mode number");
+  s.mode = static_cast<int>(mode) - 1;
+  s.min_amplitude_m = r.number("min_amplitude_m", std::nullopt, limits::kStroke, " m");
+  s.max_amplitude_m = r.number("max_amplitude_m", std::nullopt, limits::kStroke, " m");
+  if (!(s.max_amplitude_m > s.min_amplitude_m)) r.fail("max_amplitude_m", "must be > min_amplitude_m");
+  s.amplitude_points = r.integer("amplitude_points", s.amplitude_points, 2, 50);
+  s.objective = r.text("objective", std::string("mean"), {"mean", "worst"}) == "worst"
+                    ? ModesClearanceSearch::Objective::kWorst
+                    : ModesClearanceSearch::Objective::kMean;
+  // Each candidate is a DEM calibration of minutes: a handful, not a fine grid.
+  constexpr int kMaxCandidates = 20;
+  if (r.has("clearances_m")) {
+    for (const char* key : {"min_clearance_m", "max_clearance_m", "candidates"})
+      if (r.has(key)) r.fail(key, "must not be given with clearances_m (the candidates are listed)");
+    s.clearances_m = r.number_array("clearances_m", limits::kClearance, " m", 2);
+    if (s.clearances_m.size() > kMaxCandidates)
+      r.fail("clearances_m", "has " + std::to_string(s.clearances_m.size()) + " entries: at most " +
+                                 std::to_string(kMaxCandidates) + " (each is a DEM calibration)");
+    if (std::adjacent_find(s.clearances_m.begin(), s.clearances_m.end(), std::greater_equal<>()) != s.clearances_m.end())
+      r.fail("clearances_m", "must be strictly ascending");
+  } else {
+    const double lo = r.number("min_clearance_m", std::nullopt, limits::kClearance, " m");
+    const double hi = r.number("max_clearance_m", std::nullopt, limits::kClearance, " m");
+    if (!(hi > lo)) r.fail("max_clearance_m", "must be > min_clearance_m");
+    const int n = r.integer("candidates", 5, 2, kMaxCandidates);
+    for (int k = 0; k < n; ++k) s.clearances_m.push_back(lo * std::pow(hi / lo, static_cast<double>(k) / (n - 1)));
+  }
+  s.calibration.modes = {s.mode};
+  r.object("calibration", false, [&](ObjectReader& b) { read_calibration_settings(b, s.calibration); });
+  r.object("verify", false, [&](ObjectReader& v) {
+    s.verify = read_mode_decays(v, c, {s.mode});
+    // The prediction of a decay from X down to fraction·X reads the calibrated strokes only.
+    const double lo = s.min_amplitude_m / s.verify->amplitude_fraction;
+    for (std::size_t k = 0; k < s.verify->amplitudes_m.size(); ++k)
+      if (const double x = s.verify->amplitudes_m[k]; x < lo * (1.0 - 1e-9) || x > s.max_amplitude_m * (1.0 + 1e-9))
+        v.fail("amplitudes_m/" + std::to_string(k),
+               "= " + base::format_number(x, kMessageDigits) + " m: must lie in [min_amplitude_m/amplitude_fraction, "
+               "max_amplitude_m] = [" + base::format_number(lo, kMessageDigits) + ", " +
+                   base::format_number(s.max_amplitude_m, kMessageDigits) +
+                   "] m (a decay measured down to that fraction stays inside the calibrated strokes)");
+  });
+  // The candidates are the first damper's one layer, its length along the drive changed.
+  if (c.dampers.size() != 1 || c.dampers.front().layers.size() != 1)
+    throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) + " dampers, the first with " +
+                                              std::to_string(c.dampers.front().layers.size()) +
+                                              " layers: clearance_search takes one damper of one layer");
+  return s;
 }
 
 ModesTask read_modes(ObjectReader& r, const Case& c) {
@@ -92,23 +169,10 @@ ModesTask read_modes(ObjectReader& r, const Case& c) {
     r.fail("backbone_max_amplitude_m", "must be > backbone_min_amplitude_m");
   t.backbone_points = r.integer("backbone_points", ModesTask{}.backbone_points, 2, 10000);
   r.object("dem_check", false, [&](ObjectReader& d) {
-    ModesDemCheck check;
-    check.modes = read_mode_list(d, t.mode_count);
-    check.amplitudes_m = d.number_array("amplitudes_m", limits::kStroke, " m", 1);
-    if (check.amplitudes_m.size() > 20)
-      d.fail("amplitudes_m", "has " + std::to_string(check.amplitudes_m.size()) + " entries: at most 20 (each is a DEM decay)");
-    if (!std::is_sorted(check.amplitudes_m.begin(), check.amplitudes_m.end()))
-      d.fail("amplitudes_m", "must be ascending");
-    check.periods = d.integer("periods", check.periods, 4, 10000);
-    check.amplitude_fraction = d.number("amplitude_fraction", check.amplitude_fraction, {0.0, 1.0, true});
-    if (check.amplitude_fraction >= 1.0) d.fail("amplitude_fraction", "must be < 1 (a fraction of the start)");
-    check.tolerance_relative = d.number("tolerance_relative", check.tolerance_relative, {0.0, 10.0, true});
-    if (c.dampers.size() != 1)
-      throw CaseError(r.file(), "/dampers", "has " + std::to_string(c.dampers.size()) +
-                                                " dampers: the DEM check of task kind modes takes a case of one damper");
-    t.dem_check = check;
+    t.dem_check = read_mode_decays(d, c, read_mode_list(d, t.mode_count));
   });
   r.object("calibration", false, [&](ObjectReader& b) { t.calibration = read_modes_calibration(b, t); });
+  r.object("clearance_search", false, [&](ObjectReader& s) { t.clearance_search = read_clearance_search(s, c, t); });
   return t;
 }
 

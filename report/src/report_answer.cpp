@@ -377,28 +377,60 @@ Answer modes_answer(const tasks::ModesResult& r) {
     p << ".";
     a.paragraphs.push_back(p.str());
   }
-  if (r.dem_checks.empty()) return a;
   std::ostringstream verdict;
-  std::vector<std::string> missed;
-  for (std::size_t k = 0; k < r.dem_checks.size(); ++k) {
-    const auto& check = r.dem_checks[k];
-    if (!r.dem_check_passed(k))
-      missed.push_back("mode " + std::to_string(check.mode + 1) + " from " + in_mm(check.damper_amplitude_m) + " (" +
-                       percent(check.whole_relative_difference()) + ")");
+  if (!r.dem_checks.empty()) {
+    std::vector<std::string> missed;
+    for (std::size_t k = 0; k < r.dem_checks.size(); ++k) {
+      const auto& check = r.dem_checks[k];
+      if (!r.dem_check_passed(k))
+        missed.push_back("mode " + std::to_string(check.mode + 1) + " from " + in_mm(check.damper_amplitude_m) + " (" +
+                         percent(check.whole_relative_difference()) + ")");
+    }
+    verdict << "The DEM in the loop decayed " << r.dem_checks.size() << " modes and strokes; ";
+    if (missed.empty()) {
+      verdict << "each mode's damping ratio by the prediction lies within the case's " << percent(r.dem_check_tolerance)
+              << " of the DEM's: the damping against amplitude can be trusted at the strokes checked. ";
+    } else {
+      verdict << "the prediction misses the DEM's damping ratio by more than the case's " << percent(r.dem_check_tolerance)
+              << " at ";
+      for (std::size_t k = 0; k < missed.size(); ++k) verdict << (k == 0 ? "" : ", ") << missed[k];
+      verdict << ": there the damping ratio is the DEM's"
+              << (r.calibrations.empty() ? "; a calibration of the task's modes takes the bed from the DEM. " : ". ");
+    }
+    a.passed = missed.empty();
   }
-  verdict << "The DEM in the loop decayed " << r.dem_checks.size() << " modes and strokes; ";
-  if (missed.empty()) {
-    verdict << "each mode's damping ratio by the prediction lies within the case's " << percent(r.dem_check_tolerance)
-            << " of the DEM's: the damping against amplitude can be trusted at the strokes checked.";
-  } else {
-    verdict << "the prediction misses the DEM's damping ratio by more than the case's " << percent(r.dem_check_tolerance)
-            << " at ";
-    for (std::size_t k = 0; k < missed.size(); ++k) verdict << (k == 0 ? "" : ", ") << missed[k];
-    verdict << ": there the damping ratio is the DEM's"
-            << (r.calibrations.empty() ? "; a calibration of the task's modes takes the bed from the DEM." : ".");
+  if (const auto& search = r.clearance_search) {
+    const auto& s = search->settings;
+    const auto& chosen = search->candidates[search->chosen];
+    std::ostringstream p;
+    p << "Clearance for mode " << s.mode + 1 << ": of " << search->candidates.size() << " clearances from "
+      << in_mm(search->candidates.front().clearance_m) << " to " << in_mm(search->candidates.back().clearance_m)
+      << ", each with its bed calibrated from DEM steady states, " << in_mm(chosen.clearance_m) << " (inner length "
+      << in_mm(chosen.inner_length_m) << ") adds the most damping over strokes of " << in_mm(s.min_amplitude_m) << " to "
+      << in_mm(s.max_amplitude_m) << ": ζ_add = " << three_digits(chosen.objective)
+      << (s.objective == case_file::ModesClearanceSearch::Objective::kWorst ? " at the worst stroke." : " on average.");
+    a.paragraphs.push_back(p.str());
+    if (search->verified) {
+      verdict << "The DEM decays of mode " << s.mode + 1 << " give ζ_add " << three_digits(chosen.dem_check_mean)
+              << " on average at the chosen clearance (calibrated " << three_digits(chosen.predicted_check_mean) << ")";
+      for (const auto& candidate : search->candidates)
+        if (!candidate.checks.empty() && &candidate != &chosen)
+          verdict << ", " << three_digits(candidate.dem_check_mean) << " at " << in_mm(candidate.clearance_m);
+      if (search->passed) {
+        verdict << ": the DEM confirms the choice within the case's " << percent(s.verify->tolerance_relative) << ".";
+      } else {
+        std::vector<std::string> failed;
+        if (!search->chosen_agrees)
+          failed.push_back("a decay at the chosen clearance misses the DEM by more than " +
+                           percent(s.verify->tolerance_relative));
+        if (!search->ranking_agrees) failed.push_back("the DEM damps a neighbouring clearance more");
+        verdict << ". " << do_not_build(failed);
+      }
+      a.passed = a.passed.value_or(true) && search->passed;
+    }
   }
   a.verdict = verdict.str();
-  a.passed = missed.empty();
+  if (!a.verdict.empty() && a.verdict.back() == ' ') a.verdict.pop_back();
   return a;
 }
 

@@ -158,6 +158,62 @@ Warnings write_files(OutputDir& out, const tasks::SensitivityResult& study) {
   return out.add_plot("sensitivity.gp", gp.str(), {"sensitivity.png", "sensitivity.svg"});
 }
 
+namespace {
+
+/// clearance_search.csv (one row per candidate: its objective, its added damping at each
+/// stroke, the means of its DEM-checked decays), clearance_search_checks.csv (the decays) and
+/// the objective against h with the DEM's means.
+Warnings clearance_search_files(OutputDir& out, const std::string& case_name, const tasks::ModeClearanceSearchResult& s) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "clearance_m,inner_length_m,objective,predicted_check_mean,dem_check_mean";
+  for (const double x : s.amplitudes_m) csv << ",added_damping_ratio_at_" << x << "_m";
+  csv << '\n';
+  const auto number = [](double v) { return std::isfinite(v) ? base::format_number(v, 10) : std::string(); };
+  for (const auto& c : s.candidates) {
+    csv << c.clearance_m << ',' << c.inner_length_m << ',' << number(c.objective) << ',' << number(c.predicted_check_mean)
+        << ',' << number(c.dem_check_mean);
+    for (const double zeta : c.added_damping_ratios) csv << ',' << number(zeta);
+    csv << '\n';
+  }
+  out.add("clearance_search.csv", csv.str());
+  if (s.verified) {
+    const base::CsvTable<tasks::ModeDecayCheck> columns(
+        {"damper_amplitude_m", base::CsvColumn("predicted_damping_ratio").nan_as(""),
+         base::CsvColumn("dem_damping_ratio").nan_as(""), base::CsvColumn("bare_damping_ratio").nan_as(""),
+         base::CsvColumn("dem_final_fraction").nan_as(""), "solve_time_s"});
+    std::string checks = "clearance_m," + columns.header() + "\n";
+    for (const auto& c : s.candidates)
+      for (const auto& check : c.checks) checks += base::format_number(c.clearance_m, 10) + "," + columns.row(check) + "\n";
+    out.add("clearance_search_checks.csv", checks);
+  }
+  const double chosen_mm = s.candidates[s.chosen].clearance_m * 1e3;
+  std::ostringstream gp;
+  gp << "# the added damping ratio of the target mode against the clearance h (calibrated beds);\n"
+     << "# pdamp modes, clearance_search; run: gnuplot clearance_search.gp\n"
+     << "set datafile separator ','\nset logscale x\nset grid\nset key top right\n"
+     << "set xlabel 'clearance h / mm'\nset ylabel 'added damping ratio {/Symbol z}_{add} of mode "
+     << s.settings.mode + 1 << "'\n"
+     << "set title " << gnuplot_string(case_name + ": clearance for the damping of mode " + std::to_string(s.settings.mode + 1))
+     << " noenhanced\n"
+     << "set arrow from " << chosen_mm << ", graph 0 to " << chosen_mm << ", graph 1 nohead lc rgb 'black' dt 2\n"
+     << "set label 'chosen' at " << chosen_mm << ", graph 0.97 left offset 0.5,0\n"
+     << "do for [t in 'pngcairo svg'] {\n"
+     << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
+     << "  set output (t eq 'svg') ? 'clearance_search.svg' : 'clearance_search.png'\n"
+     << "  plot 'clearance_search.csv' using ($1*1000):3 every ::1 with linespoints lw 2 pt 7 lc rgb 'black' "
+     << "title '" << (s.settings.objective == case_file::ModesClearanceSearch::Objective::kWorst ? "smallest" : "mean")
+     << " over the strokes (calibrated)'";
+  if (s.verified)
+    gp << ", \\\n       '' using ($1*1000):4 every ::1 with points pt 6 ps 1.5 lc rgb 'blue' "
+          "title 'mean over the checked decays, calibrated', \\\n"
+          "       '' using ($1*1000):5 every ::1 with points pt 7 ps 1.5 lc rgb 'red' title 'the same, DEM in the loop'";
+  gp << "\n}\n";
+  return out.add_plot("clearance_search.gp", gp.str(), {"clearance_search.png", "clearance_search.svg"});
+}
+
+}  // namespace
+
 Warnings write_files(OutputDir& out, const tasks::ModesResult& m) {
   ModeTable table;
   for (Eigen::Index j = 0; j < m.mode_count; ++j) {
@@ -178,9 +234,11 @@ Warnings write_files(OutputDir& out, const tasks::ModesResult& m) {
     for (const auto& check : m.dem_checks) csv += columns.row(check) + "\n";
     out.add("dem_check.csv", csv);
   }
-  return write_backbone_files(out, m.backbones, m.layer_names,
-                              m.case_name + ": backbones (" + std::string(case_file::to_string(m.method)) + ")",
-                              m.dem_checks.empty() ? "" : "dem_check.csv");
+  Warnings warnings = write_backbone_files(out, m.backbones, m.layer_names,
+                                          m.case_name + ": backbones (" + std::string(case_file::to_string(m.method)) + ")",
+                                          m.dem_checks.empty() ? "" : "dem_check.csv");
+  if (m.clearance_search) append(warnings, clearance_search_files(out, m.case_name, *m.clearance_search));
+  return warnings;
 }
 
 namespace {

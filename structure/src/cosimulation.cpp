@@ -364,6 +364,12 @@ struct Cosimulation::Impl {
   [[gnu::always_inline]] bool step_beds();
   [[gnu::always_inline]] void closing_kick();
   [[gnu::always_inline]] void account_energy();
+  bool force_start(std::size_t d, const std::function<void(std::int64_t)>& observe);
+  /// Steps of the forced start (0 without one): whole periods rounded to whole steps.
+  std::int64_t forced_start_steps() const {
+    if (options_.forced_start_periods <= 0) return 0;
+    return std::max<std::int64_t>(1, std::llround(options_.forced_start_periods / (options_.forced_start_frequency_hz * dt_)));
+  }
   [[gnu::always_inline]] void commit_step();
   [[gnu::always_inline]] void feed_measures();
   void report_progress();
@@ -696,7 +702,7 @@ void Cosimulation::Impl::build_and_settle_worlds() {
     const double settling = options_.bed_settling_time_s >= 0.0 ? options_.bed_settling_time_s
                                                                 : dem::automatic_settling_time_s(world_options_[d]);
     const auto steps = static_cast<std::int64_t>(std::llround(settling / dt_));
-    settling_steps_ = std::max(settling_steps_, steps);
+    settling_steps_ = std::max(settling_steps_, steps + forced_start_steps());
     const double end_s = static_cast<double>(planned_steps_) * dt_;
     hooks_->progress({"", "settling", 0.0, end_s, false, 0.0, NAN});
     // A big bed settles for hours: a "settling" report about every progress_interval_s, and
@@ -717,9 +723,45 @@ void Cosimulation::Impl::build_and_settle_worlds() {
     if (!dem::settle(worlds[d], containers_[d], steps, observe)) {
       outcome_ = worlds[d].status().outcome;
       message_ = "damper " + dampers_[d].name + " (settling): " + worlds[d].status().message;
+    } else if (options_.forced_start_periods > 0 && !force_start(d, observe)) {
+      outcome_ = worlds[d].status().outcome;
+      message_ = "damper " + dampers_[d].name + " (forced start): " + worlds[d].status().message;
     }
   }
   stage_times_.settling_s = seconds_since(settling_start);
+}
+
+// The forced start (CosimulationSettings::forced_start_periods): the container of bed d moves
+// as its start pose times cos(2πf t) for whole periods, t from the settled bed (at rest at the
+// start pose) to the same pose at rest again. The angle advances as 2π·periods·k/steps, so the
+// last step lands on a whole period (the step need not divide the period); that last state is
+// the start pose itself.
+bool Cosimulation::Impl::force_start(std::size_t d, const std::function<void(std::int64_t)>& observe) {
+  dem::World& world = state_.worlds[d];
+  const dem::ContainerState& start = containers_[d];
+  const auto& cd = dampers_[d];
+  const double omega = 2.0 * std::acos(-1.0) * options_.forced_start_frequency_hz;
+  const std::int64_t steps = forced_start_steps();
+  const double angle_per_step = 2.0 * std::acos(-1.0) * options_.forced_start_periods / static_cast<double>(steps);
+  dem::ContainerState s = start;
+  for (std::int64_t k = 0; k < steps; ++k) {
+    if (k + 1 == steps) {
+      s = start;
+    } else {
+      const double angle = angle_per_step * static_cast<double>(k + 1);
+      const double c = std::cos(angle), rate = -omega * std::sin(angle);
+      for (int a = 0; a < 3; ++a) {
+        s.position_m[a] = start.position_m[a] * c;
+        s.velocity_m_s[a] = start.position_m[a] * rate;
+        s.angular_velocity_rad_s[a] = cd.container_rotation_axis[a] * site_theta_[d] * rate;
+      }
+      s.orientation = site_theta_[d] == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, site_theta_[d] * c);
+    }
+    world.step(s);
+    if (world.status().outcome != dem::Outcome::kCompleted) return false;
+    observe(k);
+  }
+  return true;
 }
 
 // The loads and energies at the start, q̈(0), and the ledger's opening: this run's, or for a

@@ -215,6 +215,19 @@ std::vector<std::string> RunOptions::validate(const ModalModel& model) const {
   if (!(bed_settling_time_s == -1.0 || (bed_settling_time_s >= 0.0 && bed_settling_time_s <= 100.0)))
     p.push_back(at + "bed_settling_time_s = " + format_number(bed_settling_time_s, 12) +
                 ": must be -1 (automatic) or in [0, 100] s");
+  if (forced_start_periods < 0 || forced_start_periods > 10000)
+    p.push_back(at + "forced_start_periods = " + std::to_string(forced_start_periods) + ": must be in [0, 10000]");
+  if (forced_start_periods > 0) {
+    if (!(forced_start_frequency_hz > 0.0 && std::isfinite(forced_start_frequency_hz)))
+      p.push_back(at + "forced_start_frequency_hz = " + format_number(forced_start_frequency_hz, 12) +
+                  ": must be > 0 and finite with forced_start_periods");
+    if (harmonic(e))
+      p.push_back(at + "forced_start_periods = " + std::to_string(forced_start_periods) +
+                  ": a forced start is for a free decay (the harmonic runs have their own transient)");
+    if (initial_modal_velocities.size() && initial_modal_velocities.cwiseAbs().maxCoeff() > 0)
+      p.push_back(at + "forced_start_periods = " + std::to_string(forced_start_periods) +
+                  ": a forced start ends at rest, so the start must be at rest (initial_modal_velocities zero)");
+  }
   if (!(sample_interval_s >= 0.0 && std::isfinite(sample_interval_s)))
     p.push_back(at + "sample_interval_s = " + format_number(sample_interval_s, 12) +
                 ": must be >= 0 and finite (0 = automatic)");

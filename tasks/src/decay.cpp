@@ -290,6 +290,7 @@ CoupledRunEstimate estimate_coupled_decay(const Case& c, const st::ModalModel& m
   for (const auto& d : dampers)
     settling_s = std::max(settling_s, options.bed_settling_time_s >= 0.0 ? options.bed_settling_time_s
                                                                          : dem_reference::automatic_settling_time_s(d.world));
+  if (options.forced_start_periods > 0) settling_s += options.forced_start_periods / options.forced_start_frequency_hz;
   CoupledRunEstimate e = estimate_coupled_steps(dampers, dt, std::llround((options.duration_s + settling_s) / dt));
   // The sampled history: time, q and per bed its site's displacement, rotation, force and moment.
   const double samples = options.duration_s / options.sample_interval_s + 1.0;
@@ -335,7 +336,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
                    const std::vector<st::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
                    const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots,
-                   const DecayStop* stop) {
+                   const DecayStop* stop, const ForcedStart& forced) {
   for (auto& d : containers) d.layers.clear();
   const auto empty = detail::call_solver(c, "/dampers", [&] { return st::couple(modal, containers); });
 
@@ -350,6 +351,8 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
 
   st::DecayRun options = dem_decay_options(c, modal, q0, task.duration_s);
   options.snapshots = snapshots;
+  options.forced_start_periods = forced.periods;
+  options.forced_start_frequency_hz = forced.frequency_hz;
   // Refused here when it cannot fit; said once a resume's checkpoint is accepted.
   const std::string estimate = label + ": " + estimate_text(check_coupled_decay(c, modal, dampers, options, label,
                                                                                 duration_pointer, hooks));

@@ -1,4 +1,5 @@
-// Private helper of task kind modes: one mode's calibrated bed (modes.hpp, ModeCalibration).
+// Private helpers of task kind modes: one mode's calibrated bed (modes.hpp, ModeCalibration)
+// and the clearance search on calibrated beds (ModeClearanceSearchResult).
 #pragma once
 
 #include <filesystem>
@@ -24,5 +25,13 @@ struct ModeCalibrationRange {
 ModeCalibration calibrate_mode(const case_file::Case& c, const case_file::ModesCalibrationSpec& spec,
                                const ModeCalibrationRange& range, const std::filesystem::path& cache_dir,
                                base::RunHooks& hooks);
+
+/// The task's clearance_search: each candidate a variant of `c` (its clearance, the search's
+/// strokes as the backbone, its mode calibrated with the search's settings) through
+/// run_modes, the best by the objective, and with `verify` the DEM decays of it and its
+/// neighbours in the list. Calibrations cached in `cache_dir`; warnings appended to `warnings`.
+/// InputError naming /task/clearance_search/clearances_m/k for a candidate the case refuses.
+ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const std::filesystem::path& cache_dir,
+                                                base::RunHooks& hooks, std::vector<std::string>& warnings);
 
 }  // namespace pdamp::tasks::detail

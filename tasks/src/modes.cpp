@@ -163,7 +163,7 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
   if (!out.converged) setup.warnings.add("some backbone points did not converge (converged = 0 in backbone_mode<j>.csv)");
   if (from_task && c.task.modes->dem_check) {
     const case_file::ModesDemCheck& check = *c.task.modes->dem_check;
-    const ModeDecayWindow window{check.periods, check.amplitude_fraction};
+    const ModeDecayWindow window{check.periods, check.amplitude_fraction, check.forced_start_periods};
     out.dem_check_tolerance = check.tolerance_relative;
     for (const int j : check.modes) {
       const double b = std::abs(coupled.drive_shapes(j, 0));
@@ -192,6 +192,19 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
   }
   out.modal = modal;
   out.warnings = setup.warnings.list();
+  if (from_task && c.task.modes->clearance_search) {
+    const int j = c.task.modes->clearance_search->mode;
+    if (!moves_damper(j))
+      throw base::InputError(c.path, "/task/clearance_search/mode",
+                             "mode " + std::to_string(j + 1) + " does not move damper " + dampers.front().name +
+                                 " along its drive: no clearance changes its damping");
+    if (out.calibration_cache.empty()) {
+      out.calibration_cache = options.calibration_cache.empty() ? default_calibration_cache() : options.calibration_cache;
+      if (const std::string problem = prepare_calibration_cache(out.calibration_cache); !problem.empty())
+        throw base::InputError(c.path, "/task/clearance_search", "the calibration cache " + problem);
+    }
+    out.clearance_search = detail::search_mode_clearance(c, out.calibration_cache, hooks, out.warnings);
+  }
   return out;
 }
 
@@ -225,6 +238,22 @@ const base::Fields<ModeCalibration>& ModeCalibration::fields() {
           .derived("file", [](const M& m) { return m.file.string(); }, "", "its cache file")
           .field("cached", &M::cached, "", "read from the cache (not run now)")
           .field("wall_time_s", &M::wall_time_s, "s", "of its DEM points (0 when cached)");
+  return f;
+}
+
+const base::Fields<ModeClearanceCandidate>& ModeClearanceCandidate::fields() {
+  using M = ModeClearanceCandidate;
+  static const auto f =
+      base::Fields<M>()
+          .field("clearance_m", &M::clearance_m, "m", "the layer's clearance h (inner length minus the lattice's extent)")
+          .field("inner_length_m", &M::inner_length_m, "m", "the container's inner length along the drive")
+          .field("added_damping_ratios", &M::added_damping_ratios, "1", "zeta_add of the mode at the search's strokes")
+          .field("objective", &M::objective, "1", "their mean, or the smallest (the search's objective)", base::kNullable)
+          .field("converged", &M::converged, "", "every backbone point converged")
+          .field("predicted_check_mean", &M::predicted_check_mean, "1",
+                 "mean zeta_add of its DEM-checked decays by the calibrated bed", base::kNullable)
+          .field("dem_check_mean", &M::dem_check_mean, "1", "the same by the DEM in the loop", base::kNullable)
+          .field("checks_passed", &M::checks_passed, "", "every checked decay's whole zeta within the tolerance");
   return f;
 }
 
@@ -312,6 +341,33 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
   if (!r.calibrations.empty()) {
     result["calibration"] = {{"cache", r.calibration_cache.string()}, {"what", ModeCalibration::kWhat}, {"modes", json::array()}};
     for (const auto& m : r.calibrations) result["calibration"]["modes"].push_back(base::to_json(m));
+  }
+  result["clearance_search"] = nullptr;
+  if (const auto& search = r.clearance_search) {
+    const auto& s = search->settings;
+    json candidates = json::array();
+    for (const auto& candidate : search->candidates) {
+      json item = base::to_json(candidate);
+      item["calibration"] = base::to_json(candidate.calibration);
+      item["dem_check"] = json::array();
+      for (const auto& check : candidate.checks) item["dem_check"].push_back(base::to_json(check));
+      candidates.push_back(std::move(item));
+    }
+    result["clearance_search"] = {
+        {"mode", s.mode + 1},
+        {"objective", s.objective == case_file::ModesClearanceSearch::Objective::kWorst ? "worst" : "mean"},
+        {"amplitudes_m", search->amplitudes_m},
+        {"candidates", candidates},
+        {"chosen_clearance_m", search->candidates[search->chosen].clearance_m},
+        {"chosen_inner_length_m", search->candidates[search->chosen].inner_length_m},
+        {"file", folder.file("clearance_search.csv")},
+        {"plot", folder.file("clearance_search.png")},
+        {"verification", nullptr}};
+    if (search->verified)
+      result["clearance_search"]["verification"] = {{"tolerance_relative", s.verify->tolerance_relative},
+                                                    {"chosen_agrees", search->chosen_agrees},
+                                                    {"ranking_agrees", search->ranking_agrees},
+                                                    {"outcome", search->passed ? "passed" : "failed"}};
   }
   result["dem_check"] = nullptr;
   result["dem_check_outcome"] = nullptr;

@@ -738,3 +738,104 @@ TEST_CASE("shipped free-free beam: the calibrated bed predicts the DEM decay of 
   CHECK(std::abs(check["whole_relative_difference"].get<double>()) <= 0.15);
   CHECK(r["dem_check_outcome"] == "passed");
 }
+
+// The clearance search's plumbing on the shipped case's bed (its physics: the shipped case's
+// DEM check, docs/optimizer.md): three clearances, each bed a field of 2 strokes x 2
+// frequencies at E/100 with 1 + 2 periods a point, and the DEM decay of mode 3 from 2 mm for
+// the chosen clearance and its neighbours (4 periods: too short to measure down to half, which
+// the warnings say). The chosen clearance has the largest objective; the verdict follows
+// from the DEM means as documented; a second run reads every bed from the cache.
+TEST_CASE("pdamp modes searches the clearance for a mode's damping on calibrated beds", "[cli][structure][dem][long]") {
+  const TempDir dir("modes_clearance_search");
+  const auto cache = dir.path / "cache";
+  const std::string path = edited_shipped_case(dir.path, "free_free_beam_mode_clearance.json", [](json& c) {
+    json& s = c["task"]["clearance_search"];
+    s.erase("min_clearance_m");
+    s.erase("max_clearance_m");
+    s.erase("candidates");
+    s["clearances_m"] = {0.002, 0.008, 0.016};
+    s["min_amplitude_m"] = 0.001;
+    s["max_amplitude_m"] = 0.002;
+    s["amplitude_points"] = 2;
+    s["calibration"] = {{"strokes_per_decade", 1}, {"stiffness_softening", 0.01}};
+    s["verify"] = {{"amplitudes_m", {0.002}}, {"periods", 4}};
+    c["dem"] = {{"transient_periods", 1},
+                {"analysed_periods", 2},
+                {"approach", {{"amplitude_m", 0.002}, {"hold_periods", 0}, {"ramp_periods", 1}}}};
+  });
+  const std::string cache_flag = "--calibration-cache=" + cache.string();
+  const json r = run_json({"modes", path, cache_flag, "-o", (dir.path / "out").string()});
+  const json& s = r["clearance_search"];
+  REQUIRE(s.is_object());
+  CHECK(s["mode"] == 3);
+  REQUIRE(s["candidates"].size() == 3);
+  std::size_t best = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const json& candidate = s["candidates"][k];
+    CHECK(candidate["added_damping_ratios"].size() == 2);
+    const auto& zeta = candidate["added_damping_ratios"];
+    CHECK(candidate["objective"].get<double>() == Approx(0.5 * (zeta[0].get<double>() + zeta[1].get<double>())));
+    CHECK(candidate["calibration"]["cached"] == false);
+    // The clearance is the length beyond the staggered lattice: every inner length minus h is that extent.
+    CHECK(candidate["inner_length_m"].get<double>() - candidate["clearance_m"].get<double>() ==
+          Approx(20.0 * std::sqrt(2.0) * 0.0025 + 0.005).epsilon(1e-9));
+    if (candidate["objective"].get<double>() > s["candidates"][best]["objective"].get<double>()) best = k;
+  }
+  CHECK(s["chosen_clearance_m"] == s["candidates"][best]["clearance_m"]);
+  // The chosen clearance and its neighbours in the list were decayed by the DEM.
+  for (std::size_t k = 0; k < 3; ++k)
+    CHECK(s["candidates"][k]["dem_check"].size() == (k + 1 >= best && k <= best + 1 ? 1u : 0u));
+  const json& v = s["verification"];
+  CHECK(v["chosen_agrees"] == s["candidates"][best]["checks_passed"]);
+  CHECK(v["outcome"] == (v["chosen_agrees"].get<bool>() && v["ranking_agrees"].get<bool>() ? "passed" : "failed"));
+  CHECK_THAT(r["warnings"].dump(), Catch::Contains("clearance search, h = "));
+  for (const char* file : {"clearance_search.csv", "clearance_search_checks.csv", "clearance_search.gp"})
+    CHECK(std::filesystem::exists(dir.path / "out" / file));
+  std::ifstream csv(dir.path / "out" / "clearance_search.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header.rfind("clearance_m,inner_length_m,objective,predicted_check_mean,dem_check_mean,added_damping_ratio_at_", 0) == 0);
+
+  const json again = run_json({"modes", path, cache_flag});
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(again["clearance_search"]["candidates"][k]["calibration"]["cached"] == true);
+    CHECK(again["clearance_search"]["candidates"][k]["objective"] == s["candidates"][k]["objective"]);
+  }
+}
+
+TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 2", "[cli][structure]") {
+  const TempDir dir("modes_clearance_search_bad");
+  const std::vector<std::pair<std::function<void(json&)>, std::string>> bad = {
+      {[](json& c) { c["task"]["clearance_search"]["mode"] = 0; }, "/task/clearance_search/mode"},
+      {[](json& c) { c["task"]["clearance_search"]["mode"] = 2.5; }, "/task/clearance_search/mode"},
+      {[](json& c) { c["task"]["clearance_search"]["max_amplitude_m"] = 0.0004; }, "/task/clearance_search/max_amplitude_m"},
+      {[](json& c) { c["task"]["clearance_search"]["amplitude_points"] = 1; }, "/task/clearance_search/amplitude_points"},
+      {[](json& c) { c["task"]["clearance_search"]["objective"] = "best"; }, "/task/clearance_search/objective"},
+      {[](json& c) { c["task"]["clearance_search"]["max_clearance_m"] = 0.001; }, "/task/clearance_search/max_clearance_m"},
+      {[](json& c) { c["task"]["clearance_search"]["candidates"] = 21; }, "/task/clearance_search/candidates"},
+      {[](json& c) { c["task"]["clearance_search"]["clearances_m"] = {0.002, 0.004}; },
+       "/task/clearance_search/min_clearance_m"},
+      {[](json& c) {
+         json& s = c["task"]["clearance_search"];
+         for (const char* key : {"min_clearance_m", "max_clearance_m", "candidates"}) s.erase(key);
+         s["clearances_m"] = {0.004, 0.002};
+       },
+       "/task/clearance_search/clearances_m"},
+      {[](json& c) { c["task"]["clearance_search"]["verify"]["amplitudes_m"] = {0.0008, 0.002}; },
+       "/task/clearance_search/verify/amplitudes_m/0"},
+      {[](json& c) { c["task"]["clearance_search"]["verify"]["amplitudes_m"] = {0.002, 0.005}; },
+       "/task/clearance_search/verify/amplitudes_m/1"},
+      {[](json& c) { c["task"]["clearance_search"]["calibration"]["strokes_per_decade"] = 0; },
+       "/task/clearance_search/calibration/strokes_per_decade"},
+      {[](json& c) { c["task"]["clearance_search"]["unknown"] = 1; }, "/task/clearance_search/unknown"},
+      {[](json& c) { c["dampers"][0]["layers"][0]["particles"]["lattice"] = "dense"; },
+       "/dampers/0/layers/0/particles/lattice"},
+      // The staggered lattice of 260 spheres is 75.7 mm long.
+      {[](json& c) { c["dampers"][0]["layers"][0]["container"]["inner_length_m"] = 0.075; }, "/dampers/0/layers/0"},
+  };
+  for (const auto& [edit, key] : bad) {
+    INFO(key);
+    require_one_line_error(run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_mode_clearance.json", edit)}),
+                           key);
+  }
+}

@@ -154,6 +154,10 @@ struct ModesDemCheck {
   std::vector<double> amplitudes_m;  ///< the first damper's stroke at each decay's start, m, ascending
   int periods = 40;                  ///< each decay's length in periods of its mode, [4, 10000]
   double amplitude_fraction = 0.5;   ///< measured down to this fraction of the start, (0, 1)
+  /// The DEM's bed driven this many periods in the mode's motion at the start amplitude before
+  /// the release (a decay from steady forced vibration, as a shaker cut off), [0, 10000];
+  /// 0: released from the bed as placed (the collected lattice, settled).
+  int forced_start_periods = 0;
   /// A decay passes when the mode's whole damping ratio (bare plus added) by the prediction
   /// lies within this fraction of the DEM's, dimensionless, (0, 10].
   double tolerance_relative = 0.15;
@@ -169,6 +173,27 @@ struct ModesCalibrationSpec {
   double stiffness_softening = 1.0;  ///< factor on every Young's modulus of its runs, on top of /dem's, (0, 1]
 };
 
+/// `clearance_search` of task kind modes (docs/optimizer.md, "Clearance for a mode's damping"):
+/// the clearance of the first damper's (one) layer that adds the most damping to one mode over
+/// a range of the damper's strokes, each candidate's bed calibrated from DEM steady states (as
+/// `calibration` does), with an optional DEM check of the chosen clearance and its neighbours.
+struct ModesClearanceSearch {
+  int mode = 0;                  ///< 0-based here (the case counts from 1)
+  double min_amplitude_m = 0.0;  ///< the strokes over which the damping counts, m
+  double max_amplitude_m = 0.0;  ///< (> min)
+  int amplitude_points = 5;      ///< log-spaced strokes the objective takes, [2, 50]
+  /// kMean: the mean added damping ratio over the strokes; kWorst: the smallest.
+  enum class Objective { kMean, kWorst } objective = Objective::kMean;
+  /// The candidates, m, ascending, >= 2: the layer's clearance h (inner length along the
+  /// drive minus the collected lattice's extent); explicit, or log-spaced from min to max.
+  std::vector<double> clearances_m;
+  /// `calibration`: each candidate's strokes per decade and softening (its modes: {mode}).
+  ModesCalibrationSpec calibration;
+  /// `verify`: the target mode's DEM decays at the chosen clearance and its neighbours in
+  /// clearances_m (modes = {mode}); absent: none.
+  std::optional<ModesDemCheck> verify;
+};
+
 /// `task` kind modes: natural frequencies, shapes and backbones.
 struct ModesTask {
   int mode_count = 0;                       ///< modes reported, [1, the structure's mode_count]
@@ -177,6 +202,7 @@ struct ModesTask {
   int backbone_points = 50;                 ///< [2, 10000]
   std::optional<ModesDemCheck> dem_check;   ///< `dem_check`: absent, none
   std::optional<ModesCalibrationSpec> calibration;  ///< `calibration`: absent, the loss models alone
+  std::optional<ModesClearanceSearch> clearance_search;  ///< `clearance_search`: absent, none
 };
 
 /// `verify` of task kind filling_ratios: the DEM-in-the-loop free decay
@@ -402,6 +428,11 @@ Case with_design(const Case& c, const std::vector<long>& slabs, double stiffness
 /// read again by the case reader (CaseError naming the layer's key for a clearance the
 /// reader refuses).
 Case with_clearance(const Case& c, double clearance_m);
+/// The merge patch (with_merge_patch) that gives the first damper's first layer of a format-2
+/// case the clearance h: its inner length along the drive changed by h minus its clearance (a
+/// box, or a cylinder along the drive; CaseError naming the axis otherwise), `clearance_m`
+/// moved with it. The reader checks that the bed still fits.
+nlohmann::json clearance_patch(const Case& c, double clearance_m);
 
 /// The case with `patch` merged into its document (RFC 7396: objects merge key by key, null
 /// removes a key, anything else replaces), read again by the case reader (a CaseError names

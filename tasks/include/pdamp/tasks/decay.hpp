@@ -56,6 +56,13 @@ struct DecayStop {
   static constexpr int kSamplesPerPeriod = 20;
 };
 
+/// A DEM decay released from steady forced vibration (structure::CosimulationSettings::
+/// forced_start_periods): the beds driven `periods` whole periods of frequency_hz first.
+struct ForcedStart {
+  int periods = 0;  ///< 0: released from the beds as placed and settled
+  double frequency_hz = 0.0;
+};
+
 /// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds) from
 /// rest at q0 over task.duration_s and measures its settling against
 /// task.settling_threshold (structure::sampled_settling). With a checkpoint file the run
@@ -74,7 +81,7 @@ DemDecay dem_decay(const case_file::Case& c, const structure::ModalModel& modal,
                    const std::vector<structure::CosimulationDamper>& dampers, const Eigen::VectorXd& q0,
                    const case_file::DecayTask& task, const std::string& label, const std::string& duration_pointer,
                    const DemDecayCheckpoint& checkpoint, base::RunHooks& hooks, int snapshots = 0,
-                   const DecayStop* stop = nullptr);
+                   const DecayStop* stop = nullptr, const ForcedStart& forced = {});
 
 /// The cost of a DEM-in-the-loop run before it starts, computed without building its
 /// worlds: the coupled step, the steps, every bed's particles, and the memory of its worlds

@@ -23,6 +23,9 @@ namespace pdamp::tasks {
 struct ModeDecayWindow {
   int periods = 40;                 ///< the decay's length in periods of the mode, >= 4
   double amplitude_fraction = 0.5;  ///< measured down to this fraction of the first period, (0, 1)
+  /// The DEM's beds driven this many periods in the mode's motion before the release (ForcedStart);
+  /// 0: released from the beds as placed.
+  int forced_start_periods = 0;
 };
 
 /// One mode's decay from rest at modal amplitude a (q_j(0) = a, every other mode 0): the

@@ -37,8 +37,8 @@ struct ModesOptions {
 /// One mode's calibrated bed (case_file::ModesCalibrationSpec): the first damper's bed as a
 /// DEM effective field over two frequencies, the mode's with the bed carried whole (m_app =
 /// m_bed) and with the containers empty (m_app = 0), each widened by 1 %, and the backbone's
-/// amplitudes (log-spaced); each point below the largest comes down from it (the descending
-/// branch a decay follows, docs/dem.md "Approach"). Cached like the filling-ratio beds, in a
+/// amplitudes (log-spaced); every point comes down from 25 % above the largest (the
+/// descending branch a decay follows, docs/dem.md "Approach"). Cached like the filling-ratio beds, in a
 /// field file of its own under a key of the physics it depends on.
 struct ModeCalibration {
   int mode = 0;  ///< 0-based
@@ -52,9 +52,37 @@ struct ModeCalibration {
   surrogate::EffectiveField field;
   static constexpr std::string_view kWhat =
       "for each calibrated mode, the first damper's bed as a DEM effective field from steady states between the mode's "
-      "frequency with the bed carried whole and with the containers empty, over the backbone's strokes, each below the "
-      "largest approached from it; that mode's backbone and dem_check prediction use it";
+      "frequency with the bed carried whole and with the containers empty, over the backbone's strokes, each approached "
+      "from 25 % above the largest; that mode's backbone and dem_check prediction use it";
   static const base::Fields<ModeCalibration>& fields();
+};
+
+/// One candidate clearance of the search (case_file::ModesClearanceSearch): its calibrated bed,
+/// the mode's added damping at the search's strokes, and, when verified, its DEM decays.
+struct ModeClearanceCandidate {
+  double clearance_m = 0.0;     ///< the layer's clearance h (inner length minus the lattice's extent)
+  double inner_length_m = 0.0;  ///< the container's inner length along the drive
+  std::vector<double> added_damping_ratios;  ///< ζ_add at the search's strokes (the backbone's)
+  double objective = NAN;       ///< their mean, or the smallest (the search's objective)
+  bool converged = true;        ///< every backbone point converged
+  ModeCalibration calibration;
+  /// The verify decays (the chosen clearance and its neighbours; empty otherwise), and the mean
+  /// ζ_add over them by the prediction and by the DEM.
+  std::vector<ModeDecayCheck> checks;
+  double predicted_check_mean = NAN, dem_check_mean = NAN;
+  bool checks_passed = false;  ///< every decay's whole ζ within the tolerance
+  static const base::Fields<ModeClearanceCandidate>& fields();
+};
+
+struct ModeClearanceSearchResult {
+  case_file::ModesClearanceSearch settings;
+  std::vector<double> amplitudes_m;  ///< the strokes the objective takes (log-spaced)
+  std::vector<ModeClearanceCandidate> candidates;  ///< in the search's order (ascending h)
+  std::size_t chosen = 0;                          ///< the largest objective
+  /// The DEM verification (settings.verify): the chosen clearance's decays pass, and no
+  /// neighbour's DEM mean ζ_add beats the chosen's by more than the tolerance on the whole ζ
+  /// (bare plus added; the DEM does not contradict the choice).
+  bool verified = false, chosen_agrees = false, ranking_agrees = false, passed = false;
 };
 
 struct ModesResult {
@@ -83,6 +111,8 @@ struct ModesResult {
   /// The calibrated modes' beds (in the calibration's order); empty without a calibration.
   std::vector<ModeCalibration> calibrations;
   std::filesystem::path calibration_cache;  ///< where they are cached (with calibrations)
+  /// The task's clearance_search (its candidates calibrated whatever the method), if any.
+  std::optional<ModeClearanceSearchResult> clearance_search;
   std::vector<std::string> warnings;
   /// The prediction of check k within dem_check_tolerance of the DEM (whole damping ratios).
   bool dem_check_passed(std::size_t k) const;
