@@ -732,30 +732,38 @@ void Cosimulation::Impl::build_and_settle_worlds() {
 }
 
 // The forced start (CosimulationSettings::forced_start_periods): the container of bed d moves
-// as its start pose times cos(2πf t) for whole periods, t from the settled bed (at rest at the
-// start pose) to the same pose at rest again. The angle advances as 2π·periods·k/steps, so the
-// last step lands on a whole period (the step need not divide the period); that last state is
-// the start pose itself.
+// as its start pose times a(t)·cos φ(t), t from the settled bed (at rest at the start pose) to
+// the same pose at rest again. φ advances 2π·periods·k/steps (the last step lands on a whole
+// period, the step need not divide it); a = 1 + (P − 1)·sin²(πk/steps) rises to the peak
+// factor P half-way and eases back to 1 with zero slope at both ends. The last state is the
+// start pose itself.
 bool Cosimulation::Impl::force_start(std::size_t d, const std::function<void(std::int64_t)>& observe) {
   dem::World& world = state_.worlds[d];
   const dem::ContainerState& start = containers_[d];
   const auto& cd = dampers_[d];
-  const double omega = 2.0 * std::acos(-1.0) * options_.forced_start_frequency_hz;
+  const double pi = std::acos(-1.0);
   const std::int64_t steps = forced_start_steps();
-  const double angle_per_step = 2.0 * std::acos(-1.0) * options_.forced_start_periods / static_cast<double>(steps);
+  const double n = static_cast<double>(steps);
+  const double angle_per_step = 2.0 * pi * options_.forced_start_periods / n;
+  const double omega = angle_per_step / dt_;
+  const double rise = options_.forced_start_peak_factor - 1.0;
   dem::ContainerState s = start;
   for (std::int64_t k = 0; k < steps; ++k) {
     if (k + 1 == steps) {
       s = start;
     } else {
-      const double angle = angle_per_step * static_cast<double>(k + 1);
-      const double c = std::cos(angle), rate = -omega * std::sin(angle);
+      const double step = static_cast<double>(k + 1);
+      const double c = std::cos(angle_per_step * step), sn = std::sin(angle_per_step * step);
+      const double envelope = 1.0 + rise * std::pow(std::sin(pi * step / n), 2);
+      const double envelope_rate = rise * std::sin(2.0 * pi * step / n) * pi / (n * dt_);
+      const double scale = envelope * c, rate = envelope_rate * c - envelope * omega * sn;
       for (int a = 0; a < 3; ++a) {
-        s.position_m[a] = start.position_m[a] * c;
+        s.position_m[a] = start.position_m[a] * scale;
         s.velocity_m_s[a] = start.position_m[a] * rate;
         s.angular_velocity_rad_s[a] = cd.container_rotation_axis[a] * site_theta_[d] * rate;
       }
-      s.orientation = site_theta_[d] == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, site_theta_[d] * c);
+      s.orientation =
+          site_theta_[d] == 0.0 ? dem::kIdentity : rotation_about(cd.container_rotation_axis, site_theta_[d] * scale);
     }
     world.step(s);
     if (world.status().outcome != dem::Outcome::kCompleted) return false;

@@ -221,6 +221,8 @@ std::vector<std::string> RunOptions::validate(const ModalModel& model) const {
     if (!(forced_start_frequency_hz > 0.0 && std::isfinite(forced_start_frequency_hz)))
       p.push_back(at + "forced_start_frequency_hz = " + format_number(forced_start_frequency_hz, 12) +
                   ": must be > 0 and finite with forced_start_periods");
+    if (!(forced_start_peak_factor >= 1.0 && forced_start_peak_factor <= 10.0))
+      p.push_back(at + "forced_start_peak_factor = " + format_number(forced_start_peak_factor, 12) + ": must be in [1, 10]");
     if (harmonic(e))
       p.push_back(at + "forced_start_periods = " + std::to_string(forced_start_periods) +
                   ": a forced start is for a free decay (the harmonic runs have their own transient)");

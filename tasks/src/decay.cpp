@@ -353,6 +353,7 @@ DemDecay dem_decay(const Case& c, const st::ModalModel& modal, std::vector<st::D
   options.snapshots = snapshots;
   options.forced_start_periods = forced.periods;
   options.forced_start_frequency_hz = forced.frequency_hz;
+  options.forced_start_peak_factor = forced.peak_factor;
   // Refused here when it cannot fit; said once a resume's checkpoint is accepted.
   const std::string estimate = label + ": " + estimate_text(check_coupled_decay(c, modal, dampers, options, label,
                                                                                 duration_pointer, hooks));

@@ -98,6 +98,12 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
   // NaN objectives (no converged backbone) never win.
   for (std::size_t k = 0; k < out.candidates.size(); ++k)
     if (!(out.candidates[k].objective <= out.candidates[out.chosen].objective)) out.chosen = k;
+  if (out.chosen == 0 || out.chosen + 1 == out.candidates.size())
+    warnings.push_back("clearance search: the best clearance is the " +
+                       std::string(out.chosen == 0 ? "smallest" : "largest") + " candidate, h = " +
+                       millimetres(out.candidates[out.chosen].clearance_m) + ": the optimum may lie " +
+                       (out.chosen == 0 ? "below" : "above") +
+                       " the candidates (extend /task/clearance_search/clearances_m where a bed can be built)");
 
   if (!s.verify) return out;
   out.verified = true;

@@ -118,7 +118,7 @@ ModeDecayCheck mode_decay_check(const case_file::Case& c, std::size_t damper_ind
   // there (0.9 of it, under the 0.976 that two sampled peaks allow; DecayStop).
   const DecayStop stop{mode, frequency_hz, 0.9 * window.amplitude_fraction};
   const DemDecay d = dem_decay(c, modal, {damper}, {bed}, q0, decay, label, periods_pointer, {}, hooks, 0, &stop,
-                               ForcedStart{window.forced_start_periods, frequency_hz});
+                               ForcedStart{window.forced_start_periods, frequency_hz, kDescendingBranchFactor});
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const auto& h = d.cosimulation.history;
   const Eigen::VectorXd q = h.modal_displacements.col(mode);

@@ -237,6 +237,8 @@ const base::Fields<ModeCalibration>& ModeCalibration::fields() {
           .field("key", &M::key, "", "16 hex digits of the physics it depends on")
           .derived("file", [](const M& m) { return m.file.string(); }, "", "its cache file")
           .field("cached", &M::cached, "", "read from the cache (not run now)")
+          .field("lower_branch_strokes_m", &M::lower_branch_strokes_m, "m",
+                 "strokes where its frequencies found different motion modes: the smaller eta* taken at both")
           .field("wall_time_s", &M::wall_time_s, "s", "of its DEM points (0 when cached)");
   return f;
 }

@@ -680,6 +680,28 @@ TEST_CASE("pdamp modes calibrates the bed of the task's modes by DEM steady stat
   CHECK(second["calibration"]["modes"][0]["key"] == bed["key"]);
   CHECK(backbone("second") == backbone("first"));
 
+  {  // two states at one stroke (the frequencies' motion modes differ): both take the lower branch
+    const std::string file = bed["file"].get<std::string>();
+    std::ifstream in(file);
+    json field = json::parse(in);
+    json& table = field["table"];  // rows frequency-major: (f0, X0), (f0, X1), (f1, X0), (f1, X1)
+    const std::size_t mode_column = 7, eta_column = 2;
+    table[0][mode_column] = "upper_state";
+    table[0][eta_column] = 10.0 * table[2][eta_column].get<double>();
+    in.close();
+    std::ofstream(file) << field.dump();
+    const json mixed = run_json({"modes", path, cache_flag, "-o", (dir.path / "mixed").string()});
+    const json& strokes = mixed["calibration"]["modes"][0]["lower_branch_strokes_m"];
+    REQUIRE(strokes.size() == 1);
+    CHECK(strokes[0].get<double>() == Approx(0.001).epsilon(1e-9));
+    // Node (f0, X0) took (f1, X0)'s point: the backbone equals that of a field holding it there.
+    for (std::size_t c = 2; c < table[0].size(); ++c) table[0][c] = table[2][c];
+    std::ofstream(file) << field.dump();
+    run_json({"modes", path, cache_flag, "-o", (dir.path / "lower").string()});
+    CHECK(backbone("lower") == backbone("mixed"));
+    CHECK(backbone("mixed") != backbone("first"));
+  }
+
   {  // a field under this key's name that is another bed's is run again, with a note
     const std::string file = bed["file"].get<std::string>();
     std::ifstream in(file);
@@ -750,9 +772,6 @@ TEST_CASE("pdamp modes searches the clearance for a mode's damping on calibrated
   const auto cache = dir.path / "cache";
   const std::string path = edited_shipped_case(dir.path, "free_free_beam_mode_clearance.json", [](json& c) {
     json& s = c["task"]["clearance_search"];
-    s.erase("min_clearance_m");
-    s.erase("max_clearance_m");
-    s.erase("candidates");
     s["clearances_m"] = {0.002, 0.008, 0.016};
     s["min_amplitude_m"] = 0.001;
     s["max_amplitude_m"] = 0.002;
@@ -811,16 +830,25 @@ TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 
       {[](json& c) { c["task"]["clearance_search"]["max_amplitude_m"] = 0.0004; }, "/task/clearance_search/max_amplitude_m"},
       {[](json& c) { c["task"]["clearance_search"]["amplitude_points"] = 1; }, "/task/clearance_search/amplitude_points"},
       {[](json& c) { c["task"]["clearance_search"]["objective"] = "best"; }, "/task/clearance_search/objective"},
-      {[](json& c) { c["task"]["clearance_search"]["max_clearance_m"] = 0.001; }, "/task/clearance_search/max_clearance_m"},
-      {[](json& c) { c["task"]["clearance_search"]["candidates"] = 21; }, "/task/clearance_search/candidates"},
-      {[](json& c) { c["task"]["clearance_search"]["clearances_m"] = {0.002, 0.004}; },
-       "/task/clearance_search/min_clearance_m"},
       {[](json& c) {
          json& s = c["task"]["clearance_search"];
-         for (const char* key : {"min_clearance_m", "max_clearance_m", "candidates"}) s.erase(key);
-         s["clearances_m"] = {0.004, 0.002};
+         s.erase("clearances_m");
+         s["min_clearance_m"] = 0.004;
+         s["max_clearance_m"] = 0.002;
        },
-       "/task/clearance_search/clearances_m"},
+       "/task/clearance_search/max_clearance_m"},
+      {[](json& c) {
+         json& s = c["task"]["clearance_search"];
+         s.erase("clearances_m");
+         s["min_clearance_m"] = 0.002;
+         s["max_clearance_m"] = 0.004;
+         s["candidates"] = 21;
+       },
+       "/task/clearance_search/candidates"},
+      {[](json& c) { c["task"]["clearance_search"]["min_clearance_m"] = 0.002; }, "/task/clearance_search/min_clearance_m"},
+      {[](json& c) { c["task"]["clearance_search"]["clearances_m"] = {0.004, 0.002}; }, "/task/clearance_search/clearances_m"},
+      {[](json& c) { c["task"]["clearance_search"]["verify"]["forced_start_periods"] = -1; },
+       "/task/clearance_search/verify/forced_start_periods"},
       {[](json& c) { c["task"]["clearance_search"]["verify"]["amplitudes_m"] = {0.0008, 0.002}; },
        "/task/clearance_search/verify/amplitudes_m/0"},
       {[](json& c) { c["task"]["clearance_search"]["verify"]["amplitudes_m"] = {0.002, 0.005}; },

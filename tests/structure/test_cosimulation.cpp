@@ -597,7 +597,8 @@ TEST_CASE("a continuation at a new frequency keeps the step, the phase and the b
 }
 
 // The forced start (a decay released from steady forced vibration): the beds are driven in
-// the start pose's motion for whole periods before the coupling, and the ledger opens after
+// the start pose's motion (rising to 1.25 times it and easing back) for whole periods before
+// the coupling, and the ledger opens after
 // it, so the energy account of the coupled run still closes (1 %, as without it) while the
 // bed it starts from is another one (impacting spheres: the decay's history differs). The
 // forced steps are the periods rounded to whole steps, counted with the settling.
@@ -611,6 +612,7 @@ TEST_CASE("a forced start drives the beds before the release and the ledger stil
   const CosimulationResult rest = cosimulate(model, {tip_damper(world, 0.02)}, o);
   o.forced_start_periods = 3;
   o.forced_start_frequency_hz = 10.0;
+  o.forced_start_peak_factor = 1.25;
   const CosimulationResult forced = cosimulate(model, {tip_damper(world, 0.02)}, o);
   REQUIRE(forced.outcome == dem::Outcome::kCompleted);
   CHECK(forced.settling_steps - rest.settling_steps == std::llround(3 / (10.0 * forced.time_step_s)));
@@ -621,11 +623,13 @@ TEST_CASE("a forced start drives the beds before the release and the ledger stil
 
   o.initial_modal_velocities = Eigen::VectorXd::Constant(1, 0.1);
   o.forced_start_frequency_hz = 0.0;
+  o.forced_start_peak_factor = 0.5;
   try {
     cosimulate(model, {tip_damper(world, 0.02)}, o);
     FAIL("no exception");
   } catch (const std::invalid_argument& e) {
     CHECK_THAT(e.what(), Catch::Contains("forced_start_frequency_hz = 0: must be > 0"));
     CHECK_THAT(e.what(), Catch::Contains("the start must be at rest"));
+    CHECK_THAT(e.what(), Catch::Contains("forced_start_peak_factor = 0.5: must be in [1, 10]"));
   }
 }

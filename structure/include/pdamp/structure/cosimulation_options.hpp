@@ -47,12 +47,16 @@ struct CosimulationSettings {
   double bed_settling_time_s = -1.0;
   /// A start from steady forced vibration (a decay released as a shaker is cut off): after
   /// settling, each bed is driven for this many whole periods of forced_start_frequency_hz,
-  /// its container moving as its start pose times cos(2πft) (translation and rotation; the
+  /// its container moving as its start pose times a(t)·cos(2πft) (translation and rotation; the
   /// run ends at the start pose, at rest), so that the coupled run begins with the bed in
   /// its steady state at the start amplitude rather than as placed. 0: none, [0, 10000].
   /// Needs a start at rest (zero initial modal velocities) and no base motion.
   int forced_start_periods = 0;
   double forced_start_frequency_hz = 0.0;  ///< Hz, > 0 and finite with forced_start_periods
+  /// The forced start's amplitude rises to this factor on the start pose half-way and eases
+  /// back (1 + (P − 1)·sin²(π t/T)): the bed is released on the descending branch, as in a
+  /// decay that began higher. [1, 10]; 1: a constant amplitude.
+  double forced_start_peak_factor = 1.0;
   /// Output sampling of the time histories, s: rounded to whole steps (at least one);
   /// 0 = automatic: period/64 for the harmonic kinds, duration/2000 for a free decay.
   double sample_interval_s = 0.0;

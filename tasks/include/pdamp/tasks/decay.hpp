@@ -61,6 +61,7 @@ struct DecayStop {
 struct ForcedStart {
   int periods = 0;  ///< 0: released from the beds as placed and settled
   double frequency_hz = 0.0;
+  double peak_factor = 1.0;  ///< structure::CosimulationSettings::forced_start_peak_factor
 };
 
 /// Co-simulates the free decay of `modal` with `dampers` (their beds as DEM worlds) from

@@ -19,12 +19,19 @@
 
 namespace pdamp::tasks {
 
+/// A mode's bed is taken on the descending branch, as a decay that began higher passes it: a
+/// calibration's points are approached from this factor above its largest stroke, and a
+/// forced start (ModeDecayWindow::forced_start_periods) rises to it before the release. 25 %:
+/// above the stroke, close enough to stay in its regime (a grid step of a coarse grid, a
+/// factor 10 at one stroke per decade, would not).
+inline constexpr double kDescendingBranchFactor = 1.25;
+
 /// How a mode's decay is measured: its length and the amplitude it is measured down to.
 struct ModeDecayWindow {
   int periods = 40;                 ///< the decay's length in periods of the mode, >= 4
   double amplitude_fraction = 0.5;  ///< measured down to this fraction of the first period, (0, 1)
-  /// The DEM's beds driven this many periods in the mode's motion before the release (ForcedStart);
-  /// 0: released from the beds as placed.
+  /// The DEM's beds driven this many periods in the mode's motion before the release, rising to
+  /// kDescendingBranchFactor times the start half-way (ForcedStart); 0: released from the beds as placed.
   int forced_start_periods = 0;
 };
 

@@ -49,6 +49,9 @@ struct ModeCalibration {
   std::filesystem::path file;    ///< its cache file
   bool cached = false;           ///< read from the cache (not run now)
   double wall_time_s = 0.0;      ///< of its DEM points (when they ran)
+  /// Strokes at which its two frequencies found the bed in different motion modes: both take
+  /// the point of the smaller η* there (the lower branch; the cached file keeps the DEM's).
+  std::vector<double> lower_branch_strokes_m;
   surrogate::EffectiveField field;
   static constexpr std::string_view kWhat =
       "for each calibrated mode, the first damper's bed as a DEM effective field from steady states between the mode's "
