@@ -96,8 +96,10 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
     out.candidates.push_back(std::move(candidate));
   }
   // NaN objectives (no converged backbone) never win.
-  for (std::size_t k = 0; k < out.candidates.size(); ++k)
-    if (!(out.candidates[k].objective <= out.candidates[out.chosen].objective)) out.chosen = k;
+  for (std::size_t k = 0; k < out.candidates.size(); ++k) {
+    const double objective = out.candidates[k].objective;
+    if (std::isfinite(objective) && !(objective <= out.candidates[out.chosen].objective)) out.chosen = k;
+  }
   if (out.chosen == 0 || out.chosen + 1 == out.candidates.size())
     warnings.push_back("clearance search: the best clearance is the " +
                        std::string(out.chosen == 0 ? "smallest" : "largest") + " candidate, h = " +
