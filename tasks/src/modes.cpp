@@ -107,13 +107,20 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
     return std::abs(coupled.drive_shapes(j, 0)) > kNoMotionFraction * largest_drive;
   };
 
+  // The folder of the DEM-calibrated beds (the calibration's and the clearance search's), made
+  // ready once; `pointer` names the block that needs it.
+  const auto use_calibration_cache = [&](const std::string& pointer) {
+    if (!out.calibration_cache.empty()) return;
+    out.calibration_cache = options.calibration_cache.empty() ? default_calibration_cache() : options.calibration_cache;
+    if (const std::string problem = prepare_calibration_cache(out.calibration_cache); !problem.empty())
+      throw base::InputError(c.path, pointer, "the calibration cache " + problem);
+  };
+
   // The calibrated modes: the first damper's bed as the DEM sees it around each one, between
   // the mode's frequency with the bed carried whole and with the containers empty.
   std::map<Eigen::Index, std::vector<st::Damper>> calibrated_dampers;
   if (const auto calibration = modes_calibration(c, options)) {
-    out.calibration_cache = options.calibration_cache.empty() ? default_calibration_cache() : options.calibration_cache;
-    if (const std::string problem = prepare_calibration_cache(out.calibration_cache); !problem.empty())
-      throw base::InputError(c.path, "/task/calibration", "the calibration cache " + problem);
+    use_calibration_cache("/task/calibration");
     std::vector<st::Damper> carried = containers;
     for (std::size_t d = 0; d < carried.size(); ++d)
       for (const auto& l : dampers[d].layers) carried[d].container_mass_kg += l.bed_mass_kg;
@@ -198,11 +205,7 @@ ModesResult run_modes(const case_file::Case& c, const ModesOptions& options, bas
       throw base::InputError(c.path, "/task/clearance_search/mode",
                              "mode " + std::to_string(j + 1) + " does not move damper " + dampers.front().name +
                                  " along its drive: no clearance changes its damping");
-    if (out.calibration_cache.empty()) {
-      out.calibration_cache = options.calibration_cache.empty() ? default_calibration_cache() : options.calibration_cache;
-      if (const std::string problem = prepare_calibration_cache(out.calibration_cache); !problem.empty())
-        throw base::InputError(c.path, "/task/clearance_search", "the calibration cache " + problem);
-    }
+    use_calibration_cache("/task/clearance_search");
     out.clearance_search = detail::search_mode_clearance(c, out.calibration_cache, hooks, out.warnings);
   }
   return out;
