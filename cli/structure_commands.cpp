@@ -90,13 +90,25 @@ int run_modes_case(const ParsedArgs& args, CommandContext& context, const Case& 
   if (const auto& search = modes.clearance_search) {
     for (std::size_t k = 0; k < search->candidates.size(); ++k) {
       const auto& candidate = search->candidates[k];
-      std::string row = "zeta_add " + (std::isfinite(candidate.objective) ? format_number(100.0 * candidate.objective, 4) + " %" : "-") +
-                        " (inner length " + format_number(candidate.inner_length_m * 1e3, 5) + " mm; calibration " +
-                        (candidate.calibration.cached ? "cached" : format_number(candidate.calibration.wall_time_s, 3) + " s") + ")";
+      const bool lined = !search->settings.wall_layer_thicknesses_m.empty();
+      std::string row =
+          !candidate.buildable
+              ? "not run: the lining's tip strain " + format_number(candidate.layer_tip_strain, 3) +
+                    " under the buffer's design impact exceeds the allowable strain"
+              : "zeta_add " + (std::isfinite(candidate.objective) ? format_number(100.0 * candidate.objective, 4) + " %" : "-") +
+                    " (inner length " + format_number(candidate.inner_length_m * 1e3, 5) + " mm" +
+                    (std::isfinite(candidate.layer_tip_strain)
+                         ? "; lining tip strain " + format_number(candidate.layer_tip_strain, 3)
+                         : std::string()) +
+                    "; calibration " +
+                    (candidate.calibration.cached ? "cached" : format_number(candidate.calibration.wall_time_s, 3) + " s") + ")";
       if (!candidate.checks.empty())
         row += "; checked decays: calibrated " + format_number(100.0 * candidate.predicted_check_mean, 4) + " %, DEM " +
                format_number(100.0 * candidate.dem_check_mean, 4) + " %" + (candidate.checks_passed ? "" : " (a decay missed)");
-      rows.push_back({"h = " + format_number(candidate.clearance_m * 1e3, 4) + " mm" + (k == search->chosen ? " (chosen)" : ""), row});
+      rows.push_back({"h = " + format_number(candidate.clearance_m * 1e3, 4) + " mm" +
+                          (lined ? ", t = " + format_number(candidate.wall_layer_thickness_m * 1e3, 4) + " mm" : "") +
+                          (k == search->chosen ? " (chosen)" : ""),
+                      row});
     }
     if (search->verified)
       rows.push_back({"clearance search", std::string(search->passed ? "passed" : "failed") + ": chosen " +

@@ -79,6 +79,16 @@ nlohmann::json clearance_patch(const Case& c, double clearance_m) {
   return {{"dampers", dampers}};  // a merge patch replaces arrays whole
 }
 
+json wall_layer_patch(const Case& c, double thickness_m) {
+  json dampers = c.document.at("dampers");
+  json& layer_json = dampers[0]["layers"][0];
+  if (!layer_json.contains("wall_layer"))
+    throw CaseError(c.path, "/dampers/0/layers/0/wall_layer",
+                    "is absent: a wall-layer thickness variant needs the layer's buffered wall");
+  layer_json["wall_layer"]["thickness_m"] = thickness_m;
+  return {{"dampers", dampers}};
+}
+
 Case with_clearance(const Case& c, double clearance_m) {
   if (!c.task.clearance || c.format_version != 2)
     throw CaseError(c.path, "/task", "a clearance variant needs a format-2 case of task kind clearance");

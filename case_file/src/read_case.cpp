@@ -123,6 +123,7 @@ Case read_case(const json& root, const std::string& path) {
       LayerSpec layer;
       layer.name = "layer_1";
       detail::read_damper_drive(d, damper);
+      layer.compartment.layer = detail::provisional_wall_layer(root);
       detail::read_layer_bed(d, c, damper, layer);
       damper.layers.push_back(std::move(layer));
       c.dampers.push_back(std::move(damper));

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "pdamp/base/number_text.hpp"
 #include "readers.hpp"
 
 namespace pdamp::case_file::detail {
@@ -139,8 +140,15 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
   for (const auto& line : layer.container.validate("damper/container")) r.fail("container", line);
   if (!c.materials.count(layer.particle_material))
     r.fail("particles/material", "'" + layer.particle_material + "' is not defined in /materials (nor built in)");
+  // A buffered wall's lining takes its thickness off the room the bed has (the DEM's
+  // spheres meet the lining's surface), so the clearance is the free length between linings.
+  const dem_reference::WallLayerOptions& lining = layer.compartment.layer;
+  const fm::Container free_space = layer.container.lined(lining.thickness_m, lining.axis);
+  if (!free_space.validate("").empty())
+    throw CaseError(r.file(), (c.format_version == 1 ? "/dem" : r.pointer()) + "/wall_layer/thickness_m",
+                    "= " + base::format_number(lining.thickness_m, 6) + " m: the lining leaves the container no room");
   try {
-    layer.bed = fm::collected_lattice(layer.container, layer.particle_count, layer.particle_radius_m, packing);
+    layer.bed = fm::collected_lattice(free_space, layer.particle_count, layer.particle_radius_m, packing);
   } catch (const std::invalid_argument& e) {
     r.fail("particles", e.what());
   }
@@ -156,7 +164,7 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
     out.precision(10);
     if (settled == layer.bed.clearance_m) {
       out << "the collected bed leaves a clearance of " << layer.bed.clearance_m << " m (" << layer.bed.slabs
-          << " slabs of 2r in " << layer.container.inner_length(d.drive_axis) << " m): " << limits::kClearance.text()
+          << " slabs of 2r in " << free_space.inner_length(d.drive_axis) << " m): " << limits::kClearance.text()
           << " m";
     } else {
       out << "the bed is stacked more than one sphere high across gravity: it settles into bottom rows that leave "
@@ -172,7 +180,8 @@ void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& d, LayerSp
     std::ostringstream out;
     out.precision(10);  // 0.1000001 is not 0.1
     out << "= " << *explicit_clearance << ": must be <= the free length along the drive, " << settled
-        << " m (inner length " << layer.container.inner_length(d.drive_axis) << " m minus the settled bed)";
+        << " m (inner length " << free_space.inner_length(d.drive_axis) << " m"
+        << (lining.thickness_m > 0.0 ? " inside the wall layers" : "") << " minus the settled bed)";
     r.fail("clearance_m", out.str());
   }
   const double volume = 4.0 / 3.0 * fm::kPi * std::pow(layer.particle_radius_m, 3);
@@ -266,8 +275,8 @@ void read_dampers(ObjectReader& root, Case& c) {
         if (other.name == layer.name) l.fail("name", "'" + layer.name + "' names another layer of this damper already");
       }
       layer.field_file = resolve_case_relative(l, l.text("field_file", std::string()));
-      read_layer_bed(l, c, d, layer);
       read_layer_geometry(l, c, layer);
+      read_layer_bed(l, c, d, layer);
       layer.compartment.offset_m = l.vector3("offset_m", fm::Vec3{0.0, 0.0, 0.0}, limits::kPosition, " m");
       d.layers.push_back(std::move(layer));
     });

@@ -99,6 +99,20 @@ void read_layer_geometry(ObjectReader& r, const Case& c, LayerSpec& layer) {
   });
 }
 
+dr::WallLayerOptions provisional_wall_layer(const json& root) {
+  dr::WallLayerOptions layer;
+  const json* dem = root.contains("dem") ? &root.at("dem") : nullptr;
+  if (!dem || !dem->is_object() || !dem->contains("wall_layer") || !dem->at("wall_layer").is_object()) return layer;
+  const json& l = dem->at("wall_layer");
+  const json* thickness = l.contains("thickness_m") ? &l.at("thickness_m") : nullptr;
+  if (!thickness || !thickness->is_number() || !limits::kContainerSize.contains(thickness->get<double>())) return layer;
+  const std::string axis = l.contains("axis") && l.at("axis").is_string() ? l.at("axis").get<std::string>() : "all";
+  if (axis != "all" && axis != "x" && axis != "y" && axis != "z") return layer;
+  layer.thickness_m = thickness->get<double>();
+  layer.axis = axis == "all" ? -1 : axis_index(axis);
+  return layer;
+}
+
 void read_dem(ObjectReader& r, Case& c) {
   DemSpec& dem = c.dem;
   dr::DamperSimulationOptions& sim = dem.simulation;

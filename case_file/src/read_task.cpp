@@ -137,6 +137,20 @@ ModesClearanceSearch read_clearance_search(ObjectReader& r, const Case& c, const
     const int n = r.integer("candidates", 5, 2, kMaxCandidates);
     for (int k = 0; k < n; ++k) s.clearances_m.push_back(lo * std::pow(hi / lo, static_cast<double>(k) / (n - 1)));
   }
+  if (r.has("wall_layer_thicknesses_m")) {
+    const dem_reference::WallLayerOptions& lining = c.dampers.front().layers.front().compartment.layer;
+    if (!(lining.thickness_m > 0.0) || (lining.axis >= 0 && lining.axis != c.dampers.front().drive_axis))
+      r.fail("wall_layer_thicknesses_m", "needs a wall_layer on the faces across the drive of the damper's layer "
+                                         "(/dampers/0/layers/0/wall_layer with axis all or the drive axis)");
+    s.wall_layer_thicknesses_m = r.number_array("wall_layer_thicknesses_m", limits::kContainerSize, " m", 1);
+    const auto& t = s.wall_layer_thicknesses_m;
+    if (std::adjacent_find(t.begin(), t.end(), std::greater_equal<>()) != t.end())
+      r.fail("wall_layer_thicknesses_m", "must be strictly ascending");
+    if (t.size() * s.clearances_m.size() > kMaxCandidates)
+      r.fail("wall_layer_thicknesses_m", "has " + std::to_string(t.size()) + " entries with " +
+                                             std::to_string(s.clearances_m.size()) + " clearances: at most " +
+                                             std::to_string(kMaxCandidates) + " pairs (each is a DEM calibration)");
+  }
   s.calibration.modes = {s.mode};
   r.object("calibration", false, [&](ObjectReader& b) { read_calibration_settings(b, s.calibration); });
   r.object("verify", false, [&](ObjectReader& v) {

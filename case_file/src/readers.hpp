@@ -17,11 +17,16 @@ int material_index(const ObjectReader& r, const std::string& key, const std::str
 /// `dampers[i]`).
 void read_damper_drive(ObjectReader& r, DamperSpec& damper);
 /// Container, particles, lattice and clearance of one layer (format 1: `damper`; format
-/// 2: `dampers[i].layers[k]`), with the derived bed quantities under `derived`.
+/// 2: `dampers[i].layers[k]`), with the derived bed quantities under `derived`. The bed
+/// sits inside layer.compartment.layer's lining (read before): its clearance is the free
+/// length between the linings' surfaces.
 void read_layer_bed(ObjectReader& r, const Case& c, const DamperSpec& damper, LayerSpec& layer);
 /// The DEM geometry of one layer's compartment: wall material, placement, inner
 /// structures, wall layer (format 1: in `dem`; format 2: in each layer).
 void read_layer_geometry(ObjectReader& r, const Case& c, LayerSpec& layer);
+/// Format 1's /dem/wall_layer thickness and axis as written, for the bed that is read
+/// before /dem (read_layer_geometry checks them there); no layer where they are malformed.
+dem_reference::WallLayerOptions provisional_wall_layer(const nlohmann::json& root);
 /// A structure-plane direction [x, y] at `key`, normalised (and resolved so); CaseError
 /// for a zero or non-finite one. Without `fallback` the key is required.
 PlaneVector read_plane_direction(ObjectReader& r, const std::string& key, std::optional<PlaneVector> fallback);

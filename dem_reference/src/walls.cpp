@@ -24,18 +24,7 @@ WallFeature plane(int compartment, int material, const Vec3& offset, int axis, d
 }  // namespace
 
 formulas::Container layered_container(const CompartmentOptions& c) {
-  formulas::Container inner = c.container;
-  const double t = c.layer.thickness_m;
-  if (t <= 0.0) return inner;
-  if (inner.shape == formulas::ContainerShape::kBox) {
-    for (int a = 0; a < 3; ++a) {
-      if (layered(c.layer, a)) inner.box_inner_size_m[static_cast<std::size_t>(a)] -= 2.0 * t;
-    }
-  } else {
-    if (layered(c.layer, inner.cylinder_axis)) inner.cylinder_inner_length_m -= 2.0 * t;
-    if (c.layer.axis < 0 || c.layer.axis != inner.cylinder_axis) inner.cylinder_inner_radius_m -= t;
-  }
-  return inner;
+  return c.container.lined(c.layer.thickness_m, c.layer.axis);
 }
 
 std::vector<WallFeature> build_walls(const WorldOptions& options) {

@@ -462,7 +462,11 @@ inline bool World::Impl::touching_wall(const Slot& slot, int s, const WallFrame&
   }
   wall_kinematics(i, ri, n_body, gap, frame, out);
   StepDissipation& diss = sweep.dissipation;
-  if (out.k.delta > sweep.overlap_limit * ri) diss.max_overlap_ratio = std::max(diss.max_overlap_ratio, out.k.delta / ri);
+  // A buffer layer's surface is exempt: a sphere sinks into a soft layer by a good part of
+  // its thickness (that is the layer's purpose), and beyond the thickness the hard face
+  // under it engages, whose overlap is watched.
+  if (out.k.delta > sweep.overlap_limit * ri && walls[static_cast<std::size_t>(slot.j)].layer_thickness_m == 0.0)
+    diss.max_overlap_ratio = std::max(diss.max_overlap_ratio, out.k.delta / ri);
   out.fresh = -1;
   if (slot.contact < 0) {
     StagedContact& staged = sweep.part.fresh_walls.emplace_back();

@@ -241,6 +241,20 @@ double Container::inner_length(int axis) const {
   return axis == cylinder_axis ? cylinder_inner_length_m : 2.0 * cylinder_inner_radius_m;
 }
 
+Container Container::lined(double thickness_m, int axis) const {
+  Container inner = *this;
+  if (!(thickness_m > 0.0)) return inner;
+  const auto covered = [&](int face_axis) { return axis < 0 || axis == face_axis; };
+  if (shape == ContainerShape::kBox) {
+    for (int a = 0; a < 3; ++a)
+      if (covered(a)) inner.box_inner_size_m[static_cast<std::size_t>(a)] -= 2.0 * thickness_m;
+  } else {
+    if (covered(cylinder_axis)) inner.cylinder_inner_length_m -= 2.0 * thickness_m;
+    if (axis < 0 || axis != cylinder_axis) inner.cylinder_inner_radius_m -= thickness_m;
+  }
+  return inner;
+}
+
 std::vector<std::string> Container::validate(const std::string& prefix) const {
   std::vector<std::string> problems;
   const auto positive = [&](double value, const std::string& name) {

@@ -204,22 +204,53 @@ std::vector<std::string> BufferDesignInput::validate() const {
   return problems;
 }
 
+namespace {
+
+/// The design impact of a buffer: the stroke (given, or from Γ), the impact speed (given,
+/// or the bouncing optimum's 2XΩ) and the mass m* that drives one contact.
+struct DesignImpact {
+  double stroke_m = 0.0, speed_m_s = 0.0, effective_mass_kg = 0.0;
+};
+
+DesignImpact design_impact(const BufferDesignInput& input, const char* caller) {
+  if (const auto problems = input.validate(); !problems.empty())
+    throw std::invalid_argument(std::string(caller) + ": " + joined(problems));
+  const double omega = 2.0 * kPi * input.frequency_hz;
+  const double r = input.particle_radius_m;
+  DesignImpact impact;
+  impact.stroke_m = input.amplitude_m > 0.0 ? input.amplitude_m : input.intensity * kStandardGravity / (omega * omega);
+  impact.speed_m_s = input.impact_velocity_m_s > 0.0 ? input.impact_velocity_m_s : 2.0 * impact.stroke_m * omega;
+  impact.effective_mass_kg = input.particles_per_contact * input.particle.density_kg_m3 * 4.0 / 3.0 * kPi * r * r * r;
+  return impact;
+}
+
+LayeredContact layer_contact(const BufferDesignInput& input, double thickness_m) {
+  return LayeredContact(input.particle_radius_m, input.layer.youngs_modulus_pa, input.layer.poisson_ratio,
+                        input.particle.youngs_modulus_pa, input.particle.poisson_ratio, thickness_m);
+}
+
+}  // namespace
+
+double layer_tip_strain(const BufferDesignInput& input, double thickness_m) {
+  const DesignImpact impact = design_impact(input, "layer_tip_strain");
+  if (!(thickness_m > 0.0) || !std::isfinite(thickness_m))
+    throw std::invalid_argument("layer_tip_strain: thickness_m = " + format_number(thickness_m, 6) +
+                                ": must be > 0 and finite");
+  return layered_impact(layer_contact(input, thickness_m), impact.effective_mass_kg, impact.speed_m_s).max_overlap_m /
+         thickness_m;
+}
+
 BufferDesign size_buffer_layer(const BufferDesignInput& input) {
-  if (const auto problems = input.validate(); !problems.empty()) {
-    throw std::invalid_argument("size_buffer_layer: " + joined(problems));
-  }
+  const DesignImpact impact = design_impact(input, "size_buffer_layer");
   const double f = input.frequency_hz;
   const double omega = 2.0 * kPi * f;
   const double r = input.particle_radius_m;
-  const double stroke =
-      input.amplitude_m > 0.0 ? input.amplitude_m : input.intensity * kStandardGravity / (omega * omega);
+  const double stroke = impact.stroke_m;
   const double intensity = stroke * omega * omega / kStandardGravity;
 
   BufferDesign design;
-  design.impact_velocity_m_s =
-      input.impact_velocity_m_s > 0.0 ? input.impact_velocity_m_s : 2.0 * stroke * omega;
-  const double particle_mass = input.particle.density_kg_m3 * 4.0 / 3.0 * kPi * r * r * r;
-  design.effective_mass_kg = input.particles_per_contact * particle_mass;
+  design.impact_velocity_m_s = impact.speed_m_s;
+  design.effective_mass_kg = impact.effective_mass_kg;
   // E* from both materials (the layer may be incompressible: E*, not Material::validate).
   const double layer_compliance =
       (1.0 - input.layer.poisson_ratio * input.layer.poisson_ratio) / input.layer.youngs_modulus_pa;
@@ -227,10 +258,7 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
   const double v = design.impact_velocity_m_s;
   const double half_space_thickness = max_penetration(contact, v);
   design.half_space_thickness_m = half_space_thickness;
-  const auto layered = [&](double thickness_m) {
-    return LayeredContact(r, input.layer.youngs_modulus_pa, input.layer.poisson_ratio,
-                          input.particle.youngs_modulus_pa, input.particle.poisson_ratio, thickness_m);
-  };
+  const auto layered = [&](double thickness_m) { return layer_contact(input, thickness_m); };
   const LayeredContact half_space_design = layered(half_space_thickness);
   design.layered_compression_of_half_space_design =
       layered_impact(half_space_design, design.effective_mass_kg, v).max_overlap_m / half_space_thickness;
@@ -286,7 +314,7 @@ BufferDesign size_buffer_layer(const BufferDesignInput& input) {
                    "and meets the other wall moving at -V (docs/theory.md, section 2).");
   }
   if (input.particles_per_contact == 1.0) {
-    said.push_back("One sphere (r = " + format_number(r, 4) + " m, m = " + format_number(particle_mass, 4) +
+    said.push_back("One sphere (r = " + format_number(r, 4) + " m, m = " + format_number(design.effective_mass_kg, 4) +
                    " kg) hits the layer alone: particles_per_contact = 1.");
   } else {
     said.push_back("The bed's mass is shared over its front row: each front-row sphere (r = " + format_number(r, 4) +

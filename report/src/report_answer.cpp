@@ -2,6 +2,7 @@
 // damper is built with (g, mm, s), from the typed result and the case.
 #include "report_answer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -403,19 +404,30 @@ Answer modes_answer(const tasks::ModesResult& r) {
     const auto& s = search->settings;
     const auto& chosen = search->candidates[search->chosen];
     std::ostringstream p;
-    p << "Clearance for mode " << s.mode + 1 << ": of " << search->candidates.size() << " clearances from "
-      << in_mm(search->candidates.front().clearance_m) << " to " << in_mm(search->candidates.back().clearance_m)
-      << ", each with its bed calibrated from DEM steady states, " << in_mm(chosen.clearance_m) << " (inner length "
+    const bool lined = !s.wall_layer_thicknesses_m.empty();
+    const auto not_built = std::count_if(search->candidates.begin(), search->candidates.end(),
+                                         [](const auto& k) { return !k.buildable; });
+    p << "Clearance for mode " << s.mode + 1 << ": of " << s.clearances_m.size() << " clearances from "
+      << in_mm(s.clearances_m.front()) << " to " << in_mm(s.clearances_m.back());
+    if (lined)
+      p << ", each with buffered walls lined " << in_mm(s.wall_layer_thicknesses_m.front()) << " to "
+        << in_mm(s.wall_layer_thicknesses_m.back()) << " thick (" << s.wall_layer_thicknesses_m.size() << " linings)";
+    p << ", each with its bed calibrated from DEM steady states, " << in_mm(chosen.clearance_m)
+      << (lined ? " with a " + in_mm(chosen.wall_layer_thickness_m) + " lining" : std::string()) << " (inner length "
       << in_mm(chosen.inner_length_m) << ") adds the most damping over strokes of " << in_mm(s.min_amplitude_m) << " to "
       << in_mm(s.max_amplitude_m) << ": ζ_add = " << three_digits(chosen.objective)
       << (s.objective == case_file::ModesClearanceSearch::Objective::kWorst ? " at the worst stroke." : " on average.");
+    if (not_built > 0)
+      p << " " << not_built << " candidate" << (not_built == 1 ? " was" : "s were")
+        << " not run: the buffer's design impact strains their lining beyond its allowable strain.";
     a.paragraphs.push_back(p.str());
     if (search->verified) {
       verdict << "The DEM decays of mode " << s.mode + 1 << " give ζ_add " << three_digits(chosen.dem_check_mean)
               << " on average at the chosen clearance (calibrated " << three_digits(chosen.predicted_check_mean) << ")";
       for (const auto& candidate : search->candidates)
         if (!candidate.checks.empty() && &candidate != &chosen)
-          verdict << ", " << three_digits(candidate.dem_check_mean) << " at " << in_mm(candidate.clearance_m);
+          verdict << ", " << three_digits(candidate.dem_check_mean) << " at " << in_mm(candidate.clearance_m)
+                  << (lined ? " lined " + in_mm(candidate.wall_layer_thickness_m) : std::string());
       if (search->passed) {
         verdict << ": the DEM confirms the choice within the case's " << percent(s.verify->tolerance_relative) << ".";
       } else {
@@ -423,7 +435,7 @@ Answer modes_answer(const tasks::ModesResult& r) {
         if (!search->chosen_agrees)
           failed.push_back("a decay at the chosen clearance misses the DEM by more than " +
                            percent(s.verify->tolerance_relative));
-        if (!search->ranking_agrees) failed.push_back("the DEM damps a neighbouring clearance more");
+        if (!search->ranking_agrees) failed.push_back("the DEM damps a neighbouring candidate more");
         verdict << ". " << do_not_build(failed);
       }
       a.passed = a.passed.value_or(true) && search->passed;

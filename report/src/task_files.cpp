@@ -166,13 +166,15 @@ namespace {
 Warnings clearance_search_files(OutputDir& out, const std::string& case_name, const tasks::ModeClearanceSearchResult& s) {
   std::ostringstream csv;
   csv.precision(10);
-  csv << "clearance_m,inner_length_m,objective,predicted_check_mean,dem_check_mean";
+  csv << "clearance_m,inner_length_m,wall_layer_thickness_m,layer_tip_strain,buildable,objective,predicted_check_mean,"
+         "dem_check_mean";
   for (const double x : s.amplitudes_m) csv << ",added_damping_ratio_at_" << x << "_m";
   csv << '\n';
   const auto number = [](double v) { return std::isfinite(v) ? base::format_number(v, 10) : std::string(); };
   for (const auto& c : s.candidates) {
-    csv << c.clearance_m << ',' << c.inner_length_m << ',' << number(c.objective) << ',' << number(c.predicted_check_mean)
-        << ',' << number(c.dem_check_mean);
+    csv << c.clearance_m << ',' << c.inner_length_m << ',' << c.wall_layer_thickness_m << ',' << number(c.layer_tip_strain)
+        << ',' << (c.buildable ? 1 : 0) << ',' << number(c.objective) << ',' << number(c.predicted_check_mean) << ','
+        << number(c.dem_check_mean);
     for (const double zeta : c.added_damping_ratios) csv << ',' << number(zeta);
     csv << '\n';
   }
@@ -182,16 +184,18 @@ Warnings clearance_search_files(OutputDir& out, const std::string& case_name, co
         {"damper_amplitude_m", base::CsvColumn("predicted_damping_ratio").nan_as(""),
          base::CsvColumn("dem_damping_ratio").nan_as(""), base::CsvColumn("bare_damping_ratio").nan_as(""),
          base::CsvColumn("dem_final_fraction").nan_as(""), "solve_time_s"});
-    std::string checks = "clearance_m," + columns.header() + "\n";
+    std::string checks = "clearance_m,wall_layer_thickness_m," + columns.header() + "\n";
     for (const auto& c : s.candidates)
-      for (const auto& check : c.checks) checks += base::format_number(c.clearance_m, 10) + "," + columns.row(check) + "\n";
+      for (const auto& check : c.checks)
+        checks += base::format_number(c.clearance_m, 10) + "," + base::format_number(c.wall_layer_thickness_m, 10) + "," +
+                  columns.row(check) + "\n";
     out.add("clearance_search_checks.csv", checks);
   }
   const double chosen_mm = s.candidates[s.chosen].clearance_m * 1e3;
   std::ostringstream gp;
-  gp << "# the added damping ratio of the target mode against the clearance h (calibrated beds);\n"
+  gp << "# the added damping ratio of the target mode against the clearance h (calibrated beds), one curve per lining;\n"
      << "# pdamp modes, clearance_search; run: gnuplot clearance_search.gp\n"
-     << "set datafile separator ','\nset logscale x\nset grid\nset key top right\n"
+     << "set datafile separator ','\nset logscale x\nset grid\nset key below\n"
      << "set xlabel 'clearance h / mm'\nset ylabel 'added damping ratio {/Symbol z}_{add} of mode "
      << s.settings.mode + 1 << "'\n"
      << "set title " << gnuplot_string(case_name + ": clearance for the damping of mode " + std::to_string(s.settings.mode + 1))
@@ -201,13 +205,29 @@ Warnings clearance_search_files(OutputDir& out, const std::string& case_name, co
      << "do for [t in 'pngcairo svg'] {\n"
      << "  set terminal t size 1000,600 enhanced font 'Sans,11'\n"
      << "  set output (t eq 'svg') ? 'clearance_search.svg' : 'clearance_search.png'\n"
-     << "  plot 'clearance_search.csv' using ($1*1000):3 every ::1 with linespoints lw 2 pt 7 lc rgb 'black' "
-     << "title '" << (s.settings.objective == case_file::ModesClearanceSearch::Objective::kWorst ? "smallest" : "mean")
-     << " over the strokes (calibrated)'";
+     << "  plot ";
+  // One curve per lining (the search's thicknesses; one curve without them), its rows picked
+  // by the thickness column within a relative 1e-6 (the CSV's ten digits).
+  const std::string objective =
+      s.settings.objective == case_file::ModesClearanceSearch::Objective::kWorst ? "smallest" : "mean";
+  std::vector<double> linings;
+  for (const auto& c : s.candidates)  // a lining none of whose candidates was run has no curve
+    if (c.buildable && std::find(linings.begin(), linings.end(), c.wall_layer_thickness_m) == linings.end())
+      linings.push_back(c.wall_layer_thickness_m);
+  const char* colours[] = {"black", "dark-green", "orange", "purple", "brown", "dark-cyan"};
+  const bool lined = !s.settings.wall_layer_thicknesses_m.empty();
+  for (std::size_t i = 0; i < linings.size(); ++i) {
+    const std::string t = base::format_number(linings[i], 10);
+    const std::string pick = lined ? "abs($3 - " + t + ") <= 1e-6 * " + t : "1";
+    gp << (i == 0 ? "" : ", \\\n       ") << "'clearance_search.csv' using (" << pick
+       << " ? $1*1000 : 1/0):6 every ::1 with linespoints lw 2 pt 7 lc rgb '" << colours[i % 6] << "' title '" << objective
+       << " over the strokes (calibrated)"
+       << (lined ? ", lining " + base::format_number(linings[i] * 1e3, 4) + " mm" : std::string()) << "'";
+  }
   if (s.verified)
-    gp << ", \\\n       '' using ($1*1000):4 every ::1 with points pt 6 ps 1.5 lc rgb 'blue' "
+    gp << ", \\\n       'clearance_search.csv' using ($1*1000):7 every ::1 with points pt 6 ps 1.5 lc rgb 'blue' "
           "title 'mean over the checked decays, calibrated', \\\n"
-          "       '' using ($1*1000):5 every ::1 with points pt 7 ps 1.5 lc rgb 'red' title 'the same, DEM in the loop'";
+          "       '' using ($1*1000):8 every ::1 with points pt 7 ps 1.5 lc rgb 'red' title 'the same, DEM in the loop'";
   gp << "\n}\n";
   return out.add_plot("clearance_search.gp", gp.str(), {"clearance_search.png", "clearance_search.svg"});
 }

@@ -1,6 +1,6 @@
 // The clearance search of task kind modes (modes.hpp, ModeClearanceSearchResult): each
-// candidate clearance a variant of the case whose target mode is calibrated from DEM steady
-// states (run_modes with a calibration of that mode alone), the best by the mode's added
+// candidate clearance (and buffered wall's lining) a variant of the case whose target mode is
+// calibrated from DEM steady states (run_modes with a calibration of that mode alone), the best by the mode's added
 // damping over the search's strokes, and the DEM decays of it and its neighbours.
 #include <algorithm>
 #include <cmath>
@@ -9,6 +9,7 @@
 #include "mode_calibration.hpp"
 #include "pdamp/base/input_error.hpp"
 #include "pdamp/base/number_text.hpp"
+#include "pdamp/formulas/hertz_impact.hpp"
 #include "task_support.hpp"
 
 namespace pdamp::tasks::detail {
@@ -49,6 +50,19 @@ double mean(const std::vector<double>& values) {
   return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
 
+/// The candidates' grid: ascending t, within each t ascending h (the thicknesses searched, or
+/// the case's own lining alone).
+struct Grid {
+  std::vector<double> clearances_m, thicknesses_m;
+  std::size_t index(std::size_t h, std::size_t t) const { return t * clearances_m.size() + h; }
+  std::size_t size() const { return clearances_m.size() * thicknesses_m.size(); }
+};
+
+std::string candidate_name(const ModeClearanceCandidate& candidate, bool lined) {
+  return "h = " + millimetres(candidate.clearance_m) +
+         (lined ? ", lining " + millimetres(candidate.wall_layer_thickness_m) : std::string());
+}
+
 }  // namespace
 
 ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const std::filesystem::path& cache_dir,
@@ -60,29 +74,68 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
   ModesOptions options;
   options.calibrated = true;
   options.calibration_cache = cache_dir;
+  const bool lined = !s.wall_layer_thicknesses_m.empty();
+  const Grid grid{s.clearances_m,
+                  lined ? s.wall_layer_thicknesses_m
+                        : std::vector<double>{c.dampers.front().layers.front().compartment.layer.thickness_m}};
+  if (lined && s.calibration.stiffness_softening * c.dem.stiffness_softening < 1.0)
+    warnings.push_back("clearance search: the calibration softens every Young's modulus by " +
+                       base::format_number(s.calibration.stiffness_softening * c.dem.stiffness_softening, 3) +
+                       ", the lining's too, whose compliance is what its thickness changes: the linings are compared "
+                       "softened (/task/clearance_search/calibration/stiffness_softening 1 compares them as built)");
+  // A candidate: the lining's thickness first (the container as it is), then the clearance
+  // between the linings (the container lengthened or shortened along the drive).
   const auto variant = [&](std::size_t k, bool verify) {
-    json patch = case_file::clearance_patch(c, s.clearances_m[k]);
-    patch["task"] = variant_task(s, verify);
+    const std::size_t h = k % grid.clearances_m.size(), t = k / grid.clearances_m.size();
+    std::string key = "/task/clearance_search/clearances_m/" + std::to_string(h);
     try {
-      return case_file::with_merge_patch(c, patch);
+      const case_file::Case lining =
+          lined ? case_file::with_merge_patch(c, case_file::wall_layer_patch(c, grid.thicknesses_m[t])) : c;
+      if (lined) key = "/task/clearance_search/wall_layer_thicknesses_m/" + std::to_string(t);
+      json patch = case_file::clearance_patch(lining, grid.clearances_m[h]);
+      patch["task"] = variant_task(s, verify);
+      return case_file::with_merge_patch(lining, patch);
     } catch (const base::InputError& e) {  // the candidate's bed does not fit, for one
-      throw base::InputError(c.path, "/task/clearance_search/clearances_m/" + std::to_string(k),
-                             millimetres(s.clearances_m[k]) + ": the case with this clearance is refused (" +
-                                 e.pointer() + ": " + e.rule() + ")");
+      throw base::InputError(c.path, key,
+                             "h = " + millimetres(grid.clearances_m[h]) +
+                                 (lined ? ", lining " + millimetres(grid.thicknesses_m[t]) : std::string()) +
+                                 ": the case with this candidate is refused (" + e.pointer() + ": " + e.rule() + ")");
     }
   };
 
   // Every candidate read before any DEM work: one the case refuses stops the search at once.
   std::vector<case_file::Case> variants;
-  for (std::size_t k = 0; k < s.clearances_m.size(); ++k) variants.push_back(variant(k, false));
-  for (std::size_t k = 0; k < s.clearances_m.size(); ++k) {
-    hooks.note("pdamp modes (clearance search): candidate " + std::to_string(k + 1) + " of " +
-               std::to_string(s.clearances_m.size()) + ", h = " + millimetres(s.clearances_m[k]));
-    const case_file::Case& vc = variants[k];
-    const ModesResult r = run_modes(vc, options, hooks);
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    variants.push_back(variant(k, false));
+    const case_file::Case& vc = variants.back();
     ModeClearanceCandidate candidate;
-    candidate.clearance_m = s.clearances_m[k];
+    candidate.clearance_m = grid.clearances_m[k % grid.clearances_m.size()];
+    candidate.wall_layer_thickness_m = grid.thicknesses_m[k / grid.clearances_m.size()];
     candidate.inner_length_m = vc.dampers.front().layers.front().container.inner_length(vc.dampers.front().drive_axis);
+    if (c.buffer && candidate.wall_layer_thickness_m > 0.0) {
+      // The lining must survive the buffer's design impact (docs/hertz_and_buffer.md).
+      candidate.layer_tip_strain = formulas::layer_tip_strain(c.buffer->input, candidate.wall_layer_thickness_m);
+      candidate.buildable = candidate.layer_tip_strain <= c.buffer->input.allowable_strain;
+    }
+    out.candidates.push_back(std::move(candidate));
+  }
+  if (std::none_of(out.candidates.begin(), out.candidates.end(), [](const auto& k) { return k.buildable; }))
+    throw base::InputError(c.path, "/task/clearance_search/wall_layer_thicknesses_m",
+                           "every lining is strained beyond the buffer's allowable strain " +
+                               base::format_number(c.buffer->input.allowable_strain, 3) +
+                               " by its design impact: list thicker ones (pdamp buffer sizes the thinnest)");
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    ModeClearanceCandidate& candidate = out.candidates[k];
+    if (!candidate.buildable) {
+      warnings.push_back("clearance search, " + candidate_name(candidate, lined) + ": its tip strain " +
+                         base::format_number(candidate.layer_tip_strain, 3) + " under the buffer's design impact "
+                         "exceeds the allowable " + base::format_number(c.buffer->input.allowable_strain, 3) +
+                         ": not run");
+      continue;
+    }
+    hooks.note("pdamp modes (clearance search): candidate " + std::to_string(k + 1) + " of " +
+               std::to_string(grid.size()) + ", " + candidate_name(candidate, lined));
+    const ModesResult r = run_modes(variants[k], options, hooks);
     for (const auto& p : r.backbones.at(r.backbone_of_mode.at(s.mode)).points) {
       candidate.added_damping_ratios.push_back(p.added_damping_ratio);
       candidate.converged = candidate.converged && p.converged;
@@ -91,29 +144,41 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
     candidate.objective = s.objective == Search::Objective::kWorst ? *std::min_element(zeta.begin(), zeta.end()) : mean(zeta);
     candidate.calibration = r.calibrations.front();
     if (!candidate.converged)
-      warnings.push_back("clearance search, h = " + millimetres(candidate.clearance_m) +
+      warnings.push_back("clearance search, " + candidate_name(candidate, lined) +
                          ": some backbone points did not converge");
-    out.candidates.push_back(std::move(candidate));
   }
-  // NaN objectives (no converged backbone) never win.
+  // NaN objectives (no converged backbone, or not built) never win.
   for (std::size_t k = 0; k < out.candidates.size(); ++k) {
     const double objective = out.candidates[k].objective;
     if (std::isfinite(objective) && !(objective <= out.candidates[out.chosen].objective)) out.chosen = k;
   }
-  if (out.chosen == 0 || out.chosen + 1 == out.candidates.size())
+  const std::size_t chosen_h = out.chosen % grid.clearances_m.size(), chosen_t = out.chosen / grid.clearances_m.size();
+  const ModeClearanceCandidate& best = out.candidates[out.chosen];
+  if (chosen_h == 0 || chosen_h + 1 == grid.clearances_m.size())
     warnings.push_back("clearance search: the best clearance is the " +
-                       std::string(out.chosen == 0 ? "smallest" : "largest") + " candidate, h = " +
-                       millimetres(out.candidates[out.chosen].clearance_m) + ": the optimum may lie " +
-                       (out.chosen == 0 ? "below" : "above") +
+                       std::string(chosen_h == 0 ? "smallest" : "largest") + " candidate, h = " +
+                       millimetres(best.clearance_m) + ": the optimum may lie " + (chosen_h == 0 ? "below" : "above") +
                        " the candidates (extend /task/clearance_search/clearances_m where a bed can be built)");
+  // At the thinnest buildable lining the strength bound decides, not the search's edge.
+  const bool thinnest_listed = chosen_t == 0, thickest = chosen_t + 1 == grid.thicknesses_m.size();
+  if (lined && grid.thicknesses_m.size() > 1 && (thinnest_listed || thickest))
+    warnings.push_back("clearance search: the best lining is the " + std::string(thickest ? "thickest" : "thinnest") +
+                       " candidate, " + millimetres(best.wall_layer_thickness_m) + ": the optimum may lie " +
+                       (thickest ? "above" : "below") + " the candidates (extend /task/clearance_search/wall_layer_thicknesses_m)");
 
   if (!s.verify) return out;
   out.verified = true;
-  const std::size_t first = out.chosen == 0 ? 0 : out.chosen - 1;
-  const std::size_t last = std::min(out.chosen + 1, out.candidates.size() - 1);
-  for (std::size_t k = first; k <= last; ++k) {
+  // The chosen candidate and its neighbours: the next clearances at its lining, the next
+  // buildable linings at its clearance.
+  std::vector<std::size_t> checked{out.chosen};
+  if (chosen_h > 0) checked.push_back(grid.index(chosen_h - 1, chosen_t));
+  if (chosen_h + 1 < grid.clearances_m.size()) checked.push_back(grid.index(chosen_h + 1, chosen_t));
+  if (chosen_t > 0 && out.candidates[grid.index(chosen_h, chosen_t - 1)].buildable)
+    checked.push_back(grid.index(chosen_h, chosen_t - 1));
+  if (chosen_t + 1 < grid.thicknesses_m.size()) checked.push_back(grid.index(chosen_h, chosen_t + 1));
+  for (const std::size_t k : checked) {
     ModeClearanceCandidate& candidate = out.candidates[k];
-    hooks.note("pdamp modes (clearance search): DEM check of h = " + millimetres(candidate.clearance_m) +
+    hooks.note("pdamp modes (clearance search): DEM check of " + candidate_name(candidate, lined) +
                (k == out.chosen ? " (chosen)" : " (neighbour)"));
     const ModesResult r = run_modes(variant(k, true), options, hooks);
     candidate.checks = r.dem_checks;
@@ -127,7 +192,7 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
     candidate.dem_check_mean = mean(dem);
     for (const auto& w : r.warnings)  // a decay cut short of its measure (the rest are the case's own)
       if (w.rfind("pdamp modes (dem_check", 0) == 0)
-        warnings.push_back("clearance search, h = " + millimetres(candidate.clearance_m) + ": " + w);
+        warnings.push_back("clearance search, " + candidate_name(candidate, lined) + ": " + w);
   }
   const ModeClearanceCandidate& chosen = out.candidates[out.chosen];
   out.chosen_agrees = chosen.checks_passed;
@@ -138,9 +203,8 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
   for (const auto& check : chosen.checks) bare += check.bare_damping_ratio / static_cast<double>(chosen.checks.size());
   const double allowance = s.verify->tolerance_relative * (bare + chosen.dem_check_mean);
   out.ranking_agrees = true;
-  for (std::size_t k = first; k <= last; ++k)
-    if (k != out.chosen && !(out.candidates[k].dem_check_mean - chosen.dem_check_mean <= allowance))
-      out.ranking_agrees = false;
+  for (const std::size_t k : checked)
+    if (!(out.candidates[k].dem_check_mean - chosen.dem_check_mean <= allowance)) out.ranking_agrees = false;
   out.passed = out.chosen_agrees && out.ranking_agrees;
   return out;
 }

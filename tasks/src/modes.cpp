@@ -252,6 +252,10 @@ const base::Fields<ModeClearanceCandidate>& ModeClearanceCandidate::fields() {
       base::Fields<M>()
           .field("clearance_m", &M::clearance_m, "m", "the layer's clearance h (inner length minus the lattice's extent)")
           .field("inner_length_m", &M::inner_length_m, "m", "the container's inner length along the drive")
+          .field("wall_layer_thickness_m", &M::wall_layer_thickness_m, "m", "the buffered wall's lining (0: none)")
+          .field("layer_tip_strain", &M::layer_tip_strain, "1",
+                 "delta_max/t of the lining under the buffer's design impact", base::kNullable)
+          .field("buildable", &M::buildable, "", "the lining survives the buffer's design impact (else not run)")
           .field("added_damping_ratios", &M::added_damping_ratios, "1", "zeta_add of the mode at the search's strokes")
           .field("objective", &M::objective, "1", "their mean, or the smallest (the search's objective)", base::kNullable)
           .field("converged", &M::converged, "", "every backbone point converged")
@@ -365,6 +369,7 @@ json to_json(const ModesResult& r, const OutputFolder& folder) {
         {"candidates", candidates},
         {"chosen_clearance_m", search->candidates[search->chosen].clearance_m},
         {"chosen_inner_length_m", search->candidates[search->chosen].inner_length_m},
+        {"chosen_wall_layer_thickness_m", search->candidates[search->chosen].wall_layer_thickness_m},
         {"file", folder.file("clearance_search.csv")},
         {"plot", folder.file("clearance_search.png")},
         {"verification", nullptr}};

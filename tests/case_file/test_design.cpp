@@ -2,6 +2,8 @@
 // again by the reader, with their own beds, resolved JSON and physics hash.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
 #include "pdamp/case_file/case.hpp"
 
 using namespace pdamp;
@@ -70,4 +72,32 @@ TEST_CASE("a clearance variant is the case read again with its container changed
   } catch (const case_file::CaseError& e) {
     CHECK_THAT(e.pointer(), Catch::StartsWith("/dampers/0/layers/0"));
   }
+}
+
+// Reference: geometry by hand. The shipped buffered case lines both end caps (t = 2 mm) of a
+// 99.5 mm cylinder around a staggered lattice of 21 slabs, 20√2 r + 2r = 75.71 mm: the clearance
+// between the linings is 99.5 − 4 − 75.71 mm. A thicker lining in the same container takes twice
+// its change off h; the clearance patch on that case restores h with the container 2Δt longer.
+TEST_CASE("a buffered wall's lining takes its thickness off the clearance, and its variant keeps h", "[case_file]") {
+  const auto c = case_file::load_case(std::string(PDAMP_SOURCE_DIR) + "/cases/free_free_beam_buffered_clearance.json");
+  const auto& layer = c.dampers.front().layers.front();
+  const double extent = 20.0 * std::sqrt(2.0) * 0.0025 + 0.005;
+  REQUIRE(layer.compartment.layer.thickness_m == 0.002);
+  CHECK(layer.clearance_m == Approx(0.0995 - 0.004 - extent).epsilon(1e-12));
+  const auto thicker = case_file::with_merge_patch(c, case_file::wall_layer_patch(c, 0.003));
+  CHECK(thicker.dampers.front().layers.front().clearance_m == Approx(layer.clearance_m - 0.002).epsilon(1e-12));
+  const auto same_h = case_file::with_merge_patch(thicker, case_file::clearance_patch(thicker, layer.clearance_m));
+  const auto& kept = same_h.dampers.front().layers.front();
+  CHECK(kept.clearance_m == Approx(layer.clearance_m).epsilon(1e-12));
+  CHECK(kept.compartment.layer.thickness_m == 0.003);
+  CHECK(kept.container.inner_length(0) == Approx(0.0995 + 0.002).epsilon(1e-12));
+  // A lining that leaves no room is refused naming it; a layer without one has no variant.
+  try {
+    (void)case_file::with_merge_patch(c, case_file::wall_layer_patch(c, 0.05));
+    FAIL("no error");
+  } catch (const case_file::CaseError& e) {
+    CHECK(e.pointer() == "/dampers/0/layers/0/wall_layer/thickness_m");
+  }
+  const auto bare = case_file::load_case(std::string(PDAMP_SOURCE_DIR) + "/cases/free_free_beam_mode_clearance.json");
+  CHECK_THROWS_AS(case_file::wall_layer_patch(bare, 0.001), case_file::CaseError);
 }

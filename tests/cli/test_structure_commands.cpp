@@ -767,20 +767,31 @@ TEST_CASE("shipped free-free beam: the calibrated bed predicts the DEM decay of 
 // the chosen clearance and its neighbours (4 periods: too short to measure down to half, which
 // the warnings say). The chosen clearance has the largest objective; the verdict follows
 // from the DEM means as documented; a second run reads every bed from the cache.
+namespace {
+
+/// The long tests' clearance search: strokes 1-2 mm at 2 points, each bed 2 strokes x 2
+/// frequencies at E/100 with 1 + 2 periods a point, decays from 2 mm of 4 periods.
+void short_clearance_search(json& c) {
+  json& s = c["task"]["clearance_search"];
+  s["min_amplitude_m"] = 0.001;
+  s["max_amplitude_m"] = 0.002;
+  s["amplitude_points"] = 2;
+  s["calibration"] = {{"strokes_per_decade", 1}, {"stiffness_softening", 0.01}};
+  s["verify"] = {{"amplitudes_m", {0.002}}, {"periods", 4}};
+  json& dem = c["dem"];
+  dem["transient_periods"] = 1;
+  dem["analysed_periods"] = 2;
+  dem["approach"] = {{"amplitude_m", 0.002}, {"hold_periods", 0}, {"ramp_periods", 1}};
+}
+
+}  // namespace
+
 TEST_CASE("pdamp modes searches the clearance for a mode's damping on calibrated beds", "[cli][structure][dem][long]") {
   const TempDir dir("modes_clearance_search");
   const auto cache = dir.path / "cache";
   const std::string path = edited_shipped_case(dir.path, "free_free_beam_mode_clearance.json", [](json& c) {
-    json& s = c["task"]["clearance_search"];
-    s["clearances_m"] = {0.002, 0.008, 0.016};
-    s["min_amplitude_m"] = 0.001;
-    s["max_amplitude_m"] = 0.002;
-    s["amplitude_points"] = 2;
-    s["calibration"] = {{"strokes_per_decade", 1}, {"stiffness_softening", 0.01}};
-    s["verify"] = {{"amplitudes_m", {0.002}}, {"periods", 4}};
-    c["dem"] = {{"transient_periods", 1},
-                {"analysed_periods", 2},
-                {"approach", {{"amplitude_m", 0.002}, {"hold_periods", 0}, {"ramp_periods", 1}}}};
+    short_clearance_search(c);
+    c["task"]["clearance_search"]["clearances_m"] = {0.002, 0.008, 0.016};
   });
   const std::string cache_flag = "--calibration-cache=" + cache.string();
   const json r = run_json({"modes", path, cache_flag, "-o", (dir.path / "out").string()});
@@ -813,13 +824,58 @@ TEST_CASE("pdamp modes searches the clearance for a mode's damping on calibrated
   std::ifstream csv(dir.path / "out" / "clearance_search.csv");
   std::string header;
   std::getline(csv, header);
-  CHECK(header.rfind("clearance_m,inner_length_m,objective,predicted_check_mean,dem_check_mean,added_damping_ratio_at_", 0) == 0);
+  CHECK(header.rfind("clearance_m,inner_length_m,wall_layer_thickness_m,layer_tip_strain,buildable,objective,"
+                     "predicted_check_mean,dem_check_mean,added_damping_ratio_at_",
+                     0) == 0);
 
   const json again = run_json({"modes", path, cache_flag});
   for (std::size_t k = 0; k < 3; ++k) {
     CHECK(again["clearance_search"]["candidates"][k]["calibration"]["cached"] == true);
     CHECK(again["clearance_search"]["candidates"][k]["objective"] == s["candidates"][k]["objective"]);
   }
+}
+
+// The search over a buffered wall's lining on the shipped buffered case's bed (its physics: that
+// case's DEM check, docs/optimizer.md), at the long test's settings above: linings of 1 and 2 mm
+// with clearances of 4 and 8 mm. The buffer's design impact strains the 1 mm lining to 0.45
+// (formulas::layer_tip_strain, checked against the sizing there), beyond the allowable 0.3:
+// those two candidates are not run, never chosen, never checked; the verification takes the
+// chosen candidate's clearance neighbour only. Each inner length is the lattice, both linings
+// and h.
+TEST_CASE("pdamp modes searches a buffered wall's lining with the clearance, building only linings that survive",
+          "[cli][structure][dem][long]") {
+  const TempDir dir("modes_lining_search");
+  const std::string path = edited_shipped_case(dir.path, "free_free_beam_buffered_clearance.json", [](json& c) {
+    short_clearance_search(c);
+    c["task"]["clearance_search"]["clearances_m"] = {0.004, 0.008};
+    c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.001, 0.002};
+  });
+  const json r = run_json({"modes", path, "--calibration-cache=" + (dir.path / "cache").string(), "-o",
+                           (dir.path / "out").string()});
+  const json& s = r["clearance_search"];
+  REQUIRE(s["candidates"].size() == 4);
+  const double extent = 20.0 * std::sqrt(2.0) * 0.0025 + 0.005;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const json& candidate = s["candidates"][k];
+    INFO(candidate.dump());
+    const double t = k < 2 ? 0.001 : 0.002, h = k % 2 == 0 ? 0.004 : 0.008;
+    CHECK(candidate["wall_layer_thickness_m"] == t);
+    CHECK(candidate["clearance_m"] == h);
+    CHECK(candidate["inner_length_m"].get<double>() == Approx(extent + 2.0 * t + h).epsilon(1e-9));
+    CHECK(candidate["buildable"] == (t == 0.002));
+    CHECK((t == 0.002 ? candidate["layer_tip_strain"].get<double>() < 0.3 : candidate["layer_tip_strain"].get<double>() > 0.3));
+    CHECK(candidate["objective"].is_null() == (t == 0.001));
+    CHECK(candidate["added_damping_ratios"].size() == (t == 0.002 ? 2u : 0u));
+    CHECK(candidate["dem_check"].size() == (t == 0.002 ? 1u : 0u));
+  }
+  CHECK(s["chosen_wall_layer_thickness_m"] == 0.002);
+  const std::size_t best =
+      s["candidates"][2]["objective"].get<double>() >= s["candidates"][3]["objective"].get<double>() ? 2 : 3;
+  CHECK(s["chosen_clearance_m"] == s["candidates"][best]["clearance_m"]);
+  CHECK_THAT(r["warnings"].dump(), Catch::Contains("lining 1 mm: its tip strain"));
+  std::ifstream gp(dir.path / "out" / "clearance_search.gp");
+  const std::string script((std::istreambuf_iterator<char>(gp)), std::istreambuf_iterator<char>());
+  CHECK_THAT(script, Catch::Contains("lining 2 mm") && !Catch::Contains("lining 1 mm"));
 }
 
 TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 2", "[cli][structure]") {
@@ -858,6 +914,8 @@ TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 
       {[](json& c) { c["task"]["clearance_search"]["unknown"] = 1; }, "/task/clearance_search/unknown"},
       {[](json& c) { c["dampers"][0]["layers"][0]["particles"]["lattice"] = "dense"; },
        "/dampers/0/layers/0/particles/lattice"},
+      {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.001}; },
+       "/task/clearance_search/wall_layer_thicknesses_m"},  // the layer has no wall_layer
       // The staggered lattice of 260 spheres is 75.7 mm long.
       {[](json& c) { c["dampers"][0]["layers"][0]["container"]["inner_length_m"] = 0.075; }, "/dampers/0/layers/0"},
   };
@@ -865,5 +923,22 @@ TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 
     INFO(key);
     require_one_line_error(run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_mode_clearance.json", edit)}),
                            key);
+  }
+  // The buffered case: linings out of order, too many pairs, and linings none of which survive
+  // the buffer's design impact (refused before any DEM work).
+  const std::vector<std::pair<std::function<void(json&)>, std::string>> lining = {
+      {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.002, 0.001}; },
+       "/task/clearance_search/wall_layer_thicknesses_m"},
+      {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.001, 0.002, 0.003, 0.004, 0.005, 0.006, 0.007}; },
+       "/task/clearance_search/wall_layer_thicknesses_m"},
+      {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.0005, 0.001}; },
+       "/task/clearance_search/wall_layer_thicknesses_m"},
+      {[](json& c) { c["dampers"][0]["layers"][0]["wall_layer"]["thickness_m"] = 0.05; },
+       "/dampers/0/layers/0/wall_layer/thickness_m"},
+  };
+  for (const auto& [edit, key] : lining) {
+    INFO(key);
+    require_one_line_error(
+        run_pdamp({"modes", edited_shipped_case(dir.path, "free_free_beam_buffered_clearance.json", edit)}), key);
   }
 }

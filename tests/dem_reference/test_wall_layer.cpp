@@ -125,22 +125,28 @@ TEST_CASE("a slow sphere presses into the bonded layer as the layered law predic
 // Reference: a thick layer (χ = √(rδ)/t ≈ 0.016) is a Hertz half-space, δ_max =
 // (15mv²/(16E*√r))^{2/5} with E* of steel on the layer, written out here. 1.5%:
 // Dimitriadis' first-order term makes the 45 mm layer ~1.7% stiffer in force at this χ,
-// i.e. ~0.7% less penetration, plus the 1% resolution of the peak.
+// i.e. ~0.7% less penetration, plus the 1% resolution of the peak. At 5 m/s the sphere
+// sinks 0.63 mm, 0.13 of its radius: beyond the DEM's overlap limit for hard contacts
+// (0.1 r), which a soft layer's surface must not trip (the run would stop as unstable).
 TEST_CASE("a sphere on a thick layer presses in by the Hertz half-space penetration", "[dem_reference]") {
-  const double v = 0.5, thick = 0.045;
-  const double m = kSteelRho * 4.0 / 3.0 * kPi * kRadius * kRadius * kRadius;
-  const double e_star = effective_modulus(kSteelE, kSteelNu, kLayerE, kLayerNu);
-  const double expected = elastic_penetration(m, hertz_stiffness(e_star), v);
-  const fm::Material steel{kSteelRho, kSteelE, kSteelNu}, layer{kLayerRho, kLayerE, kLayerNu};
-  REQUIRE(fm::max_penetration(fm::sphere_wall_contact(kRadius, m, steel, layer), v) ==
-          Approx(expected).epsilon(1e-12));
-  dr::WorldOptions o = layered_world(1.0, 0.9, 1.0);
-  o.compartments.front().container.box_inner_size_m = {0.2, 0.2, 0.2};
-  o.compartments.front().layer.thickness_m = thick;
-  const auto impact = layer_impact(o, v, thick);
-  INFO("penetration " << impact.penetration_m << " m, Hertz " << expected << " m");
-  CHECK(impact.penetration_m == Approx(expected).epsilon(0.015));
-  CHECK(impact.penetration_m < expected);
+  const double thick = 0.045;
+  for (const double v : {0.5, 5.0}) {
+    CAPTURE(v);
+    const double m = kSteelRho * 4.0 / 3.0 * kPi * kRadius * kRadius * kRadius;
+    const double e_star = effective_modulus(kSteelE, kSteelNu, kLayerE, kLayerNu);
+    const double expected = elastic_penetration(m, hertz_stiffness(e_star), v);
+    const fm::Material steel{kSteelRho, kSteelE, kSteelNu}, layer{kLayerRho, kLayerE, kLayerNu};
+    REQUIRE(fm::max_penetration(fm::sphere_wall_contact(kRadius, m, steel, layer), v) ==
+            Approx(expected).epsilon(1e-12));
+    dr::WorldOptions o = layered_world(1.0, 0.9, v);
+    o.compartments.front().container.box_inner_size_m = {0.2, 0.2, 0.2};
+    o.compartments.front().layer.thickness_m = thick;
+    const auto impact = layer_impact(o, v, thick);  // requires a completed run
+    INFO("penetration " << impact.penetration_m << " m, Hertz " << expected << " m");
+    CHECK(impact.penetration_m == Approx(expected).epsilon(0.015));
+    CHECK(impact.penetration_m < expected);
+    if (v > 1.0) CHECK(impact.penetration_m > o.integration.max_overlap_fraction * kRadius);
+  }
 }
 
 // Reference: energy conservation of the bottomed-out layer (50 µm: a layer that the

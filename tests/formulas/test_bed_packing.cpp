@@ -382,3 +382,28 @@ TEST_CASE("a staggered cylinder bed stacks shifted slabs in the hollows at pitch
                       Catch::Contains("no shifted site fits"));
   }
 }
+
+// Reference: geometry by hand. A lining of thickness t on the faces normal to an axis takes
+// 2t off the inner length along it; on a cylinder's mantle it takes t off the radius.
+TEST_CASE("a lined container loses the lining's thickness on the lined faces only", "[formulas]") {
+  const double t = 0.001;
+  fm::Container box;
+  box.box_inner_size_m = {0.1, 0.06, 0.04};
+  const fm::Container x_lined = box.lined(t, 0);
+  CHECK(x_lined.box_inner_size_m[0] == Approx(0.098).margin(kGeometry));
+  CHECK(x_lined.box_inner_size_m[1] == 0.06);
+  const fm::Container all_lined = box.lined(t, -1);
+  CHECK(all_lined.box_inner_size_m[1] == Approx(0.058).margin(kGeometry));
+  CHECK(all_lined.box_inner_size_m[2] == Approx(0.038).margin(kGeometry));
+  const fm::Container cyl = cylinder(0.0125, 0.1, 0);
+  const fm::Container caps = cyl.lined(t, 0);
+  CHECK(caps.cylinder_inner_length_m == Approx(0.098).margin(kGeometry));
+  CHECK(caps.cylinder_inner_radius_m == 0.0125);
+  const fm::Container mantle = cyl.lined(t, 2);
+  CHECK(mantle.cylinder_inner_length_m == 0.1);
+  CHECK(mantle.cylinder_inner_radius_m == Approx(0.0115).margin(kGeometry));
+  const fm::Container both = cyl.lined(t, -1);
+  CHECK(both.inner_length(0) == Approx(0.098).margin(kGeometry));
+  CHECK(both.inner_length(1) == Approx(0.023).margin(kGeometry));
+  CHECK(cyl.lined(0.0, -1).inner_length(0) == 0.1);
+}

@@ -329,6 +329,11 @@ TEST_CASE("the layered buffer layer's tip strain at the design impact is the all
     CHECK(design.max_penetration_m == Approx(strain * t).epsilon(1e-10));
     CHECK(design.max_force_n == Approx(law.force(strain * t)).epsilon(1e-9));
     CHECK(design.contact_radius_m == Approx(law.contact_radius(strain * t)).epsilon(1e-12));
+    // The strain check of a given layer inverts the sizing (the bisection's 1e-13 in t; the
+    // impact's own bisection to 1e-9), and a thicker layer strains less.
+    CHECK(fm::layer_tip_strain(in, t) == Approx(strain).epsilon(1e-8));
+    CHECK(fm::layer_tip_strain(in, 2.0 * t) < strain);
+    CHECK(fm::layer_tip_strain(in, 0.5 * t) > strain);
     // A smaller allowable strain needs a thicker layer (U(ε t; t) grows with t).
     CHECK(t > previous);
     previous = t;
@@ -352,6 +357,7 @@ TEST_CASE("the layered buffer layer's tip strain at the design impact is the all
   CHECK(h03.layer_thickness_m == h1.layer_thickness_m);
   CHECK(h03.allowable_strain == 1.0);
   CHECK(any_contains(h03.assumptions, "is not used by this rule"));
+  CHECK_THROWS_WITH(fm::layer_tip_strain(base, 0.0), Catch::Contains("thickness_m = 0: must be > 0"));
 }
 
 // The shipped 60 Hz case (README: pdamp buffer --frequency 60 --intensity 20 --radius

@@ -187,6 +187,12 @@ struct ModesClearanceSearch {
   /// The candidates, m, ascending, >= 2: the layer's clearance h (inner length along the
   /// drive minus the collected lattice's extent); explicit, or log-spaced from min to max.
   std::vector<double> clearances_m;
+  /// With a buffered wall on the layer's faces across the drive (its `wall_layer`), the
+  /// lining thicknesses t searched with every clearance, m, ascending: each candidate is a
+  /// pair (h, t), h the free length between the linings (the container 2t longer than
+  /// without them). Empty: the layer as it is. With the case's `buffer`, a t whose tip strain
+  /// under the buffer's design impact exceeds its allowable strain is not built (nor run).
+  std::vector<double> wall_layer_thicknesses_m;
   /// `calibration`: each candidate's strokes per decade and softening (its modes: {mode}).
   ModesCalibrationSpec calibration;
   /// `verify`: the target mode's DEM decays at the chosen clearance and its neighbours in
@@ -433,6 +439,11 @@ Case with_clearance(const Case& c, double clearance_m);
 /// box, or a cylinder along the drive; CaseError naming the axis otherwise), `clearance_m`
 /// moved with it. The reader checks that the bed still fits.
 nlohmann::json clearance_patch(const Case& c, double clearance_m);
+/// The merge patch that gives the first damper's first layer of a format-2 case a wall layer
+/// of thickness t (its `wall_layer` must exist; CaseError naming it otherwise), the container
+/// unchanged: the clearance shrinks by twice the change where the lining covers the faces
+/// across the drive (clearance_patch on the result restores it).
+nlohmann::json wall_layer_patch(const Case& c, double thickness_m);
 
 /// The case with `patch` merged into its document (RFC 7396: objects merge key by key, null
 /// removes a key, anything else replaces), read again by the case reader (a CaseError names

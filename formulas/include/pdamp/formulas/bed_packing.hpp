@@ -25,6 +25,10 @@ struct Container {
   /// Inner length along an axis (cylinder: its length, or 2R across it), m.
   /// Throws std::invalid_argument unless axis is 0, 1 or 2.
   double inner_length(int axis) const;
+  /// The free space inside a lining of thickness t >= 0 (a buffered wall's layer): the
+  /// faces normal to `axis` lined (box faces; a cylinder's end caps when it is the
+  /// cylinder's axis, else its mantle), or every face for axis = −1. t = 0: unchanged.
+  Container lined(double thickness_m, int axis) const;
   /// One line per violation of the shape in use ("<prefix>.box_inner_size_m[1] = -0.06:
   /// must be > 0 and finite"; no prefix and dot when prefix is empty): positive finite
   /// sizes, cylinder_axis in 0..2. Empty when valid.

@@ -138,5 +138,10 @@ struct BufferDesign {
 /// Throws std::invalid_argument with all of input.validate()'s lines (newline-separated)
 /// for invalid input.
 BufferDesign size_buffer_layer(const BufferDesignInput& input);
+/// The tip strain δ_max/t that the input's design impact (speed and m* as size_buffer_layer
+/// takes them) gives a bonded layer of thickness t > 0 under the layered law: a layer
+/// survives its design impact when this is at most input.allowable_strain. Throws
+/// std::invalid_argument for invalid input or t.
+double layer_tip_strain(const BufferDesignInput& input, double thickness_m);
 
 }  // namespace pdamp::formulas

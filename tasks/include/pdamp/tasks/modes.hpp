@@ -60,11 +60,17 @@ struct ModeCalibration {
   static const base::Fields<ModeCalibration>& fields();
 };
 
-/// One candidate clearance of the search (case_file::ModesClearanceSearch): its calibrated bed,
-/// the mode's added damping at the search's strokes, and, when verified, its DEM decays.
+/// One candidate of the search (case_file::ModesClearanceSearch): a clearance (and a buffered
+/// wall's lining thickness), its calibrated bed, the mode's added damping at the search's
+/// strokes, and, when verified, its DEM decays.
 struct ModeClearanceCandidate {
-  double clearance_m = 0.0;     ///< the layer's clearance h (inner length minus the lattice's extent)
+  double clearance_m = 0.0;     ///< the layer's clearance h (free length along the drive minus the lattice's extent)
   double inner_length_m = 0.0;  ///< the container's inner length along the drive
+  double wall_layer_thickness_m = 0.0;  ///< the buffered wall's lining t (0: none)
+  /// δ_max/t of the lining under the case's buffer design impact (NaN: no lining or no buffer).
+  double layer_tip_strain = NAN;
+  /// false: the strain exceeds the buffer's allowable strain; not calibrated, never chosen.
+  bool buildable = true;
   std::vector<double> added_damping_ratios;  ///< ζ_add at the search's strokes (the backbone's)
   double objective = NAN;       ///< their mean, or the smallest (the search's objective)
   bool converged = true;        ///< every backbone point converged
@@ -80,11 +86,13 @@ struct ModeClearanceCandidate {
 struct ModeClearanceSearchResult {
   case_file::ModesClearanceSearch settings;
   std::vector<double> amplitudes_m;  ///< the strokes the objective takes (log-spaced)
-  std::vector<ModeClearanceCandidate> candidates;  ///< in the search's order (ascending h)
-  std::size_t chosen = 0;                          ///< the largest objective
-  /// The DEM verification (settings.verify): the chosen clearance's decays pass, and no
+  /// In the search's order: ascending t, and within each t ascending h.
+  std::vector<ModeClearanceCandidate> candidates;
+  std::size_t chosen = 0;  ///< the largest objective among the buildable candidates
+  /// The DEM verification (settings.verify): the chosen candidate's decays pass, and no
   /// neighbour's DEM mean ζ_add beats the chosen's by more than the tolerance on the whole ζ
-  /// (bare plus added; the DEM does not contradict the choice).
+  /// (bare plus added; the DEM does not contradict the choice). The neighbours: the next
+  /// clearances at the chosen thickness, and the next buildable thicknesses at its clearance.
   bool verified = false, chosen_agrees = false, ranking_agrees = false, passed = false;
 };
 
