@@ -1,7 +1,8 @@
 // The clearance search of task kind modes (modes.hpp, ModeClearanceSearchResult): each
-// candidate clearance (and buffered wall's lining) a variant of the case whose target mode is
-// calibrated from DEM steady states (run_modes with a calibration of that mode alone), the best by the mode's added
-// damping over the search's strokes, and the DEM decays of it and its neighbours.
+// candidate clearance (with a buffered wall's lining, if searched) a variant of the case whose
+// target mode is calibrated from DEM steady states (run_modes with a calibration of that mode
+// alone), the best by the mode's added damping over the search's strokes, and the DEM decays
+// of it and its neighbours.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -120,7 +121,9 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
     out.candidates.push_back(std::move(candidate));
   }
   if (std::none_of(out.candidates.begin(), out.candidates.end(), [](const auto& k) { return k.buildable; }))
-    throw base::InputError(c.path, "/task/clearance_search/wall_layer_thicknesses_m",
+    throw base::InputError(c.path,
+                           lined ? "/task/clearance_search/wall_layer_thicknesses_m"
+                                 : "/dampers/0/layers/0/wall_layer/thickness_m",
                            "every lining is strained beyond the buffer's allowable strain " +
                                base::format_number(c.buffer->input.allowable_strain, 3) +
                                " by its design impact: list thicker ones (pdamp buffer sizes the thinnest)");
@@ -159,9 +162,10 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
                        std::string(chosen_h == 0 ? "smallest" : "largest") + " candidate, h = " +
                        millimetres(best.clearance_m) + ": the optimum may lie " + (chosen_h == 0 ? "below" : "above") +
                        " the candidates (extend /task/clearance_search/clearances_m where a bed can be built)");
-  // At the thinnest buildable lining the strength bound decides, not the search's edge.
-  const bool thinnest_listed = chosen_t == 0, thickest = chosen_t + 1 == grid.thicknesses_m.size();
-  if (lined && grid.thicknesses_m.size() > 1 && (thinnest_listed || thickest))
+  // A thinner lining than the chosen one that was listed but not built is the strength
+  // bound, not the search's edge: no warning then.
+  const bool thinnest = chosen_t == 0, thickest = chosen_t + 1 == grid.thicknesses_m.size();
+  if (lined && grid.thicknesses_m.size() > 1 && (thinnest || thickest))
     warnings.push_back("clearance search: the best lining is the " + std::string(thickest ? "thickest" : "thinnest") +
                        " candidate, " + millimetres(best.wall_layer_thickness_m) + ": the optimum may lie " +
                        (thickest ? "above" : "below") + " the candidates (extend /task/clearance_search/wall_layer_thicknesses_m)");
