@@ -35,6 +35,14 @@ double shear_modulus(const formulas::Material& m) {
   return m.youngs_modulus_pa / (2.0 * (1.0 + m.poisson_ratio));
 }
 
+/// ContactParams::inv_radius_squared from K with the kernel's operations (√R* = K/((4/3)E*),
+/// R* = √R*², 1/R*²), so that the stored value is the one the kernel formed every step.
+double inverse_radius_squared(double stiffness, const PairType& type) {
+  const double root_r = stiffness * type.inv_hertz_modulus;
+  const double r_eff = root_r * root_r;
+  return 1.0 / (r_eff * r_eff);
+}
+
 }  // namespace
 
 ContactLaw::ContactLaw(const WorldOptions& options)
@@ -95,6 +103,7 @@ ContactParams ContactLaw::particle_pair(double radius_i, double mass_i, int mate
   p.stiffness = 4.0 / 3.0 * e_star_[t] * std::sqrt(r_eff);
   p.damping_scale = std::sqrt(m_eff * p.stiffness);
   p.pair_type = type;
+  p.inv_radius_squared = inverse_radius_squared(p.stiffness, types_[t]);
   return p;
 }
 
@@ -115,6 +124,7 @@ ContactParams ContactLaw::particle_wall(double radius_i, double mass_i, int mate
   p.stiffness = 4.0 / 3.0 * e_star_[t] * std::sqrt(r_eff);
   p.damping_scale = std::sqrt(mass_i * p.stiffness);
   p.pair_type = type;
+  p.inv_radius_squared = inverse_radius_squared(p.stiffness, types_[t]);
   if (layer_thickness_m > 0.0) {
     for (std::size_t l = 0; l < layers_.size(); ++l) {
       if (layers_[l].pair_type == type && layers_[l].thickness_m == layer_thickness_m) p.layer = static_cast<int>(l);

@@ -25,6 +25,9 @@ struct PairType {
 struct ContactParams {
   double stiffness = 0.0;      ///< K = (4/3)E*√R*, N/m^{3/2}
   double damping_scale = 0.0;  ///< √(m*K), kg^{1/2} N^{1/2} m^{-3/4}
+  /// 1/R*² of the rolling spring (k_r = k_t R*²), R* = (K·inv_hertz_modulus)² as the kernel
+  /// forms it: the division the kernel would repeat every step, done once (same bits).
+  double inv_radius_squared = 0.0;
   int pair_type = 0;           ///< index of the material pair
   int layer = -1;              ///< index of the wall-layer law (ContactLaw::layer_law); −1: Hertz
 };
@@ -304,7 +307,7 @@ template <class W>
     const W wn = k.w[0] * n[0] + k.w[1] * n[1] + k.w[2] * n[2];
     const W dtheta[3] = {(k.w[0] - wn * n[0]) * step, (k.w[1] - wn * n[1]) * step, (k.w[2] - wn * n[2]) * step};
     const W r2 = r_eff * r_eff;
-    const W inv_r2 = one / r2;
+    const W inv_r2 = W::gather([&](int l) { return c.params[l]->inv_radius_squared; });
     W mr[3];
     for (int d = 0; d < 3; ++d) {
       mr[d] = W::gather([&](int l) { return type[l]->rolling_friction > 0.0 ? c.rolling_torque[l][d] : 0.0; });
