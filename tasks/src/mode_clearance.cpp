@@ -88,11 +88,12 @@ ModeClearanceSearchResult search_mode_clearance(const case_file::Case& c, const 
   // between the linings (the container lengthened or shortened along the drive).
   const auto variant = [&](std::size_t k, bool verify) {
     const std::size_t h = k % grid.clearances_m.size(), t = k / grid.clearances_m.size();
-    std::string key = "/task/clearance_search/clearances_m/" + std::to_string(h);
+    // The key of the step that may be refused: the lining first, then the clearance.
+    std::string key = "/task/clearance_search/wall_layer_thicknesses_m/" + std::to_string(t);
     try {
       const case_file::Case lining =
           lined ? case_file::with_merge_patch(c, case_file::wall_layer_patch(c, grid.thicknesses_m[t])) : c;
-      if (lined) key = "/task/clearance_search/wall_layer_thicknesses_m/" + std::to_string(t);
+      key = "/task/clearance_search/clearances_m/" + std::to_string(h);
       json patch = case_file::clearance_patch(lining, grid.clearances_m[h]);
       patch["task"] = variant_task(s, verify);
       return case_file::with_merge_patch(lining, patch);

@@ -933,6 +933,9 @@ TEST_CASE("a clearance_search and a staggered lattice refuse bad keys with exit 
        "/task/clearance_search/wall_layer_thicknesses_m"},
       {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.0005, 0.001}; },
        "/task/clearance_search/wall_layer_thicknesses_m"},
+      // A lining that leaves the container no room: the search names that lining.
+      {[](json& c) { c["task"]["clearance_search"]["wall_layer_thicknesses_m"] = {0.002, 0.05}; },
+       "/task/clearance_search/wall_layer_thicknesses_m/1"},
       {[](json& c) { c["dampers"][0]["layers"][0]["wall_layer"]["thickness_m"] = 0.05; },
        "/dampers/0/layers/0/wall_layer/thickness_m"},
   };
