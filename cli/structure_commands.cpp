@@ -155,9 +155,10 @@ std::string dem_peak_row(const st::SteppedSinePeak& bp, std::size_t points) {
   return format_number(bp.peak.frequency_hz, 5) + " Hz (largest of " + std::to_string(points) + " points at " +
          format_number(top.frequency_hz, 5) + " Hz), |out| = " + format_number(bp.peak.magnitude, 4) +
          (bp.output == 0 && std::isfinite(top.standard_error) ? " +- " + format_number(top.standard_error, 2) : "") +
-         ", 0.9 band centre " + format_number(bp.peak.band_centre_hz, 5) + " Hz, argmax within [" +
+         ", 0.9 band centre " + format_number(bp.peak.band_centre_hz, 5) + " Hz, largest points within [" +
          format_number(bp.peak.indistinguishable_low_hz, 4) + ", " + format_number(bp.peak.indistinguishable_high_hz, 4) +
-         "] Hz, half-power zeta " + format_number(bp.peak.damping_ratio, 3);
+         "] Hz, maximum within [" + format_number(bp.peak.maximum_low_hz, 4) + ", " +
+         format_number(bp.peak.maximum_high_hz, 4) + "] Hz, half-power zeta " + format_number(bp.peak.damping_ratio, 3);
 }
 
 Rows harmonic_rows(const tasks::HarmonicFrf& h) {

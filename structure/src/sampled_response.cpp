@@ -91,6 +91,13 @@ SampledPeak sampled_peak(const std::vector<double>& f, const std::vector<double>
         peak.indistinguishable_high_hz = std::max(peak.indistinguishable_high_hz, f[i]);
       }
   }
+  std::size_t low = k, high = k;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (f[i] == peak.indistinguishable_low_hz) low = i;
+    if (f[i] == peak.indistinguishable_high_hz) high = i;
+  }
+  peak.maximum_low_hz = f[low > 0 ? low - 1 : 0];
+  peak.maximum_high_hz = f[high + 1 < n ? high + 1 : n - 1];
   return peak;
 }
 

@@ -31,9 +31,10 @@ constexpr double kMaxSweepDuration_s = 1e5;
 const char* const kDemPeakNote =
     "frequency_hz: vertex of the parabola through the largest point and its neighbours; band: where the points "
     "stay >= 0.9 of the largest (linear between points), its centre a flat top's better-conditioned resonance "
-    "frequency; indistinguishable: the points within two standard errors of the largest (the argmax lies among "
-    "them); standard error = spread/sqrt(analysed periods); damping_ratio: half-power width (f2 - f1)/(2 f) "
-    "between the points (null where a side does not fall to 1/sqrt(2) of the largest)";
+    "frequency; indistinguishable: the points within two standard errors of the largest; maximum: from the point "
+    "below them to the point above (where a curve with one maximum peaks); standard error = spread/sqrt(analysed "
+    "periods); damping_ratio: half-power width (f2 - f1)/(2 f) between the points (null where a side does not fall "
+    "to 1/sqrt(2) of the largest)";
 
 bool base_excitation(const Case& c) { return c.task.frf->excitation == case_file::FrfTask::Excitation::kBase; }
 
@@ -373,6 +374,8 @@ DemPeak dem_peak(const std::string& name, const st::SteppedSineBranch& branch, c
   out.band_centre_hz = bp.peak.band_centre_hz;
   out.indistinguishable_low_hz = bp.peak.indistinguishable_low_hz;
   out.indistinguishable_high_hz = bp.peak.indistinguishable_high_hz;
+  out.maximum_low_hz = bp.peak.maximum_low_hz;
+  out.maximum_high_hz = bp.peak.maximum_high_hz;
   out.damping_ratio = bp.peak.damping_ratio;
   return out;
 }
@@ -408,6 +411,7 @@ std::optional<PeakAgreement> peak_agreement(const st::ResponsePeak* peak, const 
   a.dem_damping_ratio = dem.damping_ratio;
   a.frequency_within_dem_indistinguishable =
       peak->frequency_hz >= dem.indistinguishable_low_hz && peak->frequency_hz <= dem.indistinguishable_high_hz;
+  a.frequency_within_dem_maximum = peak->frequency_hz >= dem.maximum_low_hz && peak->frequency_hz <= dem.maximum_high_hz;
   return a;
 }
 
@@ -646,6 +650,10 @@ const base::Fields<DemPeak>& DemPeak::fields() {
                  "lowest point within two standard errors of the largest")
           .field("indistinguishable_high_hz", &P::indistinguishable_high_hz, "Hz",
                  "highest point within two standard errors of the largest")
+          .field("maximum_low_hz", &P::maximum_low_hz, "Hz",
+                 "the point below the lowest of those (the sampled curve's maximum lies above it)")
+          .field("maximum_high_hz", &P::maximum_high_hz, "Hz",
+                 "the point above the highest of those (the sampled curve's maximum lies below it)")
           .field("damping_ratio", &P::damping_ratio, "1", "half-power width between the points", base::kNullable);
   return f;
 }
@@ -672,7 +680,9 @@ const base::Fields<PeakAgreement>& PeakAgreement::fields() {
           .field("damping_ratio", &A::damping_ratio, "1", "the method's half-power damping ratio", base::kNullable)
           .field("dem_damping_ratio", &A::dem_damping_ratio, "1", "the DEM's", base::kNullable)
           .field("frequency_within_dem_indistinguishable", &A::frequency_within_dem_indistinguishable, "",
-                 "the method's peak lies among the DEM points that cannot be told from the largest");
+                 "the method's peak lies among the DEM points that cannot be told from the largest")
+          .field("frequency_within_dem_maximum", &A::frequency_within_dem_maximum, "",
+                 "the method's peak lies where the DEM's maximum can be: between the points either side of those");
   return f;
 }
 

@@ -34,6 +34,14 @@ TEST_CASE("sampled_peak: a parabola's vertex and a tent's 0.9 band are exact", "
   // Without standard errors the argmax is the peak sample.
   CHECK(peak.indistinguishable_low_hz == 1.6);
   CHECK(peak.indistinguishable_high_hz == 1.6);
+  // The curve's maximum (1.73, not a sample) lies between the peak sample's neighbours.
+  CHECK(peak.maximum_low_hz == 1.1);
+  CHECK(peak.maximum_high_hz == 1.9);
+  CHECK((peak.maximum_low_hz < 1.73 && 1.73 < peak.maximum_high_hz));
+  // A curve rising to its last sample: the bracket stops at the end.
+  const auto rising = st::sampled_peak({1.0, 1.1, 1.2}, {1.0, 2.0, 3.0});
+  CHECK(rising.maximum_low_hz == 1.1);
+  CHECK(rising.maximum_high_hz == 1.2);
   // c = 10 − 2|f − 1.73| is linear on each flank, so is the interpolation: the level 0.9
   // of the largest sample (9.74 at 1.6) is crossed at 1.73 ± (10 − 0.9·9.74)/2 exactly
   // (the samples there bracket it on one flank each).
@@ -83,6 +91,8 @@ TEST_CASE("sampled_peak: standard errors widen the argmax's range to the points 
   const auto peak = st::sampled_peak(f, c, {0.05, 0.05, 0.05, 0.05, 0.05});
   CHECK(peak.indistinguishable_low_hz == 1.1);
   CHECK(peak.indistinguishable_high_hz == 1.3);
+  CHECK(peak.maximum_low_hz == 1.0);  // the points either side of those
+  CHECK(peak.maximum_high_hz == 1.4);
   CHECK(std::isnan(st::sampled_peak({1.0, 2.0}, {1.0, 2.0}).band.high_hz));  // no fall on the right
   // A dip inside the band (a DEM point's scatter) does not cut it: the outermost crossings.
   const auto dipped = st::sampled_peak({1.0, 1.1, 1.2, 1.3, 1.4, 1.5}, {1.0, 3.0, 3.3, 2.9, 3.1, 1.0});

@@ -56,6 +56,13 @@ struct SampledPeak {
   /// within two standard errors (m_i + 2 se_i ≥ m_max − 2 se_max): the argmax is only
   /// known to lie among them. Without standard errors, the peak sample's frequency.
   double indistinguishable_low_hz = 0.0, indistinguishable_high_hz = 0.0;
+  /// Where the sampled curve's own maximum lies: from the sample below the lowest
+  /// indistinguishable sample to the sample above the highest (the end sample at an end).
+  /// A curve with one maximum peaks between the neighbours of its largest sample, so a
+  /// maximum between two samples is located to within a spacing, not to a sample:
+  /// [indistinguishable_low_hz, indistinguishable_high_hz] alone can shrink to one
+  /// sample's frequency and refuse a peak a fraction of a spacing beside it.
+  double maximum_low_hz = 0.0, maximum_high_hz = 0.0;
   /// Half-power damping ratio (f₂ − f₁)/(2 frequency_hz), f₁, f₂ where the curve first falls
   /// below magnitude/√2 on either side of the largest sample (level_crossings), as the
   /// harmonic balance's ResponsePeak; NaN where a side does not fall that low in the samples.

@@ -97,6 +97,7 @@ struct DemPeak {
   double magnitude_standard_error = NAN;  ///< the first output's (its per-period amplitudes are recorded)
   double band_low_hz = NAN, band_high_hz = NAN, band_centre_hz = NAN;
   double indistinguishable_low_hz = NAN, indistinguishable_high_hz = NAN;
+  double maximum_low_hz = NAN, maximum_high_hz = NAN;  ///< structure::SampledPeak's bracket of the maximum
   double damping_ratio = NAN;
   static const base::Fields<DemPeak>& fields();
   /// A linear sweep's peak (no single largest point, no indistinguishable range).
@@ -111,6 +112,9 @@ struct PeakAgreement {
   double damping_ratio = NAN, dem_damping_ratio = NAN;
   /// The method's peak frequency lies among the DEM points that cannot be told from the largest.
   bool frequency_within_dem_indistinguishable = false;
+  /// The method's peak frequency lies where the DEM's sampled maximum can be: between the
+  /// points either side of those (the DEM's resolution in frequency, the agreement to ask for).
+  bool frequency_within_dem_maximum = false;
   static const base::Fields<PeakAgreement>& fields();
 };
 
