@@ -82,20 +82,17 @@ SampledPeak sampled_peak(const std::vector<double>& f, const std::vector<double>
   peak.band_centre_hz = 0.5 * (peak.band.low_hz + peak.band.high_hz);
   const LevelCrossings half_power = level_crossings(f, c, k, k, c[k] / std::sqrt(2.0));
   peak.damping_ratio = (half_power.high_hz - half_power.low_hz) / (2.0 * peak.frequency_hz);
-  peak.indistinguishable_low_hz = peak.indistinguishable_high_hz = f[k];
+  std::size_t low = k, high = k;  // the first and last sample indistinguishable from the largest
   if (!standard_errors.empty()) {
     const double floor = c[k] - 2.0 * standard_errors[k];
     for (std::size_t i = 0; i < n; ++i)
       if (c[i] + 2.0 * standard_errors[i] >= floor) {
-        peak.indistinguishable_low_hz = std::min(peak.indistinguishable_low_hz, f[i]);
-        peak.indistinguishable_high_hz = std::max(peak.indistinguishable_high_hz, f[i]);
+        low = std::min(low, i);
+        high = std::max(high, i);
       }
   }
-  std::size_t low = k, high = k;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (f[i] == peak.indistinguishable_low_hz) low = i;
-    if (f[i] == peak.indistinguishable_high_hz) high = i;
-  }
+  peak.indistinguishable_low_hz = f[low];
+  peak.indistinguishable_high_hz = f[high];
   peak.maximum_low_hz = f[low > 0 ? low - 1 : 0];
   peak.maximum_high_hz = f[high + 1 < n ? high + 1 : n - 1];
   return peak;
