@@ -150,11 +150,11 @@ template <class W>
   return out;
 }
 
-/// The tangential (or rolling) spring update shared by both springs, lane-wise: rotate
-/// the stored vector s into the plane normal to n keeping its magnitude, apply the
-/// Mindlin stiffness change without injecting energy, add −k·Δu, cap at the Coulomb
-/// limit. Returns the energy dissipated in the step per lane, J. With kMasked only the
-/// lanes of `active` take the rare paths (the others' results are to be discarded).
+/// The tangential (or rolling) spring update shared by both springs, lane-wise: project
+/// the stored vector s into the plane normal to n, apply the Mindlin stiffness change
+/// without injecting energy, add −k·Δu, cap at the Coulomb limit. Returns the energy
+/// dissipated in the step per lane, J. With kMasked only the lanes of `active` take the
+/// rare paths (the others' results are to be discarded).
 ///
 /// Why: with a stiffness k(δ) that changes during the contact, storing the
 /// displacement (F = kξ) injects energy on loading and storing the force (ΔF = kΔξ)
@@ -162,9 +162,15 @@ template <class W>
 /// unloading (Thornton et al. 2011): the stored energy |F|²/2k then only ever drops,
 /// and the drop is counted as tangential dissipation (Mindlin's micro-slip hysteresis).
 ///
-/// Branches are lane masks; the rare paths (a spring turned by more than 0.6°, sliding)
-/// run only when a lane needs them. Each lane performs the operations of the scalar
-/// update in the scalar order (the width-1 instantiation is the scalar update).
+/// The projection drops the spring's normal component sn = s·n without restoring the
+/// magnitude (docs/dem.md "Tangential spring", physics version 4): the contact plane turns
+/// by ~1e-4 rad a step, so the part lost, |s|²q/2 with q = sn²/|s|² ~ 1e-8, is far below
+/// the step's other terms, and it is counted in the ledger like the Mindlin drop (the
+/// stored energy goes from |s|²/2k_prev to |r|²·ratio/2k_prev with |r|² = |s|² − sn²).
+///
+/// Branches are lane masks; the rare path (sliding) runs only when a lane needs it. Each
+/// lane performs the operations of the scalar update in the scalar order (the width-1
+/// instantiation is the scalar update).
 template <class W, bool kMasked>
 [[gnu::always_inline]] inline W update_spring(W* s, const W* n, W k, W inv_k, W inv_k_prev, const W* du, W cap,
                                              W cap_prev, typename W::Mask active) {
@@ -179,18 +185,15 @@ template <class W, bool kMasked>
   if (any(turn)) {
     const W sn = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
     const W r[3] = {s[0] - sn * n[0], s[1] - sn * n[1], s[2] - sn * n[2]};
-    // The contact plane turns by a tiny angle per step: q = |s·n|²/|s|² ~ 1e-8, so the
-    // first-order magnitude correction 1 + q/2 is exact to round-off; exact otherwise.
-    const W q = sn * sn / s2;
-    const Mask small = q < W::splat(1e-4);
-    W keep = one + half * q;
-    if (any(andnot(small, turn))) keep = select(small, keep, select(q < one, sqrt(one / (one - q)), zero));
+    const W r2 = s2 - sn * sn;
     const W ratio = k * inv_k_prev;
     const Mask unloading = ratio < one;
-    const W loss_unloading = half * s2 * inv_k_prev * (one - ratio);
-    const W loss_loading = half * s2 * (inv_k_prev - inv_k);
+    // Stored energy before, |s|²/2k_prev, minus after: |r|²·ratio/2k_prev on unloading
+    // (the force scaled with k), |r|²/2k on loading (the force kept).
+    const W loss_unloading = half * inv_k_prev * (s2 - r2 * ratio);
+    const W loss_loading = half * (s2 * inv_k_prev - r2 * inv_k);
     const W turned_loss = select(unloading, loss_unloading, loss_loading);
-    const W scale = select(unloading, keep * ratio, keep);
+    const W scale = select(unloading, ratio, one);
     // Every lane turning (a persisting contact in each: the common case) needs no select,
     // which costs three instructions a value without SSE4.1; the values are the same.
     if (all(turn)) {

@@ -2,6 +2,7 @@
 // exit codes, JSON keys, files in -o DIR, bad budgets and layers, the physics claim that
 // the optimised three-layer design settles faster than the best single layer of the same mass,
 // and the DEM verification (cut short here; the shipped case's full one is in docs/optimizer.md).
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -252,9 +253,21 @@ TEST_CASE("the shipped optimisations on calibrated beds predict the DEM within t
     const json r = calibrated_and_verified(dir, kCase);
     CHECK(r["calibration"]["runs"] == 11);
     require_confirmed(r);
-    // The budget binds: six slabs of 8.2 g in each design.
-    for (const char* name : {"chosen", "baseline"})
-      CHECK(r["designs"][name]["total_mass_kg"].get<double>() > r["mass_budget_kg"].get<double>() - 0.0083);
+    // The chosen design spends the budget: six slabs of 8.2 g. Not asked of the baseline,
+    // the best single layer over its slab count (tests/optimizer): a lighter layer may
+    // settle sooner (on other realisations of the calibrating decays the medium layer's
+    // three slabs, 24.7 g, were the best).
+    CHECK(r["designs"]["chosen"]["total_mass_kg"].get<double>() > r["mass_budget_kg"].get<double>() - 0.0083);
+    // The baseline is the best single layer: no enumerated one-layer design settles sooner.
+    REQUIRE(r["rounding"]["enumerated"] == true);
+    int single_layers = 0;
+    for (const auto& d : r["rounding"]["neighbours"]) {
+      const auto& slabs = d["slabs"];
+      if (std::count_if(slabs.begin(), slabs.end(), [](const json& n) { return n.get<double>() > 0.0; }) != 1) continue;
+      ++single_layers;
+      CHECK(r["designs"]["baseline"]["objective"].get<double>() <= d["objective"].get<double>() * (1.0 + 1e-12));
+    }
+    CHECK(single_layers > 0);
   }
   {
     const TempDir dir("optimize_cantilever_verify");

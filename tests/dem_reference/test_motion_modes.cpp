@@ -154,10 +154,11 @@ TEST_CASE("the shipped layer at X/h = 0.6 is rolling collect-and-collide", "[dem
 
 // Reference: the shipped layer with ε = 0.7, μ = 0.15, μ_r = 0.005 and identical spheres (no
 // lot variation): the 36 clones scatter η* from period to period (coefficient of
-// variation 0.2-0.3, standard error 0.06) while the bed crosses the clearance in step
-// with the drive. The label reads the phase-locked crossing, not that scatter: rolling
-// at X = 0.4 h (η* 0.89, high) and X = h (η* 0.58; the old rule, variation < 0.25 and
-// period correlation > 0.8, called it scattering).
+// variation 0.15-0.41, standard error 0.05-0.07; the premise asks for more than 0.1) while
+// the bed crosses the clearance in step with the drive. The label reads the phase-locked
+// crossing, not that scatter: rolling at X = 0.4 h (η* 0.89-0.92, high) and X = h (η*
+// 0.46-0.58 in physics versions 4 and 3; the old rule, variation < 0.25 and period
+// correlation > 0.8, called it scattering).
 TEST_CASE("rolling runs with period-to-period scatter are rolling collect-and-collide", "[dem_reference]") {
   for (const double x : {0.4, 1.0}) {
     auto o = layer(x, 0.7, 0.15, 0.005, 100.0);
@@ -165,7 +166,7 @@ TEST_CASE("rolling runs with period-to-period scatter are rolling collect-and-co
     const auto r = run(o, 3, 8);
     INFO("X/h = " << x << ": " << describe(r));
     CHECK(label(r) == "rolling_collect_and_collide");
-    CHECK(r.indicators.eta_star_variation > 0.15);
+    CHECK(r.indicators.eta_star_variation > 0.1);
     CHECK(r.indicators.phase_coherence > 0.9);
     CHECK(r.eta_star > (x < 0.5 ? 0.8 : 0.45));
   }

@@ -155,7 +155,7 @@ TEST_CASE("a seeded run reproduces its final-state hash", "[dem_reference]") {
   const dr::Vec3 box{0.04, 0.04, 0.04};
   const std::uint64_t hash = colliding_gas_hash(1, 60, 0.003, box, 40000);
   CHECK(colliding_gas_hash(1, 60, 0.003, box, 40000) == hash);
-  CHECK(hash == 0x31b91ec74643efc5ULL);
+  CHECK(hash == 0x78458023c787e669ULL);
 }
 
 // Two threads: partitions, halo forces and their fixed summation order. The hash pins
@@ -165,19 +165,18 @@ TEST_CASE("a seeded run reproduces its final-state hash", "[dem_reference]") {
 // kernel written over the lane type (detail::contact_force_lanes; with rolling
 // resistance too; the rest of a block in fewer lanes). The lanes repeat the scalar
 // kernel's operations in its order, so they must give its bits: the expected hashes
-// here are those of the scalar kernel alone (commit f3e8b96, before the lanes), and the
-// two tests around, with rolling resistance, were pinned when those contacts took the
-// scalar kernel.
+// here are those of the scalar kernel alone (physics version 4: a build with
+// -DPDAMP_DEM_LANES=1 gives them), and the two tests around, with rolling resistance, too.
 TEST_CASE("the two-lane contact kernel gives the bits of the scalar kernel", "[dem_reference]") {
-  CHECK(colliding_gas_hash(1, 60, 0.003, dr::Vec3{0.04, 0.04, 0.04}, 40000, 0.0) == 0xd50b6ff37544ee46ULL);
-  CHECK(colliding_gas_hash(2, 1600, 0.0015, dr::Vec3{0.05, 0.05, 0.06}, 1500, 0.0) == 0xc7dac9fe27563c19ULL);
+  CHECK(colliding_gas_hash(1, 60, 0.003, dr::Vec3{0.04, 0.04, 0.04}, 40000, 0.0) == 0x63c204eb54dd530cULL);
+  CHECK(colliding_gas_hash(2, 1600, 0.0015, dr::Vec3{0.05, 0.05, 0.06}, 1500, 0.0) == 0x9eddb2e27323a0e3ULL);
 }
 
 TEST_CASE("a parallel run is identical run to run for a fixed thread count", "[dem_reference]") {
   const dr::Vec3 box{0.05, 0.05, 0.06};
   const std::uint64_t hash = colliding_gas_hash(2, 1600, 0.0015, box, 1500);
   CHECK(colliding_gas_hash(2, 1600, 0.0015, box, 1500) == hash);
-  CHECK(hash == 0xc4f980e97c8e8599ULL);
+  CHECK(hash == 0x3e1411105f1ae556ULL);
 }
 
 TEST_CASE("invalid world options are refused with every violation named", "[dem_reference]") {

@@ -82,12 +82,14 @@ namespace {
 
 /// The shipped optimisation cut short (fewer evaluations, a 1 s verification of contacts
 /// softened 1e-4) with its softening check on or off.
-case_file::Case short_verification(bool softening_check, double axial_gravity_m_s2 = 0.0) {
+case_file::Case short_verification(bool softening_check, double axial_gravity_m_s2 = 0.0,
+                                   double stiffness_softening = 1e-4) {
   std::ifstream in(case_path("manipulator_link_optimize.json"));
   nlohmann::json c = nlohmann::json::parse(in);
   c["task"]["global_evaluations"] = 30;
   c["task"]["max_evaluations"] = 120;
-  c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", 1e-4}, {"softening_check", softening_check}};
+  c["task"]["verify"] = {{"duration_s", 1.0}, {"stiffness_softening", stiffness_softening},
+                         {"softening_check", softening_check}};
   c["task"].erase("calibration");
   if (axial_gravity_m_s2 != 0.0) {
     c["structure"]["axial_gravity_m_s2"] = axial_gravity_m_s2;
@@ -148,8 +150,10 @@ TEST_CASE("the DEM verification checks its softening against contacts ten times 
 // then structure_setup and the static release on it): a link standing under axial gravity,
 // whose geometric stiffness the beds' weights load. The verification scores each design on
 // those modes; the search's modes (the case's starting design's) differ where the mass does.
+// Contacts softened 1e-3, not 1e-4: the beds' impacts on the link's lighter, standing modes
+// reach the DEM's overlap limit (0.1 r) at 1e-4 on some realisations of the beds.
 TEST_CASE("under axial gravity the verification scores each design on its own modes", "[tasks]") {
-  const case_file::Case c = short_verification(false, -9.80665);
+  const case_file::Case c = short_verification(false, -9.80665, 1e-3);
   tasks::FillingRatiosOptions options;
   const auto r = tasks::run_filling_ratios(c, options, base::silent_hooks(), base::local_executor());
   REQUIRE(r.verification);
@@ -323,17 +327,20 @@ TEST_CASE("the design loop recalibrates the chosen design's beds and stops after
   }
   REQUIRE(r.rounds.size() == 2);
   CHECK(r.loop_outcome == tasks::LoopOutcome::kRoundsExhausted);
-  CHECK(first.recalibrated.size() == static_cast<std::size_t>(layers));
+  // A bed of the chosen design whose decay alone is slower than the design's now carries the
+  // difference, the damping its other beds add; one that decays faster alone (the other beds
+  // add nothing it lacks) keeps its calibration, as does every bed outside the design.
+  CHECK_FALSE(first.recalibrated.empty());
+  CHECK(first.recalibrated.size() <= static_cast<std::size_t>(layers));
   CHECK(r.rounds.back().recalibrated.empty());
-  // The chosen design's beds now carry the damping its other beds add; the others none.
   int raised = 0;
   for (const auto& bed : r.calibration->beds) {
     const bool in_design = first.designs.front().slabs.at(static_cast<std::size_t>(bed.layer_index)) == bed.slabs;
-    CHECK((bed.extra_damping_ratio > 0.0) == in_design);
+    if (bed.extra_damping_ratio > 0.0) CHECK(in_design);
     raised += bed.extra_damping_ratio > 0.0 ? 1 : 0;
   }
-  CHECK(raised == layers);
-  CHECK(r.calibration->runs == 11 + layers);
+  CHECK(raised == static_cast<int>(first.recalibrated.size()));
+  CHECK(r.calibration->runs == 11 + raised);
   // A design verified in both rounds: the same DEM decay, not a new one.
   for (const auto& d : r.rounds.back().designs)
     for (const auto& before : first.designs)

@@ -19,7 +19,9 @@ namespace pdamp::dem_reference {
 /// every step, the impact speed from the free-fall height.
 /// 3: wall layers with the bonded-layer contact law (worlds without layers give the
 /// same results as in version 2).
-inline constexpr int kPhysicsModelVersion = 3;
+/// 4: the tangential and rolling springs projected into the new contact plane without
+/// the rescale to their old magnitude (docs/dem.md "Tangential").
+inline constexpr int kPhysicsModelVersion = 4;
 
 /// The automatic time-step bound (docs/dem.md "Time step").
 struct TimeStepBound {
