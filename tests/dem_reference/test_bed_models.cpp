@@ -169,8 +169,8 @@ TEST_CASE("a one-high layer's jump and peak give a bed restitution below its fro
 }
 
 // Above its peak the rebounding layer (ε = 0.9) follows η*_pk·X_pk/X = 4h/(π²X) whatever e_b
-// (docs/theory.md §3.1), an observation: the DEM lies 10-13 % below it at X/h = 0.55-1.0
-// (0.666, 0.518, 0.353 against 0.737, 0.579, 0.405; standard errors 1-3 %). Checked within
+// (docs/theory.md §3.1), an observation: the DEM lies 6-13 % below it at X/h = 0.55-1.0
+// (0.691, 0.546, 0.351 against 0.737, 0.579, 0.405; standard errors 2-4 %). Checked within
 // 15 %, the spread the peak itself has between neighbouring strokes and restitutions here.
 TEST_CASE("above its peak a rebounding layer follows eta*_pk X_pk / X", "[dem_reference][long]") {
   const double h = 0.006;
