@@ -163,8 +163,8 @@ template <class W>
 /// and the drop is counted as tangential dissipation (Mindlin's micro-slip hysteresis).
 ///
 /// The projection drops the spring's normal component sn = s·n without restoring the
-/// magnitude (docs/dem.md "Tangential spring", physics version 4): the contact plane turns
-/// by ~1e-4 rad a step, so the part lost, |s|²q/2 with q = sn²/|s|² ~ 1e-8, is far below
+/// magnitude (docs/dem.md "Tangential", physics version 4): the contact plane turns by
+/// ~1e-4 rad a step, so the part lost, |s|²q/2k with q = sn²/|s|² ~ 1e-8, is far below
 /// the step's other terms, and it is counted in the ledger like the Mindlin drop (the
 /// stored energy goes from |s|²/2k_prev to |r|²·ratio/2k_prev with |r|² = |s|² − sn²).
 ///
