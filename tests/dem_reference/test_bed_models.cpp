@@ -114,6 +114,20 @@ Landmarks sweep(double restitution, const std::vector<double>& strokes_over_h, d
   return l;
 }
 
+/// The ranges of e_b a sweep's landmarks give (fit_bed_restitution): from the jump at either
+/// end of its interval, from the peak at ±2 standard errors. A largest η* at the grid's end
+/// is no peak: the jump alone gives e_b (the range from the peak is then the whole [0, 1]).
+struct RestitutionRanges {
+  double onset_lo, onset_hi, peak_lo, peak_hi;
+};
+RestitutionRanges restitution_ranges(const Landmarks& l, double kappa, double h) {
+  const auto at = [&](double jump_over_h, double peak) { return fm::fit_bed_restitution(kappa, h, jump_over_h * h, peak); };
+  return {at(l.jump_over_h + l.resolution_over_h, l.peak).from_onset,
+          at(l.jump_over_h - l.resolution_over_h, l.peak).from_onset,
+          l.peak_bracketed ? at(l.jump_over_h, l.peak - 2.0 * l.peak_stderr).from_peak : 0.0,
+          l.peak_bracketed ? at(l.jump_over_h, l.peak + 2.0 * l.peak_stderr).from_peak : 1.0};
+}
+
 }  // namespace
 
 // The rebounding bed (docs/theory.md §3.1) in a one-high layer of 12 spheres (not a shipped
@@ -140,14 +154,7 @@ TEST_CASE("a one-high layer's jump and peak give a bed restitution below its fro
     const Landmarks l = sweep(eps, grid, h);
     REQUIRE(l.jump_over_h > 0.0);
     const auto fit = fm::fit_bed_restitution(kappa, h, l.jump_over_h * h, l.peak);
-    // e_b from the jump at either end of its interval, from the peak at ±2 standard errors.
-    const auto at = [&](double jump_over_h, double peak) { return fm::fit_bed_restitution(kappa, h, jump_over_h * h, peak); };
-    const double onset_lo = at(l.jump_over_h + l.resolution_over_h, l.peak).from_onset;
-    const double onset_hi = at(l.jump_over_h - l.resolution_over_h, l.peak).from_onset;
-    // A largest η* at the grid's end is no peak: the jump alone gives e_b (the range from the
-    // peak is then the whole [0, 1]).
-    const double peak_lo = l.peak_bracketed ? at(l.jump_over_h, l.peak - 2.0 * l.peak_stderr).from_peak : 0.0;
-    const double peak_hi = l.peak_bracketed ? at(l.jump_over_h, l.peak + 2.0 * l.peak_stderr).from_peak : 1.0;
+    const auto [onset_lo, onset_hi, peak_lo, peak_hi] = restitution_ranges(l, kappa, h);
     std::printf("eps %.2f: jump %.2f h (+- %.2f), %s %.3f +- %.3f at %.2f h; e_b %.3f, from the jump [%.3f, %.3f], "
                 "from the peak [%.3f, %.3f]; frictionless wall %.3f\n",
                 eps, l.jump_over_h, l.resolution_over_h, l.peak_bracketed ? "peak" : "largest (grid end)", l.peak,
@@ -243,13 +250,7 @@ TEST_CASE("a lone sphere per lane rebounds between a frictionless wall's e_b and
   for (const double eps : {0.3, 0.5}) {
     const Landmarks l = sweep(eps, grid, h, 1, 10);
     REQUIRE(l.jump_over_h > 0.0);
-    const auto at = [&](double jump_over_h, double peak) { return fm::fit_bed_restitution(kappa, h, jump_over_h * h, peak); };
-    const double onset_lo = at(l.jump_over_h + l.resolution_over_h, l.peak).from_onset;
-    const double onset_hi = at(l.jump_over_h - l.resolution_over_h, l.peak).from_onset;
-    // A largest η* at the grid's end is no peak: the jump alone gives e_b (the range from the
-    // peak is then the whole [0, 1]).
-    const double peak_lo = l.peak_bracketed ? at(l.jump_over_h, l.peak - 2.0 * l.peak_stderr).from_peak : 0.0;
-    const double peak_hi = l.peak_bracketed ? at(l.jump_over_h, l.peak + 2.0 * l.peak_stderr).from_peak : 1.0;
+    const auto [onset_lo, onset_hi, peak_lo, peak_hi] = restitution_ranges(l, kappa, h);
     const double frictionless = fm::frictionless_wall_restitution(eps, kappa), bound = fm::bed_restitution_bound(eps, kappa);
     std::printf("lone sphere eps %.2f: jump %.2f h, peak %.3f at %.2f h; e_b from the jump [%.3f, %.3f], from the peak "
                 "[%.3f, %.3f]; frictionless wall %.3f, bound %.3f\n",
