@@ -166,8 +166,11 @@ void read_dem(ObjectReader& r, Case& c) {
 
   auto& integration = world.integration;
   integration.time_step_s = r.number("time_step_s", 0.0, {0.0, dr::limits::kMaxTimeStep_s}, " s (0 = automatic)");
-  integration.steps_per_contact = r.integer("steps_per_contact", integration.steps_per_contact, dr::limits::kMinStepsPerContact,
-                                            dr::limits::kMaxStepsPerContact);
+  integration.steps_per_contact = r.integer("steps_per_contact", 0, 0, dr::limits::kMaxStepsPerContact);
+  if (integration.steps_per_contact != 0 && integration.steps_per_contact < dr::limits::kMinStepsPerContact)
+    r.fail("steps_per_contact", "= " + std::to_string(integration.steps_per_contact) + ": must be 0 (automatic) or in [" +
+                                    std::to_string(dr::limits::kMinStepsPerContact) + ", " +
+                                    std::to_string(dr::limits::kMaxStepsPerContact) + "]");
   if (const auto v = r.optional_number("max_impact_speed_m_s", limits::kImpactSpeed, " m/s")) integration.max_impact_speed_m_s = *v;
   integration.skin_fraction = r.number("skin_fraction", integration.skin_fraction,
                                        {dr::limits::kMinSkinFraction, dr::limits::kMaxSkinFraction});

@@ -15,8 +15,6 @@ namespace {
 
 using detail::norm;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 /// Inner extent of a compartment along gravity (g_norm = |g| > 0), m.
 double extent_along_gravity(const CompartmentOptions& c, const Vec3& gravity, double g_norm) {
   double h = 0.0;
@@ -54,40 +52,6 @@ double free_fall_height(const WorldOptions& w) {
   return height;
 }
 
-/// Fewest steps per contact at the impact speed that a user time step may give
-/// (docs/dem.md "Integration and time step"): the single-impact restitution error of
-/// the leapfrog with the half-step damping velocity follows −(0.6 ln²ε + 0.1)/N from
-/// here on for every ε >= 0.05; below it heavily damped contacts overshoot (ε = 0.05
-/// realises up to 0.11 at 10 steps, ε = 0.01 up to 1.0 at 20).
-constexpr double kMinStepsPerContact = 20.0;
-
-/// The largest relative restitution error of one impact at N steps per contact, for
-/// the target ε: (0.6 ln²ε + 0.1)/N (measured bound, tests/dem_reference/test_measures.cpp).
-double restitution_error_bound(double restitution, double steps_per_contact) {
-  const double l = std::log(restitution);
-  return (0.6 * l * l + 0.1) / steps_per_contact;
-}
-
-/// The smallest restitution the pairs can give (constant or table nodes); NaN when a
-/// pair uses a model.
-double smallest_restitution(const WorldOptions& w) {
-  double e = 1.0;
-  bool model = false;
-  const auto consider = [&](const ContactPairOptions& p) {
-    const auto& r = p.restitution;
-    if (r.model) {
-      model = true;
-    } else if (!r.table_values.empty()) {
-      e = std::min(e, *std::min_element(r.table_values.begin(), r.table_values.end()));
-    } else {
-      e = std::min(e, r.constant);
-    }
-  };
-  consider(w.default_pair);
-  for (const auto& p : w.pairs) consider(p);
-  return model ? kNaN : e;
-}
-
 void check_timing(const DriveTiming& drive) {
   std::ostringstream errors;
   if (!(std::isfinite(drive.period_s) && drive.period_s > 0.0)) {
@@ -105,11 +69,11 @@ void check_timing(const DriveTiming& drive) {
 }
 
 /// The warning for a user step dt above the automatic bound (docs/dem.md).
-std::string user_step_warning(const DriveTimeStep& t, double user_step, double automatic_steps_per_contact) {
+std::string user_step_warning(const DriveTimeStep& t, double user_step) {
   std::ostringstream w;
   w << "dem.integration.time_step_s = " << user_step << " s is above the automatic bound "
     << t.bound.max_time_step_s << " s: " << t.steps_per_contact << " steps per contact at the impact speed "
-    << t.impact_speed_m_s << " m/s (automatic: " << automatic_steps_per_contact << ")";
+    << t.impact_speed_m_s << " m/s (automatic: " << t.bound.steps_per_contact << ")";
   const double e_min = smallest_restitution(t.world);
   if (std::isfinite(e_min)) {
     w << "; one impact then realises a restitution low by up to (0.6 ln^2(e) + 0.1)/N = "
@@ -139,15 +103,16 @@ DriveTimeStep drive_time_step(const WorldOptions& world, const DriveTiming& driv
   const TimeStepBound& bound = t.bound;
   t.impact_speed_m_s = integ.max_impact_speed_m_s;
   // Stability limit: the Rayleigh time (the explicit critical step of the wave through a
-  // sphere, Li, Xu & Thornton 2005) and kMinStepsPerContact at the impact speed.
-  t.stability_limit_s = std::min(bound.rayleigh_time_s, bound.contact_time_s / kMinStepsPerContact);
+  // sphere, Li, Xu & Thornton 2005) and limits::kMinStepsPerContact at the impact speed.
+  const double fewest_steps = limits::kMinStepsPerContact;
+  t.stability_limit_s = std::min(bound.rayleigh_time_s, bound.contact_time_s / fewest_steps);
   if (user_step > t.stability_limit_s) {
     std::ostringstream msg;
     msg << "dem.integration.time_step_s = " << user_step << ": must be <= " << t.stability_limit_s
         << " s, the stability limit: the Rayleigh time " << bound.rayleigh_time_s << " s or "
-        << kMinStepsPerContact << " steps of the contact time " << bound.contact_time_s << " s at "
+        << fewest_steps << " steps of the contact time " << bound.contact_time_s << " s at "
         << integ.max_impact_speed_m_s << " m/s (the automatic step is " << bound.max_time_step_s << " s: "
-        << integ.steps_per_contact << " steps per contact or " << integ.rayleigh_fraction << " of the Rayleigh time)";
+        << bound.steps_per_contact << " steps per contact or " << integ.rayleigh_fraction << " of the Rayleigh time)";
     throw std::invalid_argument(msg.str());
   }
   // The automatic bound of metre-sized soft spheres can exceed the largest step the
@@ -166,8 +131,8 @@ DriveTimeStep drive_time_step(const WorldOptions& world, const DriveTiming& driv
     // is: t_c ∝ v^{−1/5}, v_w = v·(t_c(v)/(N_c·dt))^5. That speed only sets the world's
     // bound and its energy-growth threshold (½m_bed v_w²); restitution laws were
     // validated up to v above.
-    t.warnings.push_back(user_step_warning(t, user_step, integ.steps_per_contact));
-    const double ratio = bound.contact_time_s / (integ.steps_per_contact * t.time_step_s);
+    t.warnings.push_back(user_step_warning(t, user_step));
+    const double ratio = bound.contact_time_s / (bound.steps_per_contact * t.time_step_s);
     integ.max_impact_speed_m_s = t.impact_speed_m_s * std::pow(ratio, 5.0);
     integ.rayleigh_fraction = std::min(1.0, std::max(integ.rayleigh_fraction, t.time_step_s / bound.rayleigh_time_s));
     for (int k = 0; k < 8 && time_step_bound(t.world).max_time_step_s < t.time_step_s; ++k) {

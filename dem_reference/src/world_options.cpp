@@ -343,9 +343,10 @@ std::vector<std::string> WorldOptions::validate(const std::string& prefix) const
   v.check(in.time_step_s == 0.0 || within(in.time_step_s, limits::kMinTimeStep_s, limits::kMaxTimeStep_s),
           ip + "time_step_s", in.time_step_s,
           "must be 0 (automatic) or in " + interval(limits::kMinTimeStep_s, limits::kMaxTimeStep_s) + " s");
-  v.check(in.steps_per_contact >= limits::kMinStepsPerContact && in.steps_per_contact <= limits::kMaxStepsPerContact,
+  v.check(in.steps_per_contact == 0 ||
+              (in.steps_per_contact >= limits::kMinStepsPerContact && in.steps_per_contact <= limits::kMaxStepsPerContact),
           ip + "steps_per_contact", in.steps_per_contact,
-          "must be in [" + std::to_string(limits::kMinStepsPerContact) + ", " +
+          "must be 0 (automatic) or in [" + std::to_string(limits::kMinStepsPerContact) + ", " +
               std::to_string(limits::kMaxStepsPerContact) + "]");
   v.check(std::isfinite(in.rayleigh_fraction) && in.rayleigh_fraction > 0.0 && in.rayleigh_fraction <= 1.0,
           ip + "rayleigh_fraction", in.rayleigh_fraction, "must be in (0, 1]");

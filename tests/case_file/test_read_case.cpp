@@ -150,13 +150,13 @@ TEST_CASE("a layer of one particle per lane or a few particles is warned about; 
 
 TEST_CASE("omitted keys are resolved to their defaults", "[case_file]") {
   const Case c = load_case(shipped("low_intensity_36_spheres.json"));
-  CHECK(c.resolved["dem"]["steps_per_contact"] == 50);
+  CHECK(c.resolved["dem"]["steps_per_contact"] == 0);  // automatic
   CHECK(c.resolved["dem"]["wall_material"] == "steel");
   CHECK(c.resolved["design"]["sweep_points"] == 301);
   CHECK(c.resolved["damper"]["model_options"]["rolling_calibration"] == 0.8976);
   CHECK(c.resolved["damper"]["particles"]["lot_diameter_variation_m"] == 5e-6);
   CHECK(c.resolved["format_version"] == 1);
-  CHECK(c.dem.simulation.world.integration.steps_per_contact == 50);
+  CHECK(c.dem.simulation.world.integration.steps_per_contact == 0);
 }
 
 TEST_CASE("the DEM options of a format-1 case carry its compartment, gravity and drive", "[case_file]") {

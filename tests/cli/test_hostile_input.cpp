@@ -741,8 +741,8 @@ TEST_CASE("a write that fails (a file-size limit, a full disk) keeps the folder'
 // A DEM-in-the-loop run whose estimate is beyond a week (kMaxDemWallTime_s) does not start
 // unless the user accepts it; validate reports the cost. The link decay with 2016 spheres
 // over 1e5 s: about 160 days at the benchmark rate (before, it started and ran for months).
-// The verification of a filling_ratios task at full stiffness over 1e5 s: about 16 days,
-// refused before the optimisation.
+// The verification of a filling_ratios task at full stiffness and 200 steps per contact
+// over 1e5 s: about 60 days, refused before the optimisation.
 TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless --accept-long-run", "[cli]") {
   TempDir tmp("long_runs");
   const fs::path big = tmp.path / "big_bed_decay.json";
@@ -800,6 +800,7 @@ TEST_CASE("a DEM run estimated beyond a week is refused before it starts unless 
     json c = json::parse(slurp(case_path("manipulator_link_optimize.json")));
     c["task"]["verify"]["duration_s"] = 1e5;
     c["task"]["verify"]["stiffness_softening"] = 1.0;
+    c["dem"]["steps_per_contact"] = 200;
     std::ofstream(verify) << c.dump(2);
   }
   require_one_line_error(run_pdamp({"optimize", verify.string(), "--method", "formulas"}), "/task/verify/duration_s");

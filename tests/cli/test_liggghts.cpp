@@ -173,12 +173,13 @@ TEST_CASE("pdamp import liggghts refuses a missing or garbled output with one li
 }
 
 TEST_CASE("pdamp export liggghts takes a user time step above the automatic bound as pdamp dem does", "[cli][liggghts]") {
-  // Full stiffness at 1 us: above the automatic bound (50 steps per contact), below the
-  // stability limit (20 steps, the Rayleigh time): pdamp dem runs it with a warning, so
+  // Full stiffness at 1 us: above the automatic bound at 50 steps per contact (given), below
+  // the stability limit (20 steps, the Rayleigh time): pdamp dem runs it with a warning, so
   // the export must write it, with the same warning, not refuse it.
   const auto stepped = edited_case("pdamp_liggghts_step.json", [](json& c) {
     c["dem"]["stiffness_softening"] = 1.0;
     c["dem"]["time_step_s"] = 1e-6;
+    c["dem"]["steps_per_contact"] = 50;
   });
   const fs::path dir = fresh_dir("step");
   const auto r = run_pdamp({"export", "liggghts", stepped, "-o", dir.string(), "--periods", "1", "--json"});
@@ -308,7 +309,10 @@ TEST_CASE("pdamp import liggghts refuses an edited record and outputs that overf
 // must start from 1). A drive of 7.4e9 steps is written as consecutive runs of at most
 // 2^31 − 1 that add up to it (once: `run 7384805604`, which LIGGGHTS refuses).
 TEST_CASE("pdamp export liggghts splits a run beyond LIGGGHTS' 2^31 - 1 steps", "[cli][liggghts]") {
-  const auto long_case = edited_case("pdamp_liggghts_long.json", [](json& c) { c["dem"]["samples_per_period"] = 16; });
+  const auto long_case = edited_case("pdamp_liggghts_long.json", [](json& c) {
+    c["dem"]["samples_per_period"] = 16;
+    c["dem"]["steps_per_contact"] = 50;  // the 7.4e9 steps below
+  });
   const fs::path dir = fresh_dir("long_run");
   const auto r = run_pdamp({"export", "liggghts", long_case, "-o", dir.string(), "--periods", "50000", "--json"});
   INFO(r.err);

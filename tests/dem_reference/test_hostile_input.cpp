@@ -193,7 +193,7 @@ TEST_CASE("every DEM option has a physical range", "[dem_reference]") {
   refused([](auto& o) { o.world.integration.time_step_s = 1e-15; },
           "dem.integration.time_step_s = 1e-15: must be 0 (automatic) or in [1e-10, 0.001] s");
   refused([](auto& o) { o.world.integration.steps_per_contact = 1000000; },
-          "dem.integration.steps_per_contact = 1000000: must be in [40, 10000]");
+          "dem.integration.steps_per_contact = 1000000: must be 0 (automatic) or in [20, 10000]");
   refused([](auto& o) { o.world.integration.skin_fraction = 1e-6; },
           "dem.integration.skin_fraction = 1e-06: must be in [0.01, 2]");
   refused([](auto& o) { o.world.threads = 100000; }, "dem.threads = 100000: must be in [0, 1024] (0 = all available)");

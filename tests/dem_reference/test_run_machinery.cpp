@@ -209,13 +209,15 @@ TEST_CASE("the energy ledger closes and the drive bins account for the work of a
 
 // Reference: the rule of docs/dem.md "Integration and time step". Whole steps per period:
 // dt·M equals the period to round-off (1e-12) and the step is the target shortened by
-// less than one step per block. A user step 1.5 times the automatic bound (below the
-// stability limit min(T_R, t_c/20), since the bound is t_c/50 or T_R/4) is accepted with a
+// less than one step per block. A user step 1.5 times the automatic bound at 50 steps per
+// contact (given; below the stability limit min(T_R, t_c/20), since the bound is t_c/50 or
+// T_R/4) is accepted with a
 // warning stating its steps per contact, and the world built from the returned options
 // accepts it; a step above the limit and a timing out of range are refused by name.
 TEST_CASE("the time-step rule of a drive gives whole steps per period and warns or refuses user steps",
           "[dem_reference]") {
-  const auto o = small_damper();
+  auto o = small_damper();
+  o.world.integration.steps_per_contact = 50;
   const dr::DriveTiming timing = harmonic_timing(o);
   const dr::DriveTimeStep automatic = dr::drive_time_step(o.world, timing);
   CHECK(automatic.steps_per_period == automatic.steps_per_block * timing.blocks_per_period);

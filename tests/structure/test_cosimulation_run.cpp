@@ -100,7 +100,7 @@ TEST_CASE("a free decay advanced in uneven segments with a checkpoint between th
           "[cosimulation]") {
   const ModalModel model = two_modes();
   const auto dampers = impacting_bed();
-  DecayRun options = decay(0.3);
+  DecayRun options = decay(0.6);
   options.snapshots = 40;  // the beds for ParaView, some before the checkpoint and some after
   CosimulationState whole_state;
   const CosimulationResult whole = cosimulate(model, dampers, options, whole_state);

@@ -48,9 +48,11 @@ inline constexpr double kMaxImpactSpeed_m_s = 1000.0;
 /// material the model takes is resolved (the bound check refuses it anyway).
 inline constexpr double kMinTimeStep_s = 1e-10;
 inline constexpr double kMaxTimeStep_s = 1e-3;
-/// Steps per contact time: >= 40 for a resolved impact (the restitution is then
-/// within 1%); beyond 10,000 only the cost grows.
-inline constexpr int kMinStepsPerContact = 40;
+/// Steps per contact time at the largest impact speed: below 20 heavily damped contacts
+/// overshoot (ε = 0.05 realises up to 0.11 at 10 steps); from 20 on one impact's
+/// restitution error follows (0.6 ln²ε + 0.1)/N (docs/dem.md "Integration and time
+/// step"). Beyond 10,000 only the cost grows.
+inline constexpr int kMinStepsPerContact = 20;
 inline constexpr int kMaxStepsPerContact = 10'000;
 /// Verlet skin over the largest radius: below 1% the lists are rebuilt nearly every
 /// step; above 2 they hold most of the bed.
@@ -185,12 +187,16 @@ struct CompartmentOptions {
 
 /// Time integration, neighbour search and instability detection.
 struct IntegrationOptions {
-  /// Time step, s; 0 = automatic: min(t_c(v_max)/steps_per_contact, rayleigh_fraction·T_R),
-  /// t_c the Hertz contact time of the stiffest pair at max_impact_speed_m_s and T_R
-  /// the Rayleigh time of the smallest sphere. A value above that bound is refused.
+  /// Time step, s; 0 = automatic: min(t_c(v_max)/N, rayleigh_fraction·T_R), t_c the
+  /// Hertz contact time of the stiffest pair at max_impact_speed_m_s, T_R the Rayleigh
+  /// time of the smallest sphere and N the steps per contact (automatic_steps_per_contact
+  /// unless steps_per_contact is given). A value above that bound is refused.
   /// Otherwise in [1e-10, 1e-3] s (limits::kMinTimeStep_s, kMaxTimeStep_s).
   double time_step_s = 0.0;
-  int steps_per_contact = 50;      ///< in [40, 10000]
+  /// Steps per contact time of the automatic step: 0 = automatic (the fewest in [20, 50]
+  /// that keep one impact's restitution error within 1 %, automatic_steps_per_contact),
+  /// else in [20, 10000].
+  int steps_per_contact = 0;
   double rayleigh_fraction = 0.25; ///< fraction of the Rayleigh time, in (0, 1]
   /// Largest normal impact speed expected, m/s, in (0, 1000] (run_harmonic raises it
   /// to at least 2XΩ + √(2|g|(H − 2r)) of the drive, which must stay <= 1000 m/s as well).
