@@ -189,19 +189,31 @@ TEST_CASE("low-intensity sweep shows the jump to rolling collect-and-collide nea
   // The jump: below the onset the scattered state dissipates far less than the peak.
   CHECK(eta[1] < 0.5 * *peak);
   CHECK(mass_fraction_small == Approx(2.0 / 7.0).epsilon(0.25));
-  // Stiffness: E/100 against E/20 at the design stroke, within 10% (3 standard errors
-  // of the per-period scatter, measured ~3%).
-  const auto soft = dr::run_harmonic(low_intensity(0.42, 100.0));
-  const auto stiff = dr::run_harmonic(low_intensity(0.42, 20.0));
-  std::printf("stiffness check at X/h = 0.42: eta* %.4f (E/100) vs %.4f (E/20)\n", soft.eta_star, stiff.eta_star);
-  CHECK(soft.eta_star == Approx(stiff.eta_star).epsilon(0.10));
+  // Stiffness: E/100 against E/20 at the design stroke, each the mean of four seeds, within
+  // 10%. One seed is no measure here: at 0.42 h the bed's orbit differs from seed to seed
+  // (η* 0.66-0.90 at E/100, sd ~0.09, each within a few per cent period to period);
+  // the means' standard error is ~0.045 each (measured means 0.798 and 0.819).
+  const auto seed_mean = [](double softening) {
+    double sum = 0.0;
+    for (const std::uint64_t seed : {1, 2, 3, 4}) {
+      auto o = low_intensity(0.42, softening);
+      o.world.seed = seed;
+      sum += dr::run_harmonic(o).eta_star;
+    }
+    return sum / 4.0;
+  };
+  const double soft = seed_mean(100.0);
+  const double stiff = seed_mean(20.0);
+  std::printf("stiffness check at X/h = 0.42, mean of four seeds: eta* %.4f (E/100) vs %.4f (E/20)\n", soft, stiff);
+  CHECK(soft == Approx(stiff).epsilon(0.10));
 }
 
 // Reference: the ideal bouncing collect-and-collide model of docs/theory.md
 // §2 — onset h/√(π²+4) = 0.2685 h where the orbit's η* is 4π/(π²+4) = 0.906, and
 // η* = (1 − cos φ*)²/π above X_opt = h/π. The jump is the smallest stroke from which η*
-// stays at or above 0.906 for every larger stroke of the sweep; it must lie within 10% of
-// the onset. η* must lie within 15% of the ideal for X in [1, 1.3] h/π; at and
+// stays at or above 0.906 for every larger stroke of the sweep, within two standard errors
+// of its per-period scatter (at the jump the bed switches between orbits from period to
+// period: 0.87 ± 0.23 at 0.28 h); it must lie within 10% of the onset. η* must lie within 15% of the ideal for X in [1, 1.3] h/π; at and
 // just above the peak (X < 1.15 h/π) the lattice bed sits higher — its aligned chains of
 // spheres pass the impact on like a Newton's cradle, so the bed is not a plastic block
 // (docs/theory.md §2: 4/π is not an upper bound with partial rebound; measured +15-22%, independent
@@ -234,7 +246,7 @@ TEST_CASE("high-intensity sweep without gravity follows the bouncing collect-and
   const double onset = 1.0 / std::sqrt(kPi * kPi + 4.0);
   const double eta_onset = 4.0 * kPi / (kPi * kPi + 4.0);
   std::size_t jump = strokes.size();
-  while (jump > 0 && results[jump - 1].eta_star >= eta_onset) --jump;
+  while (jump > 0 && results[jump - 1].eta_star + 2.0 * results[jump - 1].eta_star_stderr >= eta_onset) --jump;
   REQUIRE(jump < strokes.size());
   std::printf("jump at X/h = %.3f, ideal onset %.4f\n", strokes[jump], onset);
   CHECK(strokes[jump] == Approx(onset).epsilon(0.10));
