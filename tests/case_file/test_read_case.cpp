@@ -229,6 +229,10 @@ TEST_CASE("ranges owned by an option struct come from its validate()", "[case_fi
   // dem_reference's validate(): a pin of the case, named by its pointer under /dem.
   require_refused(edited(dir, [](json& c) { c["dem"]["restitution_typo"] = 1; }), "/dem/restitution_typo",
                      "unknown key");
+  // Steps per contact: 0 (automatic) or a resolved impact's 20 and more.
+  require_refused(edited(dir, [](json& c) { c["dem"]["steps_per_contact"] = 10; }), "/dem/steps_per_contact",
+                  "= 10: must be 0 (automatic) or in [20, 10000]");
+  require_refused(edited(dir, [](json& c) { c["dem"]["steps_per_contact"] = -1; }), "/dem/steps_per_contact", "-1");
 }
 
 TEST_CASE("the DEM's option names become the case keys they come from", "[case_file]") {
