@@ -74,8 +74,7 @@ double smallest_restitution(const WorldOptions& options) {
 int automatic_steps_per_contact(const WorldOptions& options) {
   const double e = smallest_restitution(options);
   if (!(e > 0.0)) return kMaxAutomaticStepsPerContact;
-  const double l = std::log(e);
-  const double needed = std::ceil((0.6 * l * l + 0.1) / kAutomaticRestitutionError);
+  const double needed = std::ceil(restitution_error_bound(e, 1.0) / kAutomaticRestitutionError);
   return static_cast<int>(std::clamp(needed, double{limits::kMinStepsPerContact}, double{kMaxAutomaticStepsPerContact}));
 }
 

@@ -122,7 +122,7 @@ TEST_CASE("eta* and the apparent mass do not depend on samples_per_period", "[de
 // holds the bound that run_harmonic's warning quotes and the automatic step's choice of N
 // rests on; tolerance: the bound itself. Below 40 steps the bound is approached from
 // above at small ε (ε = 0.5 at N = 20: −2.04 % against −1.94 %, +0.86 % against
-// +0.75 %): the automatic N of each ε (N = 0: 20 for ε >= 0.64, 26 at 0.6, 39 at 0.5,
+// +0.75 %): the automatic N of each ε (N = 0: 20 for ε >= 0.665, 26 at 0.6, 39 at 0.5,
 // 50 below 0.44) is checked for what the rule promises, an error within 1 %.
 namespace {
 

@@ -50,8 +50,8 @@ inline constexpr double kMinTimeStep_s = 1e-10;
 inline constexpr double kMaxTimeStep_s = 1e-3;
 /// Steps per contact time at the largest impact speed: below 20 heavily damped contacts
 /// overshoot (ε = 0.05 realises up to 0.11 at 10 steps); from 20 on one impact's
-/// restitution error follows (0.6 ln²ε + 0.1)/N (docs/dem.md "Integration and time
-/// step"). Beyond 10,000 only the cost grows.
+/// restitution error is about (0.6 ln²ε + 0.1)/N (restitution_error_bound; docs/dem.md
+/// "Integration and time step"). Beyond 10,000 only the cost grows.
 inline constexpr int kMinStepsPerContact = 20;
 inline constexpr int kMaxStepsPerContact = 10'000;
 /// Verlet skin over the largest radius: below 1% the lists are rebuilt nearly every
