@@ -165,13 +165,12 @@ TEST_CASE("the realised restitution stays within its bound over 40 to 200 steps 
     for (const int steps : {0, 40, 50, 70, 100, 140, 200}) {
       const auto [lo, hi] = restitution_error_range(eps, steps);
       const int n = steps > 0 ? steps : dr::automatic_steps_per_contact(dem_test::box_world(1, 0.005, eps, 0.0));
-      const double l = std::log(eps);
       INFO("eps " << eps << ", " << n << " steps per contact" << (steps == 0 ? " (automatic)" : "")
                   << ": relative error in [" << lo << ", " << hi << "]");
       if (steps == 0 && eps >= 0.44) {
         CHECK(std::max(-lo, hi) <= dr::kAutomaticRestitutionError);
       } else {
-        CHECK(lo >= -(0.6 * l * l + 0.1) / n);
+        CHECK(lo >= -dr::restitution_error_bound(eps, n));
         CHECK(hi <= 0.15 / n);
       }
     }
