@@ -26,6 +26,9 @@
 #include <immintrin.h>
 #define PDAMP_LANES_AVX2 1
 #endif
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+#define PDAMP_LANES_AVX512 1
+#endif
 
 #define PDAMP_LANE_INLINE [[gnu::always_inline]] inline
 
@@ -238,6 +241,50 @@ PDAMP_LANE_INLINE void scatter(A4 a, F&& f) {
 }
 #endif
 
+
+#if defined(PDAMP_LANES_AVX512)
+// ---- eight lanes of an AVX-512 register (a build with -mavx512f -mavx512dq) ---------
+struct LanesAvx512 {
+  static constexpr int kWidth = 8;
+  struct Mask {
+    __mmask8 m;
+  };
+  __m512d v;
+  PDAMP_LANE_INLINE static LanesAvx512 splat(double x) { return {_mm512_set1_pd(x)}; }
+  template <class F>
+  PDAMP_LANE_INLINE static LanesAvx512 gather(F&& f) {
+    return {_mm512_set_pd(f(7), f(6), f(5), f(4), f(3), f(2), f(1), f(0))};  // lane 0 = f(0)
+  }
+};
+using A8 = LanesAvx512;
+PDAMP_LANE_INLINE A8 operator+(A8 a, A8 b) { return {_mm512_add_pd(a.v, b.v)}; }
+PDAMP_LANE_INLINE A8 operator-(A8 a, A8 b) { return {_mm512_sub_pd(a.v, b.v)}; }
+PDAMP_LANE_INLINE A8 operator*(A8 a, A8 b) { return {_mm512_mul_pd(a.v, b.v)}; }
+PDAMP_LANE_INLINE A8 operator/(A8 a, A8 b) { return {_mm512_div_pd(a.v, b.v)}; }
+PDAMP_LANE_INLINE A8 operator-(A8 a) { return {_mm512_xor_pd(a.v, _mm512_set1_pd(-0.0))}; }
+PDAMP_LANE_INLINE A8 sqrt(A8 a) { return {_mm512_sqrt_pd(a.v)}; }
+PDAMP_LANE_INLINE A8::Mask operator<(A8 a, A8 b) { return {_mm512_cmp_pd_mask(a.v, b.v, _CMP_LT_OQ)}; }
+PDAMP_LANE_INLINE A8::Mask operator>(A8 a, A8 b) { return {_mm512_cmp_pd_mask(a.v, b.v, _CMP_GT_OQ)}; }
+PDAMP_LANE_INLINE A8::Mask operator&(A8::Mask a, A8::Mask b) { return {static_cast<__mmask8>(a.m & b.m)}; }
+PDAMP_LANE_INLINE A8::Mask operator|(A8::Mask a, A8::Mask b) { return {static_cast<__mmask8>(a.m | b.m)}; }
+PDAMP_LANE_INLINE A8::Mask andnot(A8::Mask a, A8::Mask b) { return {static_cast<__mmask8>(~a.m & b.m)}; }
+PDAMP_LANE_INLINE bool any(A8::Mask a) { return a.m != 0; }
+PDAMP_LANE_INLINE bool all(A8::Mask a) { return a.m == 0xff; }
+PDAMP_LANE_INLINE bool lane(A8::Mask a, int l) { return ((a.m >> l) & 1) != 0; }
+PDAMP_LANE_INLINE A8 select(A8::Mask m, A8 yes, A8 no) { return {_mm512_mask_blend_pd(m.m, no.v, yes.v)}; }
+PDAMP_LANE_INLINE double lane(A8 a, int l) {
+  alignas(64) double t[8];
+  _mm512_store_pd(t, a.v);
+  return t[l];
+}
+template <class F>
+PDAMP_LANE_INLINE void scatter(A8 a, F&& f) {
+  alignas(64) double t[8];
+  _mm512_store_pd(t, a.v);
+  for (int l = 0; l < 8; ++l) f(l) = t[l];
+}
+#endif
+
 /// The best two-lane type of the build.
 #if defined(PDAMP_LANES_SSE2)
 using Lanes2 = LanesSse2;
@@ -247,17 +294,22 @@ using Lanes2 = LanesNeon;
 using Lanes2 = LanesPortable2;
 #endif
 
-/// The lane type the force sweep evaluates touching contacts in: two lanes. Four AVX2
-/// lanes do not pay (bench_dem, 2-core Xeon, best of 3, M particle-steps/s on 1/2
-/// threads: 1000 spheres 51.5/51.2 against 53.0/53.0 for two SSE2 lanes without
-/// -march, 10,000 spheres 34.6/62.4 against 34.3/61.1: within the run-to-run spread).
-/// Probably two contacts already hide the kernel's latency chain, and four pay more to
-/// gather their operands and take a rare path whenever one lane needs it.
-/// PDAMP_DEM_LANES=1, 2 or 4 forces a width (for measurements; 4 needs -mavx2).
+/// The lane type the force sweep evaluates touching contacts in: two lanes, the widest
+/// every x86-64 has. Wider lanes pay little, and only where the build may assume them:
+/// on a 2-core Xeon four AVX2 lanes were within the run-to-run spread (bench_dem, 1000
+/// spheres 51.5 against 53.0 M particle-steps/s, 10,000 spheres 34.6 against 34.3); on a
+/// 2-core AMD EPYC (Zen 5) whole runs of the 6 x 6 bench layer, paired against two SSE2
+/// lanes, took 0.929 of the time with four AVX2 lanes and 0.881 with eight AVX-512 lanes
+/// (docs/dem.md, Performance design). Gathering a contact's operands and adding its
+/// forces stay one lane at a time whatever the width, and the rest of a block runs in
+/// fewer lanes. PDAMP_DEM_LANES=1, 2, 4 or 8 forces a width (for measurements; 4 needs
+/// -mavx2, 8 -mavx512f -mavx512dq).
 #if defined(PDAMP_DEM_LANES) && PDAMP_DEM_LANES == 1
 using SweepLanes = Lanes1;
 #elif defined(PDAMP_DEM_LANES) && PDAMP_DEM_LANES == 4 && defined(PDAMP_LANES_AVX2)
 using SweepLanes = LanesAvx2;
+#elif defined(PDAMP_DEM_LANES) && PDAMP_DEM_LANES == 8 && defined(PDAMP_LANES_AVX512)
+using SweepLanes = LanesAvx512;
 #else
 using SweepLanes = Lanes2;
 #endif

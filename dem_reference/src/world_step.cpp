@@ -552,11 +552,16 @@ inline void World::Impl::contact_forces(const WaitingWall* w, PartitionSweep& sw
   for (int l = 0; l < kN; ++l) apply_wall_force(sweep.forces, sweep.load, out[l], w[l].i, w[l].ri, w[l].rc);
 }
 
-// The count < SweepLanes::kWidth contacts left waiting at the end of a block: two lanes at a
-// time, then one.
+// The count < SweepLanes::kWidth contacts left waiting at the end of a block: four lanes at a
+// time (eight-lane builds), two, then one.
 template <class Waiting>
 inline void World::Impl::flush(const Waiting* w, int& count, PartitionSweep& sweep) {
   int done = 0;
+#if defined(PDAMP_LANES_AVX2)
+  if constexpr (detail::simd::SweepLanes::kWidth > 4) {
+    for (; count - done >= 4; done += 4) contact_forces<detail::simd::LanesAvx2>(w + done, sweep);
+  }
+#endif
   if constexpr (detail::simd::SweepLanes::kWidth > 2) {
     for (; count - done >= 2; done += 2) contact_forces<detail::simd::Lanes2>(w + done, sweep);
   }

@@ -212,10 +212,13 @@ void check_lanes_against_scalar() {
 // Reference: the one-lane instantiation (the scalar kernel, pinned by the state hashes
 // of test_world.cpp). The lanes run the same IEEE operations in the same order, so the
 // histories, results and dissipation sums must be the same bits (tolerance: none).
-TEST_CASE("the contact kernel in two or four lanes gives the bits of the one-lane kernel", "[dem_reference]") {
+TEST_CASE("the contact kernel in two, four or eight lanes gives the bits of the one-lane kernel", "[dem_reference]") {
   SECTION("two lanes in plain C++ (the portable fallback)") { check_lanes_against_scalar<dd::simd::LanesPortable2>(); }
   SECTION("two lanes of the build (SSE2, NEON or plain C++)") { check_lanes_against_scalar<dd::simd::Lanes2>(); }
 #if defined(PDAMP_LANES_AVX2)
   SECTION("four AVX2 lanes") { check_lanes_against_scalar<dd::simd::LanesAvx2>(); }
+#endif
+#if defined(PDAMP_LANES_AVX512)
+  SECTION("eight AVX-512 lanes") { check_lanes_against_scalar<dd::simd::LanesAvx512>(); }
 #endif
 }
