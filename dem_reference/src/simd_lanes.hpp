@@ -241,7 +241,6 @@ PDAMP_LANE_INLINE void scatter(A4 a, F&& f) {
 }
 #endif
 
-
 #if defined(PDAMP_LANES_AVX512)
 // ---- eight lanes of an AVX-512 register (a build with -mavx512f -mavx512dq) ---------
 struct LanesAvx512 {
@@ -303,7 +302,7 @@ using Lanes2 = LanesPortable2;
 /// (docs/dem.md, Performance design). Gathering a contact's operands and adding its
 /// forces stay one lane at a time whatever the width, and the rest of a block runs in
 /// fewer lanes. PDAMP_DEM_LANES=1, 2, 4 or 8 forces a width (for measurements; 4 needs
-/// -mavx2, 8 -mavx512f -mavx512dq).
+/// -mavx2, 8 -mavx512f -mavx512dq, and Eigen then wants -mfma).
 #if defined(PDAMP_DEM_LANES) && PDAMP_DEM_LANES == 1
 using SweepLanes = Lanes1;
 #elif defined(PDAMP_DEM_LANES) && PDAMP_DEM_LANES == 4 && defined(PDAMP_LANES_AVX2)
